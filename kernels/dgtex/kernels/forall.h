@@ -1,0 +1,22 @@
+#pragma once
+// forall: the one parallel loop of dgtex kernels. Every kernel is written as a body over
+// an index so the same code runs serially (the reference) or with OpenMP (and later on a
+// device). Static scheduling keeps each index's work on a fixed thread per count, but
+// kernels never rely on that: each index writes only its own outputs.
+#include <cstdint>
+
+namespace dgtex::kernels {
+
+enum class Execution { serial, parallel };
+
+template <class Body>
+void forall(std::int64_t n, Body&& body, Execution execution = Execution::parallel) {
+  if (execution == Execution::parallel) {
+#pragma omp parallel for schedule(static)
+    for (std::int64_t i = 0; i < n; ++i) body(i);
+  } else {
+    for (std::int64_t i = 0; i < n; ++i) body(i);
+  }
+}
+
+}  // namespace dgtex::kernels
