@@ -6,6 +6,7 @@
 // and (i+1, j) is cut; wall_north the edge between (i, j) and (i, j+1). A wall on the tile
 // border means a zero-Neumann boundary there. inactive texels lie outside the domain
 // (e.g. the upper half of a tri6 element's square). dirichlet texels hold a fixed value.
+#include <cstddef>
 #include <cstdint>
 #include <vector>
 
@@ -25,7 +26,7 @@ struct TexelTile {
   std::vector<double> values;       // width * height (Dirichlet data, or a solution)
 
   TexelTile() = default;
-  TexelTile(int w, int h) : width(w), height(h), flags(static_cast<size_t>(w) * h, 0), values(static_cast<size_t>(w) * h, 0.0) {}
+  TexelTile(int w, int h) : width(w), height(h), flags(static_cast<std::size_t>(w) * h, 0), values(static_cast<std::size_t>(w) * h, 0.0) {}
   int index(int i, int j) const { return j * width + i; }
   bool is_wall_east(int i, int j) const { return flags[index(i, j)] & wall_east; }
   bool is_wall_north(int i, int j) const { return flags[index(i, j)] & wall_north; }

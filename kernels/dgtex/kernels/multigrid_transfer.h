@@ -1,0 +1,24 @@
+#pragma once
+// Grid transfers between a level and the next coarser one with the operator-dependent
+// interpolation P (multigrid_grid.h): restriction b_coarse = P^T r_fine and prolongation
+// x_fine += P x_coarse. Both are gathers (each output written by one index), so the
+// parallel forms equal the serial ones bit for bit.
+#include <cstdint>
+
+#include "dgtex/kernels/forall.h"
+#include "dgtex/kernels/multigrid_grid.h"
+
+namespace dgtex::kernels {
+
+void restrict_residual(GridShape fine, GridShape coarse, InterpolationView p, const double* r_fine, double* b_coarse,
+                       Execution execution = Execution::parallel);
+void restrict_residual_reference(GridShape fine, GridShape coarse, InterpolationView p, const double* r_fine,
+                                 double* b_coarse);
+
+// Adds the interpolated coarse correction at fine nodes with fine_active != 0 only.
+void prolong_correction(GridShape fine, GridShape coarse, InterpolationView p, const double* x_coarse,
+                        const std::uint8_t* fine_active, double* x_fine, Execution execution = Execution::parallel);
+void prolong_correction_reference(GridShape fine, GridShape coarse, InterpolationView p, const double* x_coarse,
+                                  const std::uint8_t* fine_active, double* x_fine);
+
+}  // namespace dgtex::kernels

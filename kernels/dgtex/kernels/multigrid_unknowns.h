@@ -1,0 +1,45 @@
+#pragma once
+// Which texels of a TexelTile are unknowns of the harmonic (Laplace) problem.
+// The discrete problem shared by the multigrid, the direct solver and the enrichment code:
+// texels (i, j) and a 4-neighbour are coupled (weight 1) iff both are active (not
+// `inactive`), both lie in the tile and no wall separates them. Dirichlet texels keep their
+// value; at every other active texel  sum over coupled neighbours (u_n - u_c) = 0.
+// A component of free texels (connected through couplings between free texels) that
+// touches no Dirichlet texel has no data: its value is defined to be 0 (thesis §5.5.2)
+// and it is not an unknown, so the remaining system is symmetric positive definite.
+#include <cstddef>  // texel_grid.h uses size_t without including it
+#include <cstdint>
+#include <vector>
+
+#include "dgtex/kernels/texel_grid.h"
+
+namespace dgtex::kernels {
+
+// Bits of one byte per texel that describe its row of the 5-point operator.
+enum LaplaceTexelBits : std::uint8_t {
+  couples_west_unknown = 1u << 0,  // coupled to the west neighbour, which is an unknown
+  couples_east_unknown = 1u << 1,
+  couples_south_unknown = 1u << 2,
+  couples_north_unknown = 1u << 3,
+  degree_shift = 4,  // bits 4..6: number of coupled active neighbours (0..4), Dirichlet included
+  is_unknown = 1u << 7,
+};
+constexpr std::uint8_t laplace_degree_mask = 7u << degree_shift;
+inline int laplace_degree(std::uint8_t bits) { return (bits & laplace_degree_mask) >> degree_shift; }
+
+// Whether texel (i, j) is coupled to (i+1, j) / (i, j+1) (both active, no wall, in the tile).
+inline bool texels_coupled_east(const TexelTile& tile, int i, int j) {
+  return i + 1 < tile.width && !(tile.flags[tile.index(i, j)] & (wall_east | inactive)) &&
+         !(tile.flags[tile.index(i + 1, j)] & inactive);
+}
+inline bool texels_coupled_north(const TexelTile& tile, int i, int j) {
+  return j + 1 < tile.height && !(tile.flags[tile.index(i, j)] & (wall_north | inactive)) &&
+         !(tile.flags[tile.index(i, j + 1)] & inactive);
+}
+
+// Writes one LaplaceTexelBits byte per texel into `bits` (width * height). Flood fill
+// (serial: one pass over the tile with an explicit stack, deterministic). Returns the
+// number of free texels in components without Dirichlet data (not unknowns, value 0).
+int classify_laplace_texels(const TexelTile& tile, std::vector<std::uint8_t>& bits);
+
+}  // namespace dgtex::kernels

@@ -1,0 +1,48 @@
+#pragma once
+// Edge terms of the DG Kirchhoff-Love shell (shell report eq. 14/37, Noels & Radovitzky):
+// on interior edges the jump of the normal rotation is penalised and the consistency and
+// symmetry terms couple it to the average bending moment; on clamped boundary edges the
+// same terms hold the normal against its prescribed (rest) value.
+//
+// Departure from eq. 37, on purpose: the terms act on the hinge component
+//   g = dt(u) . nu   (nu = t0 x tau: in-plane normal of the edge, pointing into K+)
+// of each side's normal change, with the conjugate moment m_nunu. The other component,
+// dt . tau = -u,tau . t0, has jump -u,tau . [[t0]] for C0 fields: zero on flat edges, but on
+// the kinked edges of a curved mesh it is non-zero for a rigid rotation, so keeping it
+// would give rigid modes strain energy. With g both sides measure the rotation about the
+// common tangent tau, which a rigid motion leaves equal.
+//
+// Per edge e: edges[4e..4e+3] = (plus element, plus local edge, minus element, minus local
+// edge); the minus element is -1 on boundary edges. The plus element traverses the edge in
+// its own local direction (it lies on the left); the minus element traverses it reversed.
+// Local basis order of an edge: the plus element's npe nodes, then the minus element's.
+// Outputs: blocks #edges x (2 npe)^2 x 9, forces #edges x 2 npe x 3 (minus half zero on
+// boundary edges). Rotations (optional): #edges x nq x 9.
+#include <cstdint>
+
+#include "dgtex/kernels/forall.h"
+#include "dgtex/kernels/shape_functions.h"
+#include "dgtex/kernels/shell_element_kernel.h"
+
+namespace dgtex::kernels {
+
+struct EdgeBatch {
+  ElementType type;
+  std::int64_t count;
+  const int* edges;             // #edges x 4
+  const double* edge_size;      // h^e per edge (report eq. 16)
+  double penalty;               // eta (eq. 15): eta^e = eta / h^e
+  int quadrature_points;        // Gauss points along the edge
+  const int* connectivity;      // #elements x npe
+  const double* positions;      // rest, #nodes x 3
+  const ShellSection* sections; // per element
+};
+
+void shell_edge_stiffness(const EdgeBatch& batch, const double* rotations, double* blocks, double* forces,
+                          Execution execution = Execution::parallel);
+
+// Rotation of the edge frame (tangent, averaged normal) from rest to current positions.
+void shell_edge_rotations(const EdgeBatch& batch, const double* current_positions, double* rotations,
+                          Execution execution = Execution::parallel);
+
+}  // namespace dgtex::kernels

@@ -1,0 +1,86 @@
+#include "dgtex/kernels/multigrid_smooth.h"
+
+#include "dgtex/kernels/multigrid_unknowns.h"
+
+namespace dgtex::kernels {
+namespace {
+
+// 1 / degree, indexed by the degree bits; computed as 1.0 / d like the reference does.
+constexpr double inverse_degree[8] = {0.0, 1.0, 1.0 / 2.0, 1.0 / 3.0, 1.0 / 4.0, 0.0, 0.0, 0.0};
+
+// Sum over the eight off-diagonal couplings of a 9-point stencil times x, in a fixed order.
+inline double stencil9_offdiagonal(const Stencil9View& a, const double* x, std::int64_t t, std::int64_t s) {
+  return a.e[t - 1] * x[t - 1] + a.e[t] * x[t + 1] + a.n[t - s] * x[t - s] + a.n[t] * x[t + s] +
+         a.ne[t - s - 1] * x[t - s - 1] + a.nw[t - s + 1] * x[t - s + 1] + a.nw[t] * x[t + s - 1] +
+         a.ne[t] * x[t + s + 1];
+}
+
+}  // namespace
+
+void smooth_texels_color(GridShape shape, const std::uint8_t* bits, const double* b, double* x, int color,
+                         Execution execution) {
+  const std::int64_t s = shape.stride();
+  forall(
+      shape.ny,
+      [&](std::int64_t j) {
+        const std::int64_t row = shape.at(0, static_cast<int>(j));
+        for (int i = static_cast<int>((color + j) & 1); i < shape.nx; i += 2) {
+          const std::int64_t t = row + i;
+          const std::uint8_t m = bits[t];
+          const double sum = b[t] + ((m & couples_west_unknown) ? x[t - 1] : 0.0) +
+                             ((m & couples_east_unknown) ? x[t + 1] : 0.0) +
+                             ((m & couples_south_unknown) ? x[t - s] : 0.0) +
+                             ((m & couples_north_unknown) ? x[t + s] : 0.0);
+          if (m & is_unknown) x[t] = sum * inverse_degree[laplace_degree(m)];
+        }
+      },
+      execution);
+}
+
+void smooth_texels_color_reference(GridShape shape, const std::uint8_t* bits, const double* b, double* x, int color) {
+  for (int j = 0; j < shape.ny; ++j)
+    for (int i = 0; i < shape.nx; ++i) {
+      if ((i + j) % 2 != color) continue;
+      const std::int64_t t = shape.at(i, j);
+      if (!(bits[t] & is_unknown)) continue;
+      double sum = b[t];
+      sum += (bits[t] & couples_west_unknown) ? x[shape.at(i - 1, j)] : 0.0;
+      sum += (bits[t] & couples_east_unknown) ? x[shape.at(i + 1, j)] : 0.0;
+      sum += (bits[t] & couples_south_unknown) ? x[shape.at(i, j - 1)] : 0.0;
+      sum += (bits[t] & couples_north_unknown) ? x[shape.at(i, j + 1)] : 0.0;
+      x[t] = sum * (1.0 / laplace_degree(bits[t]));
+    }
+}
+
+void smooth_stencil9_color(GridShape shape, Stencil9View a, const double* b, double* x, int color, Execution execution) {
+  const std::int64_t s = shape.stride();
+  const int ci = color & 1, cj = color >> 1;
+  const int rows = (shape.ny - cj + 1) / 2;
+  forall(
+      rows,
+      [&](std::int64_t r) {
+        const int j = static_cast<int>(2 * r + cj);
+        const std::int64_t row = shape.at(0, j);
+        for (int i = ci; i < shape.nx; i += 2) {
+          const std::int64_t t = row + i;
+          if (a.c[t] > 0) x[t] = (b[t] - stencil9_offdiagonal(a, x, t, s)) / a.c[t];
+        }
+      },
+      execution);
+}
+
+void smooth_stencil9_color_reference(GridShape shape, Stencil9View a, const double* b, double* x, int color) {
+  const std::int64_t s = shape.stride();
+  for (int j = 0; j < shape.ny; ++j)
+    for (int i = 0; i < shape.nx; ++i) {
+      if ((i % 2) + 2 * (j % 2) != color) continue;
+      const std::int64_t t = shape.at(i, j);
+      if (!(a.c[t] > 0)) continue;
+      const double offdiagonal = a.e[t - 1] * x[t - 1] + a.e[t] * x[t + 1] + a.n[t - s] * x[t - s] +
+                                 a.n[t] * x[t + s] + a.ne[t - s - 1] * x[t - s - 1] +
+                                 a.nw[t - s + 1] * x[t - s + 1] + a.nw[t] * x[t + s - 1] + a.ne[t] * x[t + s + 1];
+      x[t] = (b[t] - offdiagonal) / a.c[t];
+    }
+}
+
+}  // namespace dgtex::kernels

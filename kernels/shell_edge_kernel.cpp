@@ -1,0 +1,183 @@
+#include "dgtex/kernels/shell_edge_kernel.h"
+
+#include <cmath>
+
+#include "dgtex/kernels/shell_point.h"
+
+namespace dgtex::kernels {
+namespace {
+
+inline double dot(const double* a, const double* b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+inline void cross(const double* a, const double* b, double* c) {
+  c[0] = a[1] * b[2] - a[2] * b[1];
+  c[1] = a[2] * b[0] - a[0] * b[2];
+  c[2] = a[0] * b[1] - a[1] * b[0];
+}
+inline void normalize(double* v) {
+  const double l = std::sqrt(dot(v, v));
+  v[0] /= l, v[1] /= l, v[2] /= l;
+}
+
+// One side of an edge at parameter t (in the plus element's direction).
+struct Side {
+  ShapeValues shape;
+  RestPoint point;
+  double tangent[3];  // dphi/dt
+};
+
+void evaluate_side(const EdgeBatch& b, int element, int local_edge, double t, const double* positions, Side& s) {
+  const int npe = nodes_per_element(b.type);
+  double xi[2], dxi[2];
+  local_edge_point(b.type, local_edge, t, xi, dxi);
+  evaluate_shape(b.type, xi[0], xi[1], s.shape);
+  evaluate_rest_point(s.shape, b.connectivity + static_cast<long>(element) * npe, positions, s.point);
+  tangent_along(s.point, dxi, s.tangent);
+}
+
+// Edge frame (unit tangent, unit averaged normal, in-plane normal) as matrix columns.
+void edge_frame(const Side& plus, const Side* minus, double frame[9]) {
+  double f1[3] = {plus.tangent[0], plus.tangent[1], plus.tangent[2]};
+  normalize(f1);
+  double n[3] = {plus.point.t0[0], plus.point.t0[1], plus.point.t0[2]};
+  if (minus)
+    for (int k = 0; k < 3; ++k) n[k] += minus->point.t0[k];
+  const double nt = dot(n, f1);
+  for (int k = 0; k < 3; ++k) n[k] -= nt * f1[k];
+  normalize(n);
+  double f2[3];
+  cross(n, f1, f2);
+  for (int k = 0; k < 3; ++k) {
+    frame[k * 3 + 0] = f1[k];
+    frame[k * 3 + 1] = f2[k];
+    frame[k * 3 + 2] = n[k];
+  }
+}
+
+void edge_stiffness(const EdgeBatch& b, std::int64_t e, const double* rotations, double* blocks, double* forces) {
+  const int npe = nodes_per_element(b.type);
+  const int nb = 2 * npe;
+  const int* ed = b.edges + 4 * e;
+  const bool interior = ed[2] >= 0;
+  double* K = blocks + e * nb * nb * 9;
+  for (int i = 0; i < nb * nb * 9; ++i) K[i] = 0;
+  double* f = forces ? forces + e * nb * 3 : nullptr;
+  if (f)
+    for (int i = 0; i < nb * 3; ++i) f[i] = 0;
+
+  const ShellSection& sp = b.sections[ed[0]];
+  const ShellSection& sm = b.sections[interior ? ed[2] : ed[0]];
+  const double dm_plus = bending_rigidity(sp.youngs_modulus, sp.poisson_ratio, sp.thickness);
+  const double dm_minus = bending_rigidity(sm.youngs_modulus, sm.poisson_ratio, sm.thickness);
+  const double penalty = b.penalty / b.edge_size[e] * (interior ? 0.5 * (dm_plus + dm_minus) : dm_plus);
+  const double average = interior ? 0.5 : 1.0;
+  const LineRule rule = gauss_legendre(b.quadrature_points);
+
+  for (int q = 0; q < rule.count; ++q) {
+    const double t = rule.t[q];
+    Side plus, minus;
+    evaluate_side(b, ed[0], ed[1], t, b.positions, plus);
+    if (interior) evaluate_side(b, ed[2], ed[3], -t, b.positions, minus);
+    const double ds = std::sqrt(dot(plus.tangent, plus.tangent)) * rule.weight[q];
+    double tau[3] = {plus.tangent[0], plus.tangent[1], plus.tangent[2]};
+    normalize(tau);
+
+    // Rows over the edge's local basis: G = [[g]] (jump of the hinge rotation measure) and
+    // Mbar = {m_nunu} (average normal bending moment), each 3 columns per basis function.
+    double G[2 * max_element_nodes][3] = {}, M[2 * max_element_nodes][3] = {};
+    for (int side = 0; side < (interior ? 2 : 1); ++side) {
+      const Side& s = side == 0 ? plus : minus;
+      const ShellSection& sec = side == 0 ? sp : sm;
+      const double nu_p = sec.poisson_ratio;
+      const double dm = side == 0 ? dm_plus : dm_minus;
+      const double sign = side == 0 ? 1.0 : -1.0;
+      double nu_vec[3], e1[3], e2[3];
+      cross(s.point.t0, tau, nu_vec);
+      frame_along(s.point, tau, e1, e2);  // e1 = tau, e2 = t0 x tau = nu
+      for (int a = 0; a < npe; ++a) {
+        double T[9], Bb[9];
+        normal_change_operator(s.point, s.shape.dN[a], T);
+        bending_rows(s.point, e1, e2, s.shape.dN[a], s.shape.d2N[a], Bb);
+        const int i = side * npe + a;
+        for (int c = 0; c < 3; ++c) {
+          G[i][c] = sign * (nu_vec[0] * T[0 * 3 + c] + nu_vec[1] * T[1 * 3 + c] + nu_vec[2] * T[2 * 3 + c]);
+          // m_nunu = D (nu rho_11 + rho_22) in the frame (tau, nu).
+          M[i][c] = average * dm * (nu_p * Bb[0 * 3 + c] + Bb[1 * 3 + c]);
+        }
+      }
+    }
+    const double* R = rotations ? rotations + (e * rule.count + q) * 9 : nullptr;
+    double gd = 0, md = 0;  // G . d and M . d for the corrective force, d = X0 - R^T X0
+    if (R && f) {
+      for (int side = 0; side < (interior ? 2 : 1); ++side) {
+        const int element = ed[2 * side];
+        for (int a = 0; a < npe; ++a) {
+          const double* x = b.positions + 3 * static_cast<long>(b.connectivity[static_cast<long>(element) * npe + a]);
+          const int i = side * npe + a;
+          for (int k = 0; k < 3; ++k) {
+            const double d = x[k] - (R[0 * 3 + k] * x[0] + R[1 * 3 + k] * x[1] + R[2 * 3 + k] * x[2]);
+            gd += G[i][k] * d;
+            md += M[i][k] * d;
+          }
+        }
+      }
+    }
+    if (R) {
+      for (int i = 0; i < nb; ++i) {
+        double g2[3], m2[3];
+        for (int c = 0; c < 3; ++c) {
+          g2[c] = G[i][0] * R[c * 3 + 0] + G[i][1] * R[c * 3 + 1] + G[i][2] * R[c * 3 + 2];
+          m2[c] = M[i][0] * R[c * 3 + 0] + M[i][1] * R[c * 3 + 1] + M[i][2] * R[c * 3 + 2];
+        }
+        for (int c = 0; c < 3; ++c) G[i][c] = g2[c], M[i][c] = m2[c];
+      }
+    }
+    // K += ds (penalty G^T G + M^T G + G^T M).
+    for (int i = 0; i < nb; ++i)
+      for (int j = 0; j < nb; ++j) {
+        double* blk = K + (i * nb + j) * 9;
+        for (int r = 0; r < 3; ++r)
+          for (int c = 0; c < 3; ++c)
+            blk[r * 3 + c] += ds * (penalty * G[i][r] * G[j][c] + M[i][r] * G[j][c] + G[i][r] * M[j][c]);
+      }
+    if (R && f)
+      for (int i = 0; i < nb; ++i)
+        for (int r = 0; r < 3; ++r) f[i * 3 + r] += ds * (penalty * G[i][r] * gd + M[i][r] * gd + G[i][r] * md);
+  }
+}
+
+}  // namespace
+
+void shell_edge_stiffness(const EdgeBatch& batch, const double* rotations, double* blocks, double* forces,
+                          Execution execution) {
+  forall(batch.count, [&](std::int64_t e) { edge_stiffness(batch, e, rotations, blocks, forces); }, execution);
+}
+
+void shell_edge_rotations(const EdgeBatch& b, const double* current, double* rotations, Execution execution) {
+  const LineRule rule = gauss_legendre(b.quadrature_points);
+  forall(
+      b.count,
+      [&](std::int64_t e) {
+        const int* ed = b.edges + 4 * e;
+        const bool interior = ed[2] >= 0;
+        for (int q = 0; q < rule.count; ++q) {
+          Side p0, m0, p1, m1;
+          evaluate_side(b, ed[0], ed[1], rule.t[q], b.positions, p0);
+          evaluate_side(b, ed[0], ed[1], rule.t[q], current, p1);
+          if (interior) {
+            evaluate_side(b, ed[2], ed[3], -rule.t[q], b.positions, m0);
+            evaluate_side(b, ed[2], ed[3], -rule.t[q], current, m1);
+          }
+          double rest[9], cur[9];
+          edge_frame(p0, interior ? &m0 : nullptr, rest);
+          edge_frame(p1, interior ? &m1 : nullptr, cur);
+          // R = Cur * Rest^T maps the rest frame onto the current one.
+          double* R = rotations + (e * rule.count + q) * 9;
+          for (int i = 0; i < 3; ++i)
+            for (int j = 0; j < 3; ++j)
+              R[i * 3 + j] = cur[i * 3 + 0] * rest[j * 3 + 0] + cur[i * 3 + 1] * rest[j * 3 + 1] + cur[i * 3 + 2] * rest[j * 3 + 2];
+        }
+      },
+      execution);
+}
+
+}  // namespace dgtex::kernels

@@ -1,0 +1,211 @@
+#include "dgtex/kernels/shell_element_kernel.h"
+
+#include <cmath>
+
+#include "dgtex/kernels/shell_point.h"
+
+namespace dgtex::kernels {
+namespace {
+
+
+// C = [[1, nu, 0], [nu, 1, 0], [0, 0, (1-nu)/2]] times scale, applied to a Voigt vector.
+inline void apply_plane_stress(double nu, double scale, const double in[3], double out[3]) {
+  out[0] = scale * (in[0] + nu * in[1]);
+  out[1] = scale * (nu * in[0] + in[1]);
+  out[2] = scale * 0.5 * (1 - nu) * in[2];
+}
+
+// B' = B R^T for a 3x3 row block (rows: Voigt components, columns: x, y, z).
+inline void rotate_rows(const double B[9], const double R[9], double out[9]) {
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c)
+      out[r * 3 + c] = B[r * 3 + 0] * R[c * 3 + 0] + B[r * 3 + 1] * R[c * 3 + 1] + B[r * 3 + 2] * R[c * 3 + 2];
+}
+
+void element_stiffness(const ElementBatch& b, std::int64_t e, const double* rotations, double* blocks,
+                       double* forces) {
+  const int npe = nodes_per_element(b.type);
+  const int* nodes = b.connectivity + e * npe;
+  const ShellSection& sec = b.sections[e];
+  const double nu = sec.poisson_ratio;
+  const double dn = membrane_rigidity(sec.youngs_modulus, nu, sec.thickness);
+  const double dm = bending_rigidity(sec.youngs_modulus, nu, sec.thickness);
+  const QuadratureRule rule = element_quadrature(b.type);
+
+  double* K = blocks + e * npe * npe * 9;
+  for (int i = 0; i < npe * npe * 9; ++i) K[i] = 0;
+  double* f = forces ? forces + e * npe * 3 : nullptr;
+  if (f)
+    for (int i = 0; i < npe * 3; ++i) f[i] = 0;
+
+  for (int q = 0; q < rule.count; ++q) {
+    ShapeValues s;
+    evaluate_shape(b.type, rule.xi1[q], rule.xi2[q], s);
+    RestPoint p;
+    evaluate_rest_point(s, nodes, b.positions, p);
+    double e1[3], e2[3];
+    frame_along(p, p.a1, e1, e2);
+    const double w = rule.weight[q] * p.j0;
+
+    double Bm[max_element_nodes][9], Bb[max_element_nodes][9];
+    for (int a = 0; a < npe; ++a) {
+      membrane_rows(p, e1, e2, s.dN[a], Bm[a]);
+      bending_rows(p, e1, e2, s.dN[a], s.d2N[a], Bb[a]);
+    }
+    const double* R = rotations ? rotations + (e * rule.count + q) * 9 : nullptr;
+    double strain_m[3] = {0, 0, 0}, strain_b[3] = {0, 0, 0};
+    if (R && f) {
+      // Strain of the corrective term: B (X0 - R^T X0).
+      for (int a = 0; a < npe; ++a) {
+        const double* x = b.positions + 3 * static_cast<long>(nodes[a]);
+        double d[3];
+        for (int k = 0; k < 3; ++k) d[k] = x[k] - (R[0 * 3 + k] * x[0] + R[1 * 3 + k] * x[1] + R[2 * 3 + k] * x[2]);
+        for (int r = 0; r < 3; ++r) {
+          strain_m[r] += Bm[a][r * 3 + 0] * d[0] + Bm[a][r * 3 + 1] * d[1] + Bm[a][r * 3 + 2] * d[2];
+          strain_b[r] += Bb[a][r * 3 + 0] * d[0] + Bb[a][r * 3 + 1] * d[1] + Bb[a][r * 3 + 2] * d[2];
+        }
+      }
+    }
+    if (R) {
+      for (int a = 0; a < npe; ++a) {
+        double tmp[9];
+        rotate_rows(Bm[a], R, tmp);
+        for (int i = 0; i < 9; ++i) Bm[a][i] = tmp[i];
+        rotate_rows(Bb[a], R, tmp);
+        for (int i = 0; i < 9; ++i) Bb[a][i] = tmp[i];
+      }
+    }
+    // Stress-like products D B_b, one column (x, y, z of node b) at a time.
+    double DBm[max_element_nodes][9], DBb[max_element_nodes][9];
+    for (int a = 0; a < npe; ++a)
+      for (int c = 0; c < 3; ++c) {
+        const double vm[3] = {Bm[a][0 * 3 + c], Bm[a][1 * 3 + c], Bm[a][2 * 3 + c]};
+        const double vb[3] = {Bb[a][0 * 3 + c], Bb[a][1 * 3 + c], Bb[a][2 * 3 + c]};
+        double om[3], ob[3];
+        apply_plane_stress(nu, dn, vm, om);
+        apply_plane_stress(nu, dm, vb, ob);
+        for (int r = 0; r < 3; ++r) DBm[a][r * 3 + c] = om[r], DBb[a][r * 3 + c] = ob[r];
+      }
+    for (int a = 0; a < npe; ++a)
+      for (int bb = 0; bb < npe; ++bb) {
+        double* blk = K + (a * npe + bb) * 9;
+        for (int i = 0; i < 3; ++i)
+          for (int j = 0; j < 3; ++j) {
+            double v = 0;
+            for (int r = 0; r < 3; ++r) v += Bm[a][r * 3 + i] * DBm[bb][r * 3 + j] + Bb[a][r * 3 + i] * DBb[bb][r * 3 + j];
+            blk[i * 3 + j] += w * v;
+          }
+      }
+    if (R && f) {
+      double sm[3], sb[3];
+      apply_plane_stress(nu, dn, strain_m, sm);
+      apply_plane_stress(nu, dm, strain_b, sb);
+      for (int a = 0; a < npe; ++a)
+        for (int i = 0; i < 3; ++i) {
+          double v = 0;
+          for (int r = 0; r < 3; ++r) v += Bm[a][r * 3 + i] * sm[r] + Bb[a][r * 3 + i] * sb[r];
+          f[a * 3 + i] += w * v;
+        }
+    }
+  }
+}
+
+inline void invert3(const double m[9], double inv[9]) {
+  const double c00 = m[4] * m[8] - m[5] * m[7], c01 = m[5] * m[6] - m[3] * m[8], c02 = m[3] * m[7] - m[4] * m[6];
+  const double det = m[0] * c00 + m[1] * c01 + m[2] * c02;
+  inv[0] = c00 / det;
+  inv[3] = c01 / det;
+  inv[6] = c02 / det;
+  inv[1] = (m[2] * m[7] - m[1] * m[8]) / det;
+  inv[4] = (m[0] * m[8] - m[2] * m[6]) / det;
+  inv[7] = (m[1] * m[6] - m[0] * m[7]) / det;
+  inv[2] = (m[1] * m[5] - m[2] * m[4]) / det;
+  inv[5] = (m[2] * m[3] - m[0] * m[5]) / det;
+  inv[8] = (m[0] * m[4] - m[1] * m[3]) / det;
+}
+
+}  // namespace
+
+void shell_element_stiffness(const ElementBatch& batch, const double* rotations, double* blocks, double* forces,
+                             Execution execution) {
+  forall(batch.count, [&](std::int64_t e) { element_stiffness(batch, e, rotations, blocks, forces); }, execution);
+}
+
+void shell_element_deformation_gradients(const ElementBatch& b, const double* current, double* F,
+                                         Execution execution) {
+  const int npe = nodes_per_element(b.type);
+  const QuadratureRule rule = element_quadrature(b.type);
+  forall(
+      b.count,
+      [&](std::int64_t e) {
+        const int* nodes = b.connectivity + e * npe;
+        for (int q = 0; q < rule.count; ++q) {
+          ShapeValues s;
+          evaluate_shape(b.type, rule.xi1[q], rule.xi2[q], s);
+          RestPoint p0, p;
+          evaluate_rest_point(s, nodes, b.positions, p0);
+          evaluate_rest_point(s, nodes, current, p);
+          // Columns: current (a1, a2, t) and rest (A1, A2, T0); F = Cur * Rest^-1.
+          const double rest[9] = {p0.a1[0], p0.a2[0], p0.t0[0], p0.a1[1], p0.a2[1], p0.t0[1],
+                                  p0.a1[2], p0.a2[2], p0.t0[2]};
+          const double cur[9] = {p.a1[0], p.a2[0], p.t0[0], p.a1[1], p.a2[1], p.t0[1], p.a1[2], p.a2[2], p.t0[2]};
+          double inv[9];
+          invert3(rest, inv);
+          double* out = F + (e * rule.count + q) * 9;
+          for (int i = 0; i < 3; ++i)
+            for (int j = 0; j < 3; ++j)
+              out[i * 3 + j] = cur[i * 3 + 0] * inv[0 * 3 + j] + cur[i * 3 + 1] * inv[1 * 3 + j] + cur[i * 3 + 2] * inv[2 * 3 + j];
+        }
+      },
+      execution);
+}
+
+void shell_element_mass(const ElementBatch& b, double* mass, Execution execution) {
+  const int npe = nodes_per_element(b.type);
+  const QuadratureRule rule = element_quadrature(b.type);
+  forall(
+      b.count,
+      [&](std::int64_t e) {
+        const int* nodes = b.connectivity + e * npe;
+        const double rho_h = b.sections[e].density * b.sections[e].thickness;
+        double* m = mass + e * npe * npe;
+        for (int i = 0; i < npe * npe; ++i) m[i] = 0;
+        for (int q = 0; q < rule.count; ++q) {
+          ShapeValues s;
+          evaluate_shape(b.type, rule.xi1[q], rule.xi2[q], s);
+          RestPoint p;
+          evaluate_rest_point(s, nodes, b.positions, p);
+          const double w = rule.weight[q] * p.j0 * rho_h;
+          for (int a = 0; a < npe; ++a)
+            for (int c = 0; c < npe; ++c) m[a * npe + c] += w * s.N[a] * s.N[c];
+        }
+      },
+      execution);
+}
+
+void shell_element_load_weights(const ElementBatch& b, double* area_weights, double* mass_weights,
+                                Execution execution) {
+  const int npe = nodes_per_element(b.type);
+  const QuadratureRule rule = element_quadrature(b.type);
+  forall(
+      b.count,
+      [&](std::int64_t e) {
+        const int* nodes = b.connectivity + e * npe;
+        const double rho_h = b.sections[e].density * b.sections[e].thickness;
+        for (int a = 0; a < npe; ++a) area_weights[e * npe + a] = mass_weights[e * npe + a] = 0;
+        for (int q = 0; q < rule.count; ++q) {
+          ShapeValues s;
+          evaluate_shape(b.type, rule.xi1[q], rule.xi2[q], s);
+          RestPoint p;
+          evaluate_rest_point(s, nodes, b.positions, p);
+          const double w = rule.weight[q] * p.j0;
+          for (int a = 0; a < npe; ++a) {
+            area_weights[e * npe + a] += w * s.N[a];
+            mass_weights[e * npe + a] += w * rho_h * s.N[a];
+          }
+        }
+      },
+      execution);
+}
+
+}  // namespace dgtex::kernels

@@ -1,0 +1,37 @@
+#pragma once
+// The linear system over the free DOFs of a block-sparse matrix: fixed DOFs (held at zero
+// displacement) are eliminated, and the lower triangle is laid out in compressed-column
+// form for CHOLMOD. The map from block entries to column slots is built once; each slot
+// is written by exactly one block entry, so filling is deterministic in parallel.
+#include <cstdint>
+#include <vector>
+
+#include "dgtex/block_assembly.h"
+
+namespace dgtex {
+
+class FreeDofSystem {
+ public:
+  FreeDofSystem() = default;
+  // fixed: #dofs flags (3 per node).
+  FreeDofSystem(const BlockAssembly& pattern, const std::vector<char>& fixed);
+
+  int size() const { return static_cast<int>(dof_of_unknown_.size()); }
+  std::int64_t nonzeros() const { return static_cast<std::int64_t>(row_index_.size()); }
+  const std::vector<int>& column_start() const { return column_start_; }
+  const std::vector<int>& row_index() const { return row_index_; }
+
+  // values = sa * A + sb * B (B may be null), A and B block matrices in the pattern.
+  void gather(const double* a, double sa, const double* b, double sb, std::vector<double>& values) const;
+  void restrict_vector(const std::vector<double>& full, std::vector<double>& reduced) const;
+  // full[free dofs] = reduced; fixed DOFs set to zero.
+  void expand_vector(const std::vector<double>& reduced, std::vector<double>& full) const;
+
+ private:
+  std::vector<int> dof_of_unknown_;
+  std::vector<int> unknown_of_dof_;
+  std::vector<int> column_start_, row_index_;
+  std::vector<std::int64_t> slot_source_;  // per CSC slot: block entry (block * 9 + r * 3 + c)
+};
+
+}  // namespace dgtex

@@ -1,0 +1,49 @@
+#pragma once
+// Sparse Cholesky factorisation through CHOLMOD (supernodal). The symbolic analysis (fill
+// reducing ordering, supernodes) is done once per pattern and reused by every numeric
+// factorisation with the same pattern, as in a time loop.
+//
+// Matrices are given as the LOWER triangle in compressed-column form (n x n, 0-based).
+#include <cstdint>
+#include <memory>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace dgtex {
+
+// Thrown when the matrix is not positive definite (CHOLMOD hit a non-positive pivot).
+class NotPositiveDefinite : public std::runtime_error {
+ public:
+  NotPositiveDefinite(const std::string& what, int column) : std::runtime_error(what), column_(column) {}
+  int column() const { return column_; }
+
+ private:
+  int column_;
+};
+
+class SparseCholesky {
+ public:
+  SparseCholesky();
+  ~SparseCholesky();
+  SparseCholesky(const SparseCholesky&) = delete;
+  SparseCholesky& operator=(const SparseCholesky&) = delete;
+
+  // Symbolic analysis of the pattern; values are not needed yet.
+  void analyze(int n, const std::vector<int>& column_start, const std::vector<int>& row_index);
+  bool analyzed() const;
+  // Numeric factorisation with values in the analysed pattern's order.
+  void factorize(const std::vector<double>& values);
+  // x = A^-1 b.
+  void solve(const std::vector<double>& b, std::vector<double>& x) const;
+  int size() const { return n_; }
+  // Non-zeros of the factor L (after factorize).
+  std::int64_t factor_nonzeros() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+  int n_ = 0;
+};
+
+}  // namespace dgtex

@@ -1,0 +1,39 @@
+#pragma once
+// Per-stage wall-clock statistics (mean and max over calls), in milliseconds.
+#include <chrono>
+#include <map>
+#include <string>
+
+namespace dgtex {
+
+struct StageStatistics {
+  double total_ms = 0;
+  double max_ms = 0;
+  long count = 0;
+  void add(double ms) {
+    total_ms += ms;
+    max_ms = ms > max_ms ? ms : max_ms;
+    ++count;
+  }
+  double mean_ms() const { return count ? total_ms / count : 0.0; }
+};
+
+using StageTimings = std::map<std::string, StageStatistics>;
+
+// Adds the time from construction to destruction to one stage.
+class ScopedStage {
+ public:
+  ScopedStage(StageTimings& timings, const std::string& stage)
+      : stats_(timings[stage]), start_(std::chrono::steady_clock::now()) {}
+  ~ScopedStage() {
+    stats_.add(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start_).count());
+  }
+  ScopedStage(const ScopedStage&) = delete;
+  ScopedStage& operator=(const ScopedStage&) = delete;
+
+ private:
+  StageStatistics& stats_;
+  std::chrono::steady_clock::time_point start_;
+};
+
+}  // namespace dgtex
