@@ -1,0 +1,32 @@
+#pragma once
+// Structured shell meshes of the scene file's generators (DESIGN.md, "The scene file").
+// Divisions count elements along each parameter. Every node, midside nodes included, is
+// placed ON the exact surface at its parameter value (not on chords), so curved meshes are
+// as exact as quadratic elements allow. Corner order follows the parameters, so each
+// element's normal (dx/dxi1 x dx/dxi2) points the documented way.
+// tri6: every grid cell (u0..u1) x (v0..v1) is split along its diagonal (u0,v0)-(u1,v1)
+// into two tri6; the diagonal's midside node is the cell-centre node.
+// Node numbering: row by row in the second parameter, first parameter fastest, on the
+// half-step grid (quad8 skips the cell centres). Invalid arguments throw MeshError.
+#include "dgtex/mesh.h"
+#include "dgtex/mesh_error.h"
+
+namespace dgtex {
+
+// Points (x, y, 0), x in [0, size_x], y in [0, size_y]; normal +z.
+Mesh make_rectangle(double size_x, double size_y, int nx, int ny, ElementType type);
+
+// Points (R sin t, y, R cos t), t between angle0_deg and angle1_deg (either order; the
+// range may be at most 360 degrees), y in [0, length]; t = 0 is the top (z = R), the axis
+// is y. Normal points outward (away from the y axis). A 360 degree range closes the seam:
+// the nodes at t0 and t0 + 360 are shared, so those edges are interior (needs n_angle >= 3:
+// with 2, two different edges would join the same pair of corner nodes).
+Mesh make_cylinder(double radius, double length, double angle0_deg, double angle1_deg, int n_angle,
+                   int n_length, ElementType type);
+
+// Centre at the origin, pole on +z: points (R sin p cos l, R sin p sin l, R cos p), polar
+// angle p in [hole_deg, 90] degrees (hole_deg in (0, 90)), azimuth l in [0, 360) closed
+// (needs n_azimuth >= 3). Normal outward. Boundary: the hole rim and the equator.
+Mesh make_hemisphere(double radius, double hole_deg, int n_polar, int n_azimuth, ElementType type);
+
+}  // namespace dgtex

@@ -1,0 +1,28 @@
+#pragma once
+// Checks that a mesh is usable by the shell solver, and per-element measures.
+#include "dgtex/mesh.h"
+#include "dgtex/mesh_error.h"
+
+namespace dgtex {
+
+// Throws MeshError (naming the element / node index and the value) unless:
+//  - the element type is quad8 or tri6, positions hold #nodes x 3 values and elements
+//    #elements x nodes_per_element values, with at least one element;
+//  - every coordinate is finite;
+//  - every node index is in [0, #nodes) and no element repeats a node;
+//  - every node is used by some element (a free node has no stiffness: singular system);
+//  - no element is degenerate: at each of its quadrature points the area Jacobian
+//    |dx/dxi1 x dx/dxi2| must exceed 1e-10 x (element diameter)^2, where the diameter is the
+//    largest distance between two of its nodes;
+//  - build_topology succeeds (manifold, consistently oriented, shared midside nodes).
+void validate_mesh(const Mesh& mesh);
+
+// Area of element e by its quadrature rule (exact for the flat undistorted elements,
+// degree-5 accurate otherwise). Units: length^2.
+double element_area(const Mesh& mesh, int e);
+
+// Perimeter of element e: the length of its three or four curved edges, each by 5-point
+// Gauss-Legendre quadrature. Units: length.
+double element_perimeter(const Mesh& mesh, int e);
+
+}  // namespace dgtex

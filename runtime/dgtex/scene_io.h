@@ -1,0 +1,48 @@
+#pragma once
+// Reading a scene file (JSON, version 1, format in DESIGN.md and README.md) into a
+// validated Scene. Validation is strict so that typos never pass silently: unknown keys,
+// duplicate keys, wrong types, missing required keys, non-integers where an integer is
+// needed, out-of-range values and inconsistent combinations (zero density in a dynamic
+// run, a progressive cut in a static run, ...) all throw SceneError.
+//
+// Checks that need the mesh (empty boundary selections, statically unconstrained models,
+// surface points outside the mesh) live in scene_mesh_checks.h.
+#include <stdexcept>
+#include <string>
+
+#include "dgtex/scene.h"
+
+namespace dgtex {
+
+// A problem with a scene file. what() is always exactly one line:
+//   <file>: <json.path[0].like.this>: <problem>, got <value>; <what would be valid>
+// (", got <value>" is left out when there is no value, e.g. a missing key). JSON syntax
+// errors read  <file>:<line>:<column>: invalid JSON: <problem>.
+class SceneError : public std::runtime_error {
+ public:
+  // got: the offending value as JSON text (empty: none); valid: what would be accepted.
+  SceneError(const std::string& source_name, const std::string& json_path, const std::string& problem,
+             const std::string& got, const std::string& valid);
+  // For errors that have no JSON path (unreadable file, syntax errors); message as given.
+  SceneError(const std::string& source_name, const std::string& message);
+
+  const std::string& json_path() const { return json_path_; }
+
+ private:
+  std::string json_path_;
+};
+
+// Reads and validates the scene file at path. Relative paths inside it (mesh.file)
+// resolve against the scene file's folder.
+Scene load_scene(const std::string& path);
+
+// Validates json_text. source_name is used in messages and its parent folder (if any)
+// resolves relative paths, so parse_scene(text, "dir/scene.json") behaves like
+// load_scene("dir/scene.json").
+Scene parse_scene(const std::string& json_text, const std::string& source_name);
+
+// The scene as canonical JSON text (every key written, defaults included), which
+// parse_scene reads back into an equal Scene. Used to echo the effective scene.
+std::string scene_to_json_text(const Scene& scene);
+
+}  // namespace dgtex

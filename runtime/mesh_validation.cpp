@@ -1,0 +1,146 @@
+#include "dgtex/mesh_validation.h"
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+#include "dgtex/topology.h"
+
+namespace dgtex {
+namespace {
+
+struct Vec3 {
+  double x = 0, y = 0, z = 0;
+};
+
+double norm(const Vec3& v) { return std::sqrt(v.x * v.x + v.y * v.y + v.z * v.z); }
+
+Vec3 cross(const Vec3& a, const Vec3& b) {
+  return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
+}
+
+// Tangents dx/dxi1, dx/dxi2 of element e at (xi1, xi2).
+void tangents(const Mesh& mesh, int e, double xi1, double xi2, Vec3& t1, Vec3& t2) {
+  kernels::ShapeValues s;
+  kernels::evaluate_shape(mesh.type, xi1, xi2, s);
+  const int* en = mesh.element_nodes(e);
+  t1 = t2 = Vec3{};
+  for (int a = 0; a < s.count; ++a) {
+    const double* p = mesh.node(en[a]);
+    t1.x += s.dN[a][0] * p[0], t1.y += s.dN[a][0] * p[1], t1.z += s.dN[a][0] * p[2];
+    t2.x += s.dN[a][1] * p[0], t2.y += s.dN[a][1] * p[1], t2.z += s.dN[a][1] * p[2];
+  }
+}
+
+double area_jacobian(const Mesh& mesh, int e, double xi1, double xi2) {
+  Vec3 t1, t2;
+  tangents(mesh, e, xi1, xi2, t1, t2);
+  return norm(cross(t1, t2));
+}
+
+double element_diameter(const Mesh& mesh, int e) {
+  const int* en = mesh.element_nodes(e);
+  const int n = mesh.nodes_per_element();
+  double d2 = 0;
+  for (int a = 0; a < n; ++a)
+    for (int b = a + 1; b < n; ++b) {
+      const double* p = mesh.node(en[a]);
+      const double* q = mesh.node(en[b]);
+      const double dx = p[0] - q[0], dy = p[1] - q[1], dz = p[2] - q[2];
+      d2 = std::max(d2, dx * dx + dy * dy + dz * dz);
+    }
+  return std::sqrt(d2);
+}
+
+void check_element_index(const Mesh& mesh, int e, const char* function) {
+  if (e < 0 || e >= mesh.num_elements())
+    throw MeshError(std::string(function) + ": element index " + std::to_string(e) + " out of range [0, " +
+                    std::to_string(mesh.num_elements()) + ")");
+}
+
+}  // namespace
+
+void validate_mesh(const Mesh& mesh) {
+  if (mesh.type != ElementType::quad8 && mesh.type != ElementType::tri6)
+    throw MeshError("mesh element type must be quad8 or tri6, got " + std::to_string(static_cast<int>(mesh.type)));
+  if (mesh.positions.size() % 3 != 0)
+    throw MeshError("mesh positions must hold 3 coordinates per node, got " + std::to_string(mesh.positions.size()) +
+                    " values");
+  const int npe = mesh.nodes_per_element();
+  if (mesh.elements.size() % npe != 0)
+    throw MeshError("mesh elements must hold " + std::to_string(npe) + " node indices per element, got " +
+                    std::to_string(mesh.elements.size()) + " values");
+  if (mesh.num_elements() == 0) throw MeshError("mesh has no elements");
+
+  const int nodes = mesh.num_nodes();
+  for (int n = 0; n < nodes; ++n) {
+    const double* p = mesh.node(n);
+    if (!std::isfinite(p[0]) || !std::isfinite(p[1]) || !std::isfinite(p[2]))
+      throw MeshError("node " + std::to_string(n) + " has a non-finite coordinate (" + mesh_number(p[0]) + ", " +
+                      mesh_number(p[1]) + ", " + mesh_number(p[2]) + ")");
+  }
+
+  std::vector<char> used(nodes, 0);
+  for (int e = 0; e < mesh.num_elements(); ++e) {
+    const int* en = mesh.element_nodes(e);
+    for (int a = 0; a < npe; ++a) {
+      if (en[a] < 0 || en[a] >= nodes)
+        throw MeshError("element " + std::to_string(e) + " local node " + std::to_string(a) + " refers to node " +
+                            std::to_string(en[a]) + ", outside [0, " + std::to_string(nodes) + ")",
+                        {e});
+      for (int b = 0; b < a; ++b)
+        if (en[a] == en[b])
+          throw MeshError("element " + std::to_string(e) + " repeats node " + std::to_string(en[a]) +
+                              " (local nodes " + std::to_string(b) + " and " + std::to_string(a) + ")",
+                          {e});
+      used[en[a]] = 1;
+    }
+  }
+  for (int n = 0; n < nodes; ++n)
+    if (!used[n])
+      throw MeshError("node " + std::to_string(n) +
+                      " is used by no element; its displacement would be undetermined (remove it)");
+
+  const kernels::QuadratureRule rule = kernels::element_quadrature(mesh.type);
+  for (int e = 0; e < mesh.num_elements(); ++e) {
+    const double h = element_diameter(mesh, e);
+    const double threshold = 1e-10 * h * h;
+    for (int q = 0; q < rule.count; ++q) {
+      const double j = area_jacobian(mesh, e, rule.xi1[q], rule.xi2[q]);
+      if (!(j > threshold))
+        throw MeshError("element " + std::to_string(e) + " is degenerate: area Jacobian " + mesh_number(j) +
+                            " at quadrature point " + std::to_string(q) + " (xi = " + mesh_number(rule.xi1[q]) +
+                            ", " + mesh_number(rule.xi2[q]) + ") is below 1e-10 x diameter^2 = " +
+                            mesh_number(threshold) + " (zero area, collapsed or collinear nodes)",
+                        {e});
+    }
+  }
+
+  build_topology(mesh);
+}
+
+double element_area(const Mesh& mesh, int e) {
+  check_element_index(mesh, e, "element_area");
+  const kernels::QuadratureRule rule = kernels::element_quadrature(mesh.type);
+  double area = 0;
+  for (int q = 0; q < rule.count; ++q) area += rule.weight[q] * area_jacobian(mesh, e, rule.xi1[q], rule.xi2[q]);
+  return area;
+}
+
+double element_perimeter(const Mesh& mesh, int e) {
+  check_element_index(mesh, e, "element_perimeter");
+  const kernels::LineRule line = kernels::gauss_legendre(5);
+  double length = 0;
+  for (int k = 0; k < kernels::corners_per_element(mesh.type); ++k)
+    for (int q = 0; q < line.count; ++q) {
+      double xi[2], dxi[2];
+      kernels::local_edge_point(mesh.type, k, line.t[q], xi, dxi);
+      Vec3 t1, t2;
+      tangents(mesh, e, xi[0], xi[1], t1, t2);
+      const Vec3 dx{t1.x * dxi[0] + t2.x * dxi[1], t1.y * dxi[0] + t2.y * dxi[1], t1.z * dxi[0] + t2.z * dxi[1]};
+      length += line.weight[q] * norm(dx);
+    }
+  return length;
+}
+
+}  // namespace dgtex

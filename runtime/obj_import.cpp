@@ -1,0 +1,137 @@
+#include "dgtex/obj_import.h"
+
+#include <cmath>
+#include <cstdlib>
+#include <fstream>
+#include <map>
+#include <sstream>
+#include <utility>
+#include <vector>
+
+#include "dgtex/mesh_validation.h"
+
+namespace dgtex {
+namespace {
+
+struct ObjFace {
+  std::vector<int> vertices;  // 0-based OBJ vertex indices
+  int line = 0;
+};
+
+std::string where(const std::string& path, int line) { return path + ":" + std::to_string(line); }
+
+double parse_coordinate(const std::string& token, const std::string& path, int line) {
+  char* end = nullptr;
+  const double value = std::strtod(token.c_str(), &end);
+  if (token.empty() || *end != '\0' || !std::isfinite(value))
+    throw MeshError(where(path, line) + ": vertex coordinate '" + token + "' is not a finite number");
+  return value;
+}
+
+// "7", "7/2", "7//3", "7/2/3", "-1" -> 0-based vertex index.
+int parse_face_corner(const std::string& token, int vertices_so_far, const std::string& path, int line) {
+  const std::string index_text = token.substr(0, token.find('/'));
+  char* end = nullptr;
+  const long index = std::strtol(index_text.c_str(), &end, 10);
+  if (index_text.empty() || *end != '\0')
+    throw MeshError(where(path, line) + ": face corner '" + token + "' does not start with a vertex index");
+  const long resolved = index > 0 ? index - 1 : vertices_so_far + index;
+  if (index == 0 || resolved < 0 || resolved >= vertices_so_far)
+    throw MeshError(where(path, line) + ": face corner '" + token + "' refers to vertex " + std::to_string(index) +
+                    ", but only " + std::to_string(vertices_so_far) + " vertices are defined before this line " +
+                    "(valid: 1.." + std::to_string(vertices_so_far) + " or -1..-" + std::to_string(vertices_so_far) +
+                    ")");
+  return static_cast<int>(resolved);
+}
+
+}  // namespace
+
+Mesh load_obj(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw MeshError(path + ": cannot open OBJ file for reading");
+
+  std::vector<double> vertices;
+  std::vector<ObjFace> faces;
+  std::string text;
+  for (int line = 1; std::getline(in, text); ++line) {
+    if (!text.empty() && text.back() == '\r') text.pop_back();
+    std::istringstream tokens(text);
+    std::string keyword;
+    if (!(tokens >> keyword) || keyword[0] == '#') continue;
+    if (keyword == "v") {
+      std::string c[3];
+      if (!(tokens >> c[0] >> c[1] >> c[2]))
+        throw MeshError(where(path, line) + ": vertex needs three coordinates 'v x y z', got '" + text + "'");
+      for (int d = 0; d < 3; ++d) vertices.push_back(parse_coordinate(c[d], path, line));
+    } else if (keyword == "f") {
+      ObjFace face;
+      face.line = line;
+      const int defined = static_cast<int>(vertices.size() / 3);
+      for (std::string corner; tokens >> corner;) face.vertices.push_back(parse_face_corner(corner, defined, path, line));
+      const int n = static_cast<int>(face.vertices.size());
+      if (n != 3 && n != 4)
+        throw MeshError(where(path, line) + ": face has " + std::to_string(n) +
+                        " corners; only triangles (-> tri6) and quads (-> quad8) are supported");
+      for (int a = 0; a < n; ++a)
+        for (int b = 0; b < a; ++b)
+          if (face.vertices[a] == face.vertices[b])
+            throw MeshError(where(path, line) + ": face repeats vertex " + std::to_string(face.vertices[a] + 1));
+      if (!faces.empty() && faces.front().vertices.size() != face.vertices.size())
+        throw MeshError(where(path, line) + ": face has " + std::to_string(n) + " corners but the face at " +
+                        where(path, faces.front().line) + " has " + std::to_string(faces.front().vertices.size()) +
+                        "; a mesh must be all triangles or all quads");
+      faces.push_back(std::move(face));
+    }
+  }
+  if (in.bad()) throw MeshError(path + ": read error");
+  if (faces.empty()) throw MeshError(path + ": no faces ('f' lines) found");
+
+  const int corners = static_cast<int>(faces.front().vertices.size());
+  Mesh mesh;
+  mesh.type = corners == 3 ? ElementType::tri6 : ElementType::quad8;
+
+  // Referenced vertices become nodes in file order.
+  const int vertex_count = static_cast<int>(vertices.size() / 3);
+  std::vector<char> referenced(vertex_count, 0);
+  for (const ObjFace& f : faces)
+    for (int v : f.vertices) referenced[v] = 1;
+  std::vector<int> node_of_vertex(vertex_count, -1);
+  for (int v = 0; v < vertex_count; ++v)
+    if (referenced[v]) {
+      node_of_vertex[v] = mesh.num_nodes();
+      mesh.positions.insert(mesh.positions.end(), &vertices[3 * v], &vertices[3 * v] + 3);
+    }
+
+  // One midside node per corner pair, shared by both faces of an edge.
+  std::map<std::pair<int, int>, int> midside;
+  for (const ObjFace& f : faces) {
+    int element[8];
+    for (int k = 0; k < corners; ++k) element[k] = node_of_vertex[f.vertices[k]];
+    for (int k = 0; k < corners; ++k) {
+      const int a = element[k], b = element[(k + 1) % corners];
+      const auto key = std::make_pair(std::min(a, b), std::max(a, b));
+      auto it = midside.find(key);
+      if (it == midside.end()) {
+        it = midside.emplace(key, mesh.num_nodes()).first;
+        const double* pa = mesh.node(a);
+        const double* pb = mesh.node(b);
+        const double mid[3] = {0.5 * (pa[0] + pb[0]), 0.5 * (pa[1] + pb[1]), 0.5 * (pa[2] + pb[2])};
+        mesh.positions.insert(mesh.positions.end(), mid, mid + 3);
+      }
+      element[corners + k] = it->second;
+    }
+    mesh.elements.insert(mesh.elements.end(), element, element + 2 * corners);
+  }
+
+  try {
+    validate_mesh(mesh);
+  } catch (const MeshError& error) {
+    std::string faces_involved;
+    for (int e : error.elements())
+      faces_involved += "; element " + std::to_string(e) + " is the face at " + where(path, faces[e].line);
+    throw MeshError(path + ": " + error.what() + faces_involved, error.elements());
+  }
+  return mesh;
+}
+
+}  // namespace dgtex

@@ -1,0 +1,878 @@
+// Strict reader for scene files, version 1. Every value is checked where it is read, so
+// each error names the JSON path of the offending value; cross-field checks (density in
+// dynamic runs, schedules in static runs, surface points vs. element type) run last.
+#include "dgtex/scene_io.h"
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <initializer_list>
+#include <set>
+#include <sstream>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+namespace dgtex {
+
+using json = nlohmann::json;
+
+namespace {
+
+// Beyond this magnitude a number is certainly a typo and products such as E h^3 would
+// approach overflow.
+constexpr double kMaxMagnitude = 1e30;
+constexpr int kMaxDivisions = 100000;
+constexpr long long kMaxGeneratedCells = 10000000;
+constexpr int kMaxSteps = 1000000000;
+
+std::string one_line(std::string text) {
+  std::replace(text.begin(), text.end(), '\n', ' ');
+  std::replace(text.begin(), text.end(), '\r', ' ');
+  return text;
+}
+
+std::string value_text(const json& value) {
+  std::string text = value.dump(-1, ' ', false, json::error_handler_t::replace);
+  constexpr size_t kMaxChars = 80;
+  if (text.size() > kMaxChars) {
+    size_t cut = kMaxChars - 3;
+    while (cut > 0 && (static_cast<unsigned char>(text[cut]) & 0xC0) == 0x80) --cut;  // keep UTF-8 whole
+    text = text.substr(0, cut) + "...";
+  }
+  return text;
+}
+
+std::string number_text(double x) {
+  std::ostringstream out;
+  out.precision(17);
+  out << x;
+  return out.str();
+}
+
+std::string child(const std::string& path, const std::string& key) { return path.empty() ? key : path + "." + key; }
+std::string item(const std::string& path, size_t index) { return path + "[" + std::to_string(index) + "]"; }
+
+size_t edit_distance(const std::string& a, const std::string& b) {
+  std::vector<size_t> row(b.size() + 1);
+  for (size_t j = 0; j <= b.size(); ++j) row[j] = j;
+  for (size_t i = 1; i <= a.size(); ++i) {
+    size_t diagonal = row[0];
+    row[0] = i;
+    for (size_t j = 1; j <= b.size(); ++j) {
+      const size_t above = row[j];
+      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diagonal + (a[i - 1] == b[j - 1] ? 0 : 1)});
+      diagonal = above;
+    }
+  }
+  return row[b.size()];
+}
+
+std::string join(const std::vector<std::string>& words, const std::string& separator = ", ") {
+  std::string out;
+  for (size_t i = 0; i < words.size(); ++i) out += (i ? separator : "") + words[i];
+  return out;
+}
+
+double norm(const Vec3& v) { return std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]); }
+Vec3 difference(const Vec3& a, const Vec3& b) { return {a[0] - b[0], a[1] - b[1], a[2] - b[2]}; }
+
+// Rejects duplicate keys while nlohmann parses (it would silently keep the last one),
+// tracking the JSON path of every object so the message can name it.
+class DuplicateKeyCheck {
+ public:
+  explicit DuplicateKeyCheck(std::string source) : source_(std::move(source)) {}
+
+  bool operator()(int, json::parse_event_t event, json& parsed) {
+    switch (event) {
+      case json::parse_event_t::object_start:
+      case json::parse_event_t::array_start:
+        frames_.push_back({event == json::parse_event_t::array_start, 0, "", {}, current_path()});
+        break;
+      case json::parse_event_t::key: {
+        Frame& top = frames_.back();
+        top.key = parsed.get<std::string>();
+        if (!top.keys.insert(top.key).second)
+          throw SceneError(source_, child(top.path, top.key), "duplicate key", "",
+                           "each key may appear only once in an object");
+        break;
+      }
+      case json::parse_event_t::object_end:
+      case json::parse_event_t::array_end:
+        frames_.pop_back();
+        element_done();
+        break;
+      case json::parse_event_t::value:
+        element_done();
+        break;
+    }
+    return true;
+  }
+
+ private:
+  struct Frame {
+    bool is_array;
+    size_t index;
+    std::string key;
+    std::set<std::string> keys;
+    std::string path;
+  };
+
+  std::string current_path() const {
+    if (frames_.empty()) return "";
+    const Frame& top = frames_.back();
+    return top.is_array ? item(top.path, top.index) : child(top.path, top.key);
+  }
+  void element_done() {
+    if (!frames_.empty() && frames_.back().is_array) ++frames_.back().index;
+  }
+
+  std::string source_;
+  std::vector<Frame> frames_;
+};
+
+json parse_json_text(const std::string& text, const std::string& source) {
+  try {
+    return json::parse(text, DuplicateKeyCheck(source), /*allow_exceptions=*/true, /*ignore_comments=*/false);
+  } catch (const json::parse_error& e) {
+    // nlohmann: "[json.exception.parse_error.101] parse error at line L, column C: detail".
+    std::string detail = e.what();
+    const size_t column = detail.find(", column ");
+    const size_t colon = column == std::string::npos ? std::string::npos : detail.find(": ", column);
+    if (colon != std::string::npos) detail = detail.substr(colon + 2);
+    // Locate the byte nlohmann stopped at (1-based) as line:column.
+    size_t line = 1, col = 1;
+    for (size_t i = 0; i + 1 < e.byte && i < text.size(); ++i) {
+      if (text[i] == '\n') {
+        ++line;
+        col = 1;
+      } else {
+        ++col;
+      }
+    }
+    // Compiler-style "file:line:column: ..." so editors can jump to the spot.
+    throw SceneError(source + ":" + std::to_string(line) + ":" + std::to_string(col),
+                     "invalid JSON: " + detail + " (comments, trailing commas, NaN and Infinity are not JSON)");
+  } catch (const json::exception& e) {
+    // e.g. "[json.exception.out_of_range.406] number overflow parsing '1e400'".
+    std::string detail = e.what();
+    const size_t bracket = detail.find("] ");
+    if (bracket != std::string::npos) detail = detail.substr(bracket + 2);
+    throw SceneError(source, "invalid JSON: " + detail);
+  }
+}
+
+// Validating reader: each method reads one value at a JSON path or throws SceneError
+// naming that path and the value.
+class SceneReader {
+ public:
+  SceneReader(std::string source, std::string base_dir) : source_(std::move(source)), base_dir_(std::move(base_dir)) {}
+
+  Scene read(const json& root) {
+    Scene scene;
+    scene.source_name = source_;
+    scene.base_dir = base_dir_;
+    if (!root.is_object()) fail("(root)", "the scene must be a JSON object", root, "{\"mesh\": {...}, \"material\": {...}, ...}");
+    check_keys(root, "",
+               {"mesh", "material", "penalty", "boundary", "loads", "analysis", "probes", "cuts", "enrichment", "render",
+                "output"});
+    scene.mesh = read_mesh(require(root, "", "mesh", "a generator object or {\"file\": ...}"), "mesh");
+    scene.material = read_material(require(root, "", "material", "an object with youngs_modulus, poisson_ratio, thickness"),
+                                   "material");
+    if (const json* v = find(root, "penalty")) scene.penalty = positive(*v, "penalty");
+    if (const json* v = find(root, "analysis")) scene.analysis = read_analysis(*v, "analysis");
+    if (const json* v = find(root, "boundary")) {
+      for_each_item(*v, "boundary", [&](const json& e, const std::string& p) { scene.boundary.push_back(read_boundary(e, p)); });
+    }
+    if (const json* v = find(root, "loads")) {
+      for_each_item(*v, "loads", [&](const json& e, const std::string& p) { scene.loads.push_back(read_load(e, p)); });
+    }
+    if (const json* v = find(root, "probes")) {
+      for_each_item(*v, "probes", [&](const json& e, const std::string& p) { scene.probes.push_back(read_probe(e, p)); });
+      check_unique_probe_names(*v, scene.probes);
+    }
+    if (const json* v = find(root, "cuts")) {
+      for_each_item(*v, "cuts", [&](const json& e, const std::string& p) { scene.cuts.push_back(read_cut(e, p)); });
+    }
+    if (const json* v = find(root, "enrichment")) scene.enrichment = read_enrichment(*v, "enrichment");
+    if (const json* v = find(root, "render")) scene.render = read_render(*v, "render");
+    if (const json* v = find(root, "output")) scene.output = read_output(*v, "output");
+    check_combinations(root, scene);
+    return scene;
+  }
+
+ private:
+  // ---- errors and generic readers -------------------------------------------------------
+  [[noreturn]] void fail(const std::string& path, const std::string& problem, const json& got,
+                         const std::string& valid) const {
+    throw SceneError(source_, path, problem, value_text(got), valid);
+  }
+  [[noreturn]] void fail_without_value(const std::string& path, const std::string& problem,
+                                       const std::string& valid) const {
+    throw SceneError(source_, path, problem, "", valid);
+  }
+
+  void expect_object(const json& v, const std::string& path) const {
+    if (!v.is_object()) fail(path, "expected an object", v, "write {...} here");
+  }
+
+  void check_keys(const json& object, const std::string& path, std::initializer_list<const char*> allowed) const {
+    expect_object(object, path);
+    std::vector<std::string> names(allowed.begin(), allowed.end());
+    for (auto it = object.begin(); it != object.end(); ++it) {
+      if (std::find(names.begin(), names.end(), it.key()) != names.end()) continue;
+      std::string valid = "valid keys here: " + join(names);
+      size_t best = it.key().size() / 3 + 2;
+      std::string suggestion;
+      for (const std::string& name : names) {
+        const size_t d = edit_distance(it.key(), name);
+        if (d < best) best = d, suggestion = name;
+      }
+      if (!suggestion.empty()) valid = "did you mean \"" + suggestion + "\"? " + valid;
+      fail(child(path, it.key()), "unknown key", it.value(), valid);
+    }
+  }
+
+  static const json* find(const json& object, const char* key) {
+    auto it = object.find(key);
+    return it == object.end() ? nullptr : &*it;
+  }
+  const json& require(const json& object, const std::string& path, const char* key, const std::string& valid) const {
+    const json* v = find(object, key);
+    if (!v) fail_without_value(child(path, key), "missing required key", "expected " + valid);
+    return *v;
+  }
+
+  double number(const json& v, const std::string& path) const {
+    if (!v.is_number()) fail(path, "expected a number", v, "write a plain JSON number");
+    const double x = v.get<double>();
+    if (!std::isfinite(x) || std::abs(x) > kMaxMagnitude)
+      fail(path, "number out of range", v, "magnitudes up to 1e30 are accepted");
+    return x;
+  }
+  double positive(const json& v, const std::string& path) const {
+    const double x = number(v, path);
+    if (!(x > 0)) fail(path, "must be positive", v, "expected a number > 0");
+    return x;
+  }
+  double non_negative(const json& v, const std::string& path) const {
+    const double x = number(v, path);
+    if (!(x >= 0)) fail(path, "must not be negative", v, "expected a number >= 0");
+    return x;
+  }
+  int integer(const json& v, const std::string& path, long long lo, long long hi) const {
+    const std::string range = "expected an integer in " + std::to_string(lo) + ".." + std::to_string(hi);
+    if (!v.is_number_integer()) fail(path, "expected an integer", v, range);
+    const long long x = v.is_number_unsigned() && v.get<unsigned long long>() > static_cast<unsigned long long>(hi)
+                            ? hi + 1
+                            : v.get<long long>();
+    if (x < lo || x > hi) fail(path, "out of range", v, range);
+    return static_cast<int>(x);
+  }
+  bool boolean(const json& v, const std::string& path) const {
+    if (!v.is_boolean()) fail(path, "expected true or false", v, "write true or false (without quotes)");
+    return v.get<bool>();
+  }
+  std::string string(const json& v, const std::string& path) const {
+    if (!v.is_string()) fail(path, "expected a string", v, "write a string in double quotes");
+    return v.get<std::string>();
+  }
+  // One of the given words; returns its index.
+  int choice(const json& v, const std::string& path, std::initializer_list<const char*> words) const {
+    std::vector<std::string> names(words.begin(), words.end());
+    std::vector<std::string> quoted;
+    for (const std::string& n : names) quoted.push_back("\"" + n + "\"");
+    const std::string valid = "expected one of " + join(quoted);
+    if (!v.is_string()) fail(path, "expected a string", v, valid);
+    const auto it = std::find(names.begin(), names.end(), v.get<std::string>());
+    if (it == names.end()) fail(path, "unknown value", v, valid);
+    return static_cast<int>(it - names.begin());
+  }
+  template <size_t N>
+  std::array<double, N> numbers(const json& v, const std::string& path) const {
+    if (!v.is_array() || v.size() != N) fail(path, "expected an array of " + std::to_string(N) + " numbers", v, "e.g. " + example(N));
+    std::array<double, N> out{};
+    for (size_t i = 0; i < N; ++i) out[i] = number(v[i], item(path, i));
+    return out;
+  }
+  Vec3 vec3(const json& v, const std::string& path) const { return numbers<3>(v, path); }
+  static std::string example(size_t n) { return n == 2 ? "[0.0, 1.0]" : "[0.0, 0.0, 1.0]"; }
+
+  template <class F>
+  void for_each_item(const json& v, const std::string& path, F&& read_item) const {
+    if (!v.is_array()) fail(path, "expected an array", v, "write [...] here");
+    for (size_t i = 0; i < v.size(); ++i) read_item(v[i], item(path, i));
+  }
+
+  // ---- sections -------------------------------------------------------------------------
+  MeshSpec read_mesh(const json& v, const std::string& path) const {
+    MeshSpec mesh;
+    expect_object(v, path);
+    const json* file = find(v, "file");
+    const json* generator = find(v, "generator");
+    if (!file && !generator) {
+      check_keys(v, path, {"generator", "file", "element", "size", "divisions", "radius", "length", "angle_deg", "hole_deg"});
+      fail(path, "needs \"generator\" or \"file\"", v,
+           "expected e.g. {\"generator\": \"rectangle\", ...} or {\"file\": \"mesh.obj\"}");
+    }
+    if (file && generator) fail(child(path, "file"), "\"file\" and \"generator\" exclude each other", *file, "give only one of them");
+    if (file) {
+      check_keys(v, path, {"file", "element"});
+      mesh.source = MeshSource::file;
+      const std::string name = string(*file, child(path, "file"));
+      if (name.empty()) fail(child(path, "file"), "empty file name", *file, "expected the path of an OBJ file");
+      std::filesystem::path resolved(name);
+      if (resolved.is_relative() && !base_dir_.empty()) resolved = std::filesystem::path(base_dir_) / resolved;
+      mesh.file = resolved.lexically_normal().string();
+      std::error_code error;
+      if (!std::filesystem::is_regular_file(mesh.file, error))
+        fail(child(path, "file"), "no such file (resolved to " + mesh.file + ")", *file,
+             "relative paths are resolved against the scene file's folder");
+      if (const json* e = find(v, "element")) mesh.element = element_type(*e, child(path, "element"));
+      return mesh;
+    }
+    mesh.source = static_cast<MeshSource>(choice(*generator, child(path, "generator"), {"rectangle", "cylinder", "hemisphere"}));
+    switch (mesh.source) {
+      case MeshSource::rectangle:
+        check_keys(v, path, {"generator", "size", "divisions", "element"});
+        mesh.size = numbers<2>(require(v, path, "size", "[a, b]"), child(path, "size"));
+        for (int i = 0; i < 2; ++i)
+          if (!(mesh.size[i] > 0)) fail(item(child(path, "size"), i), "must be positive", v["size"][i], "expected a length > 0");
+        break;
+      case MeshSource::cylinder: {
+        check_keys(v, path, {"generator", "radius", "length", "angle_deg", "divisions", "element"});
+        mesh.radius = positive(require(v, path, "radius", "a radius > 0"), child(path, "radius"));
+        mesh.length = positive(require(v, path, "length", "a length > 0"), child(path, "length"));
+        const json& angles = require(v, path, "angle_deg", "[t0, t1] in degrees with t0 < t1 <= t0 + 360");
+        mesh.angle_deg = numbers<2>(angles, child(path, "angle_deg"));
+        const double range = std::abs(mesh.angle_deg[1] - mesh.angle_deg[0]);
+        if (!(range > 0) || range > 360)
+          fail(child(path, "angle_deg"), "angle range must be non-empty and at most 360 degrees", angles,
+               "expected [t0, t1] with 0 < |t1 - t0| <= 360");
+        break;
+      }
+      case MeshSource::hemisphere: {
+        check_keys(v, path, {"generator", "radius", "hole_deg", "divisions", "element"});
+        mesh.radius = positive(require(v, path, "radius", "a radius > 0"), child(path, "radius"));
+        const json& hole = require(v, path, "hole_deg", "a polar hole angle in (0, 90) degrees");
+        mesh.hole_deg = number(hole, child(path, "hole_deg"));
+        if (!(mesh.hole_deg > 0 && mesh.hole_deg < 90))
+          fail(child(path, "hole_deg"), "out of range", hole, "expected 0 < hole_deg < 90 (degrees)");
+        break;
+      }
+      case MeshSource::file:
+        break;
+    }
+    const json& divisions = require(v, path, "divisions", "two element counts, e.g. [4, 4]");
+    const std::string divisions_path = child(path, "divisions");
+    if (!divisions.is_array() || divisions.size() != 2)
+      fail(divisions_path, "expected an array of 2 integers", divisions, "e.g. [4, 4]");
+    for (int i = 0; i < 2; ++i) mesh.divisions[i] = integer(divisions[i], item(divisions_path, i), 1, kMaxDivisions);
+    // A closed ring of one cell would join an element to itself along its seam.
+    const bool closed_ring = mesh.source == MeshSource::hemisphere || mesh.closed_cylinder();
+    const int ring_index = mesh.source == MeshSource::hemisphere ? 1 : 0;
+    if (closed_ring && mesh.divisions[ring_index] < 2)
+      fail(item(divisions_path, ring_index), "a closed 360-degree ring needs at least 2 divisions", divisions[ring_index],
+           "expected an integer >= 2");
+    if (static_cast<long long>(mesh.divisions[0]) * mesh.divisions[1] > kMaxGeneratedCells)
+      fail(divisions_path, "too many cells", divisions, "at most 10000000 cells (product of the divisions)");
+    mesh.element = ElementType::quad8;
+    if (const json* e = find(v, "element")) mesh.element = element_type(*e, child(path, "element"));
+    return mesh;
+  }
+
+  ElementType element_type(const json& v, const std::string& path) const {
+    return choice(v, path, {"quad8", "tri6"}) == 0 ? ElementType::quad8 : ElementType::tri6;
+  }
+
+  Material read_material(const json& v, const std::string& path) const {
+    check_keys(v, path, {"youngs_modulus", "poisson_ratio", "thickness", "density"});
+    Material m;
+    m.youngs_modulus = positive(require(v, path, "youngs_modulus", "Young's modulus > 0"), child(path, "youngs_modulus"));
+    const json& nu = require(v, path, "poisson_ratio", "Poisson's ratio with -1 < nu < 0.5");
+    m.poisson_ratio = number(nu, child(path, "poisson_ratio"));
+    if (!(m.poisson_ratio > -1 && m.poisson_ratio < 0.5))
+      fail(child(path, "poisson_ratio"), "out of range", nu, "expected -1 < poisson_ratio < 0.5");
+    m.thickness = positive(require(v, path, "thickness", "a thickness > 0"), child(path, "thickness"));
+    if (const json* d = find(v, "density")) m.density = non_negative(*d, child(path, "density"));
+    return m;
+  }
+
+  Analysis read_analysis(const json& v, const std::string& path) const {
+    expect_object(v, path);
+    Analysis a;
+    const json& type = require(v, path, "type", "\"static\" or \"dynamic\"");
+    a.type = choice(type, child(path, "type"), {"static", "dynamic"}) == 0 ? Analysis::Type::static_equilibrium
+                                                                            : Analysis::Type::dynamic;
+    if (!a.is_dynamic()) {
+      for (const char* key : {"time_step", "steps", "corotational", "damping"})
+        if (const json* k = find(v, key))
+          fail(child(path, key), "only allowed when analysis.type is \"dynamic\"", *k,
+               "remove it or set \"type\": \"dynamic\"");
+      check_keys(v, path, {"type"});
+      return a;
+    }
+    check_keys(v, path, {"type", "time_step", "steps", "corotational", "damping"});
+    a.time_step = positive(require(v, path, "time_step", "a time step > 0"), child(path, "time_step"));
+    a.steps = integer(require(v, path, "steps", "a number of steps >= 1"), child(path, "steps"), 1, kMaxSteps);
+    if (const json* c = find(v, "corotational")) a.corotational = boolean(*c, child(path, "corotational"));
+    if (const json* d = find(v, "damping")) {
+      const std::string damping = child(path, "damping");
+      check_keys(*d, damping, {"mass", "stiffness"});
+      if (const json* m = find(*d, "mass")) a.damping.mass = non_negative(*m, child(damping, "mass"));
+      if (const json* k = find(*d, "stiffness")) a.damping.stiffness = non_negative(*k, child(damping, "stiffness"));
+    }
+    return a;
+  }
+
+  BoundaryCondition read_boundary(const json& v, const std::string& path) const {
+    check_keys(v, path, {"select", "fix", "clamp"});
+    BoundaryCondition bc;
+    bc.select = read_select(require(v, path, "select", "{\"plane\": {...}} or {\"box\": {...}}"), child(path, "select"));
+    const std::string fix_path = child(path, "fix");
+    const json& fix = require(v, path, "fix", "the held components, e.g. [\"x\", \"y\", \"z\"]");
+    if (!fix.is_array()) fail(fix_path, "expected an array of components", fix, "e.g. [\"x\", \"y\", \"z\"] or []");
+    for (size_t i = 0; i < fix.size(); ++i) {
+      const int c = choice(fix[i], item(fix_path, i), {"x", "y", "z"});
+      if (bc.fixed[c]) fail(item(fix_path, i), "component listed twice", fix[i], "list each of x, y, z at most once");
+      bc.fixed[c] = true;
+    }
+    if (const json* c = find(v, "clamp")) bc.clamp = boolean(*c, child(path, "clamp"));
+    if (fix.empty() && !bc.clamp)
+      fail(fix_path, "this boundary condition holds nothing", fix, "list components to fix or set \"clamp\": true");
+    return bc;
+  }
+
+  BoundarySelect read_select(const json& v, const std::string& path) const {
+    check_keys(v, path, {"plane", "box", "tolerance"});
+    BoundarySelect s;
+    const json* plane = find(v, "plane");
+    const json* box = find(v, "box");
+    if (plane && box) fail(child(path, "box"), "\"plane\" and \"box\" exclude each other", *box, "give only one of them");
+    if (!plane && !box)
+      fail(path, "needs \"plane\" or \"box\"", v,
+           "expected {\"plane\": {\"normal\": [..], \"offset\": ..}} or {\"box\": {\"min\": [..], \"max\": [..]}}");
+    if (plane) {
+      const std::string p = child(path, "plane");
+      check_keys(*plane, p, {"normal", "offset"});
+      s.kind = BoundarySelect::Kind::plane;
+      const json& normal = require(*plane, p, "normal", "a non-zero vector [nx, ny, nz]");
+      const Vec3 n = vec3(normal, child(p, "normal"));
+      const double length = norm(n);
+      if (!(length > 0)) fail(child(p, "normal"), "zero normal", normal, "expected a non-zero vector [nx, ny, nz]");
+      s.normal = {n[0] / length, n[1] / length, n[2] / length};
+      s.offset = number(require(*plane, p, "offset", "the plane's signed distance from the origin"), child(p, "offset"));
+    } else {
+      const std::string b = child(path, "box");
+      check_keys(*box, b, {"min", "max"});
+      s.kind = BoundarySelect::Kind::box;
+      s.min = vec3(require(*box, b, "min", "the lower corner [x, y, z]"), child(b, "min"));
+      const json& max = require(*box, b, "max", "the upper corner [x, y, z]");
+      s.max = vec3(max, child(b, "max"));
+      for (size_t i = 0; i < 3; ++i)
+        if (!(s.min[i] <= s.max[i]))
+          fail(item(child(b, "max"), i), "box max below min (" + number_text(s.min[i]) + ")", max[i],
+               "expected min <= max in every component");
+    }
+    if (const json* t = find(v, "tolerance")) s.tolerance = non_negative(*t, child(path, "tolerance"));
+    return s;
+  }
+
+  Load read_load(const json& v, const std::string& path) const {
+    expect_object(v, path);
+    const json* type = find(v, "type");
+    if (!type) {
+      check_keys(v, path, {"type", "acceleration", "force_per_area", "position", "force"});
+      fail_without_value(child(path, "type"), "missing required key", "expected \"gravity\", \"area_force\" or \"point\"");
+    }
+    Load load;
+    load.type = static_cast<Load::Type>(choice(*type, child(path, "type"), {"gravity", "area_force", "point"}));
+    switch (load.type) {
+      case Load::Type::gravity:
+        check_keys(v, path, {"type", "acceleration"});
+        load.acceleration = vec3(require(v, path, "acceleration", "[gx, gy, gz]"), child(path, "acceleration"));
+        break;
+      case Load::Type::area_force:
+        check_keys(v, path, {"type", "force_per_area"});
+        load.force_per_area = vec3(require(v, path, "force_per_area", "[fx, fy, fz]"), child(path, "force_per_area"));
+        break;
+      case Load::Type::point:
+        check_keys(v, path, {"type", "position", "force"});
+        load.position = vec3(require(v, path, "position", "[x, y, z]"), child(path, "position"));
+        load.force = vec3(require(v, path, "force", "[fx, fy, fz]"), child(path, "force"));
+        break;
+    }
+    return load;
+  }
+
+  Probe read_probe(const json& v, const std::string& path) const {
+    check_keys(v, path, {"name", "position"});
+    Probe probe;
+    const json& name = require(v, path, "name", "a non-empty name");
+    probe.name = string(name, child(path, "name"));
+    if (probe.name.empty()) fail(child(path, "name"), "empty probe name", name, "expected a non-empty name");
+    probe.position = vec3(require(v, path, "position", "[x, y, z]"), child(path, "position"));
+    return probe;
+  }
+
+  void check_unique_probe_names(const json& v, const std::vector<Probe>& probes) const {
+    for (size_t i = 0; i < probes.size(); ++i)
+      for (size_t j = 0; j < i; ++j)
+        if (probes[i].name == probes[j].name)
+          fail(child(item("probes", i), "name"), "duplicate probe name", v[i]["name"],
+               "probes[" + std::to_string(j) + "] already uses it; names must be unique");
+  }
+
+  Cut read_cut(const json& v, const std::string& path) const {
+    check_keys(v, path, {"points", "surface_points", "start_time", "speed"});
+    Cut cut;
+    const json* points = find(v, "points");
+    const json* surface = find(v, "surface_points");
+    if (points && surface)
+      fail(child(path, "surface_points"), "\"points\" and \"surface_points\" exclude each other", *surface,
+           "give only one of them");
+    if (!points && !surface)
+      fail(path, "needs \"points\" or \"surface_points\"", v,
+           "expected {\"points\": [[x, y, z], ...]} or {\"surface_points\": [{\"element\": e, \"xi\": [a, b]}, ...]}");
+    if (points) {
+      cut.kind = Cut::Kind::points;
+      const std::string p = child(path, "points");
+      if (!points->is_array() || points->size() < 2)
+        fail(p, "a cut needs at least 2 points", *points, "expected [[x, y, z], [x, y, z], ...]");
+      for (size_t i = 0; i < points->size(); ++i) cut.points.push_back(vec3((*points)[i], item(p, i)));
+      double total = 0;
+      for (size_t i = 1; i < cut.points.size(); ++i) total += norm(difference(cut.points[i], cut.points[i - 1]));
+      if (!(total > 0)) fail(p, "zero-length cut", *points, "expected points that span a positive length");
+      for (size_t i = 1; i < cut.points.size(); ++i)
+        if (cut.points[i] == cut.points[i - 1])
+          fail(item(p, i), "repeats the previous point (zero-length segment)", (*points)[i], "remove the repeated point");
+    } else {
+      cut.kind = Cut::Kind::surface_points;
+      const std::string p = child(path, "surface_points");
+      if (!surface->is_array() || surface->size() < 2)
+        fail(p, "a cut needs at least 2 points", *surface, "expected [{\"element\": e, \"xi\": [a, b]}, ...]");
+      for (size_t i = 0; i < surface->size(); ++i) {
+        const json& point = (*surface)[i];
+        const std::string q = item(p, i);
+        check_keys(point, q, {"element", "xi"});
+        CutSurfacePoint sp;
+        sp.element = integer(require(point, q, "element", "an element index >= 0"), child(q, "element"), 0, 2147483647);
+        sp.xi = numbers<2>(require(point, q, "xi", "parametric coordinates [xi1, xi2]"), child(q, "xi"));
+        cut.surface_points.push_back(sp);
+      }
+      bool all_same = true;
+      for (size_t i = 1; i < cut.surface_points.size(); ++i) {
+        const CutSurfacePoint& a = cut.surface_points[i - 1];
+        const CutSurfacePoint& b = cut.surface_points[i];
+        if (a.element != b.element || a.xi != b.xi) all_same = false;
+      }
+      if (all_same) fail(p, "zero-length cut", *surface, "expected points that span a positive length");
+      for (size_t i = 1; i < cut.surface_points.size(); ++i) {
+        const CutSurfacePoint& a = cut.surface_points[i - 1];
+        const CutSurfacePoint& b = cut.surface_points[i];
+        if (a.element == b.element && a.xi == b.xi)
+          fail(item(p, i), "repeats the previous point (zero-length segment)", (*surface)[i], "remove the repeated point");
+      }
+    }
+    if (const json* t = find(v, "start_time")) {
+      cut.has_schedule = true;
+      cut.start_time = non_negative(*t, child(path, "start_time"));
+    }
+    if (const json* s = find(v, "speed")) {
+      cut.has_schedule = true;
+      cut.speed = positive(*s, child(path, "speed"));
+    }
+    return cut;
+  }
+
+  EnrichmentOptions read_enrichment(const json& v, const std::string& path) const {
+    check_keys(v, path, {"texture_resolution", "solver", "new_cut_length", "new_cut_angle_deg"});
+    EnrichmentOptions e;
+    if (const json* r = find(v, "texture_resolution")) {
+      const std::string p = child(path, "texture_resolution");
+      e.texture_resolution = integer(*r, p, 8, 4096);
+      if ((e.texture_resolution & (e.texture_resolution - 1)) != 0)
+        fail(p, "not a power of two", *r, "expected one of 8, 16, 32, 64, 128, 256, 512, 1024, 2048, 4096");
+    }
+    if (const json* s = find(v, "solver"))
+      e.solver = choice(*s, child(path, "solver"), {"multigrid", "cholmod"}) == 0 ? EnrichmentOptions::Solver::multigrid
+                                                                                  : EnrichmentOptions::Solver::cholmod;
+    if (const json* l = find(v, "new_cut_length")) e.new_cut_length = positive(*l, child(path, "new_cut_length"));
+    if (const json* a = find(v, "new_cut_angle_deg")) e.new_cut_angle_deg = positive(*a, child(path, "new_cut_angle_deg"));
+    return e;
+  }
+
+  RenderOptions read_render(const json& v, const std::string& path) const {
+    check_keys(v, path, {"width", "height", "camera", "every_steps", "shading", "background"});
+    RenderOptions r;
+    if (const json* w = find(v, "width")) r.width = integer(*w, child(path, "width"), 1, 8192);
+    if (const json* h = find(v, "height")) r.height = integer(*h, child(path, "height"), 1, 8192);
+    if (const json* c = find(v, "camera")) read_camera(*c, child(path, "camera"), r);
+    if (const json* n = find(v, "every_steps")) r.every_steps = integer(*n, child(path, "every_steps"), 1, kMaxSteps);
+    if (const json* s = find(v, "shading"))
+      r.shading = choice(*s, child(path, "shading"), {"flat", "smooth"}) == 0 ? RenderOptions::Shading::flat
+                                                                              : RenderOptions::Shading::smooth;
+    if (const json* b = find(v, "background")) {
+      const std::string p = child(path, "background");
+      r.background = vec3(*b, p);
+      for (size_t i = 0; i < 3; ++i)
+        if (!(r.background[i] >= 0 && r.background[i] <= 1))
+          fail(item(p, i), "colour component out of range", (*b)[i], "expected a number in [0, 1]");
+    }
+    return r;
+  }
+
+  void read_camera(const json& v, const std::string& path, RenderOptions& r) const {
+    check_keys(v, path, {"position", "target", "up", "fov_deg"});
+    if (const json* p = find(v, "position")) r.camera_position = vec3(*p, child(path, "position"));
+    if (const json* t = find(v, "target")) r.camera_target = vec3(*t, child(path, "target"));
+    if (const json* u = find(v, "up")) {
+      r.camera_up = vec3(*u, child(path, "up"));
+      if (!(norm(r.camera_up) > 0)) fail(child(path, "up"), "zero up vector", *u, "expected a non-zero vector");
+    }
+    if (const json* f = find(v, "fov_deg")) {
+      r.fov_deg = number(*f, child(path, "fov_deg"));
+      if (!(r.fov_deg > 0 && r.fov_deg < 180)) fail(child(path, "fov_deg"), "out of range", *f, "expected 0 < fov_deg < 180");
+    }
+    if (r.camera_position && r.camera_target) {
+      const Vec3 view = difference(*r.camera_target, *r.camera_position);
+      if (!(norm(view) > 0))
+        fail(child(path, "target"), "camera target equals its position", v["target"], "expected a target away from the camera");
+      const Vec3& u = r.camera_up;
+      const Vec3 cross{view[1] * u[2] - view[2] * u[1], view[2] * u[0] - view[0] * u[2], view[0] * u[1] - view[1] * u[0]};
+      if (!(norm(cross) > 1e-9 * norm(view) * norm(u)))
+        fail(child(path, "up"), "up is parallel to the viewing direction", find(v, "up") ? v["up"] : json(u),
+             "expected an up vector not parallel to target - position");
+    }
+  }
+
+  OutputOptions read_output(const json& v, const std::string& path) const {
+    check_keys(v, path, {"report"});
+    OutputOptions o;
+    if (const json* r = find(v, "report")) {
+      o.report = string(*r, child(path, "report"));
+      if (o.report.empty() || o.report == "." || o.report == ".." || o.report.find_first_of("/\\") != std::string::npos)
+        fail(child(path, "report"), "not a plain file name", *r, "expected a file name such as \"report.json\" (it is written inside the output folder)");
+    }
+    return o;
+  }
+
+  // ---- checks across sections -----------------------------------------------------------
+  void check_combinations(const json& root, const Scene& scene) const {
+    const json* material = find(root, "material");
+    const json* density = find(*material, "density");
+    if (scene.analysis.is_dynamic() && !(scene.material.density > 0)) {
+      if (!density)
+        fail_without_value("material.density", "missing, but required in a dynamic analysis", "expected a density > 0");
+      fail("material.density", "must be positive in a dynamic analysis", *density, "expected a density > 0");
+    }
+    for (size_t i = 0; i < scene.loads.size(); ++i) {
+      if (scene.loads[i].type != Load::Type::gravity || scene.material.density > 0) continue;
+      const std::string why = "loads[" + std::to_string(i) + "] is gravity, which needs a density > 0";
+      if (!density) fail_without_value("material.density", "missing", why);
+      fail("material.density", "zero density", *density, why);
+    }
+    for (size_t i = 0; i < scene.cuts.size(); ++i) {
+      const Cut& cut = scene.cuts[i];
+      const json& cut_json = root["cuts"][i];
+      const std::string path = item("cuts", i);
+      if (cut.has_schedule && !scene.analysis.is_dynamic()) {
+        const char* key = find(cut_json, "start_time") ? "start_time" : "speed";
+        fail(child(path, key), "a progressive cut needs a dynamic analysis", cut_json[key],
+             "remove start_time/speed or set analysis.type to \"dynamic\"");
+      }
+      if (cut.kind == Cut::Kind::surface_points) check_surface_points(cut, cut_json, path, scene.mesh);
+    }
+  }
+
+  // Parametric coordinates must lie in the reference element (when the element type is
+  // known); element indices below the generator's element count.
+  void check_surface_points(const Cut& cut, const json& cut_json, const std::string& path, const MeshSpec& mesh) const {
+    constexpr double kSlack = 1e-12;
+    for (size_t k = 0; k < cut.surface_points.size(); ++k) {
+      const CutSurfacePoint& sp = cut.surface_points[k];
+      const std::string p = item(child(path, "surface_points"), k);
+      const json& point = cut_json["surface_points"][k];
+      const double a = sp.xi[0], b = sp.xi[1];
+      if (!mesh.element) {
+        if (std::abs(a) > 1 + kSlack || std::abs(b) > 1 + kSlack)
+          fail(child(p, "xi"), "outside every reference element", point["xi"], "expected xi in [-1, 1]^2");
+      } else if (*mesh.element == ElementType::quad8) {
+        if (std::abs(a) > 1 + kSlack || std::abs(b) > 1 + kSlack)
+          fail(child(p, "xi"), "outside the quad8 reference element", point["xi"], "expected xi1, xi2 in [-1, 1]");
+      } else if (a < -kSlack || b < -kSlack || a + b > 1 + kSlack) {
+        fail(child(p, "xi"), "outside the tri6 reference element", point["xi"], "expected xi1, xi2 >= 0 and xi1 + xi2 <= 1");
+      }
+      if (mesh.source != MeshSource::file) {
+        const long long count = static_cast<long long>(mesh.divisions[0]) * mesh.divisions[1] *
+                                (*mesh.element == ElementType::tri6 ? 2 : 1);
+        if (sp.element >= count)
+          fail(child(p, "element"), "no such element", point["element"],
+               "the generated mesh has elements 0.." + std::to_string(count - 1));
+      }
+    }
+  }
+
+  std::string source_;
+  std::string base_dir_;
+};
+
+}  // namespace
+
+SceneError::SceneError(const std::string& source_name, const std::string& json_path, const std::string& problem,
+                       const std::string& got, const std::string& valid)
+    : std::runtime_error(one_line(source_name + ": " + json_path + ": " + problem + (got.empty() ? "" : ", got " + got) +
+                                  (valid.empty() ? "" : "; " + valid))),
+      json_path_(json_path) {}
+
+SceneError::SceneError(const std::string& source_name, const std::string& message)
+    : std::runtime_error(one_line(source_name + ": " + message)) {}
+
+Scene parse_scene(const std::string& json_text, const std::string& source_name) {
+  const std::string base_dir = std::filesystem::path(source_name).parent_path().string();
+  const json root = parse_json_text(json_text, source_name);
+  return SceneReader(source_name, base_dir).read(root);
+}
+
+Scene load_scene(const std::string& path) {
+  std::error_code error;
+  if (!std::filesystem::exists(path, error)) throw SceneError(path, "cannot read the scene file: no such file");
+  if (!std::filesystem::is_regular_file(path, error)) throw SceneError(path, "cannot read the scene file: not a regular file");
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw SceneError(path, "cannot read the scene file: permission denied or unreadable");
+  std::ostringstream text;
+  text << in.rdbuf();
+  return parse_scene(text.str(), path);
+}
+
+// ---- canonical JSON ---------------------------------------------------------------------
+namespace {
+
+json to_json(const Vec3& v) { return json::array({v[0], v[1], v[2]}); }
+
+json select_to_json(const BoundarySelect& s) {
+  json out;
+  if (s.kind == BoundarySelect::Kind::plane) {
+    out["plane"] = {{"normal", to_json(s.normal)}, {"offset", s.offset}};
+  } else {
+    out["box"] = {{"min", to_json(s.min)}, {"max", to_json(s.max)}};
+  }
+  out["tolerance"] = s.tolerance;
+  return out;
+}
+
+const char* element_name(ElementType type) { return type == ElementType::quad8 ? "quad8" : "tri6"; }
+
+json mesh_to_json(const MeshSpec& m) {
+  json out;
+  if (m.source == MeshSource::file) {
+    out["file"] = m.file;
+    if (m.element) out["element"] = element_name(*m.element);
+    return out;
+  }
+  out["element"] = element_name(m.element.value_or(ElementType::quad8));
+  out["divisions"] = {m.divisions[0], m.divisions[1]};
+  switch (m.source) {
+    case MeshSource::rectangle:
+      out["generator"] = "rectangle";
+      out["size"] = {m.size[0], m.size[1]};
+      break;
+    case MeshSource::cylinder:
+      out["generator"] = "cylinder";
+      out["radius"] = m.radius;
+      out["length"] = m.length;
+      out["angle_deg"] = {m.angle_deg[0], m.angle_deg[1]};
+      break;
+    case MeshSource::hemisphere:
+      out["generator"] = "hemisphere";
+      out["radius"] = m.radius;
+      out["hole_deg"] = m.hole_deg;
+      break;
+    case MeshSource::file:
+      break;
+  }
+  return out;
+}
+
+}  // namespace
+
+std::string scene_to_json_text(const Scene& scene) {
+  json out;
+  out["mesh"] = mesh_to_json(scene.mesh);
+  const Material& m = scene.material;
+  out["material"] = {{"youngs_modulus", m.youngs_modulus},
+                     {"poisson_ratio", m.poisson_ratio},
+                     {"thickness", m.thickness},
+                     {"density", m.density}};
+  out["penalty"] = scene.penalty;
+  out["boundary"] = json::array();
+  for (const BoundaryCondition& bc : scene.boundary) {
+    json fix = json::array();
+    for (int c = 0; c < 3; ++c)
+      if (bc.fixed[c]) fix.push_back(std::string(1, static_cast<char>('x' + c)));
+    out["boundary"].push_back({{"select", select_to_json(bc.select)}, {"fix", fix}, {"clamp", bc.clamp}});
+  }
+  out["loads"] = json::array();
+  for (const Load& load : scene.loads) {
+    switch (load.type) {
+      case Load::Type::gravity:
+        out["loads"].push_back({{"type", "gravity"}, {"acceleration", to_json(load.acceleration)}});
+        break;
+      case Load::Type::area_force:
+        out["loads"].push_back({{"type", "area_force"}, {"force_per_area", to_json(load.force_per_area)}});
+        break;
+      case Load::Type::point:
+        out["loads"].push_back({{"type", "point"}, {"position", to_json(load.position)}, {"force", to_json(load.force)}});
+        break;
+    }
+  }
+  const Analysis& a = scene.analysis;
+  if (a.is_dynamic()) {
+    out["analysis"] = {{"type", "dynamic"},
+                       {"time_step", a.time_step},
+                       {"steps", a.steps},
+                       {"corotational", a.corotational},
+                       {"damping", {{"mass", a.damping.mass}, {"stiffness", a.damping.stiffness}}}};
+  } else {
+    out["analysis"] = {{"type", "static"}};
+  }
+  out["probes"] = json::array();
+  for (const Probe& p : scene.probes) out["probes"].push_back({{"name", p.name}, {"position", to_json(p.position)}});
+  out["cuts"] = json::array();
+  for (const Cut& cut : scene.cuts) {
+    json c;
+    if (cut.kind == Cut::Kind::points) {
+      c["points"] = json::array();
+      for (const Vec3& p : cut.points) c["points"].push_back(to_json(p));
+    } else {
+      c["surface_points"] = json::array();
+      for (const CutSurfacePoint& sp : cut.surface_points)
+        c["surface_points"].push_back({{"element", sp.element}, {"xi", {sp.xi[0], sp.xi[1]}}});
+    }
+    if (cut.has_schedule) c["start_time"] = cut.start_time;
+    if (cut.speed) c["speed"] = *cut.speed;
+    out["cuts"].push_back(c);
+  }
+  const EnrichmentOptions& e = scene.enrichment;
+  out["enrichment"] = {{"texture_resolution", e.texture_resolution},
+                       {"solver", e.solver == EnrichmentOptions::Solver::multigrid ? "multigrid" : "cholmod"}};
+  if (e.new_cut_length) out["enrichment"]["new_cut_length"] = *e.new_cut_length;
+  if (e.new_cut_angle_deg) out["enrichment"]["new_cut_angle_deg"] = *e.new_cut_angle_deg;
+  if (scene.render) {
+    const RenderOptions& r = *scene.render;
+    json camera = {{"up", to_json(r.camera_up)}, {"fov_deg", r.fov_deg}};
+    if (r.camera_position) camera["position"] = to_json(*r.camera_position);
+    if (r.camera_target) camera["target"] = to_json(*r.camera_target);
+    out["render"] = {{"width", r.width},
+                     {"height", r.height},
+                     {"camera", camera},
+                     {"every_steps", r.every_steps},
+                     {"shading", r.shading == RenderOptions::Shading::flat ? "flat" : "smooth"},
+                     {"background", to_json(r.background)}};
+  }
+  out["output"] = {{"report", scene.output.report}};
+  return out.dump(2);
+}
+
+}  // namespace dgtex

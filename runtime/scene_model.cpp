@@ -1,0 +1,66 @@
+#include "dgtex/scene_model.h"
+
+#include "dgtex/boundary_selection.h"
+#include "dgtex/mesh_generators.h"
+#include "dgtex/obj_import.h"
+#include "dgtex/scene_mesh_checks.h"
+#include "dgtex/surface_point.h"
+#include "dgtex/topology.h"
+
+namespace dgtex {
+
+Mesh build_scene_mesh(const Scene& scene) {
+  const MeshSpec& m = scene.mesh;
+  const ElementType type = m.element.value_or(ElementType::quad8);
+  switch (m.source) {
+    case MeshSource::rectangle: return make_rectangle(m.size[0], m.size[1], m.divisions[0], m.divisions[1], type);
+    case MeshSource::cylinder:
+      return make_cylinder(m.radius, m.length, m.angle_deg[0], m.angle_deg[1], m.divisions[0], m.divisions[1], type);
+    case MeshSource::hemisphere: return make_hemisphere(m.radius, m.hole_deg, m.divisions[0], m.divisions[1], type);
+    case MeshSource::file: return load_obj(m.file);
+  }
+  return {};
+}
+
+SceneModel build_scene_model(const Scene& scene, const Mesh& mesh) {
+  check_scene_against_mesh(scene, mesh);
+  const Topology topology = build_topology(mesh);
+  SceneModel out;
+  out.fixed.assign(3 * mesh.num_nodes(), 0);
+  std::vector<char> clamp_node(mesh.num_nodes(), 0);
+  for (const BoundaryCondition& bc : scene.boundary) {
+    for (int node : select_nodes(mesh, bc.select)) {
+      for (int c = 0; c < 3; ++c)
+        if (bc.fixed[c]) out.fixed[3 * node + c] = 1;
+      if (bc.clamp) clamp_node[node] = 1;
+    }
+  }
+  // A boundary edge is clamped when all three of its nodes are selected by a clamp.
+  std::vector<int> clamped;
+  for (size_t k = 0; k < topology.boundary_edges.size(); ++k) {
+    const MeshEdge& e = topology.boundary_edges[k];
+    if (clamp_node[e.nodes[0]] && clamp_node[e.nodes[1]] && clamp_node[e.nodes[2]]) clamped.push_back(static_cast<int>(k));
+  }
+  const Material& mat = scene.material;
+  std::vector<kernels::ShellSection> sections(
+      mesh.num_elements(), {mat.youngs_modulus, mat.poisson_ratio, mat.thickness, mat.density});
+  ShellModelOptions options;
+  options.penalty = scene.penalty;
+  out.model = std::make_unique<ShellModel>(mesh, topology, sections, clamped, options);
+
+  out.external_force.assign(out.model->num_dofs(), 0.0);
+  for (const Load& load : scene.loads) {
+    switch (load.type) {
+      case Load::Type::gravity: out.model->add_gravity(load.acceleration.data(), out.external_force); break;
+      case Load::Type::area_force: out.model->add_area_force(load.force_per_area.data(), out.external_force); break;
+      case Load::Type::point: {
+        const SurfacePoint p = closest_surface_point(mesh, load.position.data());
+        out.model->add_point_force(p.element, p.xi, load.force.data(), out.external_force);
+        break;
+      }
+    }
+  }
+  return out;
+}
+
+}  // namespace dgtex

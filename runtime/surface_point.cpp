@@ -1,0 +1,313 @@
+#include "dgtex/surface_point.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
+#include <string>
+#include <vector>
+
+namespace dgtex {
+namespace {
+
+using kernels::ElementType;
+
+// The geometry of one element and the squared-distance objective f = 1/2 |x(xi) - p|^2.
+class ElementDistance {
+ public:
+  ElementDistance(const Mesh& mesh, int e, const double p[3]) : type_(mesh.type) {
+    const int* en = mesh.element_nodes(e);
+    count_ = mesh.nodes_per_element();
+    for (int a = 0; a < count_; ++a)
+      for (int d = 0; d < 3; ++d) nodes_[a][d] = mesh.node(en[a])[d];
+    for (int d = 0; d < 3; ++d) p_[d] = p[d];
+  }
+
+  // x(xi), tangents J (columns dx/dxi1, dx/dxi2) and second derivatives (d11, d22, d12).
+  void evaluate(const double xi[2], double x[3], double J[3][2], double D[3][3]) const {
+    kernels::ShapeValues s;
+    kernels::evaluate_shape(type_, xi[0], xi[1], s);
+    for (int d = 0; d < 3; ++d) {
+      x[d] = 0;
+      J[d][0] = J[d][1] = 0;
+      D[d][0] = D[d][1] = D[d][2] = 0;
+      for (int a = 0; a < count_; ++a) {
+        x[d] += s.N[a] * nodes_[a][d];
+        J[d][0] += s.dN[a][0] * nodes_[a][d];
+        J[d][1] += s.dN[a][1] * nodes_[a][d];
+        for (int c = 0; c < 3; ++c) D[d][c] += s.d2N[a][c] * nodes_[a][d];
+      }
+    }
+  }
+
+  double objective(const double xi[2]) const {
+    double x[3], J[3][2], D[3][3];
+    evaluate(xi, x, J, D);
+    return 0.5 * squared_gap(x);
+  }
+
+  double squared_gap(const double x[3]) const {
+    double s = 0;
+    for (int d = 0; d < 3; ++d) s += (x[d] - p_[d]) * (x[d] - p_[d]);
+    return s;
+  }
+
+  const double* query() const { return p_; }
+
+ private:
+  ElementType type_;
+  int count_ = 0;
+  double nodes_[kernels::max_element_nodes][3] = {};
+  double p_[3] = {};
+};
+
+// Euclidean projection onto the reference element.
+void project_to_reference(ElementType type, double xi[2]) {
+  if (type == ElementType::quad8) {
+    xi[0] = std::clamp(xi[0], -1.0, 1.0);
+    xi[1] = std::clamp(xi[1], -1.0, 1.0);
+    return;
+  }
+  if (xi[0] >= 0 && xi[1] >= 0 && xi[0] + xi[1] <= 1) return;
+  // Outside: the nearest point lies on one of the three edges.
+  static const double corner[3][2] = {{0, 0}, {1, 0}, {0, 1}};
+  double best[2] = {0, 0}, best_d2 = std::numeric_limits<double>::infinity();
+  for (int k = 0; k < 3; ++k) {
+    const double* a = corner[k];
+    const double* b = corner[(k + 1) % 3];
+    const double ab[2] = {b[0] - a[0], b[1] - a[1]};
+    double t = ((xi[0] - a[0]) * ab[0] + (xi[1] - a[1]) * ab[1]) / (ab[0] * ab[0] + ab[1] * ab[1]);
+    t = std::clamp(t, 0.0, 1.0);
+    const double q[2] = {a[0] + t * ab[0], a[1] + t * ab[1]};
+    const double d2 = (q[0] - xi[0]) * (q[0] - xi[0]) + (q[1] - xi[1]) * (q[1] - xi[1]);
+    if (d2 < best_d2) best_d2 = d2, best[0] = q[0], best[1] = q[1];
+  }
+  // Snap to the exact boundary so active constraints are detected exactly.
+  xi[0] = best[0];
+  xi[1] = best[1];
+  if (xi[0] + xi[1] > 1) xi[1] = 1 - xi[0];
+}
+
+// Reference-element bounds as half-planes n . xi <= c (n the outward normal).
+struct Bound {
+  double n[2];
+  double c;
+};
+
+int reference_bounds(ElementType type, Bound bounds[4]) {
+  if (type == ElementType::quad8) {
+    bounds[0] = {{-1, 0}, 1};
+    bounds[1] = {{1, 0}, 1};
+    bounds[2] = {{0, -1}, 1};
+    bounds[3] = {{0, 1}, 1};
+    return 4;
+  }
+  bounds[0] = {{-1, 0}, 0};
+  bounds[1] = {{0, -1}, 0};
+  bounds[2] = {{1, 1}, 1};
+  return 3;
+}
+
+// Minimises 1/2 |x(xi) - p|^2 over the reference element from xi (updated in place).
+void refine(const ElementDistance& f, ElementType type, double xi[2]) {
+  Bound bounds[4];
+  const int bound_count = reference_bounds(type, bounds);
+  double x[3], J[3][2], D[3][3];
+  for (int iteration = 0; iteration < 100; ++iteration) {
+    f.evaluate(xi, x, J, D);
+    const double* p = f.query();
+    const double r[3] = {x[0] - p[0], x[1] - p[1], x[2] - p[2]};
+    const double f0 = 0.5 * f.squared_gap(x);
+    double g[2] = {0, 0}, gn[2][2] = {{0, 0}, {0, 0}}, h[2][2];
+    for (int d = 0; d < 3; ++d) {
+      g[0] += J[d][0] * r[d];
+      g[1] += J[d][1] * r[d];
+      gn[0][0] += J[d][0] * J[d][0];
+      gn[0][1] += J[d][0] * J[d][1];
+      gn[1][1] += J[d][1] * J[d][1];
+    }
+    gn[1][0] = gn[0][1];
+    h[0][0] = gn[0][0], h[0][1] = gn[0][1], h[1][1] = gn[1][1];
+    for (int d = 0; d < 3; ++d) {
+      h[0][0] += r[d] * D[d][0];
+      h[1][1] += r[d] * D[d][1];
+      h[0][1] += r[d] * D[d][2];
+    }
+    h[1][0] = h[0][1];
+
+    // Active set: bounds we sit on whose outward normal the descent direction -g points along.
+    int active[2], active_count = 0;
+    for (int b = 0; b < bound_count && active_count < 2; ++b) {
+      const Bound& B = bounds[b];
+      const double slack = B.c - (B.n[0] * xi[0] + B.n[1] * xi[1]);
+      if (slack <= 1e-15 && -(B.n[0] * g[0] + B.n[1] * g[1]) > 0) active[active_count++] = b;
+    }
+    if (active_count == 2) return;  // a corner with the descent direction pointing out
+
+    double step[2];
+    bool exact_newton = true;  // step uses the true (positive) curvature, not Gauss-Newton
+    if (active_count == 0) {
+      // Newton where the Hessian is positive definite, Gauss-Newton otherwise.
+      const double(*m)[2] = h;
+      double det = h[0][0] * h[1][1] - h[0][1] * h[1][0];
+      if (!(h[0][0] > 0 && det > 1e-14 * (h[0][0] * h[0][0] + h[1][1] * h[1][1]))) {
+        m = gn;
+        det = gn[0][0] * gn[1][1] - gn[0][1] * gn[1][0];
+        exact_newton = false;
+      }
+      if (!(det > 0)) return;
+      step[0] = -(m[1][1] * g[0] - m[0][1] * g[1]) / det;
+      step[1] = -(-m[1][0] * g[0] + m[0][0] * g[1]) / det;
+    } else {
+      // Slide along the active bound.
+      const Bound& B = bounds[active[0]];
+      const double len = std::hypot(B.n[0], B.n[1]);
+      const double t[2] = {-B.n[1] / len, B.n[0] / len};
+      const double gt = g[0] * t[0] + g[1] * t[1];
+      double ht = t[0] * (h[0][0] * t[0] + h[0][1] * t[1]) + t[1] * (h[1][0] * t[0] + h[1][1] * t[1]);
+      if (!(ht > 0)) {
+        ht = t[0] * (gn[0][0] * t[0] + gn[0][1] * t[1]) + t[1] * (gn[1][0] * t[0] + gn[1][1] * t[1]);
+        exact_newton = false;
+      }
+      if (!(ht > 0)) return;
+      step[0] = -gt / ht * t[0];
+      step[1] = -gt / ht * t[1];
+    }
+
+    const double step_size = std::max(std::fabs(step[0]), std::fabs(step[1]));
+    if (step_size < 1e-15) return;  // converged
+    // Near a minimum (positive curvature, small step) take the Newton step as it is: f stops
+    // resolving progress at sqrt(machine epsilon) relative accuracy, the step does not.
+    if (exact_newton && step_size < 1e-6) {
+      xi[0] += step[0];
+      xi[1] += step[1];
+      project_to_reference(type, xi);
+      continue;
+    }
+
+    // Projected backtracking: accept the first step that decreases f. A projected
+    // Newton step can fail on a bound that is not active; the projected gradient step then
+    // still descends unless xi is already a constrained minimum.
+    const double scale = gn[0][0] + gn[1][1];
+    const double gradient_step[2] = {-g[0] / scale, -g[1] / scale};
+    const double* directions[2] = {step, gradient_step};
+    bool moved = false;
+    for (int which = 0; which < 2 && !moved; ++which) {
+      if (which == 1 && !(scale > 0)) break;
+      double alpha = 1;
+      for (int tries = 0; tries < 40; ++tries, alpha *= 0.5) {
+        double trial[2] = {xi[0] + alpha * directions[which][0], xi[1] + alpha * directions[which][1]};
+        project_to_reference(type, trial);
+        if (f.objective(trial) < f0) {
+          const double change = std::hypot(trial[0] - xi[0], trial[1] - xi[1]);
+          xi[0] = trial[0];
+          xi[1] = trial[1];
+          moved = change > 0;
+          break;
+        }
+      }
+    }
+    if (!moved) return;
+  }
+}
+
+// Fixed sample points seeding the refinement.
+std::vector<std::array<double, 2>> sample_points(ElementType type) {
+  std::vector<std::array<double, 2>> s;
+  if (type == ElementType::quad8) {
+    for (int j = 0; j <= 4; ++j)
+      for (int i = 0; i <= 4; ++i) s.push_back({-1 + 0.5 * i, -1 + 0.5 * j});
+  } else {
+    for (int j = 0; j <= 4; ++j)
+      for (int i = 0; i + j <= 4; ++i) s.push_back({0.25 * i, 0.25 * j});
+  }
+  return s;
+}
+
+}  // namespace
+
+SurfacePoint closest_surface_point(const Mesh& mesh, const double p[3]) {
+  const int elements = mesh.num_elements();
+  if (elements == 0) throw MeshError("closest_surface_point: the mesh has no elements");
+  if (!std::isfinite(p[0]) || !std::isfinite(p[1]) || !std::isfinite(p[2]))
+    throw MeshError("closest_surface_point: query point (" + mesh_number(p[0]) + ", " + mesh_number(p[1]) +
+                    ", " + mesh_number(p[2]) + ") is not finite");
+
+  double lo[3], hi[3];
+  for (int d = 0; d < 3; ++d) lo[d] = hi[d] = mesh.positions[d];
+  for (int n = 0; n < mesh.num_nodes(); ++n)
+    for (int d = 0; d < 3; ++d) lo[d] = std::min(lo[d], mesh.node(n)[d]), hi[d] = std::max(hi[d], mesh.node(n)[d]);
+  const double tie_tolerance = 1e-12 * std::sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) +
+                                                 (hi[2] - lo[2]) * (hi[2] - lo[2]));
+
+  // Sampled distance per element, with its best sample and a margin (half the diameter)
+  // below which the element's true distance cannot fall.
+  const auto samples = sample_points(mesh.type);
+  std::vector<kernels::ShapeValues> shapes(samples.size());
+  for (size_t s = 0; s < samples.size(); ++s) kernels::evaluate_shape(mesh.type, samples[s][0], samples[s][1], shapes[s]);
+  struct Seed {
+    double distance, margin;
+    int element, sample;
+  };
+  std::vector<Seed> seeds(elements);
+  const int npe = mesh.nodes_per_element();
+  for (int e = 0; e < elements; ++e) {
+    const int* en = mesh.element_nodes(e);
+    Seed seed{std::numeric_limits<double>::infinity(), 0, e, 0};
+    for (int a = 0; a < npe; ++a)
+      for (int b = a + 1; b < npe; ++b) {
+        const double* u = mesh.node(en[a]);
+        const double* v = mesh.node(en[b]);
+        seed.margin = std::max(seed.margin, 0.5 * std::sqrt((u[0] - v[0]) * (u[0] - v[0]) + (u[1] - v[1]) * (u[1] - v[1]) +
+                                                            (u[2] - v[2]) * (u[2] - v[2])));
+      }
+    for (size_t s = 0; s < samples.size(); ++s) {
+      double x[3] = {0, 0, 0};
+      for (int a = 0; a < npe; ++a)
+        for (int d = 0; d < 3; ++d) x[d] += shapes[s].N[a] * mesh.node(en[a])[d];
+      const double dist = std::sqrt((x[0] - p[0]) * (x[0] - p[0]) + (x[1] - p[1]) * (x[1] - p[1]) +
+                                    (x[2] - p[2]) * (x[2] - p[2]));
+      if (dist < seed.distance) seed.distance = dist, seed.sample = static_cast<int>(s);
+    }
+    seeds[e] = seed;
+  }
+  std::sort(seeds.begin(), seeds.end(), [](const Seed& a, const Seed& b) {
+    return a.distance != b.distance ? a.distance < b.distance : a.element < b.element;
+  });
+
+  // Refined candidates. (Kept as a private struct: a std::vector<SurfacePoint> here would
+  // instantiate templates that clash with scene.h's different dgtex::SurfacePoint.)
+  struct Candidate {
+    int element;
+    double xi[2], position[3], distance;
+  };
+  std::vector<Candidate> candidates;
+  double best = std::numeric_limits<double>::infinity();
+  for (const Seed& seed : seeds) {
+    if (seed.distance - seed.margin > best + tie_tolerance) continue;
+    const ElementDistance f(mesh, seed.element, p);
+    Candidate c;
+    c.element = seed.element;
+    c.xi[0] = samples[seed.sample][0];
+    c.xi[1] = samples[seed.sample][1];
+    refine(f, mesh.type, c.xi);
+    double J[3][2], D[3][3];
+    f.evaluate(c.xi, c.position, J, D);
+    c.distance = std::sqrt(f.squared_gap(c.position));
+    best = std::min(best, c.distance);
+    candidates.push_back(c);
+  }
+  // Lowest element index among those within the tie tolerance of the minimum.
+  const Candidate* chosen = nullptr;
+  for (const Candidate& c : candidates)
+    if (c.distance <= best + tie_tolerance && (!chosen || c.element < chosen->element)) chosen = &c;
+  SurfacePoint result;
+  result.element = chosen->element;
+  result.xi[0] = chosen->xi[0];
+  result.xi[1] = chosen->xi[1];
+  for (int d = 0; d < 3; ++d) result.position[d] = chosen->position[d];
+  result.distance = chosen->distance;
+  return result;
+}
+
+}  // namespace dgtex

@@ -1,0 +1,101 @@
+// End-to-end: the dgtex executable on example scenes and on bad input.
+#include <gtest/gtest.h>
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <string>
+
+namespace fs = std::filesystem;
+
+namespace {
+
+struct Result {
+  int exit_code;
+  std::string stderr_text;
+};
+
+Result run_dgtex(const std::string& args, const fs::path& workdir) {
+  const fs::path err = workdir / "stderr.txt";
+  const std::string command = std::string(DGTEX_CLI) + " run " + args + " --quiet 2> " + err.string() + " > /dev/null";
+  const int status = std::system(command.c_str());
+  std::ifstream in(err);
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  return {WEXITSTATUS(status), text};
+}
+
+fs::path fresh_dir(const std::string& name) {
+  const fs::path dir = fs::temp_directory_path() / ("dgtex_cli_" + name + "_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  return dir;
+}
+
+TEST(CliRun, ClampedPlateSceneWritesReportWithinOnePercent) {
+  const fs::path dir = fresh_dir("plate");
+  const Result r = run_dgtex(std::string(DGTEX_SOURCE_DIR) + "/examples/scenes/clamped_plate.json --out " + (dir / "out").string(), dir);
+  ASSERT_EQ(r.exit_code, 0) << r.stderr_text;
+  std::ifstream in(dir / "out" / "report.json");
+  const nlohmann::json report = nlohmann::json::parse(in);
+  EXPECT_EQ(report["counts"]["elements"], 256);
+  EXPECT_EQ(report["counts"]["nodes"], 833);
+  EXPECT_EQ(report["counts"]["dofs"], 2499);
+  EXPECT_GT(report["counts"]["nonzeros"].get<long>(), 0);
+  const double w = report["probes"]["center"]["displacement"][2];
+  const double D = 1e6 * 1e-6 / (12 * (1 - 0.09));
+  EXPECT_NEAR(w / (-0.00126532 / D), 1.0, 0.01);
+  EXPECT_GE(report["timings_ms"]["solve"]["mean"].get<double>(), 0.0);
+  EXPECT_TRUE(fs::exists(dir / "out" / "deformed.vtu"));
+}
+
+TEST(CliRun, DynamicSceneWritesFramesAndIsThreadIndependent) {
+  const fs::path dir = fresh_dir("dynamic");
+  const std::string scene = std::string(DGTEX_SOURCE_DIR) + "/examples/scenes/demo_cantilever.json";
+  ASSERT_EQ(run_dgtex(scene + " --threads 1 --out " + (dir / "a").string(), dir).exit_code, 0);
+  ASSERT_EQ(run_dgtex(scene + " --threads 2 --out " + (dir / "b").string(), dir).exit_code, 0);
+  std::ifstream a(dir / "a" / "report.json"), b(dir / "b" / "report.json");
+  const nlohmann::json ra = nlohmann::json::parse(a), rb = nlohmann::json::parse(b);
+  EXPECT_EQ(ra["probes"]["tip"]["displacement"], rb["probes"]["tip"]["displacement"]);
+  EXPECT_TRUE(fs::exists(dir / "a" / "frames" / "frame_00200.vtu"));
+  EXPECT_EQ(ra["timings_ms"]["assembly"]["calls"], 200);
+}
+
+void expect_rejected(const std::string& name, const std::string& json, const std::string& fragment) {
+  const fs::path dir = fresh_dir(name);
+  std::ofstream(dir / "scene.json") << json;
+  const Result r = run_dgtex((dir / "scene.json").string() + " --out " + (dir / "out").string(), dir);
+  EXPECT_EQ(r.exit_code, 2) << r.stderr_text;
+  EXPECT_NE(r.stderr_text.find(fragment), std::string::npos) << r.stderr_text;
+  EXPECT_EQ(std::count(r.stderr_text.begin(), r.stderr_text.end(), '\n'), 1) << r.stderr_text;
+  EXPECT_FALSE(fs::exists(dir / "out" / "report.json"));
+}
+
+const char* kBase = R"({"mesh": {"generator": "rectangle", "size": [1, 1], "divisions": [2, 2], "element": "quad8"},
+  "material": {"youngs_modulus": 1e6, "poisson_ratio": NU, "thickness": 0.01, "density": 1000},
+  "penalty": PENALTY, BOUNDARY "loads": [{"type": "area_force", "force_per_area": [0, 0, -1]}]})";
+
+std::string scene(const std::string& nu, const std::string& penalty, const std::string& boundary) {
+  std::string s = kBase;
+  s.replace(s.find("NU"), 2, nu);
+  s.replace(s.find("PENALTY"), 7, penalty);
+  s.replace(s.find("BOUNDARY"), 8, boundary);
+  return s;
+}
+
+const char* kClampedLeft = R"("boundary": [{"select": {"plane": {"normal": [1, 0, 0], "offset": 0}}, "fix": ["x", "y", "z"], "clamp": true}],)";
+
+TEST(CliRun, BadInputExitsWithCodeTwoAndOneLine) {
+  expect_rejected("nu", scene("0.5", "1", kClampedLeft), "material.poisson_ratio");
+  expect_rejected("unconstrained", scene("0.3", "1", ""), "unconstrained");
+  expect_rejected("penalty", scene("0.3", "0.01", kClampedLeft), "penalty too low?");
+  expect_rejected("selection",
+                  scene("0.3", "1", R"("boundary": [{"select": {"plane": {"normal": [1, 0, 0], "offset": 5}}, "fix": ["z"]}],)"),
+                  "boundary[0].select");
+}
+
+}  // namespace
