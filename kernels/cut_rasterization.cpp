@@ -142,6 +142,10 @@ CutRaster rasterize_cut(const std::vector<TexelPoint>& polyline, TexelTile& tile
   validate_polyline(polyline, tile);
   const std::int64_t segments = static_cast<std::int64_t>(polyline.size()) - 1;
   std::vector<std::vector<CutLatticeEdge>> pieces(static_cast<std::size_t>(segments));
+  // A thread team costs more than rasterising a few segments: short polylines run serially
+  // (the result is the same either way).
+  constexpr std::int64_t min_parallel_segments = 64;
+  if (segments < min_parallel_segments) execution = Execution::serial;
   forall(
       segments, [&](std::int64_t s) { rasterize_segment(polyline[s], polyline[s + 1], tile, pieces[s]); }, execution);
   CutRaster raster;
@@ -151,6 +155,70 @@ CutRaster rasterize_cut(const std::vector<TexelPoint>& polyline, TexelTile& tile
   for (const auto& piece : pieces) raster.edges.insert(raster.edges.end(), piece.begin(), piece.end());
   mark_walls(raster.edges, tile);
   return raster;
+}
+
+namespace {
+
+// Whether the lattice edge from (x, y) along +x (axis 0) or +y (axis 1) is a wall between
+// two texels of the tile.
+bool is_wall(const TexelTile& tile, int x, int y, int axis) {
+  if (axis == 0) return y > 0 && y < tile.height && x >= 0 && x < tile.width && tile.is_wall_north(x, y - 1);
+  return x > 0 && x < tile.width && y >= 0 && y < tile.height && tile.is_wall_east(x - 1, y);
+}
+
+bool is_domain_texel(const TexelTile& tile, int i, int j) {
+  return i >= 0 && j >= 0 && i < tile.width && j < tile.height && !(tile.flags[tile.index(i, j)] & inactive);
+}
+
+// Whether lattice point (x, y) touches an earlier cut's wall or the domain boundary.
+bool touches_walls_or_boundary(const TexelTile& tile, int x, int y) {
+  if (is_wall(tile, x, y, 0) || is_wall(tile, x - 1, y, 0) || is_wall(tile, x, y, 1) || is_wall(tile, x, y - 1, 1))
+    return true;
+  return !is_domain_texel(tile, x - 1, y - 1) || !is_domain_texel(tile, x, y - 1) || !is_domain_texel(tile, x - 1, y) ||
+         !is_domain_texel(tile, x, y);
+}
+
+}  // namespace
+
+std::vector<CutRaster> split_cut_at_crossings(const CutRaster& cut, const TexelTile& earlier_walls) {
+  if (earlier_walls.width <= 0 || earlier_walls.height <= 0 ||
+      earlier_walls.flags.size() != static_cast<std::size_t>(earlier_walls.width) * earlier_walls.height)
+    throw std::invalid_argument("split_cut_at_crossings: the wall tile must be non-empty with width * height flags");
+  const std::size_t n = cut.edges.size();
+  // Path vertex k (0 < k < n) is the start of edge k; it is interior if edge k-1 ends there
+  // (clipping can leave breaks in a path; the vertices at a break are path ends).
+  auto interior = [&](std::size_t k) {
+    const CutLatticeEdge &a = cut.edges[k - 1], &b = cut.edges[k];
+    return a.x + a.dx == b.x && a.y + a.dy == b.y;
+  };
+  auto touches = [&](std::size_t k) { return touches_walls_or_boundary(earlier_walls, cut.edges[k].x, cut.edges[k].y); };
+  std::vector<std::size_t> splits;
+  for (std::size_t k = 1; k < n;) {
+    if (!interior(k) || !touches(k)) {
+      ++k;
+      continue;
+    }
+    const std::size_t first = k;
+    while (k < n && interior(k) && touches(k)) ++k;
+    // A contact that continues into a path end is where the cut starts or ends (a junction).
+    const CutLatticeEdge &before = cut.edges[first - 1], &last = cut.edges[k - 1];
+    const bool end_before = first - 1 == 0 || !interior(first - 1);
+    const bool end_after = k == n || !interior(k);
+    const bool at_end = (end_before && touches_walls_or_boundary(earlier_walls, before.x, before.y)) ||
+                        (end_after && touches_walls_or_boundary(earlier_walls, last.x + last.dx, last.y + last.dy));
+    if (!at_end) splits.push_back(first);
+  }
+  std::vector<CutRaster> pieces;
+  std::size_t begin = 0;
+  splits.push_back(n);
+  for (std::size_t end : splits) {
+    CutRaster piece;
+    piece.edges.assign(cut.edges.begin() + static_cast<std::ptrdiff_t>(begin),
+                       cut.edges.begin() + static_cast<std::ptrdiff_t>(end));
+    if (!piece.edges.empty()) pieces.push_back(std::move(piece));
+    begin = end;
+  }
+  return pieces;
 }
 
 TexelPoint texel_point_from_parametric(ElementType type, int resolution, double xi1, double xi2) {

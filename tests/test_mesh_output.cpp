@@ -1,3 +1,4 @@
+#include <unistd.h>
 // Mesh output: the VTU file carries the right counts, cell types, displaced points and
 // arrays; the OBJ triangulation keeps orientation and (for flat meshes) the exact area.
 #include <gtest/gtest.h>
@@ -44,7 +45,14 @@ std::vector<double> data_array(const std::string& text, const std::string& name_
   return values;
 }
 
-std::string temp_path(const std::string& name) { return ::testing::TempDir() + name; }
+// Unique per process and test, since CTest runs the parameterised instances in parallel.
+std::string temp_path(const std::string& name) {
+  const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+  std::string test = info ? std::string(info->test_suite_name()) + "_" + info->name() : "none";
+  for (char& c : test)
+    if (c == '/') c = '_';
+  return ::testing::TempDir() + std::to_string(::getpid()) + "_" + test + "_" + name;
+}
 
 }  // namespace
 

@@ -1,13 +1,147 @@
-// Placeholder until this command is implemented.
+// dgtex bench laplace: the harmonic texel solvers side by side on identical systems.
+#include <CLI/CLI.hpp>
+
+#include <algorithm>
 #include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <iostream>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
 
 #include "commands.h"
+#include "dgtex/laplace_benchmark.h"
+#include "dgtex/laplace_domains.h"
 
 namespace dgtex::cli {
+namespace {
 
-int bench_laplace_command(int, char**) {
-  std::fprintf(stderr, "dgtex: 'bench_laplace' is not implemented yet\n");
-  return 1;
+struct ChartSeries {
+  std::string solver;
+  std::vector<LaplaceConvergencePoint> points;
+};
+
+// Writes a residual-against-time chart with gnuplot (SVG terminal); returns false if gnuplot failed.
+bool write_chart(const std::string& path, const std::string& title, const std::vector<ChartSeries>& series) {
+  const std::string data_path = path + ".dat", script_path = path + ".gp";
+  {
+    std::ofstream data(data_path);
+    for (const ChartSeries& s : series) {
+      data << "# " << s.solver << "\n";
+      for (const LaplaceConvergencePoint& p : s.points)
+        data << std::max(p.ms, 1e-3) << " " << std::max(p.relative_residual, 1e-16) << "\n";
+      data << "\n\n";
+    }
+  }
+  std::ofstream script(script_path);
+  const bool png = path.size() > 4 && path.substr(path.size() - 4) == ".png";
+  script << "set terminal " << (png ? "png size 900,600" : "svg size 900,600") << "\nset output '" << path << "'\n"
+         << "set title '" << title << "'\nset logscale xy\nset xlabel 'time (ms)'\nset ylabel 'relative residual'\n"
+         << "set format y '10^{%L}'\nset key outside right\nplot ";
+  for (std::size_t k = 0; k < series.size(); ++k)
+    script << (k ? ", " : "") << "'" << data_path << "' index " << k << " with linespoints title '" << series[k].solver
+           << "'";
+  script << "\n";
+  script.close();
+  const std::string command = "gnuplot '" + script_path + "' 2>/dev/null";
+  const bool ok = std::system(command.c_str()) == 0;
+  std::remove(script_path.c_str());
+  std::remove(data_path.c_str());
+  return ok;
+}
+
+}  // namespace
+
+int bench_laplace_command(int argc, char** argv) {
+  CLI::App app{"Time the harmonic-enrichment Laplace solvers to a common relative residual", "dgtex bench laplace"};
+  std::vector<int> sizes = {128, 256, 512, 1024};
+  std::vector<std::string> domains = {"open", "slit", "spiral", "accordion", "chad", "one_ring"};
+  std::vector<std::string> solvers = {"multigrid", "cholmod", "cholmod_solve", "eigen_ichol_cg", "boomeramg"};
+  std::string json_path, chart_path, chart_domain = "slit";
+  int chart_size = 512, repeat = 3;
+  double tolerance = 1e-6;
+  long max_other_unknowns = 2'000'000;
+  app.add_option("--sizes", sizes, "texels per element side T")->delimiter(',');
+  app.add_option("--domains", domains, "open, slit, spiral, accordion, chad, one_ring")->delimiter(',');
+  app.add_option("--solvers", solvers, "multigrid, cholmod, cholmod_solve, eigen_ichol_cg, boomeramg")->delimiter(',');
+  app.add_option("--json", json_path, "write the results as JSON");
+  app.add_option("--chart", chart_path, "write residual against time (SVG, or PNG if FILE ends in .png)");
+  app.add_option("--chart-domain", chart_domain, "domain of the chart")->capture_default_str();
+  app.add_option("--chart-size", chart_size, "size T of the chart")->capture_default_str();
+  app.add_option("--repeat", repeat, "runs per case; the best time counts")->capture_default_str()->check(CLI::PositiveNumber);
+  app.add_option("--tolerance", tolerance, "relative residual to reach")->capture_default_str();
+  app.add_option("--max-other-unknowns", max_other_unknowns,
+                 "skip solvers other than multigrid above this many unknowns")->capture_default_str();
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e) == 0 ? 0 : 2;
+  }
+  try {
+    std::vector<LaplaceDomain> domain_list;
+    std::vector<LaplaceBenchSolver> solver_list;
+    for (const std::string& d : domains) domain_list.push_back(parse_laplace_domain(d));
+    for (const std::string& s : solvers) solver_list.push_back(parse_laplace_bench_solver(s));
+    for (int T : sizes)
+      if (T < 16) throw std::invalid_argument("--sizes: T = " + std::to_string(T) + " is too small, need >= 16");
+
+    nlohmann::json cases = nlohmann::json::array();
+    std::vector<ChartSeries> chart;
+    std::printf("%-10s %5s %9s  %-15s %10s %10s %6s\n", "domain", "T", "unknowns", "solver", "ms", "residual", "iters");
+    for (LaplaceDomain domain : domain_list)
+      for (int T : sizes) {
+        const kernels::TexelTile problem = make_laplace_domain(domain, T);
+        const TexelLaplaceSystem system = assemble_texel_laplace_system(problem);
+        const long unknowns = static_cast<long>(system.b.size());
+        const bool chart_case = !chart_path.empty() && laplace_domain_name(domain) == chart_domain && T == chart_size;
+        for (LaplaceBenchSolver solver : solver_list) {
+          const std::string name = laplace_bench_solver_name(solver);
+          if (solver != LaplaceBenchSolver::multigrid && unknowns > max_other_unknowns) {
+            std::printf("%-10s %5d %9ld  %-15s %10s (skipped: over --max-other-unknowns)\n",
+                        laplace_domain_name(domain).c_str(), T, unknowns, name.c_str(), "-");
+            continue;
+          }
+          const LaplaceBenchRun run = run_laplace_bench_solver(solver, problem, system, tolerance, repeat, chart_case);
+          std::printf("%-10s %5d %9ld  %-15s %10.2f %10.2e %6d\n", laplace_domain_name(domain).c_str(), T, unknowns,
+                      name.c_str(), run.ms, run.residual, run.iterations);
+          std::fflush(stdout);
+          cases.push_back({{"domain", laplace_domain_name(domain)}, {"size", T}, {"unknowns", unknowns},
+                           {"solver", name}, {"ms", run.ms}, {"residual", run.residual},
+                           {"iterations", run.iterations}});
+          if (chart_case) chart.push_back({name, run.history});
+        }
+      }
+    const int bandwidth_size = *std::max_element(sizes.begin(), sizes.end());
+    const SmootherBandwidth bw = measure_smoother_bandwidth(bandwidth_size, std::max(5, repeat));
+    std::printf("smoother (red-black sweep, T=%d): %.2f GB/s; array copy: %.2f GB/s; ratio %.0f%%\n", bandwidth_size,
+                bw.smoother_gb_per_s, bw.copy_gb_per_s, 100.0 * bw.smoother_gb_per_s / bw.copy_gb_per_s);
+    if (!json_path.empty()) {
+      std::ofstream out(json_path);
+      if (!out) throw std::runtime_error("cannot write --json file '" + json_path + "'");
+      out << nlohmann::json{{"tolerance", tolerance},
+                            {"cases", cases},
+                            {"smoother_bandwidth", {{"size", bandwidth_size},
+                                                    {"smoother_gb_per_s", bw.smoother_gb_per_s},
+                                                    {"copy_gb_per_s", bw.copy_gb_per_s}}}}
+                 .dump(2)
+          << "\n";
+    }
+    if (!chart_path.empty()) {
+      if (chart.empty())
+        std::fprintf(stderr, "dgtex bench laplace: no chart: --chart-domain %s / --chart-size %d is not among the cases\n",
+                     chart_domain.c_str(), chart_size);
+      else if (!write_chart(chart_path, chart_domain + ", T = " + std::to_string(chart_size), chart))
+        std::fprintf(stderr, "dgtex bench laplace: gnuplot failed to write '%s' (is gnuplot installed?)\n", chart_path.c_str());
+    }
+  } catch (const std::invalid_argument& e) {
+    std::fprintf(stderr, "dgtex bench laplace: %s\n", e.what());
+    return 2;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "dgtex bench laplace: %s\n", e.what());
+    return 1;
+  }
+  return 0;
 }
 
 }  // namespace dgtex::cli

@@ -5,6 +5,7 @@
 //              dgtex/kernels/shape_functions.h (corners counter-clockwise seen from the
 //              side the normal points to, then midsides).
 // Displacements are C0: neighbouring elements share their edge's three nodes.
+#include <cstddef>
 #include <vector>
 
 #include "dgtex/kernels/shape_functions.h"
@@ -21,8 +22,8 @@ struct Mesh {
   int nodes_per_element() const { return kernels::nodes_per_element(type); }
   int num_nodes() const { return static_cast<int>(positions.size() / 3); }
   int num_elements() const { return static_cast<int>(elements.size() / nodes_per_element()); }
-  const int* element_nodes(int e) const { return elements.data() + static_cast<size_t>(e) * nodes_per_element(); }
-  const double* node(int n) const { return positions.data() + 3 * static_cast<size_t>(n); }
+  const int* element_nodes(int e) const { return elements.data() + static_cast<std::size_t>(e) * nodes_per_element(); }
+  const double* node(int n) const { return positions.data() + 3 * static_cast<std::size_t>(n); }
 };
 
 }  // namespace dgtex

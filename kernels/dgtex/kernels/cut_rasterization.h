@@ -55,13 +55,28 @@ struct CutRaster {
 };
 
 // Reference (serial) and parallel forms: the parallel one rasterises the segments
-// concurrently and concatenates them in order; both produce identical results. The
+// concurrently (polylines of 64 segments or more; shorter ones serially) and
+// concatenates them in order; both produce identical results. The
 // tile's flags gain wall_east / wall_north bits for every path edge between two texels of
 // the tile (inactive ones included: walls next to them are harmless). Points must be
 // finite; a polyline with fewer than 2 points is an error (std::invalid_argument).
 CutRaster rasterize_cut_reference(const std::vector<TexelPoint>& polyline, TexelTile& tile);
 CutRaster rasterize_cut(const std::vector<TexelPoint>& polyline, TexelTile& tile,
                         Execution execution = Execution::parallel);
+
+// Splits a rasterised cut wherever its lattice path meets an earlier cut or the domain
+// boundary away from its own ends, so that every piece is a cut in the sense of thesis
+// §5.4.2 (it ends at the boundary, at a junction, or at its tip). App. A.2's span
+// property needs this: a cut crossing another in an X makes 4 components but
+// {1, H^1, H^2} spans only 3 dimensions; {1, H^1, H^2a, H^2b} spans all 4. The same holds
+// for a cut that touches an earlier cut (or the boundary) and turns back.
+// earlier_walls: a tile holding only the walls of the earlier cuts (and the inactive
+// texels). A contact is a maximal run of consecutive path vertices on earlier walls or on
+// the boundary; the cut is split at the first vertex of every contact that does not run
+// into one of the path's ends (a cut ending on another is a T-junction: no split).
+// Self-intersections of the cut are not split. Pieces are returned in path order (just
+// `cut` when nothing is met). A path scan, O(edges), serial only.
+std::vector<CutRaster> split_cut_at_crossings(const CutRaster& cut, const TexelTile& earlier_walls);
 
 // Element parameter coordinates -> continuous texel coordinates of a T x T tile:
 // quad8: x = (xi1 + 1) T / 2, y = (xi2 + 1) T / 2; tri6: x = xi1 T, y = xi2 T (the tri6

@@ -1,0 +1,66 @@
+#pragma once
+// Geometric multigrid for the harmonic texel problem (dgtex/kernels/multigrid_unknowns.h):
+// red-black Gauss-Seidel on the texel level, black-box (operator-dependent, Galerkin)
+// coarse levels that keep cuts as walls, a dense Cholesky on the coarsest level, used as
+// V/F-cycles or as the preconditioner of conjugate gradients (the default: see
+// laplace_multigrid.cpp for the measurements behind it).
+#include <memory>
+#include <vector>
+
+#include "dgtex/kernels/forall.h"
+#include "dgtex/kernels/texel_grid.h"
+#include "dgtex/laplace_problem.h"
+
+namespace dgtex {
+
+enum class MultigridCycle { v, f };
+
+struct LaplaceMultigridOptions {
+  double tolerance = 1e-6;        // stop at relative residual ||b - A x|| / ||b|| <= tolerance
+  int max_cycles = 100;           // cycles (or preconditioned CG iterations); throws if not converged
+  MultigridCycle cycle = MultigridCycle::v;
+  int pre_smoothing = 1;          // red-black (coarse: 4-colour) Gauss-Seidel sweeps before ...
+  int post_smoothing = 1;         // ... and after the coarse correction (equal for CG)
+  bool use_as_cg_preconditioner = true;  // one symmetric V-cycle per CG iteration
+  bool warm_start = true;         // initial guess = tile.values of the unknowns (else 0)
+  kernels::Execution execution = kernels::Execution::parallel;
+  int coarsest_nodes = 64;        // coarsen until a level has at most this many nodes ...
+  int max_orphans = 0;            // ... or until coarsening would leave more active nodes
+                                  // without interpolation (channels narrower than the coarse
+                                  // spacing); the last level is solved by sparse Cholesky
+};
+
+// One point of a convergence history: time since the solve started and relative residual.
+struct LaplaceConvergencePoint {
+  double ms = 0;
+  double relative_residual = 0;
+};
+
+// The multigrid hierarchy for one tile's flags (walls, Dirichlet and inactive texels);
+// solve() may be called repeatedly with new Dirichlet values / warm starts.
+class LaplaceMultigrid {
+ public:
+  explicit LaplaceMultigrid(const kernels::TexelTile& tile, LaplaceMultigridOptions options = {});
+  ~LaplaceMultigrid();
+  LaplaceMultigrid(LaplaceMultigrid&&) noexcept;
+  LaplaceMultigrid& operator=(LaplaceMultigrid&&) noexcept;
+
+  // Solves on `tile` (same width, height and flags as at construction) in place. Throws
+  // std::invalid_argument for a different tile, std::runtime_error if the tolerance is not
+  // reached within max_cycles. history, if given, receives one point per cycle (and the start).
+  LaplaceSolveStats solve(kernels::TexelTile& tile, std::vector<LaplaceConvergencePoint>* history = nullptr);
+
+  int level_count() const;
+  double setup_ms() const;
+  const LaplaceMultigridOptions& options() const;
+
+ private:
+  struct Hierarchy;
+  std::unique_ptr<Hierarchy> hierarchy_;
+};
+
+// Setup + solve in one call (stats.ms includes the setup).
+LaplaceSolveStats solve_laplace_multigrid(kernels::TexelTile& tile, const LaplaceMultigridOptions& options = {},
+                                          std::vector<LaplaceConvergencePoint>* history = nullptr);
+
+}  // namespace dgtex

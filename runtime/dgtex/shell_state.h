@@ -1,0 +1,52 @@
+#pragma once
+// The state of a (cut) shell at one instant: what the simulation produces and the
+// renderer, the cut-surface export and `dgtex render` consume.
+//
+// Deformed position at parameter xi of element e:
+//   x(xi) = sum_a N^a(xi) (X^a + u^a) + sum_{enrichments k of e} sum_a N^a(xi) (H_k(xi) - H_k(xi^a)) q_k^a
+// with N^a the basis of dgtex/kernels/shape_functions.h, X^a the rest positions
+// (mesh.positions), u^a the displacement, H_k the enrichment texture and q_k^a its DOFs.
+#include <string>
+#include <vector>
+
+#include "dgtex/mesh.h"
+
+namespace dgtex {
+
+// One enrichment function on one element: H sampled on a T x T texel grid over the
+// element's parameter square.
+//   quad8: texel (i, j) covers xi in [-1+2i/T, -1+2(i+1)/T] x [-1+2j/T, -1+2(j+1)/T];
+//   tri6:  texel (i, j) covers xi in [i/T, (i+1)/T] x [j/T, (j+1)/T]; texels with
+//          i + j <= T - 1 are read (those on the diagonal are cut in half by it), the
+//          others are unused.
+struct ElementEnrichment {
+  int element = -1;
+  int resolution = 0;
+  std::vector<float> values;       // T*T, texel (i,j) at j*T+i: the enrichment function H
+  std::vector<float> node_values;  // H at the element's local nodes (shifted enrichment H - H(xi^a))
+  std::vector<double> dofs;        // nodes_per_element x 3: enrichment displacement q^a of each local node
+};
+
+struct ShellState {
+  Mesh mesh;
+  std::vector<double> displacement;  // #nodes x 3 (empty means zero)
+  std::vector<ElementEnrichment> enrichments;
+  double time = 0;
+};
+
+// Checks sizes and indices; throws std::invalid_argument naming the offending field.
+void validate_state(const ShellState& state);
+
+// Binary format, little-endian, version 1 ("dgtex state"):
+//   char[8]  magic "DGTEXST\0"      u32 version = 1
+//   i32 element type (0 quad8, 1 tri6)  u64 #nodes  u64 #elements  f64 time
+//   f64 positions[#nodes*3]   i32 elements[#elements*npe]
+//   u8  has_displacement      f64 displacement[#nodes*3] if has_displacement
+//   u64 #enrichments, then per enrichment:
+//     i32 element  i32 T  f32 values[T*T]  f32 node_values[npe]  f64 dofs[npe*3]
+// Errors (cannot open, truncated, bad magic/version, inconsistent sizes) throw
+// std::runtime_error naming the file.
+void save_state(const std::string& path, const ShellState& state);
+ShellState load_state(const std::string& path);
+
+}  // namespace dgtex

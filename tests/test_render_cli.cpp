@@ -1,0 +1,115 @@
+// `dgtex render STATE --out DIR`: success, bad input (exit 2) and no EGL (exit 1 with
+// the documented one-line message).
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+
+#include <algorithm>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+#include "dgtex/png_io.h"
+#include "dgtex/shell_state.h"
+#include "render_fixtures.h"
+
+namespace dgtex {
+namespace {
+
+namespace fs = std::filesystem;
+
+fs::path work_dir() {
+  const fs::path dir = fs::path(::testing::TempDir()) / "dgtex_render_cli";
+  fs::create_directories(dir);
+  return dir;
+}
+
+struct CliResult {
+  int exit_code;
+  std::string out, err;
+};
+
+// Runs the dgtex executable through the shell with an environment prefix.
+CliResult run_cli(const std::string& environment, const std::string& arguments) {
+  // Per-test files: CTest runs the test cases of this executable in parallel.
+  const std::string test = ::testing::UnitTest::GetInstance()->current_test_info()->name();
+  const fs::path out = work_dir() / (test + ".stdout.txt"), err = work_dir() / (test + ".stderr.txt");
+  const std::string command = environment + " '" + std::string(DGTEX_CLI) + "' render " + arguments + " >'" +
+                              out.string() + "' 2>'" + err.string() + "'";
+  const int status = std::system(command.c_str());
+  auto slurp = [](const fs::path& p) {
+    std::ifstream in(p);
+    std::stringstream s;
+    s << in.rdbuf();
+    return s.str();
+  };
+  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, slurp(out), slurp(err)};
+}
+
+std::string saved_plate() {
+  const std::string test = ::testing::UnitTest::GetInstance()->current_test_info()->name();
+  const std::string path = (work_dir() / (test + ".plate.state")).string();
+  save_state(path, test::straight_cut_plate().state);
+  return path;
+}
+
+TEST(RenderCli, RendersAStateToFramePng) {
+  const fs::path out = work_dir() / "ok";
+  fs::remove_all(out);
+  const CliResult r = run_cli("", "'" + saved_plate() + "' --out '" + out.string() +
+                                "' --width 96 --height 64 --shading smooth --wireframe --cut-method drop-triangles");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const Image image = read_png((out / "frame.png").string());
+  EXPECT_EQ(image.width, 96);
+  EXPECT_EQ(image.height, 64);
+  EXPECT_NE(r.out.find("frame.png"), std::string::npos);
+}
+
+TEST(RenderCli, BadInputExitsWithTwo) {
+  const std::string out = (work_dir() / "bad").string();
+  CliResult r = run_cli("", "'" + (work_dir() / "missing.state").string() + "' --out '" + out + "'");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("missing.state"), std::string::npos) << r.err;
+  r = run_cli("", "'" + saved_plate() + "' --out '" + out + "' --shading glossy");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("valid: flat, smooth"), std::string::npos) << r.err;
+  r = run_cli("", "'" + saved_plate() + "' --out '" + out + "' --cut-method scissors");
+  EXPECT_EQ(r.exit_code, 2);
+  r = run_cli("", "'" + saved_plate() + "'");  // no --out
+  EXPECT_EQ(r.exit_code, 2);
+  r = run_cli("", "'" + saved_plate() + "' --out '" + out + "' --width 0");
+  EXPECT_EQ(r.exit_code, 2);
+}
+
+// With glvnd pointed at a vendor file that does not exist no EGL implementation loads:
+// the command must fail with exit code 1 and one line saying what was tried.
+TEST(RenderCli, NoEglFailsWithOneLineAndExitCodeOne) {
+  const std::string out = (work_dir() / "noegl").string();
+  const CliResult r = run_cli("env -u EGL_PLATFORM __EGL_VENDOR_LIBRARY_FILENAMES=/nonexistent.json",
+                        "'" + saved_plate() + "' --out '" + out + "'");
+  EXPECT_EQ(r.exit_code, 1) << r.err;
+  const std::string prefix = "dgtex render: no OpenGL 3.3+ core context through EGL (tried: ";
+  EXPECT_EQ(r.err.rfind(prefix, 0), 0u) << r.err;
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+  EXPECT_FALSE(fs::exists(fs::path(out) / "frame.png"));
+}
+
+TEST(RenderCli, SurfacelessPlatformFallbackRenders) {
+  const fs::path out = work_dir() / "surfaceless";
+  const CliResult r = run_cli("env DGTEX_EGL_DEVICE=surfaceless", "'" + saved_plate() + "' --out '" + out.string() +
+                                                                      "' --width 32 --height 24");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("EGL_MESA_platform_surfaceless"), std::string::npos) << r.out;
+  EXPECT_EQ(read_png((out / "frame.png").string()).width, 32);
+}
+
+TEST(RenderCli, BadDeviceIndexIsReported) {
+  const std::string out = (work_dir() / "baddevice").string();
+  const CliResult r = run_cli("env DGTEX_EGL_DEVICE=99", "'" + saved_plate() + "' --out '" + out + "'");
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("DGTEX_EGL_DEVICE=99"), std::string::npos) << r.err;
+}
+
+}  // namespace
+}  // namespace dgtex

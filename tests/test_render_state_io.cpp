@@ -1,0 +1,111 @@
+// save_state/load_state and PNG round trips, and their error messages.
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <string>
+
+#include "dgtex/png_io.h"
+#include "dgtex/shell_state.h"
+#include "render_fixtures.h"
+
+namespace dgtex {
+namespace {
+
+std::string temp_path(const std::string& name) {
+  return (std::filesystem::path(::testing::TempDir()) / ("dgtex_render_state_io_" + name)).string();
+}
+
+std::string error_of(const std::function<void()>& f) {
+  try {
+    f();
+  } catch (const std::exception& e) {
+    return e.what();
+  }
+  return "";
+}
+
+TEST(RenderStateIo, RoundTripIsExact) {
+  for (const ShellState& original : {test::straight_cut_plate().state, test::curved_partial_cut(8)}) {
+    ShellState state = original;
+    state.time = 0.125;
+    const std::string path = temp_path("roundtrip.state");
+    save_state(path, state);
+    const ShellState loaded = load_state(path);
+    EXPECT_EQ(loaded.mesh.type, state.mesh.type);
+    EXPECT_EQ(loaded.mesh.positions, state.mesh.positions);
+    EXPECT_EQ(loaded.mesh.elements, state.mesh.elements);
+    EXPECT_EQ(loaded.displacement, state.displacement);
+    EXPECT_EQ(loaded.time, state.time);
+    ASSERT_EQ(loaded.enrichments.size(), state.enrichments.size());
+    for (size_t k = 0; k < state.enrichments.size(); ++k) {
+      EXPECT_EQ(loaded.enrichments[k].element, state.enrichments[k].element);
+      EXPECT_EQ(loaded.enrichments[k].resolution, state.enrichments[k].resolution);
+      EXPECT_EQ(loaded.enrichments[k].values, state.enrichments[k].values);
+      EXPECT_EQ(loaded.enrichments[k].node_values, state.enrichments[k].node_values);
+      EXPECT_EQ(loaded.enrichments[k].dofs, state.enrichments[k].dofs);
+    }
+    std::remove(path.c_str());
+  }
+}
+
+TEST(RenderStateIo, EmptyDisplacementStaysEmpty) {
+  ShellState state = test::straight_cut_plate().state;
+  state.displacement.clear();
+  const std::string path = temp_path("nodisplacement.state");
+  save_state(path, state);
+  EXPECT_TRUE(load_state(path).displacement.empty());
+  std::remove(path.c_str());
+}
+
+TEST(RenderStateIo, ErrorsNameTheFileAndTheProblem) {
+  const std::string missing = temp_path("does_not_exist.state");
+  EXPECT_NE(error_of([&] { load_state(missing); }).find(missing), std::string::npos);
+
+  const std::string path = temp_path("broken.state");
+  save_state(path, test::straight_cut_plate().state);
+  const auto size = std::filesystem::file_size(path);
+  std::filesystem::resize_file(path, size - 10);
+  const std::string truncated = error_of([&] { load_state(path); });
+  EXPECT_NE(truncated.find(path), std::string::npos);
+  EXPECT_NE(truncated.find("truncated"), std::string::npos) << truncated;
+
+  {
+    std::ofstream out(path, std::ios::binary);
+    out << "not a state file at all";
+  }
+  EXPECT_NE(error_of([&] { load_state(path); }).find("bad magic"), std::string::npos);
+
+  ShellState bad = test::straight_cut_plate().state;
+  bad.enrichments[0].element = 7;
+  const std::string invalid = error_of([&] { save_state(path, bad); });
+  EXPECT_NE(invalid.find("enrichments[0].element = 7"), std::string::npos) << invalid;
+  bad = test::straight_cut_plate().state;
+  bad.enrichments[0].values.pop_back();
+  EXPECT_NE(error_of([&] { save_state(path, bad); }).find("enrichments[0].values"), std::string::npos);
+  bad = test::straight_cut_plate().state;
+  bad.mesh.elements[3] = 1000;
+  EXPECT_NE(error_of([&] { save_state(path, bad); }).find("mesh.elements[3] = 1000"), std::string::npos);
+  std::remove(path.c_str());
+}
+
+TEST(RenderStateIo, PngRoundTripIsExact) {
+  Image image(7, 5);
+  for (size_t i = 0; i < image.rgba.size(); ++i) image.rgba[i] = static_cast<std::uint8_t>((i * 37) % 256);
+  const std::string path = temp_path("image.png");
+  write_png(path, image);
+  const Image back = read_png(path);
+  EXPECT_EQ(back.width, 7);
+  EXPECT_EQ(back.height, 5);
+  EXPECT_EQ(back.rgba, image.rgba);
+  std::remove(path.c_str());
+  EXPECT_NE(error_of([&] { read_png(path); }).find(path), std::string::npos);
+  Image wrong(3, 3);
+  wrong.rgba.pop_back();
+  EXPECT_NE(error_of([&] { write_png(path, wrong); }).find("expected width * height * 4"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace dgtex
