@@ -233,7 +233,7 @@ Camera make_camera(const ShellState& state, const RenderSettings& settings) {
 struct ShellRenderer::GlObjects {
   std::map<std::string, GLuint> programs;  // by preamble (the #defines)
   std::map<std::pair<int, int>, Tessellation> tessellations;  // by (element type, subdivisions)
-  BufferTexture rest_positions, displacements, element_nodes, node_normals;
+  BufferTexture instance_elements, rest_positions, displacements, element_nodes, node_normals;
   BufferTexture element_slots, slot_tiles, slot_node_values, slot_dofs;
   GLuint atlas = 0;
   GLuint framebuffer = 0, color = 0, depth = 0;
@@ -351,7 +351,7 @@ struct ShellRenderer::GlObjects {
       glDeleteBuffers(1, &t.vertices);
       glDeleteBuffers(1, &t.indices);
     }
-    for (BufferTexture* b : {&rest_positions, &displacements, &element_nodes, &node_normals, &element_slots,
+    for (BufferTexture* b : {&instance_elements, &rest_positions, &displacements, &element_nodes, &node_normals, &element_slots,
                              &slot_tiles, &slot_node_values, &slot_dofs})
       b->release();
     if (atlas) glDeleteTextures(1, &atlas);
@@ -397,7 +397,9 @@ Image ShellRenderer::render(const ShellState& state, const RenderSettings& setti
   const int slots_per_element = shell.max_enrichments_per_element();
   const bool smooth = settings.shading == RenderSettings::Shading::smooth;
 
-  const size_t largest_buffer = std::max<size_t>(mesh.elements.size(), std::max<size_t>(mesh.num_nodes(), static_cast<size_t>(elements) * slots_per_element));
+  const size_t largest_buffer = std::max({mesh.elements.size(), static_cast<size_t>(mesh.num_nodes()),
+                                           static_cast<size_t>(elements) * slots_per_element,
+                                           state.enrichments.size() * npe});
   if (largest_buffer > static_cast<size_t>(gl.max_buffer_texels))
     throw std::invalid_argument("mesh too large for this OpenGL implementation's buffer textures (" +
                                 std::to_string(largest_buffer) + " > GL_MAX_TEXTURE_BUFFER_SIZE " +
@@ -477,19 +479,34 @@ Image ShellRenderer::render(const ShellState& state, const RenderSettings& setti
   check_gl("uploading the state");
   const auto uploaded = Clock::now();
 
-  // The program for this combination of options.
-  const int cut_method = static_cast<int>(settings.cut_method);
-  std::string preamble = "#version 330 core\n";
-  preamble += "#define NODES_PER_ELEMENT " + std::to_string(npe) + "\n";
-  preamble += "#define ELEMENT_QUAD8 " + std::string(mesh.type == ElementType::quad8 ? "1" : "0") + "\n";
-  preamble += "#define MAX_ENRICHMENTS " + std::to_string(slots_per_element) + "\n";
-  preamble += "#define CUT_METHOD " + std::to_string(cut_method) + "\n";
-  preamble += "#define SMOOTH_SHADING " + std::string(smooth ? "1" : "0") + "\n";
-  preamble += "#define WIREFRAME " + std::string(settings.wireframe ? "1" : "0") + "\n";
-  const int copies = settings.cut_method == RenderSettings::CutMethod::geometry_shader ? 1 << slots_per_element : 1;
-  preamble += "#define GEOMETRY_MAX_VERTICES " + std::to_string(3 * copies) + "\n";
+  // Two instanced draws: elements without enrichment through a program compiled without
+  // enrichment slots (cheaper vertex and geometry stages), then the enriched elements.
+  // u_instance_elements maps each draw's instances to elements.
+  std::vector<int> instance_elements;
+  instance_elements.reserve(elements);
+  for (int pass = 0; pass < 2; ++pass)
+    for (int e = 0; e < elements; ++e)
+      if (shell.enrichments_of(e).empty() == (pass == 0)) instance_elements.push_back(e);
+  int plain_elements = 0;
+  while (plain_elements < elements && shell.enrichments_of(instance_elements[plain_elements]).empty()) ++plain_elements;
+  gl.instance_elements.upload(GL_R32I, instance_elements.data(), instance_elements.size() * sizeof(int), 4);
+
+  // The programs for this combination of options.
+  auto preamble = [&](int slots) {
+    const int copies = settings.cut_method == RenderSettings::CutMethod::geometry_shader ? 1 << slots : 1;
+    std::string text = "#version 330 core\n";
+    text += "#define NODES_PER_ELEMENT " + std::to_string(npe) + "\n";
+    text += "#define ELEMENT_QUAD8 " + std::string(mesh.type == ElementType::quad8 ? "1" : "0") + "\n";
+    text += "#define MAX_ENRICHMENTS " + std::to_string(slots) + "\n";
+    text += "#define CUT_METHOD " + std::to_string(static_cast<int>(settings.cut_method)) + "\n";
+    text += "#define SMOOTH_SHADING " + std::string(smooth ? "1" : "0") + "\n";
+    text += "#define WIREFRAME " + std::string(settings.wireframe ? "1" : "0") + "\n";
+    text += "#define GEOMETRY_MAX_VERTICES " + std::to_string(3 * copies) + "\n";
+    return text;
+  };
   const auto compile_start = Clock::now();
-  const GLuint program = gl.program(preamble);
+  const GLuint plain_program = plain_elements > 0 ? gl.program(preamble(0)) : 0;
+  const GLuint enriched_program = plain_elements < elements ? gl.program(preamble(slots_per_element)) : 0;
   const Tessellation& tess = gl.tessellation(mesh.type, settings.tessellation);
   const auto drawing = Clock::now();
 
@@ -505,40 +522,48 @@ Image ShellRenderer::render(const ShellState& state, const RenderSettings& setti
   glClearDepth(1.0);
   glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
 
-  glUseProgram(program);
-  int unit = 0;
-  auto bind = [&](const char* name, GLenum target, GLuint texture) {
-    glActiveTexture(GL_TEXTURE0 + unit);
-    glBindTexture(target, texture);
-    glUniform1i(glGetUniformLocation(program, name), unit);
-    ++unit;
-  };
-  bind("u_rest_positions", GL_TEXTURE_BUFFER, gl.rest_positions.texture);
-  bind("u_displacements", GL_TEXTURE_BUFFER, gl.displacements.texture);
-  bind("u_element_nodes", GL_TEXTURE_BUFFER, gl.element_nodes.texture);
-  if (smooth) bind("u_node_normals", GL_TEXTURE_BUFFER, gl.node_normals.texture);
-  if (slots_per_element > 0) {
-    bind("u_element_slots", GL_TEXTURE_BUFFER, gl.element_slots.texture);
-    bind("u_slot_tiles", GL_TEXTURE_BUFFER, gl.slot_tiles.texture);
-    bind("u_slot_node_values", GL_TEXTURE_BUFFER, gl.slot_node_values.texture);
-    bind("u_slot_dofs", GL_TEXTURE_BUFFER, gl.slot_dofs.texture);
-    bind("u_atlas", GL_TEXTURE_2D_ARRAY, gl.atlas);
-  }
   float view_projection[16];
   for (int i = 0; i < 16; ++i) view_projection[i] = static_cast<float>(camera.view_projection[i]);
-  glUniformMatrix4fv(glGetUniformLocation(program, "u_view_projection"), 1, GL_FALSE, view_projection);
-  glUniform2f(glGetUniformLocation(program, "u_viewport_size"), float(settings.width), float(settings.height));
-  glUniform1f(glGetUniformLocation(program, "u_cut_threshold"), settings.cut_threshold);
-  glUniform1i(glGetUniformLocation(program, "u_kill_radius"), settings.kill_radius_texels);
-  glUniform3f(glGetUniformLocation(program, "u_camera_position"), float(resolved.eye[0]), float(resolved.eye[1]),
-              float(resolved.eye[2]));
-  glUniform3f(glGetUniformLocation(program, "u_surface_color"), 0.72f, 0.78f, 0.88f);
-  check_gl("setting uniforms");
-
-  glBindVertexArray(tess.vao);
-  if (elements > 0) glDrawElementsInstanced(GL_TRIANGLES, tess.index_count, GL_UNSIGNED_INT, nullptr, elements);
-  glBindVertexArray(0);
-  check_gl("drawing");
+  auto draw = [&](GLuint program, int first_instance, int count) {
+    if (count == 0) return;
+    glUseProgram(program);
+    int unit = 0;
+    auto bind = [&](const char* name, GLenum target, GLuint texture) {
+      const GLint location = glGetUniformLocation(program, name);
+      if (location < 0) return;  // unused by this combination of options
+      glActiveTexture(GL_TEXTURE0 + unit);
+      glBindTexture(target, texture);
+      glUniform1i(location, unit);
+      ++unit;
+    };
+    bind("u_instance_elements", GL_TEXTURE_BUFFER, gl.instance_elements.texture);
+    bind("u_rest_positions", GL_TEXTURE_BUFFER, gl.rest_positions.texture);
+    bind("u_displacements", GL_TEXTURE_BUFFER, gl.displacements.texture);
+    bind("u_element_nodes", GL_TEXTURE_BUFFER, gl.element_nodes.texture);
+    if (smooth) bind("u_node_normals", GL_TEXTURE_BUFFER, gl.node_normals.texture);
+    if (slots_per_element > 0) {
+      bind("u_element_slots", GL_TEXTURE_BUFFER, gl.element_slots.texture);
+      bind("u_slot_tiles", GL_TEXTURE_BUFFER, gl.slot_tiles.texture);
+      bind("u_slot_node_values", GL_TEXTURE_BUFFER, gl.slot_node_values.texture);
+      bind("u_slot_dofs", GL_TEXTURE_BUFFER, gl.slot_dofs.texture);
+      bind("u_atlas", GL_TEXTURE_2D_ARRAY, gl.atlas);
+    }
+    glUniform1i(glGetUniformLocation(program, "u_first_instance"), first_instance);
+    glUniformMatrix4fv(glGetUniformLocation(program, "u_view_projection"), 1, GL_FALSE, view_projection);
+    glUniform2f(glGetUniformLocation(program, "u_viewport_size"), float(settings.width), float(settings.height));
+    glUniform1f(glGetUniformLocation(program, "u_cut_threshold"), settings.cut_threshold);
+    glUniform1i(glGetUniformLocation(program, "u_kill_radius"), settings.kill_radius_texels);
+    glUniform3f(glGetUniformLocation(program, "u_camera_position"), float(resolved.eye[0]), float(resolved.eye[1]),
+                float(resolved.eye[2]));
+    glUniform3f(glGetUniformLocation(program, "u_surface_color"), 0.72f, 0.78f, 0.88f);
+    check_gl("setting uniforms");
+    glBindVertexArray(tess.vao);
+    glDrawElementsInstanced(GL_TRIANGLES, tess.index_count, GL_UNSIGNED_INT, nullptr, count);
+    glBindVertexArray(0);
+    check_gl("drawing");
+  };
+  draw(plain_program, 0, plain_elements);
+  draw(enriched_program, plain_elements, elements - plain_elements);
 
   Image image(settings.width, settings.height);
   std::vector<std::uint8_t> bottom_up(image.rgba.size());

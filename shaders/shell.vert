@@ -1,9 +1,11 @@
-// Vertex stage: one vertex of the static tessellation (parameter point a_xi) of element
-// gl_InstanceID. Evaluates the deformed position split as x = base + sum_k h_k A_k
+// Vertex stage: one vertex of the static tessellation (parameter point a_xi) of the
+// element drawn as instance gl_InstanceID. Evaluates the deformed position split as x = base + sum_k h_k A_k
 // (see dgtex/deformed_shell.h) so the geometry stage can move vertices to either side
 // of a cut.
 layout(location = 0) in vec2 a_xi;
 
+uniform isamplerBuffer u_instance_elements;  // element of each instance, from u_first_instance on
+uniform int u_first_instance;
 uniform samplerBuffer u_rest_positions;  // #nodes: X (xyz)
 uniform samplerBuffer u_displacements;   // #nodes: u (xyz)
 uniform isamplerBuffer u_element_nodes;  // #elements * NODES_PER_ELEMENT
@@ -51,7 +53,7 @@ void shape_functions(vec2 xi, out float N[NODES_PER_ELEMENT]) {
 }
 
 void main() {
-  int e = gl_InstanceID;
+  int e = texelFetch(u_instance_elements, u_first_instance + gl_InstanceID).r;
   float N[NODES_PER_ELEMENT];
   shape_functions(a_xi, N);
   vec3 base = vec3(0.0);

@@ -2,8 +2,8 @@
 //   #version 330 core
 //   #define NODES_PER_ELEMENT  8 (quad8) or 6 (tri6)
 //   #define ELEMENT_QUAD8      1 or 0
-//   #define MAX_ENRICHMENTS    0..4   enrichment slots per element
-//   #define CUT_METHOD         CUT_GEOMETRY_SHADER, CUT_DROP_TRIANGLES or CUT_KILL_PIXELS
+//   #define MAX_ENRICHMENTS    0..4   enrichment slots per element (0 for the draw of unenriched elements)
+//   #define CUT_METHOD         0, 1 or 2 (CUT_GEOMETRY_SHADER, CUT_DROP_TRIANGLES, CUT_KILL_PIXELS)
 //   #define SMOOTH_SHADING     0 or 1
 //   #define WIREFRAME          0 or 1
 //   #define GEOMETRY_MAX_VERTICES  3 * 2^MAX_ENRICHMENTS for CUT_GEOMETRY_SHADER, else 3

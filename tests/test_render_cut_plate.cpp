@@ -12,6 +12,7 @@
 #include <utility>
 #include <vector>
 
+#include "dgtex/deformed_shell.h"
 #include "dgtex/png_io.h"
 #include "dgtex/shell_renderer.h"
 #include "render_fixtures.h"
@@ -182,6 +183,66 @@ TEST(RenderCutPlate, StaircaseCutMatchesTheExactCoverage) {
   }
 }
 
+// The vertex stage's shape functions (GLSL twin) against the CPU evaluation: a plate
+// warped by a quadratic displacement, quad8 and tri6. Points of the surface sampled on
+// the CPU must project onto covered pixels (away from the silhouette), and no pixel
+// farther than 2 pixels from every sample may be covered.
+TEST(RenderCutPlate, DeformedGeometryMatchesTheCpuEvaluation) {
+  for (ElementType type : {ElementType::quad8, ElementType::tri6}) {
+    ShellState state;
+    state.mesh = test::rectangle_mesh(type, 2, 2, 1.6, 1.0);
+    for (int n = 0; n < state.mesh.num_nodes(); ++n) {
+      const double x = state.mesh.positions[3 * n], y = state.mesh.positions[3 * n + 1];
+      state.displacement.insert(state.displacement.end(), {0.25 * y * y, 0.2 * x * x - 0.1 * x * y, 0.0});
+    }
+    RenderSettings s = test::top_view();
+    s.tessellation = 8;
+    const Image image = renderer().render(state, s);
+    dump(image, std::string("warped_") + (type == ElementType::quad8 ? "quad8" : "tri6"));
+    const Camera camera = make_camera(state, s);
+    const DeformedShell shell(state);
+    std::vector<char> near(static_cast<size_t>(s.width) * s.height, 0);
+    int inside_checked = 0, inside_wrong = 0;
+    const int samples = 160;
+    for (int e = 0; e < state.mesh.num_elements(); ++e)
+      for (int j = 0; j <= samples; ++j)
+        for (int i = 0; i <= samples; ++i) {
+          double u = double(i) / samples, v = double(j) / samples;
+          if (type == ElementType::tri6 && u + v > 1) continue;
+          const double xi1 = type == ElementType::quad8 ? 2 * u - 1 : u, xi2 = type == ElementType::quad8 ? 2 * v - 1 : v;
+          double x[3], px, py;
+          shell.position(e, xi1, xi2, x);
+          camera.project(x, px, py);
+          for (int dy = -2; dy <= 2; ++dy)
+            for (int dx = -2; dx <= 2; ++dx) {
+              const int qx = static_cast<int>(std::floor(px)) + dx, qy = static_cast<int>(std::floor(py)) + dy;
+              if (qx >= 0 && qy >= 0 && qx < s.width && qy < s.height) near[qy * s.width + qx] = 1;
+            }
+          // Away from the plate's outer boundary (rest coordinates X = 0, 1.6, Y = 0, 1)
+          // the sample's pixel is covered.
+          kernels::ShapeValues sv;
+          kernels::evaluate_shape(type, xi1, xi2, sv);
+          double X = 0, Y = 0;
+          const int* nodes = state.mesh.element_nodes(e);
+          for (int a = 0; a < state.mesh.nodes_per_element(); ++a) {
+            X += sv.N[a] * state.mesh.positions[3 * nodes[a]];
+            Y += sv.N[a] * state.mesh.positions[3 * nodes[a] + 1];
+          }
+          const double margin = std::min({X, 1.6 - X, Y, 1.0 - Y});
+          if (margin < 0.05) continue;  // 0.05 world units is about 5 pixels here
+          ++inside_checked;
+          if (test::is_background(image, static_cast<int>(px), static_cast<int>(py), s.background)) ++inside_wrong;
+        }
+    int outside_wrong = 0;
+    for (int y = 0; y < s.height; ++y)
+      for (int x = 0; x < s.width; ++x)
+        if (!near[y * s.width + x] && !test::is_background(image, x, y, s.background)) ++outside_wrong;
+    EXPECT_GT(inside_checked, 10000);
+    EXPECT_EQ(inside_wrong, 0) << (type == ElementType::quad8 ? "quad8" : "tri6");
+    EXPECT_EQ(outside_wrong, 0) << (type == ElementType::quad8 ? "quad8" : "tri6");
+  }
+}
+
 TEST(RenderCutPlate, UncutPlateIsOneComponentAndSmoothShadingWorks) {
   auto plate = test::straight_cut_plate();
   plate.state.enrichments.clear();
@@ -213,6 +274,14 @@ TEST(RenderCutPlate, FlatShadingColoursElementsDistinctly) {
   int difference = 0;
   for (int c = 0; c < 3; ++c) difference += std::abs(p0[c] - p1[c]);
   EXPECT_GT(difference, 30);
+}
+
+TEST(RenderCutPlate, EmptyStateRendersTheBackground) {
+  RenderSettings s = test::top_view(16, 8);
+  s.background[0] = 0.2f;
+  const Image image = renderer().render(ShellState{}, s);
+  EXPECT_EQ(test::count_components(image, s.background), 0);
+  EXPECT_EQ(image.pixel(3, 3)[0], 51);
 }
 
 TEST(RenderCutPlate, RejectsTooManyEnrichmentsAndBadSettings) {
