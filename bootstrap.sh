@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # dgtex bootstrap: installs the Debian 12 packages the build needs (only those missing),
 # configures and builds, then runs one of:
-#   ./bootstrap.sh demo   build and run a real scene (writes out/demo: report, meshes, images)
+#   ./bootstrap.sh demo   build and run a real scene (writes out/demo: report.json, VTU meshes and frames)
 #   ./bootstrap.sh test   build and run the whole test suite (what .ci/run does)
 #   ./bootstrap.sh build  only install and build
 set -euo pipefail
@@ -37,7 +37,7 @@ case "$mode" in
   build) ;;
   demo)
     "$build_dir"/dgtex run examples/scenes/demo_cantilever.json --out out/demo
-    echo "demo: wrote out/demo (report.json, frames/)";;
+    echo "demo: wrote out/demo (report.json, deformed.vtu, frames/)";;
   test)
     ctest --test-dir "$build_dir" --output-on-failure -j "$(nproc)" --timeout 900;;
   *) echo "usage: $0 [build|demo|test]" >&2; exit 2;;
