@@ -3,20 +3,10 @@
 #include <cmath>
 
 #include "dgtex/kernels/shell_point.h"
+#include "dgtex/kernels/vec3.h"
 
 namespace dgtex::kernels {
 namespace {
-
-inline double dot(const double* a, const double* b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
-inline void cross(const double* a, const double* b, double* c) {
-  c[0] = a[1] * b[2] - a[2] * b[1];
-  c[1] = a[2] * b[0] - a[0] * b[2];
-  c[2] = a[0] * b[1] - a[1] * b[0];
-}
-inline void normalize(double* v) {
-  const double l = std::sqrt(dot(v, v));
-  v[0] /= l, v[1] /= l, v[2] /= l;
-}
 
 // One side of an edge at parameter t (in the plus element's direction).
 struct Side {
@@ -37,15 +27,15 @@ void evaluate_side(const EdgeBatch& b, int element, int local_edge, double t, co
 // Edge frame (unit tangent, unit averaged normal, in-plane normal) as matrix columns.
 void edge_frame(const Side& plus, const Side* minus, double frame[9]) {
   double f1[3] = {plus.tangent[0], plus.tangent[1], plus.tangent[2]};
-  normalize(f1);
+  normalize3(f1);
   double n[3] = {plus.point.t0[0], plus.point.t0[1], plus.point.t0[2]};
   if (minus)
     for (int k = 0; k < 3; ++k) n[k] += minus->point.t0[k];
-  const double nt = dot(n, f1);
+  const double nt = dot3(n, f1);
   for (int k = 0; k < 3; ++k) n[k] -= nt * f1[k];
-  normalize(n);
+  normalize3(n);
   double f2[3];
-  cross(n, f1, f2);
+  cross3(n, f1, f2);
   for (int k = 0; k < 3; ++k) {
     frame[k * 3 + 0] = f1[k];
     frame[k * 3 + 1] = f2[k];
@@ -77,9 +67,9 @@ void edge_stiffness(const EdgeBatch& b, std::int64_t e, const double* rotations,
     Side plus, minus;
     evaluate_side(b, ed[0], ed[1], t, b.positions, plus);
     if (interior) evaluate_side(b, ed[2], ed[3], -t, b.positions, minus);
-    const double ds = std::sqrt(dot(plus.tangent, plus.tangent)) * rule.weight[q];
+    const double ds = std::sqrt(dot3(plus.tangent, plus.tangent)) * rule.weight[q];
     double tau[3] = {plus.tangent[0], plus.tangent[1], plus.tangent[2]};
-    normalize(tau);
+    normalize3(tau);
 
     // Rows over the edge's local basis: G = [[g]] (jump of the hinge rotation measure) and
     // Mbar = {m_nunu} (average normal bending moment), each 3 columns per basis function.
@@ -91,7 +81,7 @@ void edge_stiffness(const EdgeBatch& b, std::int64_t e, const double* rotations,
       const double dm = side == 0 ? dm_plus : dm_minus;
       const double sign = side == 0 ? 1.0 : -1.0;
       double nu_vec[3], e1[3], e2[3];
-      cross(s.point.t0, tau, nu_vec);
+      cross3(s.point.t0, tau, nu_vec);
       frame_along(s.point, tau, e1, e2);  // e1 = tau, e2 = t0 x tau = nu
       for (int a = 0; a < npe; ++a) {
         double T[9], Bb[9];

@@ -1,19 +1,9 @@
 #include "dgtex/kernels/shell_point.h"
+#include "dgtex/kernels/vec3.h"
 
 #include <cmath>
 
 namespace dgtex::kernels {
-namespace {
-
-inline double dot(const double* a, const double* b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
-inline void cross(const double* a, const double* b, double* c) {
-  c[0] = a[1] * b[2] - a[2] * b[1];
-  c[1] = a[2] * b[0] - a[0] * b[2];
-  c[2] = a[0] * b[1] - a[1] * b[0];
-}
-
-}  // namespace
-
 void evaluate_rest_point(const ShapeValues& s, const int* nodes, const double* X, RestPoint& p) {
   for (int d = 0; d < 3; ++d) p.a1[d] = p.a2[d] = p.a11[d] = p.a22[d] = p.a12[d] = 0;
   for (int a = 0; a < s.count; ++a) {
@@ -27,13 +17,13 @@ void evaluate_rest_point(const ShapeValues& s, const int* nodes, const double* X
     }
   }
   double n[3];
-  cross(p.a1, p.a2, n);
-  p.j0 = std::sqrt(dot(n, n));
+  cross3(p.a1, p.a2, n);
+  p.j0 = std::sqrt(dot3(n, n));
   for (int d = 0; d < 3; ++d) p.t0[d] = n[d] / p.j0;
   // Dual basis: phi0^1 = (a2 x t0) / j0, phi0^2 = (t0 x a1) / j0 (so phi0^a . a_b = delta).
   double c1[3], c2[3];
-  cross(p.a2, p.t0, c1);
-  cross(p.t0, p.a1, c2);
+  cross3(p.a2, p.t0, c1);
+  cross3(p.t0, p.a1, c2);
   for (int d = 0; d < 3; ++d) {
     p.dual1[d] = c1[d] / p.j0;
     p.dual2[d] = c2[d] / p.j0;
@@ -46,17 +36,17 @@ void tangent_along(const RestPoint& p, const double d[2], double out[3]) {
 
 void frame_along(const RestPoint& p, const double tangent[3], double e1[3], double e2[3]) {
   // Project onto the tangent plane (a no-op for tangents of this surface) and normalise.
-  const double tn = dot(tangent, p.t0);
+  const double tn = dot3(tangent, p.t0);
   double t[3] = {tangent[0] - tn * p.t0[0], tangent[1] - tn * p.t0[1], tangent[2] - tn * p.t0[2]};
-  const double len = std::sqrt(dot(t, t));
+  const double len = std::sqrt(dot3(t, t));
   for (int k = 0; k < 3; ++k) e1[k] = t[k] / len;
-  cross(p.t0, e1, e2);
+  cross3(p.t0, e1, e2);
 }
 
 void cartesian_gradient(const RestPoint& p, const double e1[3], const double e2[3], const double dN[2],
                         double out[2]) {
-  out[0] = dN[0] * dot(p.dual1, e1) + dN[1] * dot(p.dual2, e1);
-  out[1] = dN[0] * dot(p.dual1, e2) + dN[1] * dot(p.dual2, e2);
+  out[0] = dN[0] * dot3(p.dual1, e1) + dN[1] * dot3(p.dual2, e1);
+  out[1] = dN[0] * dot3(p.dual1, e2) + dN[1] * dot3(p.dual2, e2);
 }
 
 void normal_change_operator(const RestPoint& p, const double dN[2], double T[9]) {
@@ -94,7 +84,7 @@ void bending_rows(const RestPoint& p, const double e1[3], const double e2[3], co
       rho[r][k] = -(d2N[r] * p.t0[k] + q[0] * T[0 * 3 + k] + q[1] * T[1 * 3 + k] + q[2] * T[2 * 3 + k]);
     }
   // Covariant tensor to the frame: rho_ij = c_ia c_jb rho_ab with c_ia = phi0^a . e_i.
-  const double c[2][2] = {{dot(p.dual1, e1), dot(p.dual2, e1)}, {dot(p.dual1, e2), dot(p.dual2, e2)}};
+  const double c[2][2] = {{dot3(p.dual1, e1), dot3(p.dual2, e1)}, {dot3(p.dual1, e2), dot3(p.dual2, e2)}};
   auto component = [&](int i, int j, int k) {
     return c[i][0] * c[j][0] * rho[0][k] + c[i][1] * c[j][1] * rho[1][k] +
            (c[i][0] * c[j][1] + c[i][1] * c[j][0]) * rho[2][k];
