@@ -39,6 +39,14 @@ case "$mode" in
     "$build_dir"/dgtex run examples/scenes/demo_cantilever.json --out out/demo
     echo "demo: wrote out/demo (report.json, deformed.vtu, frames/)";;
   test)
-    ctest --test-dir "$build_dir" --output-on-failure -j "$(nproc)" --timeout 900;;
+    ctest --test-dir "$build_dir" --output-on-failure -j "$(nproc)" --timeout 900
+    # Then the kernel, mesh, scene and texel-solver tests again under ASan + UBSan
+    # (labelled "sanitize" in tests/CMakeLists.txt); -O1 keeps them quick.
+    sanitize_dir="${build_dir}-sanitize"
+    cmake -S . -B "$sanitize_dir" -G Ninja -DCMAKE_BUILD_TYPE=Debug -DCMAKE_CXX_FLAGS_DEBUG="-O1 -g" \
+      -DDGTEX_SANITIZE=ON -DDGTEX_BUILD_EXAMPLES=OFF "${launcher[@]}" >/dev/null
+    cmake --build "$sanitize_dir" -j "$(nproc)" --target sanitizer_tests
+    ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1 \
+      ctest --test-dir "$sanitize_dir" --output-on-failure -j "$(nproc)" --timeout 900 -L sanitize;;
   *) echo "usage: $0 [build|demo|test]" >&2; exit 2;;
 esac

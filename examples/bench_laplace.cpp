@@ -34,6 +34,8 @@ void domains_and_sizes(benchmark::internal::Benchmark* b, std::vector<long> size
 
 BENCHMARK_CAPTURE(laplace_solve, multigrid, dgtex::LaplaceBenchSolver::multigrid)
     ->Apply([](benchmark::internal::Benchmark* b) { domains_and_sizes(b, {128, 256, 512, 1024}); });
+BENCHMARK_CAPTURE(laplace_solve, multigrid_robust, dgtex::LaplaceBenchSolver::multigrid_robust)
+    ->Apply([](benchmark::internal::Benchmark* b) { domains_and_sizes(b, {128, 256, 512, 1024}); });
 BENCHMARK_CAPTURE(laplace_solve, cholmod, dgtex::LaplaceBenchSolver::cholmod)
     ->Apply([](benchmark::internal::Benchmark* b) { domains_and_sizes(b, {128, 256, 512}); });
 BENCHMARK_CAPTURE(laplace_solve, eigen_ichol_cg, dgtex::LaplaceBenchSolver::eigen_ichol_cg)

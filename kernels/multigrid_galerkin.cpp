@@ -43,6 +43,20 @@ inline double weight(double numerator, double denominator, double diagonal) {
   return (diagonal > 0 && denominator > 1e-12 * diagonal) ? -numerator / denominator : 0.0;
 }
 
+// Coupling `to_g` of an edge node to a cell-centre neighbour g (which is no interpolation
+// point) is shared between the edge node's two coarse neighbours in proportion to g's own
+// (negative) couplings to them, g_first and g_second; where g couples to neither, g is assumed to
+// follow the edge node (collapse into the centre).
+inline void distribute(double to_g, double g_first, double g_second, double& first, double& second, double& centre) {
+  const double u = g_first < 0 ? g_first : 0.0, v = g_second < 0 ? g_second : 0.0;
+  if (to_g != 0.0 && u + v < 0) {
+    first += to_g * (u / (u + v));
+    second += to_g * (v / (u + v));
+  } else {
+    centre += to_g;
+  }
+}
+
 template <class Operator>
 void build_interpolation(GridShape fine, const Operator& a, InterpolationArrays p, Execution execution) {
   const GridShape coarse = fine.coarser();
@@ -56,18 +70,22 @@ void build_interpolation(GridShape fine, const Operator& a, InterpolationArrays 
           const std::int64_t c = coarse.at(I, J);
           p.xw[c] = p.xe[c] = p.ys[c] = p.yn[c] = 0.0;
           if (2 * I + 1 < fine.nx) {
-            const std::int64_t f = fine.at(2 * I + 1, 2 * J);
-            const double west = a(f, -1, -1) + a(f, -1, 0) + a(f, -1, 1);
-            const double east = a(f, 1, -1) + a(f, 1, 0) + a(f, 1, 1);
-            const double centre = a(f, 0, -1) + a(f, 0, 0) + a(f, 0, 1);
+            const std::int64_t f = fine.at(2 * I + 1, 2 * J), fs = f - fine.stride(), fn = f + fine.stride();
+            double west = a(f, -1, -1) + a(f, -1, 0) + a(f, -1, 1);
+            double east = a(f, 1, -1) + a(f, 1, 0) + a(f, 1, 1);
+            double centre = a(f, 0, 0);
+            distribute(a(f, 0, -1), a(fs, -1, 1), a(fs, 1, 1), west, east, centre);
+            distribute(a(f, 0, 1), a(fn, -1, -1), a(fn, 1, -1), west, east, centre);
             p.xw[c] = weight(west, centre, a(f, 0, 0));
             p.xe[c] = weight(east, centre, a(f, 0, 0));
           }
           if (2 * J + 1 < fine.ny) {
             const std::int64_t f = fine.at(2 * I, 2 * J + 1);
-            const double south = a(f, -1, -1) + a(f, 0, -1) + a(f, 1, -1);
-            const double north = a(f, -1, 1) + a(f, 0, 1) + a(f, 1, 1);
-            const double centre = a(f, -1, 0) + a(f, 0, 0) + a(f, 1, 0);
+            double south = a(f, -1, -1) + a(f, 0, -1) + a(f, 1, -1);
+            double north = a(f, -1, 1) + a(f, 0, 1) + a(f, 1, 1);
+            double centre = a(f, 0, 0);
+            distribute(a(f, -1, 0), a(f - 1, 1, -1), a(f - 1, 1, 1), south, north, centre);
+            distribute(a(f, 1, 0), a(f + 1, -1, -1), a(f + 1, -1, 1), south, north, centre);
             p.ys[c] = weight(south, centre, a(f, 0, 0));
             p.yn[c] = weight(north, centre, a(f, 0, 0));
           }
@@ -96,66 +114,130 @@ void build_interpolation(GridShape fine, const Operator& a, InterpolationArrays 
       execution);
 }
 
-// Interpolation weights of fine node (i, j) (parity-dependent): up to four coarse
-// neighbours as offsets (dI, dJ) from (i >> 1, j >> 1) and weights. Returns the count.
-inline int interpolation_of(GridShape coarse, const InterpolationView& p, int i, int j, int* dI, int* dJ, double* w) {
-  const std::int64_t c = coarse.at(i >> 1, j >> 1);
-  switch ((i & 1) + 2 * (j & 1)) {
-    case 0: dI[0] = 0; dJ[0] = 0; w[0] = 1.0; return 1;
-    case 1: dI[0] = 0; dJ[0] = 0; w[0] = p.xw[c]; dI[1] = 1; dJ[1] = 0; w[1] = p.xe[c]; return 2;
-    case 2: dI[0] = 0; dJ[0] = 0; w[0] = p.ys[c]; dI[1] = 0; dJ[1] = 1; w[1] = p.yn[c]; return 2;
-    default:
-      dI[0] = 0; dJ[0] = 0; w[0] = p.sw[c];
-      dI[1] = 1; dJ[1] = 0; w[1] = p.se[c];
-      dI[2] = 0; dJ[2] = 1; w[2] = p.nw[c];
-      dI[3] = 1; dJ[3] = 1; w[3] = p.ne[c];
-      return 4;
+// Compile-time view of the fine operators for the Galerkin product: entry<OX, OY>(f) is
+// A(f, f + OX + OY * stride); `couples<OX, OY>` says whether the entry can be non-zero at
+// all (the 5-point texel operator has no diagonal couplings), so whole terms vanish at
+// compile time instead of being multiplied by zero.
+struct TexelEntries {
+  const std::uint8_t* bits;
+  template <int OX, int OY>
+  static constexpr bool couples = (OX == 0 || OY == 0);
+  bool has_unknown(std::int64_t f) const { return bits[f] & is_unknown; }
+  template <int OX, int OY>
+  double entry(std::int64_t f) const {
+    const std::uint8_t m = bits[f];
+    if constexpr (OX == 0 && OY == 0) return laplace_degree(m);
+    else if constexpr (OX == -1) return (m & couples_west_unknown) ? -1.0 : 0.0;
+    else if constexpr (OX == 1) return (m & couples_east_unknown) ? -1.0 : 0.0;
+    else if constexpr (OY == -1) return (m & couples_south_unknown) ? -1.0 : 0.0;
+    else return (m & couples_north_unknown) ? -1.0 : 0.0;
   }
-}
+};
+struct Stencil9Entries {
+  Stencil9View a;
+  std::int64_t s;
+  template <int OX, int OY>
+  static constexpr bool couples = true;
+  bool has_unknown(std::int64_t f) const { return a.c[f] > 0; }
+  template <int OX, int OY>
+  double entry(std::int64_t f) const {
+    if constexpr (OX == 0 && OY == 0) return a.c[f];
+    else if constexpr (OX == 1 && OY == 0) return a.e[f];
+    else if constexpr (OX == -1 && OY == 0) return a.e[f - 1];
+    else if constexpr (OX == 0 && OY == 1) return a.n[f];
+    else if constexpr (OX == 0 && OY == -1) return a.n[f - s];
+    else if constexpr (OX == 1 && OY == 1) return a.ne[f];
+    else if constexpr (OX == -1 && OY == -1) return a.ne[f - s - 1];
+    else if constexpr (OX == -1 && OY == 1) return a.nw[f];
+    else return a.nw[f - s + 1];  // (1, -1): south-east
+  }
+};
 
-template <class Operator>
-void galerkin(GridShape fine, const Operator& a, InterpolationView p, Stencil9Arrays out, Execution execution) {
+// The Galerkin row of one coarse node C = (I, J): acc[dJ + 1][dI + 1] accumulates
+// (P^T A P)(C, (I + dI, J + dJ)). Every offset is a template argument, so the 9 x 9 x 4
+// loop nest of the definition unrolls into straight-line code (no parity switches).
+template <class Entries>
+struct GalerkinRow {
+  const Entries& a;
+  const InterpolationView& p;
+  std::int64_t c, cs, f0, fs;  // coarse index and stride, fine index of (2I, 2J) and stride
+  double acc[3][3] = {};
+
+  // acc += v * P(g, .) for the fine node g = (2I + GX, 2J + GY), GX, GY in -2..2.
+  template <int GX, int GY>
+  void add_interpolated(double v) {
+    constexpr int px = GX & 1, py = GY & 1;
+    constexpr int bx = (GX - px) / 2, by = (GY - py) / 2;  // g's base coarse node (I + bx, J + by)
+    const std::int64_t cb = c + bx + by * cs;
+    if constexpr (px == 0 && py == 0) {
+      acc[by + 1][bx + 1] += v;
+    } else if constexpr (py == 0) {
+      acc[by + 1][bx + 1] += v * p.xw[cb];
+      acc[by + 1][bx + 2] += v * p.xe[cb];
+    } else if constexpr (px == 0) {
+      acc[by + 1][bx + 1] += v * p.ys[cb];
+      acc[by + 2][bx + 1] += v * p.yn[cb];
+    } else {
+      acc[by + 1][bx + 1] += v * p.sw[cb];
+      acc[by + 1][bx + 2] += v * p.se[cb];
+      acc[by + 2][bx + 1] += v * p.nw[cb];
+      acc[by + 2][bx + 2] += v * p.ne[cb];
+    }
+  }
+
+  // P(f, C) for f = (2I + DI, 2J + DJ), DI, DJ in -1..1.
+  template <int DI, int DJ>
+  double column() const {
+    if constexpr (DJ == -1) return DI == -1 ? p.ne[c - cs - 1] : DI == 0 ? p.yn[c - cs] : p.nw[c - cs];
+    else if constexpr (DJ == 0) return DI == -1 ? p.xe[c - 1] : DI == 0 ? 1.0 : p.xw[c];
+    else return DI == -1 ? p.se[c - 1] : DI == 0 ? p.ys[c] : p.sw[c];
+  }
+
+  template <int DI, int DJ, int OX, int OY>
+  void couple(std::int64_t f, double pfc) {
+    if constexpr (Entries::template couples<OX, OY>) {
+      const double afg = a.template entry<OX, OY>(f);
+      if (afg != 0.0) add_interpolated<DI + OX, DJ + OY>(pfc * afg);
+    }
+  }
+
+  template <int DI, int DJ>
+  void visit() {
+    const double pfc = column<DI, DJ>();
+    if (pfc == 0.0) return;
+    const std::int64_t f = f0 + DI + DJ * fs;
+    if (!a.has_unknown(f)) return;
+    couple<DI, DJ, -1, -1>(f, pfc); couple<DI, DJ, 0, -1>(f, pfc); couple<DI, DJ, 1, -1>(f, pfc);
+    couple<DI, DJ, -1, 0>(f, pfc);  couple<DI, DJ, 0, 0>(f, pfc);  couple<DI, DJ, 1, 0>(f, pfc);
+    couple<DI, DJ, -1, 1>(f, pfc);  couple<DI, DJ, 0, 1>(f, pfc);  couple<DI, DJ, 1, 1>(f, pfc);
+  }
+
+  void run() {
+    visit<-1, -1>(); visit<0, -1>(); visit<1, -1>();
+    visit<-1, 0>();  visit<0, 0>();  visit<1, 0>();
+    visit<-1, 1>();  visit<0, 1>();  visit<1, 1>();
+  }
+};
+
+// Fine nodes outside the fine grid have P(f, C) = 0 (the interpolation arrays hold 0 there
+// and at ghosts), and ghost operator entries are 0, so no bounds checks are needed.
+template <class Entries>
+void galerkin(GridShape fine, const Entries& a, InterpolationView p, Stencil9Arrays out, Execution execution) {
   const GridShape coarse = fine.coarser();
-  const std::int64_t cs = coarse.stride();
+  const std::int64_t cs = coarse.stride(), fs = fine.stride();
   forall(
       coarse.ny,
       [&](std::int64_t J64) {
         const int J = static_cast<int>(J64);
         for (int I = 0; I < coarse.nx; ++I) {
           const std::int64_t c = coarse.at(I, J);
-          // P(f, C) for the fine nodes f = (2I + di, 2J + dj) around coarse node C.
-          const double column[3][3] = {
-              {p.ne[c - cs - 1], p.yn[c - cs], p.nw[c - cs]},  // dj = -1: di = -1, 0, 1
-              {p.xe[c - 1], 1.0, p.xw[c]},                      // dj = 0
-              {p.se[c - 1], p.ys[c], p.sw[c]},                  // dj = 1
-          };
-          double acc[3][3] = {};  // acc[dJ + 1][dI + 1]: coupling to coarse (I + dI, J + dJ)
-          for (int dj = -1; dj <= 1; ++dj)
-            for (int di = -1; di <= 1; ++di) {
-              const int fi = 2 * I + di, fj = 2 * J + dj;
-              if (fi < 0 || fj < 0 || fi >= fine.nx || fj >= fine.ny) continue;
-              const double pfc = column[dj + 1][di + 1];
-              if (pfc == 0.0) continue;
-              const std::int64_t f = fine.at(fi, fj);
-              for (int oy = -1; oy <= 1; ++oy)
-                for (int ox = -1; ox <= 1; ++ox) {
-                  const double afg = a(f, ox, oy);
-                  if (afg == 0.0) continue;
-                  const int gi = fi + ox, gj = fj + oy;
-                  int dI[4], dJ[4];
-                  double w[4];
-                  const int count = interpolation_of(coarse, p, gi, gj, dI, dJ, w);
-                  for (int k = 0; k < count; ++k) {
-                    const int DI = (gi >> 1) + dI[k] - I, DJ = (gj >> 1) + dJ[k] - J;
-                    acc[DJ + 1][DI + 1] += pfc * afg * w[k];
-                  }
-                }
-            }
-          out.c[c] = acc[1][1];
-          out.e[c] = acc[1][2];
-          out.n[c] = acc[2][1];
-          out.ne[c] = acc[2][2];
-          out.nw[c] = acc[2][0];
+          GalerkinRow<Entries> row{a, p, c, cs, fine.at(2 * I, 2 * J), fs};
+          row.run();
+          out.c[c] = row.acc[1][1];
+          out.e[c] = row.acc[1][2];
+          out.n[c] = row.acc[2][1];
+          out.ne[c] = row.acc[2][2];
+          out.nw[c] = row.acc[2][0];
         }
       },
       execution);
@@ -171,11 +253,11 @@ void build_interpolation_stencil9(GridShape fine, Stencil9View a, InterpolationA
 }
 void galerkin_texels(GridShape fine, const std::uint8_t* bits, InterpolationView p, Stencil9Arrays coarse_a,
                      Execution execution) {
-  galerkin(fine, TexelOperator{bits, fine.stride()}, p, coarse_a, execution);
+  galerkin(fine, TexelEntries{bits}, p, coarse_a, execution);
 }
 void galerkin_stencil9(GridShape fine, Stencil9View a, InterpolationView p, Stencil9Arrays coarse_a,
                        Execution execution) {
-  galerkin(fine, Stencil9Operator{a, fine.stride()}, p, coarse_a, execution);
+  galerkin(fine, Stencil9Entries{a, fine.stride()}, p, coarse_a, execution);
 }
 
 }  // namespace dgtex::kernels

@@ -1,6 +1,7 @@
 #include "dgtex/kernels/multigrid_residual.h"
 
 #include "dgtex/kernels/multigrid_unknowns.h"
+#include "multigrid_lagged_rows.h"
 
 namespace dgtex::kernels {
 namespace {
@@ -62,6 +63,41 @@ void residual_texels_reference(GridShape shape, const std::uint8_t* bits, const 
   }
 }
 
+void residual_texels_color(GridShape shape, const std::uint8_t* bits, const double* b, const double* x, double* r,
+                           int color, Execution execution) {
+  const std::int64_t s = shape.stride();
+  forall(
+      shape.ny,
+      [&](std::int64_t j) {
+        const std::int64_t row = shape.at(0, static_cast<int>(j));
+        for (int i = static_cast<int>((color + j) & 1); i < shape.nx; i += 2) {
+          const std::int64_t t = row + i;
+          const std::uint8_t m = bits[t];
+          r[t] = (m & is_unknown) ? b[t] - texel_operator(m, x, t, s) : 0.0;
+        }
+      },
+      execution);
+}
+
+void residual_texels_color_reference(GridShape shape, const std::uint8_t* bits, const double* b, const double* x,
+                                     double* r, int color) {
+  for (int j = 0; j < shape.ny; ++j)
+    for (int i = 0; i < shape.nx; ++i) {
+      if ((i + j) % 2 != color) continue;
+      const std::int64_t t = shape.at(i, j);
+      double value = 0;
+      if (bits[t] & is_unknown) {
+        double ax = laplace_degree(bits[t]) * x[t];
+        ax -= (bits[t] & couples_west_unknown) ? x[shape.at(i - 1, j)] : 0.0;
+        ax -= (bits[t] & couples_east_unknown) ? x[shape.at(i + 1, j)] : 0.0;
+        ax -= (bits[t] & couples_south_unknown) ? x[shape.at(i, j - 1)] : 0.0;
+        ax -= (bits[t] & couples_north_unknown) ? x[shape.at(i, j + 1)] : 0.0;
+        value = b[t] - ax;
+      }
+      r[t] = value;
+    }
+}
+
 void residual_stencil9(GridShape shape, Stencil9View a, const double* b, const double* x, double* r, double* row_norm2,
                        Execution execution) {
   const std::int64_t s = shape.stride();
@@ -120,6 +156,37 @@ void apply_texels(GridShape shape, const std::uint8_t* bits, const double* x, do
         if (row_dot) row_dot[j] = dot;
       },
       execution);
+}
+
+void update_direction_and_apply_texels(GridShape shape, const std::uint8_t* bits, const double* z, double beta,
+                                       double* p, double* q, double* row_dot, Execution execution) {
+  const std::int64_t s = shape.stride();
+  detail::lagged_rows(
+      shape.ny,
+      [&](int j) {
+        const std::int64_t row = shape.at(0, j);
+        for (int i = 0; i < shape.nx; ++i) p[row + i] = z[row + i] + beta * p[row + i];
+      },
+      [&](int j) {
+        const std::int64_t row = shape.at(0, j);
+        double dot = 0;
+        for (int i = 0; i < shape.nx; ++i) {
+          const std::int64_t t = row + i;
+          const std::uint8_t m = bits[t];
+          const double value = (m & is_unknown) ? texel_operator(m, p, t, s) : 0.0;
+          q[t] = value;
+          dot += value * p[t];
+        }
+        row_dot[j] = dot;
+      },
+      execution);
+}
+
+void update_direction_and_apply_texels_reference(GridShape shape, const std::uint8_t* bits, const double* z,
+                                                 double beta, double* p, double* q, double* row_dot) {
+  for (int j = 0; j < shape.ny; ++j)
+    for (int i = 0; i < shape.nx; ++i) p[shape.at(i, j)] = z[shape.at(i, j)] + beta * p[shape.at(i, j)];
+  apply_texels(shape, bits, p, q, row_dot, Execution::serial);
 }
 
 }  // namespace dgtex::kernels

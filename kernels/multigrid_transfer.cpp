@@ -87,4 +87,75 @@ void prolong_correction_reference(GridShape fine, GridShape coarse, Interpolatio
     }
 }
 
+void restrict_red_residual(GridShape fine, GridShape coarse, InterpolationView p, const double* r_fine, double* b_coarse,
+                           Execution execution) {
+  const std::int64_t cs = coarse.stride(), fs = fine.stride();
+  forall(
+      coarse.ny,
+      [&](std::int64_t J64) {
+        const int J = static_cast<int>(J64);
+        const std::int64_t row = coarse.at(0, J);
+        for (int I = 0; I < coarse.nx; ++I) {
+          const std::int64_t c = row + I, f = fine.at(2 * I, 2 * J);
+          b_coarse[c] = r_fine[f] + p.sw[c] * r_fine[f + fs + 1] + p.se[c - 1] * r_fine[f + fs - 1] +
+                        p.nw[c - cs] * r_fine[f - fs + 1] + p.ne[c - cs - 1] * r_fine[f - fs - 1];
+        }
+      },
+      execution);
+}
+
+void restrict_red_residual_reference(GridShape fine, GridShape coarse, InterpolationView p, const double* r_fine,
+                                     double* b_coarse) {
+  for (int J = 0; J < coarse.ny; ++J)
+    for (int I = 0; I < coarse.nx; ++I) {
+      const int i = 2 * I, j = 2 * J;
+      double sum = r_fine[fine.at(i, j)];
+      sum += p.sw[coarse.at(I, J)] * r_fine[fine.at(i + 1, j + 1)];
+      sum += p.se[coarse.at(I - 1, J)] * r_fine[fine.at(i - 1, j + 1)];
+      sum += p.nw[coarse.at(I, J - 1)] * r_fine[fine.at(i + 1, j - 1)];
+      sum += p.ne[coarse.at(I - 1, J - 1)] * r_fine[fine.at(i - 1, j - 1)];
+      b_coarse[coarse.at(I, J)] = sum;
+    }
+}
+
+void prolong_correction_red(GridShape fine, GridShape coarse, InterpolationView p, const double* x_coarse,
+                            const std::uint8_t* fine_active, double* x_fine, Execution execution) {
+  const std::int64_t cs = coarse.stride();
+  forall(
+      fine.ny,
+      [&](std::int64_t j64) {
+        const int j = static_cast<int>(j64);
+        const std::int64_t row = fine.at(0, j), crow = coarse.at(0, j >> 1);
+        if ((j & 1) == 0) {
+          for (int i = 0; i < fine.nx; i += 2)
+            if (fine_active[row + i]) x_fine[row + i] += x_coarse[crow + (i >> 1)];
+        } else {
+          for (int i = 1; i < fine.nx; i += 2) {
+            if (!fine_active[row + i]) continue;
+            const std::int64_t c = crow + (i >> 1);
+            x_fine[row + i] += p.sw[c] * x_coarse[c] + p.se[c] * x_coarse[c + 1] + p.nw[c] * x_coarse[c + cs] +
+                               p.ne[c] * x_coarse[c + cs + 1];
+          }
+        }
+      },
+      execution);
+}
+
+void prolong_correction_red_reference(GridShape fine, GridShape coarse, InterpolationView p, const double* x_coarse,
+                                      const std::uint8_t* fine_active, double* x_fine) {
+  for (int j = 0; j < fine.ny; ++j)
+    for (int i = 0; i < fine.nx; ++i) {
+      const std::int64_t t = fine.at(i, j);
+      if ((i + j) % 2 != 0 || !fine_active[t]) continue;
+      const int I = i / 2, J = j / 2;
+      if (i % 2 == 0)
+        x_fine[t] += x_coarse[coarse.at(I, J)];
+      else
+        x_fine[t] += p.sw[coarse.at(I, J)] * x_coarse[coarse.at(I, J)] +
+                     p.se[coarse.at(I, J)] * x_coarse[coarse.at(I + 1, J)] +
+                     p.nw[coarse.at(I, J)] * x_coarse[coarse.at(I, J + 1)] +
+                     p.ne[coarse.at(I, J)] * x_coarse[coarse.at(I + 1, J + 1)];
+    }
+}
+
 }  // namespace dgtex::kernels

@@ -1,8 +1,11 @@
 #include "dgtex/kernels/multigrid_unknowns.h"
 
+#include <algorithm>
+#include <cstring>
+
 namespace dgtex::kernels {
 
-int classify_laplace_texels(const TexelTile& tile, std::vector<std::uint8_t>& bits) {
+int classify_laplace_texels_reference(const TexelTile& tile, std::vector<std::uint8_t>& bits) {
   const int w = tile.width, h = tile.height;
   const std::size_t n = static_cast<std::size_t>(w) * h;
   bits.assign(n, 0);
@@ -71,6 +74,144 @@ int classify_laplace_texels(const TexelTile& tile, std::vector<std::uint8_t>& bi
       if (texels_coupled_north(tile, i, j) && (bits[t + w] & is_unknown)) bits[t] |= couples_north_unknown;
     }
   return zeroed;
+}
+
+namespace {
+
+// Root of run r with path halving (serial union-find).
+inline int find_run(std::vector<int>& parent, int r) {
+  while (parent[r] != r) {
+    parent[r] = parent[parent[r]];
+    r = parent[r];
+  }
+  return r;
+}
+
+// Core of the fast classification; writes texel (i, j) to out[base + j * stride + i].
+int classify_into(const TexelTile& tile, std::uint8_t* out, std::int64_t base, std::int64_t stride,
+                  Execution execution) {
+  const int w = tile.width, h = tile.height;
+  const std::uint8_t* flags = tile.flags.data();
+  // Pass 1 (rows in parallel): couplings to active neighbours in bits 0..3 (final meaning
+  // once both ends are known to be unknowns), the degree, and a provisional is_unknown bit
+  // marking free texels. Also: the number of runs of east-coupled free texels per row.
+  std::vector<int> runs_in_row(h + 1, 0);
+  forall(
+      h,
+      [&](std::int64_t j64) {
+        const int j = static_cast<int>(j64);
+        const std::uint8_t* row = flags + static_cast<std::int64_t>(j) * w;
+        std::uint8_t* dst = out + base + j * stride;
+        int runs = 0;
+        bool previous_free_coupled = false;
+        for (int i = 0; i < w; ++i) {
+          const std::uint8_t f = row[i];
+          if (f & inactive) {
+            dst[i] = 0;
+            previous_free_coupled = false;
+            continue;
+          }
+          const bool west = i > 0 && !(row[i - 1] & (wall_east | inactive));
+          const bool east = i + 1 < w && !(f & wall_east) && !(row[i + 1] & inactive);
+          const bool south = j > 0 && !(row[i - w] & (wall_north | inactive));
+          const bool north = j + 1 < h && !(f & wall_north) && !(row[i + w] & inactive);
+          const int degree = west + east + south + north;
+          const bool is_free = !(f & dirichlet);
+          dst[i] = static_cast<std::uint8_t>((west ? couples_west_unknown : 0) | (east ? couples_east_unknown : 0) |
+                                             (south ? couples_south_unknown : 0) |
+                                             (north ? couples_north_unknown : 0) | (degree << degree_shift) |
+                                             (is_free ? is_unknown : 0));
+          if (is_free && !(previous_free_coupled && west)) ++runs;
+          previous_free_coupled = is_free;
+        }
+        runs_in_row[j + 1] = runs;
+      },
+      execution);
+  for (int j = 0; j < h; ++j) runs_in_row[j + 1] += runs_in_row[j];
+  const int run_count = runs_in_row[h];
+
+  // Pass 2 (serial): run ids per free texel, union of runs linked across uncut north
+  // edges, and whether a run touches Dirichlet data.
+  std::vector<int> run_of(static_cast<std::size_t>(w) * h, -1), parent(run_count);
+  std::vector<std::uint8_t> has_dirichlet(run_count, 0);
+  for (int r = 0; r < run_count; ++r) parent[r] = r;
+  for (int j = 0; j < h; ++j) {
+    const std::uint8_t* dst = out + base + j * stride;
+    const std::uint8_t* row = flags + static_cast<std::int64_t>(j) * w;
+    int* runs = run_of.data() + static_cast<std::int64_t>(j) * w;
+    int next = runs_in_row[j] - 1;
+    bool previous_free = false;
+    for (int i = 0; i < w; ++i) {
+      const std::uint8_t m = dst[i];
+      if (!(m & is_unknown)) {
+        previous_free = false;
+        continue;
+      }
+      if (!(previous_free && (m & couples_west_unknown))) ++next;
+      previous_free = true;
+      runs[i] = next;
+      // Dirichlet neighbours (coupled, not free).
+      if (((m & couples_west_unknown) && (row[i - 1] & dirichlet)) ||
+          ((m & couples_east_unknown) && (row[i + 1] & dirichlet)) ||
+          ((m & couples_south_unknown) && (row[i - w] & dirichlet)) ||
+          ((m & couples_north_unknown) && (row[i + w] & dirichlet)))
+        has_dirichlet[next] = 1;
+      if ((m & couples_south_unknown) && runs[i - w] >= 0) {
+        const int a = find_run(parent, next), b = find_run(parent, runs[i - w]);
+        if (a != b) parent[std::max(a, b)] = std::min(a, b);
+      }
+    }
+  }
+  for (int r = 0; r < run_count; ++r) {
+    const int root = find_run(parent, r);
+    has_dirichlet[root] |= has_dirichlet[r];
+  }
+  std::vector<std::uint8_t> solvable(run_count, 0);
+  for (int r = 0; r < run_count; ++r) solvable[r] = has_dirichlet[find_run(parent, r)];
+
+  // Pass 3 (rows in parallel): unknown = free texel of a solvable component, coupled only
+  // to unknown neighbours (a coupled free neighbour lies in the same component); all other
+  // texels keep only their degree.
+  std::vector<int> zeroed_in_row(h, 0);
+  forall(
+      h,
+      [&](std::int64_t j64) {
+        const int j = static_cast<int>(j64);
+        const int* runs = run_of.data() + static_cast<std::int64_t>(j) * w;
+        std::uint8_t* dst = out + base + j * stride;
+        int zeroed = 0;
+        for (int i = 0; i < w; ++i) {
+          std::uint8_t m = dst[i];
+          if (runs[i] < 0 || !solvable[runs[i]]) {
+            zeroed += runs[i] >= 0;
+            dst[i] = static_cast<std::uint8_t>(m & laplace_degree_mask);
+            continue;
+          }
+          if ((m & couples_west_unknown) && runs[i - 1] < 0) m &= ~couples_west_unknown;
+          if ((m & couples_east_unknown) && runs[i + 1] < 0) m &= ~couples_east_unknown;
+          if ((m & couples_south_unknown) && runs[i - w] < 0) m &= ~couples_south_unknown;
+          if ((m & couples_north_unknown) && runs[i + w] < 0) m &= ~couples_north_unknown;
+          dst[i] = m;
+        }
+        zeroed_in_row[j] = zeroed;
+      },
+      execution);
+  int zeroed_texels = 0;
+  for (int j = 0; j < h; ++j) zeroed_texels += zeroed_in_row[j];
+  return zeroed_texels;
+}
+
+}  // namespace
+
+int classify_laplace_texels(const TexelTile& tile, std::vector<std::uint8_t>& bits, Execution execution) {
+  bits.assign(static_cast<std::size_t>(tile.width) * tile.height, 0);
+  return classify_into(tile, bits.data(), 0, tile.width, execution);
+}
+
+int classify_laplace_texels_padded(const TexelTile& tile, std::uint8_t* padded_bits, Execution execution) {
+  const std::int64_t stride = tile.width + 2;
+  std::memset(padded_bits, 0, static_cast<std::size_t>(stride) * (tile.height + 2));
+  return classify_into(tile, padded_bits, stride + 1, stride, execution);
 }
 
 }  // namespace dgtex::kernels

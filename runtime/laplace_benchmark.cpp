@@ -113,13 +113,19 @@ LaplaceBenchRun run_once(LaplaceBenchSolver solver, const kernels::TexelTile& pr
                          double tolerance, bool record_history) {
   LaplaceBenchRun run;
   switch (solver) {
-    case LaplaceBenchSolver::multigrid: {
+    case LaplaceBenchSolver::multigrid:
+    case LaplaceBenchSolver::multigrid_robust: {
       kernels::TexelTile tile = problem;
       LaplaceMultigridOptions options;
       options.tolerance = tolerance;
       options.warm_start = false;
-      const LaplaceSolveStats stats = solve_laplace_multigrid(tile, options, record_history ? &run.history : nullptr);
-      run.ms = stats.ms;
+      if (solver == LaplaceBenchSolver::multigrid_robust) options.coarse_solve_tolerance = 0.02;
+      const auto start = Clock::now();
+      LaplaceMultigrid multigrid(tile, options);
+      const LaplaceSolveStats stats = multigrid.solve(tile, record_history ? &run.history : nullptr);
+      run.ms = ms_since(start);
+      run.setup_ms = multigrid.setup_ms();
+      for (LaplaceConvergencePoint& point : run.history) point.ms += run.setup_ms;  // time since the call, as for the others
       run.iterations = stats.iterations;
       Eigen::VectorXd x(system.b.size());
       for (int k = 0; k < x.size(); ++k) x[k] = tile.values[system.texel_of_unknown[k]];
@@ -182,6 +188,7 @@ LaplaceBenchRun run_once(LaplaceBenchSolver solver, const kernels::TexelTile& pr
 std::string laplace_bench_solver_name(LaplaceBenchSolver solver) {
   switch (solver) {
     case LaplaceBenchSolver::multigrid: return "multigrid";
+    case LaplaceBenchSolver::multigrid_robust: return "multigrid_robust";
     case LaplaceBenchSolver::cholmod: return "cholmod";
     case LaplaceBenchSolver::cholmod_solve: return "cholmod_solve";
     case LaplaceBenchSolver::eigen_ichol_cg: return "eigen_ichol_cg";
@@ -191,7 +198,8 @@ std::string laplace_bench_solver_name(LaplaceBenchSolver solver) {
 }
 
 const std::vector<LaplaceBenchSolver>& all_laplace_bench_solvers() {
-  static const std::vector<LaplaceBenchSolver> solvers = {LaplaceBenchSolver::multigrid, LaplaceBenchSolver::cholmod,
+  static const std::vector<LaplaceBenchSolver> solvers = {LaplaceBenchSolver::multigrid,
+                                                          LaplaceBenchSolver::multigrid_robust, LaplaceBenchSolver::cholmod,
                                                           LaplaceBenchSolver::cholmod_solve,
                                                           LaplaceBenchSolver::eigen_ichol_cg, LaplaceBenchSolver::boomeramg};
   return solvers;
@@ -201,7 +209,7 @@ LaplaceBenchSolver parse_laplace_bench_solver(const std::string& name) {
   for (LaplaceBenchSolver s : all_laplace_bench_solvers())
     if (laplace_bench_solver_name(s) == name) return s;
   throw std::invalid_argument("unknown solver '" + name +
-                              "'; valid: multigrid, cholmod, cholmod_solve, eigen_ichol_cg, boomeramg");
+                              "'; valid: multigrid, multigrid_robust, cholmod, cholmod_solve, eigen_ichol_cg, boomeramg");
 }
 
 LaplaceBenchRun run_laplace_bench_solver(LaplaceBenchSolver solver, const kernels::TexelTile& problem,
@@ -217,6 +225,7 @@ LaplaceBenchRun run_laplace_bench_solver(LaplaceBenchSolver solver, const kernel
       best.ms = run.ms;
       best.residual = run.residual;
       best.iterations = run.iterations;
+      best.setup_ms = run.setup_ms;
     }
   }
   return best;
@@ -224,19 +233,15 @@ LaplaceBenchRun run_laplace_bench_solver(LaplaceBenchSolver solver, const kernel
 
 SmootherBandwidth measure_smoother_bandwidth(int T, int repeat) {
   const kernels::TexelTile tile = make_laplace_domain(LaplaceDomain::open, T);
-  std::vector<std::uint8_t> tile_bits;
-  kernels::classify_laplace_texels(tile, tile_bits);
   const kernels::GridShape g{T, T};
   std::vector<std::uint8_t> bits(g.padded_size(), 0);
-  for (int j = 0; j < T; ++j)
-    for (int i = 0; i < T; ++i) bits[g.at(i, j)] = tile_bits[tile.index(i, j)];
+  kernels::classify_laplace_texels_padded(tile, bits.data());
   std::vector<double> x(g.padded_size(), 0.5), b(g.padded_size(), 0.25), copy_src(g.padded_size(), 1.0),
       copy_dst(g.padded_size(), 0.0);
   double best_smooth = 1e300, best_copy = 1e300;
   for (int k = 0; k < std::max(1, repeat); ++k) {
     auto start = Clock::now();
-    kernels::smooth_texels_color(g, bits.data(), b.data(), x.data(), 0);
-    kernels::smooth_texels_color(g, bits.data(), b.data(), x.data(), 1);
+    kernels::smooth_texels_sweep(g, bits.data(), b.data(), x.data(), k % 2 == 0);
     best_smooth = std::min(best_smooth, ms_since(start));
     start = Clock::now();
     const std::int64_t n = static_cast<std::int64_t>(copy_src.size());

@@ -28,6 +28,7 @@ TexelLaplaceSystem assemble_texel_laplace_system(const kernels::TexelTile& tile)
   // Columns in texel order: south, west, self, east, north are increasing texel indices,
   // so the compressed matrix is filled directly without sorting.
   system.A.resize(n, n);
+  if (n == 0) return system;  // reserve() on an empty matrix leaves Eigen reading past its index array
   system.A.reserve(Eigen::VectorXi::Constant(n, 5));
   for (int k = 0; k < n; ++k) {
     const int t = system.texel_of_unknown[k], i = t % w, j = t / w;

@@ -6,6 +6,7 @@
 #include <string>
 
 #include <Eigen/CholmodSupport>
+#include <Eigen/Dense>
 #include <Eigen/SparseCore>
 
 #include "dgtex/kernels/multigrid_galerkin.h"
@@ -14,6 +15,29 @@
 #include "dgtex/kernels/multigrid_transfer.h"
 #include "dgtex/kernels/multigrid_unknowns.h"
 
+// Choices, measured with T=256/1024 single-element solves to 1e-6 from zero (1 thread):
+// - V(1,1) as CG preconditioner (default): 6 iterations on open/slit/accordion (0.085 per
+//   iteration) where stand-alone V(1,1) cycles need 10 (0.23); V(2,2)-CG needs 5 but costs
+//   the same time; F-cycles alone do not help the hard domains (spiral 0.69 per cycle).
+// - Level 0 streams: each red-black sweep is one pass over the rows (the second colour lags
+//   one row), the black residual after a forward sweep is zero so only red residuals are
+//   formed and restricted, the coarse correction goes to red nodes only (black is
+//   recomputed next), the CG's r.z comes out of the last sweep and p-update + A p + p.Ap are
+//   one pass. Together with the setup below: T=256 open 17.6 -> ~8 ms, T=1024 551 -> ~215 ms
+//   (CPU time on a loaded 2-core machine; `dgtex bench laplace` gives wall times).
+// - Robust cycle (options.coarse_solve_tolerance > 0, not the default): the hard domains fail
+//   the 0.1-per-cycle target because coarse spaces from level 2 on miss the slow modes of
+//   sub-grid features (multigrid_galerkin.h); level 1 with an exact solve gives <= 0.082.
+//   Solving level 1 in every cycle by CG with its own V-cycle to 2% restores that: 0.08-0.094
+//   per cycle on all test domains at T=128/256, 0.092 spiral and 0.104 chad at T=1024 (6-7
+//   iterations instead of 13-22). It costs 1.05-1.4x the plain cycle's time on the measured
+//   domains (CPU: chad T=256 13 -> 18 ms, T=1024 549 -> 767 ms; open T=256 7.9 -> 11 ms),
+//   so the fast plain cycle stays the default. Fixed inner iteration counts were worse (6
+//   inner steps: chad T=1024 0.20 per cycle); the outer CG must then be flexible.
+// - Setup: components by union-find over texel runs instead of a per-texel flood fill
+//   (T=1024: ~100 -> ~23 ms), Galerkin products unrolled at compile time (T=1024 level 0:
+//   60-100 -> ~10 ms), dense Cholesky for coarsest levels up to 400 unknowns (CHOLMOD's
+//   analysis alone costs more for the usual 8x8 level).
 namespace dgtex {
 using kernels::Execution;
 using kernels::GridShape;
@@ -25,6 +49,8 @@ double ms_since(Clock::time_point start) { return std::chrono::duration<double, 
 
 // Levels smaller than this run serially: a parallel region costs more than the work.
 constexpr long parallel_min_nodes = 16384;
+// Coarsest levels up to this many unknowns are factored densely.
+constexpr int dense_coarsest_max = 400;
 
 double sum_in_order(const std::vector<double>& rows) {
   double sum = 0;
@@ -57,6 +83,12 @@ struct LaplaceMultigrid::Hierarchy {
   std::vector<double> cg_z, cg_p, cg_q;  // preconditioned CG vectors (level-0 layout)
   std::vector<std::int64_t> coarsest_nodes;
   Eigen::CholmodSupernodalLLT<Eigen::SparseMatrix<double>, Eigen::Lower> coarsest_factor;
+  Eigen::LLT<Eigen::MatrixXd> coarsest_dense;  // used up to dense_coarsest_max unknowns
+  bool coarsest_is_dense = false;
+  std::vector<double> cg_x, cg_r, cg_b;      // preconditioned CG iterate, residual, saved rhs
+  std::vector<double> k_x, k_r, k_z, k_p, k_q, k_b, k_zero, coarse_rows;  // level-1 CG of the robust cycle
+  static constexpr int coarse_solve_max_iterations = 50;
+  bool robust_coarse_solve() const { return options.coarse_solve_tolerance > 0 && levels.size() > 2; }
   int orphans_at_stop = 0;
   double setup_ms = 0;
 
@@ -69,19 +101,13 @@ struct LaplaceMultigrid::Hierarchy {
     width = tile.width;
     height = tile.height;
     tile_flags = tile.flags;
-    std::vector<std::uint8_t> tile_bits;
-    kernels::classify_laplace_texels(tile, tile_bits);
-
     Level fine;
     fine.shape = {width, height};
     fine.execution = execution_for(fine.shape);
-    bits.assign(fine.shape.padded_size(), 0);
-    fine.active.assign(fine.shape.padded_size(), 0);
-    for (int j = 0; j < height; ++j)
-      for (int i = 0; i < width; ++i) {
-        bits[fine.shape.at(i, j)] = tile_bits[tile.index(i, j)];
-        fine.active[fine.shape.at(i, j)] = (tile_bits[tile.index(i, j)] & kernels::is_unknown) ? 1 : 0;
-      }
+    bits.resize(fine.shape.padded_size());
+    kernels::classify_laplace_texels_padded(tile, bits.data(), fine.execution);
+    fine.active.resize(fine.shape.padded_size());
+    for (std::size_t t = 0; t < bits.size(); ++t) fine.active[t] = (bits[t] & kernels::is_unknown) ? 1 : 0;
     fine.x.assign(fine.shape.padded_size(), 0.0);
     fine.b = fine.r = fine.x;
     levels.clear();
@@ -121,9 +147,14 @@ struct LaplaceMultigrid::Hierarchy {
     std::size_t rows = 0;
     for (const Level& level : levels) rows = std::max<std::size_t>(rows, level.shape.ny);
     row_partial.assign(rows, 0.0);
+    if (robust_coarse_solve()) {
+      const std::size_t n1 = levels[1].shape.padded_size();
+      for (auto* v : {&k_x, &k_r, &k_z, &k_p, &k_q, &k_b, &k_zero}) v->assign(n1, 0.0);
+      coarse_rows.assign(levels[1].shape.ny, 0.0);
+    }
     if (options.use_as_cg_preconditioner) {
       cg_z.assign(levels[0].shape.padded_size(), 0.0);
-      cg_p = cg_q = cg_z;
+      cg_p = cg_q = cg_x = cg_r = cg_b = cg_z;
     }
   }
 
@@ -188,24 +219,31 @@ struct LaplaceMultigrid::Hierarchy {
     }
     Eigen::SparseMatrix<double> m(n, n);
     m.setFromTriplets(entries.begin(), entries.end());
-    if (n > 0) coarsest_factor.compute(m);
-    if (n > 0 && coarsest_factor.info() != Eigen::Success)
+    // A dense factor for small coarsest levels: CHOLMOD's analysis alone costs more than
+    // factoring a few hundred unknowns densely (measured ~0.2 ms vs ~0.02 ms for 64).
+    coarsest_is_dense = n <= dense_coarsest_max;
+    bool ok = true;
+    if (n > 0 && coarsest_is_dense) {
+      coarsest_dense.compute(Eigen::MatrixXd(m));
+      ok = coarsest_dense.info() == Eigen::Success;
+    } else if (n > 0) {
+      coarsest_factor.compute(m);
+      ok = coarsest_factor.info() == Eigen::Success;
+    }
+    if (!ok)
       throw std::runtime_error("Laplace multigrid: the coarsest operator (" + std::to_string(n) +
                                " nodes) is not positive definite; this is a bug, please report the tile");
   }
 
-  void smooth(std::size_t l, bool forward, int sweeps) {
+  void smooth(std::size_t l, bool forward, int sweeps, double* last_row_dot = nullptr) {
     Level& level = levels[l];
     for (int sweep = 0; sweep < sweeps; ++sweep) {
-      if (l == 0) {
-        for (int k = 0; k < 2; ++k)
-          kernels::smooth_texels_color(level.shape, bits.data(), level.b.data(), level.x.data(), forward ? k : 1 - k,
+      if (l == 0)
+        kernels::smooth_texels_sweep(level.shape, bits.data(), level.b.data(), level.x.data(), forward, level.execution,
+                                     sweep + 1 == sweeps ? last_row_dot : nullptr);
+      else
+        kernels::smooth_stencil9_sweep(level.shape, level.stencil(), level.b.data(), level.x.data(), forward,
                                        level.execution);
-      } else {
-        for (int k = 0; k < 4; ++k)
-          kernels::smooth_stencil9_color(level.shape, level.stencil(), level.b.data(), level.x.data(),
-                                         forward ? k : 3 - k, level.execution);
-      }
     }
   }
 
@@ -225,28 +263,72 @@ struct LaplaceMultigrid::Hierarchy {
     if (n == 0) return;
     Eigen::VectorXd rhs(n);
     for (int k = 0; k < n; ++k) rhs[k] = level.b[coarsest_nodes[k]];
-    const Eigen::VectorXd solution = coarsest_factor.solve(rhs);
+    const Eigen::VectorXd solution = coarsest_is_dense ? Eigen::VectorXd(coarsest_dense.solve(rhs))
+                                                       : Eigen::VectorXd(coarsest_factor.solve(rhs));
     for (int k = 0; k < n; ++k) level.x[coarsest_nodes[k]] = solution[k];
   }
 
-  // One cycle on level l for A_l x_l = b_l, improving x_l in place.
-  void cycle(std::size_t l, MultigridCycle type) {
+  // One cycle on level l for A_l x_l = b_l, improving x_l in place (x_l = 0 on entry if
+  // zero_guess; then it need not be initialised).
+  //
+  // Level 0 exploits red-black structure (exact-arithmetic identities, so the cycle is the
+  // same linear operator and stays symmetric for CG): after the forward sweep the black
+  // residual vanishes, so only red residuals are computed and restricted; the backward sweep
+  // starts black, and black updates ignore old black values, so only red nodes receive the
+  // coarse correction. This halves residual, restriction and prolongation traffic.
+  // row_dot (level 0 with post-smoothing only): per-row sums of b * x of the result.
+  // first_sweep_done (level 0, zero_guess): x already holds the first forward sweep from zero
+  // (done by the fused CG update).
+  void cycle(std::size_t l, MultigridCycle type, bool zero_guess, double* row_dot = nullptr,
+             bool first_sweep_done = false) {
+    Level& level = levels[l];
     if (l + 1 == levels.size()) {
-      solve_coarsest();
+      if (zero_guess) std::fill(level.x.begin(), level.x.end(), 0.0);
+      solve_coarsest();  // exact: overwrites every unknown
       return;
     }
-    Level& level = levels[l];
     Level& coarse = levels[l + 1];
-    smooth(l, true, options.pre_smoothing);
-    residual(l, nullptr);
-    kernels::restrict_residual(level.shape, coarse.shape, coarse.interpolation(), level.r.data(), coarse.b.data(),
-                               coarse.execution);
-    std::fill(coarse.x.begin(), coarse.x.end(), 0.0);
-    cycle(l + 1, type);
-    if (type == MultigridCycle::f) cycle(l + 1, MultigridCycle::v);
-    kernels::prolong_correction(level.shape, coarse.shape, coarse.interpolation(), coarse.x.data(),
-                                level.active.data(), level.x.data(), level.execution);
-    smooth(l, false, options.post_smoothing);
+    const int pre = options.pre_smoothing, post = options.post_smoothing;
+    if (l == 0) {
+      int sweeps = pre;
+      if (zero_guess && sweeps > 0) {
+        if (!first_sweep_done)
+          kernels::smooth_texels_sweep_from_zero(level.shape, bits.data(), level.b.data(), level.x.data(),
+                                                 level.execution);
+        --sweeps;
+      } else if (zero_guess) {
+        std::fill(level.x.begin(), level.x.end(), 0.0);
+      }
+      smooth(0, true, sweeps);
+      if (pre > 0) {
+        kernels::residual_texels_color(level.shape, bits.data(), level.b.data(), level.x.data(), level.r.data(), 0,
+                                       level.execution);
+        kernels::restrict_red_residual(level.shape, coarse.shape, coarse.interpolation(), level.r.data(),
+                                       coarse.b.data(), coarse.execution);
+      } else {
+        residual(0, nullptr);
+        kernels::restrict_residual(level.shape, coarse.shape, coarse.interpolation(), level.r.data(),
+                                   coarse.b.data(), coarse.execution);
+      }
+    } else {
+      if (zero_guess) std::fill(level.x.begin(), level.x.end(), 0.0);
+      smooth(l, true, pre);
+      residual(l, nullptr);
+      kernels::restrict_residual(level.shape, coarse.shape, coarse.interpolation(), level.r.data(), coarse.b.data(),
+                                 coarse.execution);
+    }
+    if (l == 0 && robust_coarse_solve())
+      solve_level1_by_cg();
+    else
+      cycle(l + 1, type, true);
+    if (type == MultigridCycle::f) cycle(l + 1, MultigridCycle::v, false);
+    if (l == 0 && post > 0)
+      kernels::prolong_correction_red(level.shape, coarse.shape, coarse.interpolation(), coarse.x.data(),
+                                      level.active.data(), level.x.data(), level.execution);
+    else
+      kernels::prolong_correction(level.shape, coarse.shape, coarse.interpolation(), coarse.x.data(),
+                                  level.active.data(), level.x.data(), level.execution);
+    smooth(l, false, post, row_dot);
   }
 
   double level0_residual_norm() {
@@ -257,6 +339,74 @@ struct LaplaceMultigrid::Hierarchy {
   }
 
   // Deterministic dot product over the level-0 layout (rows summed in order).
+  // Deterministic dot product on level l (rows summed in order).
+  double dot_on(std::size_t l, const std::vector<double>& a, const std::vector<double>& b) {
+    const GridShape g = levels[l].shape;
+    kernels::forall(
+        g.ny,
+        [&](std::int64_t j) {
+          const std::int64_t row = g.at(0, static_cast<int>(j));
+          double sum = 0;
+          for (int i = 0; i < g.nx; ++i) sum += a[row + i] * b[row + i];
+          coarse_rows[j] = sum;
+        },
+        levels[l].execution);
+    double sum = 0;
+    for (int j = 0; j < g.ny; ++j) sum += coarse_rows[j];
+    return sum;
+  }
+
+  // Level 1 solved to options.coarse_solve_tolerance by CG preconditioned with the level-1
+  // V-cycle, from x = 0 (the coarse solve of the robust cycle).
+  void solve_level1_by_cg() {
+    Level& level = levels[1];
+    const GridShape g = level.shape;
+    const Execution ex = level.execution;
+    k_b.swap(level.b);  // the right-hand side; level.b is the preconditioner's input from here
+    std::copy(k_b.begin(), k_b.end(), k_r.begin());
+    std::fill(k_x.begin(), k_x.end(), 0.0);
+    const double b2 = dot_on(1, k_r, k_r), target = options.coarse_solve_tolerance * options.coarse_solve_tolerance * b2;
+    double rz = 0, r2 = b2;
+    for (int it = 0; it < coarse_solve_max_iterations && r2 > target; ++it) {
+      level.b.swap(k_r);
+      cycle(1, MultigridCycle::v, true);
+      level.b.swap(k_r);
+      k_z.swap(level.x);
+      const double rz_new = dot_on(1, k_r, k_z);
+      const double beta = it == 0 ? 0.0 : rz_new / rz;
+      rz = rz_new;
+      kernels::forall(
+          g.ny,
+          [&](std::int64_t j) {
+            const std::int64_t row = g.at(0, static_cast<int>(j));
+            for (int i = 0; i < g.nx; ++i) k_p[row + i] = k_z[row + i] + beta * k_p[row + i];
+          },
+          ex);
+      // k_q = 0 - A p (the residual kernel with b = 0).
+      kernels::residual_stencil9(g, level.stencil(), k_zero.data(), k_p.data(), k_q.data(), nullptr, ex);
+      const double pq = -dot_on(1, k_p, k_q);
+      if (!(pq > 0)) break;
+      const double alpha = rz / pq;
+      kernels::forall(
+          g.ny,
+          [&](std::int64_t j) {
+            const std::int64_t row = g.at(0, static_cast<int>(j));
+            double norm2 = 0;
+            for (int i = 0; i < g.nx; ++i) {
+              k_x[row + i] += alpha * k_p[row + i];
+              k_r[row + i] += alpha * k_q[row + i];
+              norm2 += k_r[row + i] * k_r[row + i];
+            }
+            coarse_rows[j] = norm2;
+          },
+          ex);
+      r2 = 0;
+      for (int j = 0; j < g.ny; ++j) r2 += coarse_rows[j];
+    }
+    k_x.swap(level.x);
+    k_b.swap(level.b);
+  }
+
   double dot(const std::vector<double>& a, const std::vector<double>& b) {
     const GridShape g = levels[0].shape;
     row_partial.resize(g.ny);
@@ -278,10 +428,11 @@ LaplaceMultigrid::LaplaceMultigrid(const kernels::TexelTile& tile, LaplaceMultig
   const auto start = Clock::now();
   validate_laplace_tile(tile);
   if (!(options.tolerance > 0) || options.max_cycles < 1 || options.pre_smoothing < 0 || options.post_smoothing < 0 ||
-      options.pre_smoothing + options.post_smoothing < 1 || options.coarsest_nodes < 1)
+      options.pre_smoothing + options.post_smoothing < 1 || options.coarsest_nodes < 1 ||
+      !(options.coarse_solve_tolerance >= 0 && options.coarse_solve_tolerance < 1))
     throw std::invalid_argument(
         "Laplace multigrid: invalid options (need tolerance > 0, max_cycles >= 1, pre/post smoothing >= 0 with at "
-        "least one sweep, coarsest_nodes >= 1)");
+        "least one sweep, coarsest_nodes >= 1, 0 <= coarse_solve_tolerance < 1)");
   if (options.use_as_cg_preconditioner &&
       (options.cycle != MultigridCycle::v || options.pre_smoothing != options.post_smoothing))
     throw std::invalid_argument(
@@ -322,14 +473,18 @@ LaplaceSolveStats LaplaceMultigrid::solve(kernels::TexelTile& tile, std::vector<
           fine.x[t] = 0.0;
           if (!(h.bits[t] & kernels::is_unknown)) continue;
           const int k = tile.index(i, j);
+          // Coupled Dirichlet neighbours (the unknown itself is active), in the order west,
+          // east, south, north, written out on the flags (kernels::texels_coupled_east/north).
+          const std::uint8_t* f = tile.flags.data();
+          constexpr std::uint8_t dirichlet = kernels::dirichlet, inactive = kernels::inactive;
           double b = 0;
-          auto add = [&](bool coupled, int nb) {
-            if (coupled && (tile.flags[nb] & kernels::dirichlet)) b += tile.values[nb];
-          };
-          add(i > 0 && kernels::texels_coupled_east(tile, i - 1, j), k - 1);
-          add(kernels::texels_coupled_east(tile, i, j), k + 1);
-          add(j > 0 && kernels::texels_coupled_north(tile, i, j - 1), k - g.nx);
-          add(kernels::texels_coupled_north(tile, i, j), k + g.nx);
+          if (i > 0 && (f[k - 1] & (kernels::wall_east | inactive | dirichlet)) == dirichlet) b += tile.values[k - 1];
+          if (i + 1 < g.nx && !(f[k] & kernels::wall_east) && (f[k + 1] & (inactive | dirichlet)) == dirichlet)
+            b += tile.values[k + 1];
+          if (j > 0 && (f[k - g.nx] & (kernels::wall_north | inactive | dirichlet)) == dirichlet)
+            b += tile.values[k - g.nx];
+          if (j + 1 < g.ny && !(f[k] & kernels::wall_north) && (f[k + g.nx] & (inactive | dirichlet)) == dirichlet)
+            b += tile.values[k + g.nx];
           fine.b[t] = b;
           if (o.warm_start && std::isfinite(tile.values[k])) fine.x[t] = tile.values[k];
         }
@@ -346,60 +501,75 @@ LaplaceSolveStats LaplaceMultigrid::solve(kernels::TexelTile& tile, std::vector<
     record(relative);
     if (!o.use_as_cg_preconditioner) {
       while (relative > o.tolerance && stats.iterations < o.max_cycles) {
-        h.cycle(0, o.cycle);
+        h.cycle(0, o.cycle, false);
         ++stats.iterations;
         relative = h.level0_residual_norm() / b_norm;
         record(relative);
       }
     } else if (relative > o.tolerance) {
-      // Preconditioned CG on the residual equation: z = V-cycle(r) with zero initial guess.
-      std::vector<double> x = fine.x, r = fine.r, b = fine.b;
-      auto precondition = [&]() {
-        fine.b = r;
-        std::fill(fine.x.begin(), fine.x.end(), 0.0);
-        h.cycle(0, MultigridCycle::v);
+      // Preconditioned CG: z = V-cycle(r) from a zero initial guess. Vectors are swapped in
+      // and out of level 0 (no copies): fine.b holds r while the cycle runs.
+      h.cg_x.swap(fine.x);
+      h.cg_r.swap(fine.r);
+      h.cg_b.swap(fine.b);
+      // z = M r and r . z; the dot product comes out of the last smoothing sweep when there is one.
+      // The first forward sweep from zero can be fused into the CG update of x and r.
+      const bool fused_first_sweep = o.pre_smoothing > 0 && h.levels.size() > 1;
+      auto precondition = [&](bool first_sweep_done) {
+        fine.b.swap(h.cg_r);
+        const bool fused_dot = o.post_smoothing > 0 && h.levels.size() > 1;
+        h.cycle(0, MultigridCycle::v, true, fused_dot ? h.row_partial.data() : nullptr, first_sweep_done);
+        fine.b.swap(h.cg_r);
         h.cg_z.swap(fine.x);
-      };
-      precondition();
-      h.cg_p = h.cg_z;
-      double rz = h.dot(r, h.cg_z);
-      while (relative > o.tolerance && stats.iterations < o.max_cycles) {
-        kernels::apply_texels(g, h.bits.data(), h.cg_p.data(), h.cg_q.data(), h.row_partial.data(), fine.execution);
+        if (!fused_dot) return h.dot(h.cg_r, h.cg_z);
         h.row_partial.resize(g.ny);
-        const double pq = sum_in_order(h.row_partial);
+        return sum_in_order(h.row_partial);
+      };
+      double rz = precondition(false);
+      std::copy(h.cg_z.begin(), h.cg_z.end(), h.cg_p.begin());
+      kernels::apply_texels(g, h.bits.data(), h.cg_p.data(), h.cg_q.data(), h.row_partial.data(), fine.execution);
+      while (relative > o.tolerance && stats.iterations < o.max_cycles) {
+        h.row_partial.resize(g.ny);
+        const double pq = sum_in_order(h.row_partial);  // p . A p
         if (!(pq > 0)) break;  // the search direction vanished: converged to round-off
         const double alpha = rz / pq;
-        kernels::forall(
-            g.ny,
-            [&](std::int64_t j) {
-              const std::int64_t row = g.at(0, static_cast<int>(j));
-              double norm2 = 0;
-              for (int i = 0; i < g.nx; ++i) {
-                x[row + i] += alpha * h.cg_p[row + i];
-                r[row + i] -= alpha * h.cg_q[row + i];
-                norm2 += r[row + i] * r[row + i];
-              }
-              h.row_partial[j] = norm2;
-            },
-            fine.execution);
+        double* x = h.cg_x.data();
+        double* r = h.cg_r.data();
+        const double* pp = h.cg_p.data();
+        const double* q = h.cg_q.data();
+        if (fused_first_sweep) {
+          kernels::cg_update_and_smooth_texels_from_zero(g, h.bits.data(), alpha, pp, q, x, r, fine.x.data(),
+                                                         h.row_partial.data(), fine.execution);
+        } else {
+          kernels::forall(
+              g.ny,
+              [&](std::int64_t j) {
+                const std::int64_t row = g.at(0, static_cast<int>(j));
+                double norm2 = 0;
+                for (int i = 0; i < g.nx; ++i) {
+                  x[row + i] += alpha * pp[row + i];
+                  r[row + i] -= alpha * q[row + i];
+                  norm2 += r[row + i] * r[row + i];
+                }
+                h.row_partial[j] = norm2;
+              },
+              fine.execution);
+        }
         relative = std::sqrt(sum_in_order(h.row_partial)) / b_norm;
         ++stats.iterations;
         record(relative);
         if (relative <= o.tolerance) break;
-        precondition();
-        const double rz_new = h.dot(r, h.cg_z);
-        const double beta = rz_new / rz;
+        const double rz_new = precondition(fused_first_sweep);
+        double beta = rz_new / rz;
+        // The robust cycle's inner CG makes the preconditioner depend on r: flexible CG
+        // (Polak-Ribiere: beta = z_new . (r_new - r_old) / (z_old . r_old), r_new - r_old = -alpha q).
+        if (h.robust_coarse_solve()) beta = -alpha * h.dot(h.cg_z, h.cg_q) / rz;
         rz = rz_new;
-        kernels::forall(
-            g.ny,
-            [&](std::int64_t j) {
-              const std::int64_t row = g.at(0, static_cast<int>(j));
-              for (int i = 0; i < g.nx; ++i) h.cg_p[row + i] = h.cg_z[row + i] + beta * h.cg_p[row + i];
-            },
-            fine.execution);
+        kernels::update_direction_and_apply_texels(g, h.bits.data(), h.cg_z.data(), beta, h.cg_p.data(),
+                                                   h.cg_q.data(), h.row_partial.data(), fine.execution);
       }
-      fine.x.swap(x);
-      fine.b.swap(b);
+      h.cg_x.swap(fine.x);
+      h.cg_b.swap(fine.b);
       relative = h.level0_residual_norm() / b_norm;  // the true residual, not the recursive one
     }
     stats.relative_residual = relative;

@@ -13,6 +13,8 @@
 #include <Eigen/Dense>
 
 #include "dgtex/boundary_selection.h"
+#include "dgtex/cut_path.h"
+#include "dgtex/surface_point.h"
 #include "dgtex/scene_io.h"
 
 namespace dgtex {
@@ -226,9 +228,39 @@ void check_rigid_motions(const Scene& scene, const Mesh& mesh) {
 
 }  // namespace
 
+// cuts[i].points: each within cut_point_tolerance of the surface (they are projected
+// onto it), and a positive length once projected.
+void check_cut_points(const Scene& scene, const Mesh& mesh) {
+  if (mesh.num_elements() == 0) return;
+  const double tolerance = cut_point_tolerance(mesh);
+  for (size_t c = 0; c < scene.cuts.size(); ++c) {
+    const Cut& cut = scene.cuts[c];
+    if (cut.kind != Cut::Kind::points) continue;
+    const std::string path = "cuts[" + std::to_string(c) + "].points";
+    double total = 0;
+    Eigen::Vector3d previous = Eigen::Vector3d::Zero();
+    for (size_t k = 0; k < cut.points.size(); ++k) {
+      const SurfacePoint sp = closest_surface_point(mesh, cut.points[k].data());
+      const Eigen::Vector3d x(sp.position[0], sp.position[1], sp.position[2]);
+      if (sp.distance > tolerance)
+        throw SceneError(scene.source_name, path + "[" + std::to_string(k) + "]", "off the surface",
+                         fmt(Eigen::Vector3d(cut.points[k][0], cut.points[k][1], cut.points[k][2])),
+                         "cut points must lie within " + fmt(tolerance) +
+                             " of the surface (a quarter of the mean element edge); the nearest surface point is " +
+                             fmt(x) + " at distance " + fmt(sp.distance));
+      if (k > 0) total += (x - previous).norm();
+      previous = x;
+    }
+    if (!(total > 0))
+      throw SceneError(scene.source_name, path, "zero-length cut on the surface", "all points project to " + fmt(previous),
+                       "expected points that span a positive length on the surface");
+  }
+}
+
 void check_scene_against_mesh(const Scene& scene, const Mesh& mesh) {
   check_selections(scene, mesh);
   check_surface_points(scene, mesh);
+  check_cut_points(scene, mesh);
   check_rigid_motions(scene, mesh);
 }
 

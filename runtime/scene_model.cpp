@@ -25,16 +25,10 @@ Mesh build_scene_mesh(const Scene& scene) {
 SceneModel build_scene_model(const Scene& scene, const Mesh& mesh) {
   check_scene_against_mesh(scene, mesh);
   const Topology topology = build_topology(mesh);
-  SceneModel out;
-  out.fixed.assign(3 * mesh.num_nodes(), 0);
   std::vector<char> clamp_node(mesh.num_nodes(), 0);
-  for (const BoundaryCondition& bc : scene.boundary) {
-    for (int node : select_nodes(mesh, bc.select)) {
-      for (int c = 0; c < 3; ++c)
-        if (bc.fixed[c]) out.fixed[3 * node + c] = 1;
-      if (bc.clamp) clamp_node[node] = 1;
-    }
-  }
+  for (const BoundaryCondition& bc : scene.boundary)
+    if (bc.clamp)
+      for (int node : select_nodes(mesh, bc.select)) clamp_node[node] = 1;
   // A boundary edge is clamped when all three of its nodes are selected by a clamp.
   std::vector<int> clamped;
   for (size_t k = 0; k < topology.boundary_edges.size(); ++k) {
@@ -46,21 +40,37 @@ SceneModel build_scene_model(const Scene& scene, const Mesh& mesh) {
       mesh.num_elements(), {mat.youngs_modulus, mat.poisson_ratio, mat.thickness, mat.density});
   ShellModelOptions options;
   options.penalty = scene.penalty;
+  SceneModel out;
   out.model = std::make_unique<ShellModel>(mesh, topology, sections, clamped, options);
+  out.fixed = scene_fixed_dofs(scene, *out.model);
+  out.external_force = scene_external_force(scene, *out.model);
+  return out;
+}
 
-  out.external_force.assign(out.model->num_dofs(), 0.0);
+std::vector<char> scene_fixed_dofs(const Scene& scene, const ShellModel& model) {
+  const Mesh& mesh = model.mesh();
+  std::vector<char> fixed(model.num_dofs(), 0);  // enriched DOFs stay free (see the header)
+  for (const BoundaryCondition& bc : scene.boundary)
+    for (int node : select_nodes(mesh, bc.select))
+      for (int c = 0; c < 3; ++c)
+        if (bc.fixed[c]) fixed[3 * node + c] = 1;
+  return fixed;
+}
+
+std::vector<double> scene_external_force(const Scene& scene, const ShellModel& model) {
+  std::vector<double> f(model.num_dofs(), 0.0);
   for (const Load& load : scene.loads) {
     switch (load.type) {
-      case Load::Type::gravity: out.model->add_gravity(load.acceleration.data(), out.external_force); break;
-      case Load::Type::area_force: out.model->add_area_force(load.force_per_area.data(), out.external_force); break;
+      case Load::Type::gravity: model.add_gravity(load.acceleration.data(), f); break;
+      case Load::Type::area_force: model.add_area_force(load.force_per_area.data(), f); break;
       case Load::Type::point: {
-        const SurfacePoint p = closest_surface_point(mesh, load.position.data());
-        out.model->add_point_force(p.element, p.xi, load.force.data(), out.external_force);
+        const SurfacePoint p = closest_surface_point(model.mesh(), load.position.data());
+        model.add_point_force(p.element, p.xi, load.force.data(), f);
         break;
       }
     }
   }
-  return out;
+  return f;
 }
 
 }  // namespace dgtex

@@ -1,10 +1,12 @@
 #include "dgtex/shell_model.h"
 
 #include <algorithm>
+#include <cmath>
 #include <stdexcept>
 #include <string>
 
 #include "dgtex/kernels/polar_decomposition.h"
+#include "dgtex/kernels/shell_point.h"
 #include "dgtex/mesh_validation.h"
 
 namespace dgtex {
@@ -15,7 +17,6 @@ ShellModel::ShellModel(Mesh mesh, const Topology& topology, std::vector<kernels:
                        const std::vector<int>& clamped_edges, ShellModelOptions options)
     : mesh_(std::move(mesh)), sections_(std::move(sections)), options_(options) {
   const int ne = mesh_.num_elements();
-  const int npe = mesh_.nodes_per_element();
   if (static_cast<int>(sections_.size()) != ne)
     throw std::invalid_argument("ShellModel: " + std::to_string(sections_.size()) + " sections for " +
                                 std::to_string(ne) + " elements");
@@ -32,48 +33,270 @@ ShellModel::ShellModel(Mesh mesh, const Topology& topology, std::vector<kernels:
     edges_.insert(edges_.end(), {edge.plus_element, edge.plus_local_edge, -1, -1});
     edge_size_.push_back(size_of_element[edge.plus_element]);
   }
+  function_slot_start_.assign(1, 0);
+  rebuild();
+}
 
-  BlockSourceFamily elements{ne, npe, mesh_.elements};
-  BlockSourceFamily edges{num_edges(), 2 * npe, std::vector<int>(static_cast<size_t>(num_edges()) * 2 * npe, -1)};
-  for (int k = 0; k < num_edges(); ++k)
+// Splits elements and edges into plain and enriched ones, then builds the pattern, the
+// quadrature of the enriched ones, the mass and the load weights. Without enrichments
+// the plain arrays are the whole mesh and every result is that of the plain DG shell.
+void ShellModel::rebuild() {
+  const int ne = mesh_.num_elements();
+  const int npe = mesh_.nodes_per_element();
+  const bool enriched = !enriched_elements_.empty();
+  plain_connectivity_.clear();
+  plain_sections_.clear();
+  for (int e = 0; e < ne; ++e)
+    if (!enriched || enriched_index_[e] < 0) {
+      plain_connectivity_.insert(plain_connectivity_.end(), mesh_.element_nodes(e), mesh_.element_nodes(e) + npe);
+      plain_sections_.push_back(sections_[e]);
+    }
+  plain_edges_.clear();
+  plain_edge_size_.clear();
+  enriched_edges_.clear();
+  enriched_edge_size_.clear();
+  for (int k = 0; k < num_edges(); ++k) {
+    const int plus = edges_[4 * k], minus = edges_[4 * k + 2];
+    const bool touches = enriched && (enriched_index_[plus] >= 0 || (minus >= 0 && enriched_index_[minus] >= 0));
+    std::vector<int>& list = touches ? enriched_edges_ : plain_edges_;
+    list.insert(list.end(), edges_.begin() + 4 * k, edges_.begin() + 4 * k + 4);
+    (touches ? enriched_edge_size_ : plain_edge_size_).push_back(edge_size_[k]);
+  }
+  const int num_plain = static_cast<int>(plain_sections_.size());
+  const int num_plain_edges = static_cast<int>(plain_edge_size_.size());
+
+  std::vector<BlockSourceFamily> families;
+  families.push_back({num_plain, npe, plain_connectivity_});
+  BlockSourceFamily edges{num_plain_edges, 2 * npe, std::vector<int>(static_cast<size_t>(num_plain_edges) * 2 * npe, -1)};
+  for (int k = 0; k < num_plain_edges; ++k)
     for (int side = 0; side < 2; ++side) {
-      const int element = edges_[4 * k + 2 * side];
+      const int element = plain_edges_[4 * k + 2 * side];
       if (element < 0) continue;
       std::copy_n(mesh_.element_nodes(element), npe, edges.global_nodes.begin() + (static_cast<size_t>(k) * 2 + side) * npe);
     }
-  assembly_ = BlockAssembly(mesh_.num_nodes(), {elements, edges});
+  families.push_back(std::move(edges));
+
+  const kernels::EnrichedElementBatch eb = enriched_element_batch();
+  const kernels::EnrichedEdgeBatch gb = enriched_edge_batch(eb);
+  if (enriched) {
+    kernels::enriched_element_quadrature(eb, options_.enrichment_quadrature, element_qp_start_, element_qp_);
+    kernels::enriched_edge_quadrature(gb, options_.enrichment_quadrature, edge_qp_start_, edge_qp_);
+    families.push_back({num_enriched_elements(), width_, enriched_global_nodes_});
+    BlockSourceFamily enriched_edges{num_enriched_edges(), 2 * width_,
+                                     std::vector<int>(static_cast<size_t>(num_enriched_edges()) * 2 * width_)};
+    for (int k = 0; k < num_enriched_edges(); ++k)
+      kernels::enriched_edge_global_nodes(gb, k, enriched_edges.global_nodes.data() + static_cast<size_t>(k) * 2 * width_);
+    families.push_back(std::move(enriched_edges));
+  } else {
+    element_qp_start_.clear();
+    element_qp_.clear();
+    edge_qp_start_.clear();
+    edge_qp_.clear();
+  }
+  assembly_ = BlockAssembly(mesh_.num_nodes() + num_enriched_nodes(), families);
 
   // Mass and load weights depend on the rest geometry only.
-  std::vector<double> element_mass(static_cast<size_t>(ne) * npe * npe);
+  std::vector<double> element_mass(static_cast<size_t>(num_plain) * npe * npe);
   kernels::shell_element_mass(element_batch(), element_mass.data());
-  std::vector<double> mass_local(static_cast<size_t>(ne) * npe * npe * 9, 0.0);
+  std::vector<double> mass_local(static_cast<size_t>(num_plain) * npe * npe * 9, 0.0);
   for (size_t i = 0; i < element_mass.size(); ++i)
     for (int d = 0; d < 3; ++d) mass_local[i * 9 + d * 4] = element_mass[i];
+  std::vector<const double*> locals = {mass_local.data(), nullptr};
+  std::vector<double> enriched_mass_local;
+  if (enriched) {
+    std::vector<double> mass(static_cast<size_t>(num_enriched_elements()) * width_ * width_);
+    kernels::enriched_element_mass(eb, {element_qp_start_.data(), element_qp_.data()}, mass.data());
+    enriched_mass_local.assign(mass.size() * 9, 0.0);
+    for (size_t i = 0; i < mass.size(); ++i)
+      for (int d = 0; d < 3; ++d) enriched_mass_local[i * 9 + d * 4] = mass[i];
+    locals.insert(locals.end(), {enriched_mass_local.data(), nullptr});
+  }
   mass_blocks_.resize(assembly_.num_blocks() * 9);
-  assembly_.assemble_matrix({mass_local.data(), nullptr}, mass_blocks_.data());
-  area_weights_.resize(static_cast<size_t>(ne) * npe);
-  mass_weights_.resize(static_cast<size_t>(ne) * npe);
+  assembly_.assemble_matrix(locals, mass_blocks_.data());
+  area_weights_.resize(static_cast<size_t>(num_plain) * npe);
+  mass_weights_.resize(static_cast<size_t>(num_plain) * npe);
   kernels::shell_element_load_weights(element_batch(), area_weights_.data(), mass_weights_.data());
+  enriched_area_weights_.assign(static_cast<size_t>(num_enriched_elements()) * width_, 0.0);
+  enriched_mass_weights_.assign(enriched_area_weights_.size(), 0.0);
+  if (enriched)
+    kernels::enriched_element_load_weights(eb, {element_qp_start_.data(), element_qp_.data()},
+                                           enriched_area_weights_.data(), enriched_mass_weights_.data());
+  rest_state_ = mesh_.positions;
+  rest_state_.resize(num_dofs(), 0.0);
+}
+
+void ShellModel::install_enrichments(std::vector<EnrichmentFunction> functions) {
+  const int ne = mesh_.num_elements();
+  const int nn = mesh_.num_nodes();
+  const int npe = mesh_.nodes_per_element();
+  const ElementType type = mesh_.type;
+  auto fail = [](int i, const std::string& what) {
+    throw std::invalid_argument("enrichment function " + std::to_string(i) + ": " + what);
+  };
+  // Validation.
+  int resolution = 0;
+  for (int i = 0; i < static_cast<int>(functions.size()); ++i) {
+    const EnrichmentFunction& f = functions[i];
+    for (size_t k = 0; k < f.enriched_nodes.size(); ++k) {
+      const int a = f.enriched_nodes[k];
+      if (a < 0 || a >= nn) fail(i, "enriched node " + std::to_string(a) + " out of range [0, " + std::to_string(nn) + ")");
+      if (k > 0 && a <= f.enriched_nodes[k - 1]) fail(i, "enriched nodes must be sorted and unique (node " + std::to_string(a) + ")");
+    }
+    for (size_t k = 0; k < f.elements.size(); ++k) {
+      const ElementTexture& et = f.elements[k];
+      if (et.element < 0 || et.element >= ne)
+        fail(i, "element " + std::to_string(et.element) + " out of range [0, " + std::to_string(ne) + ")");
+      if (k > 0 && et.element <= f.elements[k - 1].element)
+        fail(i, "elements must be sorted and unique (element " + std::to_string(et.element) + ")");
+      const kernels::TexelTile& tile = et.tile;
+      if (resolution == 0) resolution = tile.width;
+      if (tile.width < 1 || tile.width != resolution || tile.height != resolution ||
+          tile.values.size() != static_cast<size_t>(resolution) * resolution || tile.flags.size() != tile.values.size())
+        fail(i, "the texture of element " + std::to_string(et.element) + " is " + std::to_string(tile.width) + "x" +
+                    std::to_string(tile.height) + " with " + std::to_string(tile.values.size()) +
+                    " values; every texture must be T x T with T*T values and flags (T = " +
+                    std::to_string(resolution) + " from the first one)");
+      for (double v : tile.values)
+        if (!std::isfinite(v)) fail(i, "the texture of element " + std::to_string(et.element) + " has a non-finite value");
+    }
+  }
+  // Node -> incident (element, local node), elements ascending.
+  std::vector<std::vector<std::pair<int, int>>> incident(nn);
+  for (int e = 0; e < ne; ++e)
+    for (int a = 0; a < npe; ++a) incident[mesh_.element_nodes(e)[a]].push_back({e, a});
+
+  enrichments_ = std::move(functions);
+  resolution_ = resolution;
+  function_slot_start_.assign(1, 0);
+  virtual_node_function_.clear();
+  virtual_node_mesh_node_.clear();
+  virtual_node_shift_.clear();
+  auto texture_of = [&](int i, int element) -> const kernels::TexelTile* {
+    const auto& list = enrichments_[i].elements;
+    auto it = std::lower_bound(list.begin(), list.end(), element,
+                               [](const ElementTexture& et, int e) { return et.element < e; });
+    return it != list.end() && it->element == element ? &it->tile : nullptr;
+  };
+  for (int i = 0; i < static_cast<int>(enrichments_.size()); ++i) {
+    for (int a : enrichments_[i].enriched_nodes) {
+      double sum = 0;
+      for (const auto& [e, local] : incident[a]) {
+        const kernels::TexelTile* tile = texture_of(i, e);
+        if (!tile)
+          fail(i, "element " + std::to_string(e) + " is incident to enriched node " + std::to_string(a) +
+                      " but has no texture (Omega_i must hold every element incident to N_i)");
+        double xi[2];
+        kernels::node_parametric_position(type, local, xi);
+        kernels::TextureSample sample;
+        kernels::sample_texture(type, resolution, {tile->values.data(), tile->flags.data()}, xi[0], xi[1], sample);
+        sum += sample.value;
+      }
+      virtual_node_function_.push_back(i);
+      virtual_node_mesh_node_.push_back(a);
+      virtual_node_shift_.push_back(incident[a].empty() ? 0.0 : sum / static_cast<double>(incident[a].size()));
+    }
+    function_slot_start_.push_back(static_cast<int>(virtual_node_function_.size()));
+  }
+
+  // Element enrichments, grouped per element in the order of the functions.
+  struct ElementEnrichment {
+    const kernels::TexelTile* tile;
+    int nodes[kernels::max_element_nodes];
+    double shifts[kernels::max_element_nodes];
+  };
+  std::vector<std::vector<ElementEnrichment>> per_element(ne);
+  for (int i = 0; i < static_cast<int>(enrichments_.size()); ++i)
+    for (const ElementTexture& et : enrichments_[i].elements) {
+      ElementEnrichment ee{&et.tile, {}, {}};
+      bool any = false;
+      for (int a = 0; a < npe; ++a) {
+        const int v = virtual_node(i, mesh_.element_nodes(et.element)[a]);
+        ee.nodes[a] = v;
+        ee.shifts[a] = v >= 0 ? virtual_node_shift_[v - nn] : 0.0;
+        any = any || v >= 0;
+      }
+      if (any) per_element[et.element].push_back(ee);
+    }
+  enriched_elements_.clear();
+  enriched_index_.assign(ne, -1);
+  enrichment_start_.assign(1, 0);
+  textures_.clear();
+  enriched_node_.clear();
+  enriched_shift_.clear();
+  for (int e = 0; e < ne; ++e) {
+    if (per_element[e].empty()) continue;
+    if (static_cast<int>(per_element[e].size()) > kernels::max_enrichments_per_element)
+      throw std::invalid_argument("enrichment: element " + std::to_string(e) + " carries " +
+                                  std::to_string(per_element[e].size()) + " enrichment functions; at most " +
+                                  std::to_string(kernels::max_enrichments_per_element) + " are supported");
+    enriched_index_[e] = static_cast<int>(enriched_elements_.size());
+    enriched_elements_.push_back(e);
+    for (const ElementEnrichment& ee : per_element[e]) {
+      textures_.push_back({ee.tile->values.data(), ee.tile->flags.data()});
+      enriched_node_.insert(enriched_node_.end(), ee.nodes, ee.nodes + npe);
+      enriched_shift_.insert(enriched_shift_.end(), ee.shifts, ee.shifts + npe);
+    }
+    enrichment_start_.push_back(static_cast<int>(textures_.size()));
+  }
+  width_ = 0;
+  kernels::EnrichedElementBatch eb = enriched_element_batch();
+  for (int e = 0; e < num_enriched_elements(); ++e) width_ = std::max(width_, kernels::enriched_basis_count(eb, e));
+  eb.width = width_;
+  enriched_global_nodes_.assign(static_cast<size_t>(num_enriched_elements()) * width_, -1);
+  for (int e = 0; e < num_enriched_elements(); ++e)
+    kernels::enriched_global_nodes(eb, e, enriched_global_nodes_.data() + static_cast<size_t>(e) * width_);
+  rebuild();
+}
+
+int ShellModel::virtual_node(int function, int node) const {
+  if (function < 0 || function >= static_cast<int>(enrichments_.size())) return -1;
+  const auto& nodes = enrichments_[function].enriched_nodes;
+  const auto it = std::lower_bound(nodes.begin(), nodes.end(), node);
+  if (it == nodes.end() || *it != node) return -1;
+  return mesh_.num_nodes() + function_slot_start_[function] + static_cast<int>(it - nodes.begin());
 }
 
 kernels::ElementBatch ShellModel::element_batch() const {
-  return {mesh_.type, mesh_.num_elements(), mesh_.elements.data(), mesh_.positions.data(), sections_.data()};
+  return {mesh_.type, static_cast<std::int64_t>(plain_sections_.size()), plain_connectivity_.data(),
+          mesh_.positions.data(), plain_sections_.data()};
 }
 
 kernels::EdgeBatch ShellModel::edge_batch() const {
-  return {mesh_.type,        num_edges(),          edges_.data(),           edge_size_.data(),
-          options_.penalty,  options_.edge_quadrature_points, mesh_.elements.data(), mesh_.positions.data(),
+  return {mesh_.type,       static_cast<std::int64_t>(plain_edge_size_.size()),
+          plain_edges_.data(), plain_edge_size_.data(),
+          options_.penalty, options_.edge_quadrature_points,
+          mesh_.elements.data(), mesh_.positions.data(),
           sections_.data()};
 }
 
+kernels::EnrichedElementBatch ShellModel::enriched_element_batch() const {
+  return {mesh_.type,        static_cast<std::int64_t>(enriched_elements_.size()),
+          enriched_elements_.data(), mesh_.elements.data(),
+          mesh_.positions.data(),    sections_.data(),
+          resolution_,       width_,
+          enrichment_start_.data(),  textures_.data(),
+          enriched_node_.data(),     enriched_shift_.data()};
+}
+
+kernels::EnrichedEdgeBatch ShellModel::enriched_edge_batch(const kernels::EnrichedElementBatch& elements) const {
+  return {mesh_.type,       static_cast<std::int64_t>(enriched_edge_size_.size()),
+          enriched_edges_.data(), enriched_edge_size_.data(),
+          options_.penalty, options_.edge_quadrature_points,
+          mesh_.elements.data(), mesh_.positions.data(),
+          sections_.data(), &elements,
+          enriched_index_.data()};
+}
+
 std::int64_t ShellModel::num_quadrature_points() const {
-  return static_cast<std::int64_t>(mesh_.num_elements()) * kernels::element_quadrature(mesh_.type).count +
-         static_cast<std::int64_t>(num_edges()) * options_.edge_quadrature_points;
+  return static_cast<std::int64_t>(plain_sections_.size()) * kernels::element_quadrature(mesh_.type).count +
+         static_cast<std::int64_t>(plain_edge_size_.size()) * options_.edge_quadrature_points +
+         num_enriched_element_quadrature_points() + num_enriched_edge_quadrature_points();
 }
 
 void ShellModel::assemble_stiffness(const double* current, std::vector<double>& blocks, std::vector<double>* corrective,
                                     Execution execution) const {
-  const int ne = mesh_.num_elements();
+  const int ne = static_cast<int>(plain_sections_.size());
+  const int nedges = static_cast<int>(plain_edge_size_.size());
   const int npe = mesh_.nodes_per_element();
   const int nq = kernels::element_quadrature(mesh_.type).count;
   const kernels::ElementBatch eb = element_batch();
@@ -84,56 +307,194 @@ void ShellModel::assemble_stiffness(const double* current, std::vector<double>& 
     element_rotations.resize(gradients.size());
     kernels::shell_element_deformation_gradients(eb, current, gradients.data(), execution);
     kernels::polar_decomposition_batch(static_cast<std::int64_t>(ne) * nq, gradients.data(), element_rotations.data(), execution);
-    edge_rotations.resize(static_cast<size_t>(num_edges()) * gb.quadrature_points * 9);
+    edge_rotations.resize(static_cast<size_t>(nedges) * gb.quadrature_points * 9);
     kernels::shell_edge_rotations(gb, current, edge_rotations.data(), execution);
   }
   std::vector<double> element_blocks(static_cast<size_t>(ne) * npe * npe * 9);
-  std::vector<double> edge_blocks(static_cast<size_t>(num_edges()) * 4 * npe * npe * 9);
+  std::vector<double> edge_blocks(static_cast<size_t>(nedges) * 4 * npe * npe * 9);
   std::vector<double> element_forces, edge_forces;
   if (current && corrective) {
     element_forces.resize(static_cast<size_t>(ne) * npe * 3);
-    edge_forces.resize(static_cast<size_t>(num_edges()) * 2 * npe * 3);
+    edge_forces.resize(static_cast<size_t>(nedges) * 2 * npe * 3);
   }
   kernels::shell_element_stiffness(eb, current ? element_rotations.data() : nullptr, element_blocks.data(),
                                    element_forces.empty() ? nullptr : element_forces.data(), execution);
   kernels::shell_edge_stiffness(gb, current ? edge_rotations.data() : nullptr, edge_blocks.data(),
                                 edge_forces.empty() ? nullptr : edge_forces.data(), execution);
+  std::vector<const double*> matrix_locals = {element_blocks.data(), edge_blocks.data()};
+  std::vector<const double*> vector_locals = {element_forces.data(), edge_forces.data()};
+
+  // Enriched elements and edges: rotations per (texel-resolving) quadrature point.
+  std::vector<double> enriched_blocks, enriched_edge_blocks, enriched_forces, enriched_edge_forces;
+  if (!enriched_elements_.empty()) {
+    const kernels::EnrichedElementBatch xb = enriched_element_batch();
+    const kernels::EnrichedEdgeBatch xg = enriched_edge_batch(xb);
+    const kernels::EnrichedQuadrature element_quad{element_qp_start_.data(), element_qp_.data()};
+    const kernels::EdgeQuadrature edge_quad{edge_qp_start_.data(), edge_qp_.data()};
+    const int W = width_;
+    std::vector<double> xrot, xedge_rot;
+    if (current) {
+      std::vector<double> gradients(static_cast<size_t>(num_enriched_element_quadrature_points()) * 9);
+      xrot.resize(gradients.size());
+      kernels::enriched_element_deformation_gradients(xb, element_quad, current, gradients.data(), execution);
+      kernels::polar_decomposition_batch(num_enriched_element_quadrature_points(), gradients.data(), xrot.data(), execution);
+      xedge_rot.resize(static_cast<size_t>(num_enriched_edge_quadrature_points()) * 9);
+      kernels::enriched_edge_rotations(xg, edge_quad, current, xedge_rot.data(), execution);
+    }
+    enriched_blocks.resize(static_cast<size_t>(num_enriched_elements()) * W * W * 9);
+    enriched_edge_blocks.resize(static_cast<size_t>(num_enriched_edges()) * 4 * W * W * 9);
+    if (current && corrective) {
+      enriched_forces.resize(static_cast<size_t>(num_enriched_elements()) * W * 3);
+      enriched_edge_forces.resize(static_cast<size_t>(num_enriched_edges()) * 2 * W * 3);
+    }
+    kernels::enriched_element_stiffness(xb, element_quad, current ? xrot.data() : nullptr, enriched_blocks.data(),
+                                        enriched_forces.empty() ? nullptr : enriched_forces.data(), execution);
+    kernels::enriched_edge_stiffness(xg, edge_quad, current ? xedge_rot.data() : nullptr, enriched_edge_blocks.data(),
+                                     enriched_edge_forces.empty() ? nullptr : enriched_edge_forces.data(), execution);
+    matrix_locals.insert(matrix_locals.end(), {enriched_blocks.data(), enriched_edge_blocks.data()});
+    vector_locals.insert(vector_locals.end(), {enriched_forces.data(), enriched_edge_forces.data()});
+  }
   blocks.resize(assembly_.num_blocks() * 9);
   const bool parallel = execution == Execution::parallel;
-  assembly_.assemble_matrix({element_blocks.data(), edge_blocks.data()}, blocks.data(), parallel);
+  assembly_.assemble_matrix(matrix_locals, blocks.data(), parallel);
   if (corrective) {
     corrective->assign(num_dofs(), 0.0);
-    if (current) assembly_.assemble_vector({element_forces.data(), edge_forces.data()}, corrective->data(), parallel);
+    if (current) assembly_.assemble_vector(vector_locals, corrective->data(), parallel);
   }
 }
 
 void ShellModel::add_gravity(const double g[3], std::vector<double>& f) const {
   const int npe = mesh_.nodes_per_element();
-  for (int e = 0; e < mesh_.num_elements(); ++e)
+  const int ne = static_cast<int>(plain_sections_.size());
+  for (int e = 0; e < ne; ++e)
     for (int a = 0; a < npe; ++a)
-      for (int c = 0; c < 3; ++c) f[3 * mesh_.element_nodes(e)[a] + c] += mass_weights_[e * npe + a] * g[c];
+      for (int c = 0; c < 3; ++c) f[3 * plain_connectivity_[e * npe + a] + c] += mass_weights_[e * npe + a] * g[c];
+  for (size_t i = 0; i < enriched_global_nodes_.size(); ++i)
+    if (enriched_global_nodes_[i] >= 0)
+      for (int c = 0; c < 3; ++c) f[3 * enriched_global_nodes_[i] + c] += enriched_mass_weights_[i] * g[c];
 }
 
 void ShellModel::add_area_force(const double q[3], std::vector<double>& f) const {
   const int npe = mesh_.nodes_per_element();
-  for (int e = 0; e < mesh_.num_elements(); ++e)
+  const int ne = static_cast<int>(plain_sections_.size());
+  for (int e = 0; e < ne; ++e)
     for (int a = 0; a < npe; ++a)
-      for (int c = 0; c < 3; ++c) f[3 * mesh_.element_nodes(e)[a] + c] += area_weights_[e * npe + a] * q[c];
+      for (int c = 0; c < 3; ++c) f[3 * plain_connectivity_[e * npe + a] + c] += area_weights_[e * npe + a] * q[c];
+  for (size_t i = 0; i < enriched_global_nodes_.size(); ++i)
+    if (enriched_global_nodes_[i] >= 0)
+      for (int c = 0; c < 3; ++c) f[3 * enriched_global_nodes_[i] + c] += enriched_area_weights_[i] * q[c];
+}
+
+void ShellModel::set_enrichments(std::vector<EnrichmentFunction> functions) {
+  install_enrichments(std::move(functions));
+  pruned_enriched_nodes_ = 0;
+  if (options_.min_enrichment_mass_ratio <= 0 || num_enriched_nodes() == 0) return;
+  // A cut that clips a node's support by a few texels leaves (H - H(xi^a)) N^a with almost
+  // no support: its mass and stiffness are tiny next to the node's own, the system loses
+  // definiteness to round-off (thesis §5.6 has no remedy). As in XFEM practice, such
+  // enriched DOFs are dropped: their diagonal mass block over the node's own is below
+  // min_enrichment_mass_ratio. The pieces they would have freed are a few texels wide
+  // and stay attached; the cut still separates everything else.
+  std::vector<double> diagonal(pattern().num_nodes(), 0.0);
+  for (int r = 0; r < pattern().num_nodes(); ++r)
+    for (std::int64_t k = pattern().row_start()[r]; k < pattern().row_start()[r + 1]; ++k)
+      if (pattern().column()[k] == r) diagonal[r] = mass_blocks_[9 * k];
+  std::vector<EnrichmentFunction> kept = enrichments_;
+  for (auto& f : kept) f.enriched_nodes.clear();
+  int pruned = 0;
+  for (int v = num_nodes(); v < pattern().num_nodes(); ++v) {
+    const int node = virtual_node_mesh_node(v);
+    if (diagonal[v] < options_.min_enrichment_mass_ratio * diagonal[node]) ++pruned;
+    else kept[virtual_node_function(v)].enriched_nodes.push_back(node);
+  }
+  if (pruned == 0) return;
+  // Functions left without nodes go; the others keep the elements of Omega_i that still
+  // touch one of their nodes.
+  std::vector<EnrichmentFunction> functions_left;
+  for (auto& f : kept) {
+    if (f.enriched_nodes.empty()) continue;
+    std::vector<ElementTexture> elements;
+    for (auto& texture : f.elements) {
+      const int* nodes = mesh_.element_nodes(texture.element);
+      bool touches = false;
+      for (int a = 0; a < mesh_.nodes_per_element() && !touches; ++a)
+        touches = std::binary_search(f.enriched_nodes.begin(), f.enriched_nodes.end(), nodes[a]);
+      if (touches) elements.push_back(std::move(texture));
+    }
+    f.elements = std::move(elements);
+    functions_left.push_back(std::move(f));
+  }
+  install_enrichments(std::move(functions_left));
+  pruned_enriched_nodes_ = pruned;
+}
+
+int ShellModel::basis_at(int element, const double xi[2], int* global, double* values) const {
+  kernels::ShapeValues s;
+  kernels::evaluate_shape(mesh_.type, xi[0], xi[1], s);
+  const int index = enriched_index_.empty() ? -1 : enriched_index_[element];
+  if (index < 0) {
+    for (int a = 0; a < s.count; ++a) global[a] = mesh_.element_nodes(element)[a], values[a] = s.N[a];
+    return s.count;
+  }
+  const kernels::EnrichedElementBatch eb = enriched_element_batch();
+  kernels::EnrichedShapeValues es;
+  kernels::evaluate_enriched_shape(eb, index, xi[0], xi[1], s, es);
+  kernels::enriched_global_nodes(eb, index, global);
+  for (int a = 0; a < es.count; ++a) values[a] = es.N[a];
+  return es.count;
 }
 
 void ShellModel::add_point_force(int element, const double xi[2], const double force[3], std::vector<double>& f) const {
-  kernels::ShapeValues s;
-  kernels::evaluate_shape(mesh_.type, xi[0], xi[1], s);
-  for (int a = 0; a < s.count; ++a)
-    for (int c = 0; c < 3; ++c) f[3 * mesh_.element_nodes(element)[a] + c] += s.N[a] * force[c];
+  int global[kernels::max_enriched_basis];
+  double values[kernels::max_enriched_basis];
+  const int n = basis_at(element, xi, global, values);
+  for (int a = 0; a < n; ++a)
+    for (int c = 0; c < 3; ++c) f[3 * global[a] + c] += values[a] * force[c];
 }
 
 void ShellModel::interpolate(const std::vector<double>& u, int element, const double xi[2], double out[3]) const {
-  kernels::ShapeValues s;
-  kernels::evaluate_shape(mesh_.type, xi[0], xi[1], s);
+  int global[kernels::max_enriched_basis];
+  double values[kernels::max_enriched_basis];
+  const int n = basis_at(element, xi, global, values);
   out[0] = out[1] = out[2] = 0;
-  for (int a = 0; a < s.count; ++a)
-    for (int c = 0; c < 3; ++c) out[c] += s.N[a] * u[3 * mesh_.element_nodes(element)[a] + c];
+  for (int a = 0; a < n; ++a)
+    for (int c = 0; c < 3; ++c) out[c] += values[a] * u[3 * global[a] + c];
+}
+
+std::vector<double> ShellModel::mass_weighted_moments(
+    const std::function<void(int element, const double xi[2], double value[3])>& g) const {
+  std::vector<double> out(num_dofs(), 0.0);
+  const kernels::QuadratureRule standard = kernels::element_quadrature(mesh_.type);
+  int global[kernels::max_enriched_basis];
+  double values[kernels::max_enriched_basis];
+  auto accumulate = [&](int e, const double xi[2], double weight) {
+    kernels::ShapeValues shape;
+    kernels::evaluate_shape(mesh_.type, xi[0], xi[1], shape);
+    kernels::RestPoint rest;
+    kernels::evaluate_rest_point(shape, mesh_.element_nodes(e), mesh_.positions.data(), rest);
+    const kernels::ShellSection& section = sections_[e];
+    const double w = weight * rest.j0 * section.density * section.thickness;
+    double value[3];
+    g(e, xi, value);
+    const int n = basis_at(e, xi, global, values);
+    for (int a = 0; a < n; ++a)
+      for (int c = 0; c < 3; ++c) out[3 * global[a] + c] += w * values[a] * value[c];
+  };
+  for (int e = 0; e < mesh_.num_elements(); ++e) {
+    const int index = enriched_index_.empty() ? -1 : enriched_index_[e];
+    if (index < 0) {
+      for (int q = 0; q < standard.count; ++q) {
+        const double xi[2] = {standard.xi1[q], standard.xi2[q]};
+        accumulate(e, xi, standard.weight[q]);
+      }
+    } else {
+      for (std::int64_t q = element_qp_start_[index]; q < element_qp_start_[index + 1]; ++q) {
+        const double xi[2] = {element_qp_[3 * q], element_qp_[3 * q + 1]};
+        accumulate(e, xi, element_qp_[3 * q + 2]);
+      }
+    }
+  }
+  return out;
 }
 
 void block_multiply(const BlockAssembly& pattern, const double* blocks, const double* x, double* y) {

@@ -13,9 +13,13 @@
 #include <vector>
 
 #include "dgtex/deformed_shell.h"
+#include "dgtex/kernels/enriched_basis.h"
 #include "dgtex_embedded_shaders.h"
 
 namespace dgtex {
+
+static_assert(kMaxEnrichmentsPerElement >= kernels::max_enrichments_per_element,
+              "the renderer must draw every element the shell model allows");
 
 const char* to_string(RenderSettings::Shading shading) {
   return shading == RenderSettings::Shading::flat ? "flat" : "smooth";
@@ -236,6 +240,7 @@ struct ShellRenderer::GlObjects {
   BufferTexture instance_elements, rest_positions, displacements, element_nodes, node_normals;
   BufferTexture element_slots, slot_tiles, slot_node_values, slot_dofs;
   GLuint atlas = 0;
+  GLuint primitives_query = 0;  // GL_PRIMITIVES_GENERATED of a render
   GLuint framebuffer = 0, color = 0, depth = 0;
   int framebuffer_width = 0, framebuffer_height = 0;
   GLint max_texture_size = 0, max_array_layers = 0, max_buffer_texels = 0;
@@ -355,6 +360,7 @@ struct ShellRenderer::GlObjects {
                              &slot_tiles, &slot_node_values, &slot_dofs})
       b->release();
     if (atlas) glDeleteTextures(1, &atlas);
+    if (primitives_query) glDeleteQueries(1, &primitives_query);
     if (framebuffer) glDeleteFramebuffers(1, &framebuffer);
     if (color) glDeleteRenderbuffers(1, &color);
     if (depth) glDeleteRenderbuffers(1, &depth);
@@ -493,15 +499,17 @@ Image ShellRenderer::render(const ShellState& state, const RenderSettings& setti
 
   // The programs for this combination of options.
   auto preamble = [&](int slots) {
-    const int copies = settings.cut_method == RenderSettings::CutMethod::geometry_shader ? 1 << slots : 1;
+    const int cuts_per_triangle =
+        settings.cut_method == RenderSettings::CutMethod::geometry_shader ? std::min(slots, kMaxCutsPerTriangle) : 0;
     std::string text = "#version 330 core\n";
     text += "#define NODES_PER_ELEMENT " + std::to_string(npe) + "\n";
     text += "#define ELEMENT_QUAD8 " + std::string(mesh.type == ElementType::quad8 ? "1" : "0") + "\n";
     text += "#define MAX_ENRICHMENTS " + std::to_string(slots) + "\n";
+    text += "#define MAX_CUTS_PER_TRIANGLE " + std::to_string(cuts_per_triangle) + "\n";
     text += "#define CUT_METHOD " + std::to_string(static_cast<int>(settings.cut_method)) + "\n";
     text += "#define SMOOTH_SHADING " + std::string(smooth ? "1" : "0") + "\n";
     text += "#define WIREFRAME " + std::string(settings.wireframe ? "1" : "0") + "\n";
-    text += "#define GEOMETRY_MAX_VERTICES " + std::to_string(3 * copies) + "\n";
+    text += "#define GEOMETRY_MAX_VERTICES " + std::to_string(3 << cuts_per_triangle) + "\n";
     return text;
   };
   const auto compile_start = Clock::now();
@@ -553,6 +561,7 @@ Image ShellRenderer::render(const ShellState& state, const RenderSettings& setti
     glUniform2f(glGetUniformLocation(program, "u_viewport_size"), float(settings.width), float(settings.height));
     glUniform1f(glGetUniformLocation(program, "u_cut_threshold"), settings.cut_threshold);
     glUniform1i(glGetUniformLocation(program, "u_kill_radius"), settings.kill_radius_texels);
+    glUniform1i(glGetUniformLocation(program, "u_tessellation"), settings.tessellation);
     glUniform3f(glGetUniformLocation(program, "u_camera_position"), float(resolved.eye[0]), float(resolved.eye[1]),
                 float(resolved.eye[2]));
     glUniform3f(glGetUniformLocation(program, "u_surface_color"), 0.72f, 0.78f, 0.88f);
@@ -562,8 +571,11 @@ Image ShellRenderer::render(const ShellState& state, const RenderSettings& setti
     glBindVertexArray(0);
     check_gl("drawing");
   };
+  if (!gl.primitives_query) glGenQueries(1, &gl.primitives_query);
+  glBeginQuery(GL_PRIMITIVES_GENERATED, gl.primitives_query);
   draw(plain_program, 0, plain_elements);
   draw(enriched_program, plain_elements, elements - plain_elements);
+  glEndQuery(GL_PRIMITIVES_GENERATED);
 
   Image image(settings.width, settings.height);
   std::vector<std::uint8_t> bottom_up(image.rgba.size());
@@ -571,6 +583,11 @@ Image ShellRenderer::render(const ShellState& state, const RenderSettings& setti
   glReadBuffer(GL_COLOR_ATTACHMENT0);
   glReadPixels(0, 0, settings.width, settings.height, GL_RGBA, GL_UNSIGNED_BYTE, bottom_up.data());
   check_gl("reading back the image");
+  GLuint primitives = 0;  // the read-back has waited for the draws: no stall here
+  glGetQueryObjectuiv(gl.primitives_query, GL_QUERY_RESULT, &primitives);
+  check_gl("reading the primitive count");
+  last_triangles_drawn_ = primitives;
+  last_triangles_submitted_ = static_cast<long long>(tess.index_count / 3) * elements;
   glBindFramebuffer(GL_FRAMEBUFFER, 0);
   const size_t row = 4 * static_cast<size_t>(settings.width);
   for (int y = 0; y < settings.height; ++y)

@@ -3,6 +3,15 @@
 #include <cholmod.h>
 
 #include <cstring>
+#include <vector>
+
+// Single-precision BLAS (Fortran interface of the system BLAS, OpenBLAS on Debian).
+extern "C" {
+void sgemv_(const char* trans, const int* m, const int* n, const float* alpha, const float* a, const int* lda,
+            const float* x, const int* incx, const float* beta, float* y, const int* incy);
+void strsv_(const char* uplo, const char* trans, const char* diag, const int* n, const float* a, const int* lda,
+            float* x, const int* incx);
+}
 
 namespace dgtex {
 
@@ -10,6 +19,8 @@ struct SparseCholesky::Impl {
   cholmod_common common;
   cholmod_sparse* matrix = nullptr;
   cholmod_factor* factor = nullptr;
+  std::vector<float> single_values;  // supernodal L in float (same layout as factor->x)
+  mutable std::vector<float> work, gathered;
 
   Impl() {
     cholmod_start(&common);
@@ -73,6 +84,61 @@ void SparseCholesky::solve(const std::vector<double>& b, std::vector<double>& x)
   std::memcpy(x.data(), sol->x, sizeof(double) * n_);
   cholmod_free_dense(&sol, &m.common);
   cholmod_free_dense(&rhs, &m.common);
+}
+
+void SparseCholesky::copy_factor_to_single_precision() {
+  Impl& m = *impl_;
+  const cholmod_factor* f = m.factor;
+  if (!f || !f->is_super || f->xtype != CHOLMOD_REAL || f->itype != CHOLMOD_INT)
+    throw std::logic_error("SparseCholesky::copy_factor_to_single_precision needs a real supernodal factor (call factorize first)");
+  const double* x = static_cast<const double*>(f->x);
+  m.single_values.resize(f->xsize);
+  for (size_t i = 0; i < f->xsize; ++i) m.single_values[i] = static_cast<float>(x[i]);
+}
+
+void SparseCholesky::solve_single_precision(const std::vector<double>& b, std::vector<double>& x) const {
+  const Impl& m = *impl_;
+  const cholmod_factor* f = m.factor;
+  if (!f || m.single_values.size() != f->xsize)
+    throw std::logic_error("SparseCholesky::solve_single_precision called without copy_factor_to_single_precision");
+  const int* super = static_cast<const int*>(f->super);
+  const int* pi = static_cast<const int*>(f->pi);
+  const int* px = static_cast<const int*>(f->px);
+  const int* rows = static_cast<const int*>(f->s);
+  const int* perm = static_cast<const int*>(f->Perm);
+  const float* L = m.single_values.data();
+  const int nsuper = static_cast<int>(f->nsuper);
+  std::vector<float>& y = m.work;
+  std::vector<float>& t = m.gathered;
+  y.resize(n_);
+  for (int k = 0; k < n_; ++k) y[k] = static_cast<float>(b[perm[k]]);  // L L^T = P A P^T
+  const int one = 1;
+  const float plus = 1, minus = -1, zero = 0;
+  // Per supernode: columns k1..k2-1, a dense nrow x ncol column-major block whose first
+  // ncol rows are the diagonal triangle and whose other rows are listed in `rows`.
+  for (int s = 0; s < nsuper; ++s) {  // forward, L y = P b
+    const int k1 = super[s], ncol = super[s + 1] - k1, nrow = pi[s + 1] - pi[s], below = nrow - ncol;
+    const float* X = L + px[s];
+    strsv_("L", "N", "N", &ncol, X, &nrow, y.data() + k1, &one);
+    if (below <= 0) continue;
+    t.resize(below);
+    sgemv_("N", &below, &ncol, &plus, X + ncol, &nrow, y.data() + k1, &one, &zero, t.data(), &one);
+    const int* r = rows + pi[s] + ncol;
+    for (int i = 0; i < below; ++i) y[r[i]] -= t[i];
+  }
+  for (int s = nsuper - 1; s >= 0; --s) {  // backward, L^T z = y
+    const int k1 = super[s], ncol = super[s + 1] - k1, nrow = pi[s + 1] - pi[s], below = nrow - ncol;
+    const float* X = L + px[s];
+    if (below > 0) {
+      t.resize(below);
+      const int* r = rows + pi[s] + ncol;
+      for (int i = 0; i < below; ++i) t[i] = y[r[i]];
+      sgemv_("T", &below, &ncol, &minus, X + ncol, &nrow, t.data(), &one, &plus, y.data() + k1, &one);
+    }
+    strsv_("L", "T", "N", &ncol, X, &nrow, y.data() + k1, &one);
+  }
+  x.resize(n_);
+  for (int k = 0; k < n_; ++k) x[perm[k]] = y[k];
 }
 
 std::int64_t SparseCholesky::factor_nonzeros() const {

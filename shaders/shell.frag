@@ -1,6 +1,6 @@
 // Fragment stage: keeps a fragment of a duplicated cut triangle only where the texel of
-// the enrichment texture lies on the copy's side (texel-resolution cut boundary), then
-// shades it with a headlight (two-sided).
+// every cutting enrichment's texture lies on the copy's side (texel-resolution cut
+// boundary), then shades it with a headlight (two-sided).
 uniform vec3 u_camera_position;
 uniform vec3 u_surface_color;  // smooth shading
 #if CUT_METHOD == CUT_KILL_PIXELS
@@ -12,8 +12,8 @@ in FragmentData {
   vec3 world;
   vec3 normal;
   flat int element;
-  flat int side_bits;
-  flat int cut_bits;
+  flat uint side_bits;
+  flat uint cut_bits;
 #if WIREFRAME
   noperspective vec3 edge_distance;
 #endif
@@ -49,15 +49,18 @@ bool near_cut(int slot, vec2 xi) {
 
 void main() {
 #if MAX_ENRICHMENTS > 0
-  if (g.cut_bits != 0) {
-    for (int k = 0; k < MAX_ENRICHMENTS; ++k) {
-      if ((g.cut_bits & (1 << k)) == 0) continue;
+  if (g.cut_bits != 0u) {
+    uint remaining = g.cut_bits;
+    for (int k = 0; k < MAX_ENRICHMENTS && remaining != 0u; ++k) {
+      uint bit = 1u << uint(k);
+      if ((remaining & bit) == 0u) continue;
+      remaining &= ~bit;
       int slot = element_slot(g.element, k);
 #if CUT_METHOD == CUT_KILL_PIXELS
       if (near_cut(slot, g.xi)) discard;
 #else
       int side = enrichment_value(slot, g.xi) >= 0.0 ? 1 : 0;
-      if (side != ((g.side_bits >> k) & 1)) discard;
+      if (side != ((g.side_bits & bit) != 0u ? 1 : 0)) discard;
 #endif
     }
   }

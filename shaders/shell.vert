@@ -1,7 +1,8 @@
 // Vertex stage: one vertex of the static tessellation (parameter point a_xi) of the
-// element drawn as instance gl_InstanceID. Evaluates the deformed position split as x = base + sum_k h_k A_k
-// (see dgtex/deformed_shell.h) so the geometry stage can move vertices to either side
-// of a cut.
+// element drawn as instance gl_InstanceID. Evaluates the deformed position split as
+// x = base + sum_k h_k A_k (see dgtex/deformed_shell.h) and passes on base and x with the
+// vertex's own values h_k = H_k(xi); the geometry stage re-evaluates A_k only for the
+// (rare) triangles a cut crosses, so the varyings do not grow with the enrichment count.
 layout(location = 0) in vec2 a_xi;
 
 uniform isamplerBuffer u_instance_elements;  // element of each instance, from u_first_instance on
@@ -14,43 +15,18 @@ uniform samplerBuffer u_node_normals;    // #nodes: normals averaged at nodes
 #endif
 #if MAX_ENRICHMENTS > 0
 uniform samplerBuffer u_slot_node_values;  // #slots * NODES_PER_ELEMENT: H(xi^a)
-uniform samplerBuffer u_slot_dofs;         // #slots * NODES_PER_ELEMENT: q^a (xyz)
 #endif
 
 out VertexData {
   vec2 xi;
-  vec3 base;
+  vec3 base;      // x without the enrichments' h_k A_k terms
+  vec3 position;  // x with the vertex's own values h_k
   vec3 normal;
   flat int element;
 #if MAX_ENRICHMENTS > 0
-  vec3 A[MAX_ENRICHMENTS];
-  float h[MAX_ENRICHMENTS];
+  flat uint sign_bits;  // bit k: h_k >= 0 (the geometry stage tests only slots whose sign changes)
 #endif
 } v;
-
-// Quadratic basis, twin of dgtex::kernels::evaluate_shape (same node order).
-void shape_functions(vec2 xi, out float N[NODES_PER_ELEMENT]) {
-  float r = xi.x, s = xi.y;
-#if ELEMENT_QUAD8
-  const vec2 corner[4] = vec2[4](vec2(-1, -1), vec2(1, -1), vec2(1, 1), vec2(-1, 1));
-  for (int a = 0; a < 4; ++a) {
-    float p = r * corner[a].x, q = s * corner[a].y;
-    N[a] = 0.25 * (1.0 + p) * (1.0 + q) * (p + q - 1.0);
-  }
-  N[4] = 0.5 * (1.0 - r * r) * (1.0 - s);
-  N[5] = 0.5 * (1.0 - s * s) * (1.0 + r);
-  N[6] = 0.5 * (1.0 - r * r) * (1.0 + s);
-  N[7] = 0.5 * (1.0 - s * s) * (1.0 - r);
-#else
-  float l = 1.0 - r - s;
-  N[0] = l * (2.0 * l - 1.0);
-  N[1] = r * (2.0 * r - 1.0);
-  N[2] = s * (2.0 * s - 1.0);
-  N[3] = 4.0 * r * l;
-  N[4] = 4.0 * r * s;
-  N[5] = 4.0 * s * l;
-#endif
-}
 
 void main() {
   int e = texelFetch(u_instance_elements, u_first_instance + gl_InstanceID).r;
@@ -65,23 +41,36 @@ void main() {
     normal += N[a] * texelFetch(u_node_normals, node).xyz;
 #endif
   }
+  vec3 position = base;
 #if MAX_ENRICHMENTS > 0
+  // An element's slots are packed from k = 0; the first unused one ends the list.
+  vec3 A[MAX_ENRICHMENTS];
+  float h[MAX_ENRICHMENTS];
+  uint sign_bits = 0u;
+  int count = 0;
   for (int k = 0; k < MAX_ENRICHMENTS; ++k) {
-    v.A[k] = vec3(0.0);
-    v.h[k] = 0.0;
     int slot = element_slot(e, k);
-    if (slot < 0) continue;
+    if (slot < 0) break;
+    A[k] = vec3(0.0);
     for (int a = 0; a < NODES_PER_ELEMENT; ++a) {
       vec3 q = texelFetch(u_slot_dofs, slot * NODES_PER_ELEMENT + a).xyz;
       float node_value = texelFetch(u_slot_node_values, slot * NODES_PER_ELEMENT + a).r;
-      v.A[k] += N[a] * q;
+      A[k] += N[a] * q;
       base -= N[a] * node_value * q;
     }
-    v.h[k] = enrichment_value(slot, a_xi);
+    h[k] = enrichment_value(slot, a_xi);
+    if (h[k] >= 0.0) sign_bits |= 1u << uint(k);
+    count = k + 1;
   }
+  // Summed after base is complete, in slot order: the geometry stage's copies of cut
+  // triangles repeat exactly these operations.
+  position = base;
+  for (int k = 0; k < count; ++k) position += h[k] * A[k];
+  v.sign_bits = sign_bits;
 #endif
   v.xi = a_xi;
   v.base = base;
+  v.position = position;
   v.normal = normal;
   v.element = e;
 }

@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <random>
 
 #include "dgtex/laplace_direct.h"
 #include "dgtex/laplace_domains.h"
@@ -32,9 +33,10 @@ double max_relative_difference(const kernels::TexelTile& a, const kernels::Texel
   return diff / scale;
 }
 
-// Cold solve to 1e-6 with the default options: geometric mean of the residual reduction per cycle.
-double mean_reduction_per_cycle(const kernels::TexelTile& problem, int* cycles) {
-  LaplaceMultigridOptions options;
+// Cold solve to 1e-6 with the given options (default: the default options): geometric mean of
+// the residual reduction per cycle.
+double mean_reduction_per_cycle(const kernels::TexelTile& problem, int* cycles,
+                                LaplaceMultigridOptions options = LaplaceMultigridOptions()) {
   options.warm_start = false;
   kernels::TexelTile tile = problem;
   std::vector<LaplaceConvergencePoint> history;
@@ -94,14 +96,82 @@ INSTANTIATE_TEST_SUITE_P(Domains, MultigridReduction,
                                            Case{LaplaceDomain::spiral, 128, TexelElementShape::tri},
                                            Case{LaplaceDomain::slit, 256, TexelElementShape::quad}),
                          name);
-// ... and NOT yet on these (known gap, measured 0.40 spiral, 0.28 chad, 0.23 chad tri per cycle: black-box
-// interpolation degrades along staircase walls and long narrow channels on 9-point levels).
-// Disabled, not weakened: run with --gtest_also_run_disabled_tests to see the numbers.
-INSTANTIATE_TEST_SUITE_P(DISABLED_KnownGap, MultigridReduction,
-                         ::testing::Values(Case{LaplaceDomain::spiral, 128, TexelElementShape::quad},
-                                           Case{LaplaceDomain::chad, 128, TexelElementShape::quad},
-                                           Case{LaplaceDomain::chad, 128, TexelElementShape::tri}),
-                         name);
+// ... but not on these with the default cycle: spiral 0.315, chad 0.235, chad tri 0.187 per cycle
+// (before the Ruge-Stueben-style sharing of cell-centre couplings in the interpolation: 0.40, 0.28,
+// 0.23). Why: with level 1 solved exactly the rate is <= 0.082 on both domains at T=256, with three
+// levels 0.24-0.28: the coarse spaces from level 2 on cannot represent the slow modes of features
+// narrower than the coarse spacing (the 2-texel bridge, the spiral's channels); more smoothing does
+// not help (see kernels/dgtex/kernels/multigrid_galerkin.h). The robust cycle below solves level 1
+// by CG to 2% in every cycle and reaches the target on every domain.
+
+class MultigridRobustCycle : public ::testing::TestWithParam<Case> {};
+
+TEST_P(MultigridRobustCycle, AtMostOneTenthPerCycleAndAgreesWithCholmod) {
+  const Case c = GetParam();
+  const kernels::TexelTile problem = make_laplace_domain(c.domain, c.T, c.shape);
+  LaplaceMultigridOptions options;
+  options.coarse_solve_tolerance = 0.02;
+  int cycles = 0;
+  const double rho = mean_reduction_per_cycle(problem, &cycles, options);
+  std::printf("%s (robust cycle): %d cycles to 1e-6, mean reduction per cycle %.3f\n", case_name(c).c_str(), cycles, rho);
+  EXPECT_LE(rho, 0.1);
+  kernels::TexelTile direct = problem, multigrid = problem;
+  solve_laplace(direct, LaplaceSolver::cholmod);
+  options.tolerance = 1e-11;
+  options.warm_start = false;
+  EXPECT_LE(solve_laplace(multigrid, LaplaceSolver::multigrid, options).relative_residual, 1e-11);
+  EXPECT_LE(max_relative_difference(multigrid, direct), 1e-8);
+}
+
+INSTANTIATE_TEST_SUITE_P(Domains, MultigridRobustCycle, all_cases, name);
+
+TEST(MultigridRobustness, RandomTilesAndCycleVariantsMatchCholmod) {
+  // Small random tiles (single texels, single rows, isolated components, Dirichlet islands)
+  // through every cycle path: CG or plain cycles, V or F, with and without pre- or
+  // post-smoothing (the red-black shortcuts apply only with both).
+  std::mt19937 rng(11);
+  struct Variant { bool cg; MultigridCycle cycle; int pre, post; double coarse_solve_tolerance; };
+  const Variant variants[] = {{true, MultigridCycle::v, 1, 1, 0.0},  {true, MultigridCycle::v, 2, 2, 0.0},
+                              {false, MultigridCycle::v, 1, 1, 0.0}, {false, MultigridCycle::f, 2, 1, 0.0},
+                              {false, MultigridCycle::v, 0, 2, 0.0}, {false, MultigridCycle::v, 2, 0, 0.0},
+                              {true, MultigridCycle::v, 1, 1, 0.02}, {false, MultigridCycle::v, 1, 1, 0.1}};
+  for (int k = 0; k < 60; ++k) {
+    const int w = 1 + static_cast<int>(rng() % 48), h = 1 + static_cast<int>(rng() % 48);
+    kernels::TexelTile problem(w, h);
+    for (std::size_t t = 0; t < problem.flags.size(); ++t) {
+      std::uint8_t f = 0;
+      if (rng() % 6 == 0) f |= kernels::wall_east;
+      if (rng() % 6 == 0) f |= kernels::wall_north;
+      if (rng() % 25 == 0) f |= kernels::dirichlet;
+      if (rng() % 30 == 0) f |= kernels::inactive;
+      problem.flags[t] = f;
+      problem.values[t] = (f & kernels::dirichlet) ? static_cast<double>(rng() % 200) / 100.0 - 1.0 : 0.0;
+    }
+    kernels::TexelTile direct = problem;
+    solve_laplace(direct, LaplaceSolver::cholmod);
+    for (const Variant& v : variants) {
+      LaplaceMultigridOptions options;
+      options.tolerance = 1e-12;
+      options.max_cycles = 400;
+      options.warm_start = false;
+      options.use_as_cg_preconditioner = v.cg;
+      options.cycle = v.cycle;
+      options.pre_smoothing = v.pre;
+      options.post_smoothing = v.post;
+      options.coarse_solve_tolerance = v.coarse_solve_tolerance;
+      options.coarsest_nodes = 4;  // deep hierarchies even on small tiles
+      kernels::TexelTile multigrid = problem;
+      solve_laplace(multigrid, LaplaceSolver::multigrid, options);
+      double diff = 0, scale = 1e-300;
+      for (std::size_t t = 0; t < direct.values.size(); ++t) {
+        diff = std::max(diff, std::abs(multigrid.values[t] - direct.values[t]));
+        scale = std::max(scale, std::abs(direct.values[t]));
+      }
+      EXPECT_LE(diff / scale, 1e-8) << "tile " << k << " (" << w << "x" << h << "), cg " << v.cg << ", pre " << v.pre
+                                    << ", post " << v.post;
+    }
+  }
+}
 
 TEST(MultigridWarmStart, AdvancingCutNeedsFewerCycles) {
   // A cut advancing by 4 texels: the previous enrichment is a good initial guess.

@@ -190,6 +190,144 @@ TEST_P(MultigridKernels, SolveIsIndependentOfThreadCount) {
   solve_laplace_multigrid(serial, options);
   EXPECT_EQ(one.values, two.values);
   EXPECT_EQ(one.values, serial.values);
+  // The robust cycle (inner CG on level 1) too.
+  TexelTile robust_one = problem, robust_two = problem, robust_serial = problem;
+  options.coarse_solve_tolerance = 0.02;
+  options.execution = Execution::parallel;
+  omp_set_num_threads(1);
+  solve_laplace_multigrid(robust_one, options);
+  omp_set_num_threads(2);
+  solve_laplace_multigrid(robust_two, options);
+  options.execution = Execution::serial;
+  solve_laplace_multigrid(robust_serial, options);
+  EXPECT_EQ(robust_one.values, robust_two.values);
+  EXPECT_EQ(robust_one.values, robust_serial.values);
+}
+
+TEST_P(MultigridKernels, FusedSweepsEqualColourByColourReference) {
+  omp_set_num_threads(2);
+  TwoLevels L(make_laplace_domain(GetParam(), 100));  // 100 rows: blocks of 32 plus a partial one
+  for (Execution ex : {Execution::serial, Execution::parallel}) {
+    for (bool forward : {true, false}) {
+      std::vector<double> ref = L.x, fused = L.x;
+      smooth_texels_color_reference(L.fine, L.bits.data(), L.b.data(), ref.data(), forward ? 0 : 1);
+      smooth_texels_color_reference(L.fine, L.bits.data(), L.b.data(), ref.data(), forward ? 1 : 0);
+      smooth_texels_sweep(L.fine, L.bits.data(), L.b.data(), fused.data(), forward, ex);
+      EXPECT_EQ(ref, fused);
+      std::vector<double> ref9 = L.xc, fused9 = L.xc;
+      for (int k = 0; k < 4; ++k)
+        smooth_stencil9_color_reference(L.coarse, L.A().view(), L.bc.data(), ref9.data(), forward ? k : 3 - k);
+      smooth_stencil9_sweep(L.coarse, L.A().view(), L.bc.data(), fused9.data(), forward, ex);
+      EXPECT_EQ(ref9, fused9);
+    }
+    // From a zero guess: x need not be initialised, non-unknowns end at 0.
+    std::vector<double> ref(L.x.size(), 0.0), fused(L.x.size(), 0.0);
+    smooth_texels_color_reference(L.fine, L.bits.data(), L.b.data(), ref.data(), 0);
+    smooth_texels_color_reference(L.fine, L.bits.data(), L.b.data(), ref.data(), 1);
+    for (int j = 0; j < L.fine.ny; ++j)
+      for (int i = 0; i < L.fine.nx; ++i) fused[L.fine.at(i, j)] = 7.0;  // garbage in the interior
+    smooth_texels_sweep_from_zero(L.fine, L.bits.data(), L.b.data(), fused.data(), ex);
+    EXPECT_EQ(ref, fused);
+  }
+}
+
+TEST_P(MultigridKernels, FusedConjugateGradientStepsEqualReference) {
+  omp_set_num_threads(2);
+  TwoLevels L(make_laplace_domain(GetParam(), 100));
+  const double alpha = 0.37, beta = -0.61;
+  for (Execution ex : {Execution::serial, Execution::parallel}) {
+    std::vector<double> x1 = L.x, r1 = L.b, z1(L.x.size(), 0.0), n1(L.fine.ny);
+    std::vector<double> x2 = L.x, r2 = L.b, z2(L.x.size(), 0.0), n2(L.fine.ny);
+    cg_update_and_smooth_texels_from_zero_reference(L.fine, L.bits.data(), alpha, L.x.data(), L.b.data(), x1.data(),
+                                                    r1.data(), z1.data(), n1.data());
+    cg_update_and_smooth_texels_from_zero(L.fine, L.bits.data(), alpha, L.x.data(), L.b.data(), x2.data(), r2.data(),
+                                          z2.data(), n2.data(), ex);
+    EXPECT_EQ(x1, x2);
+    EXPECT_EQ(r1, r2);
+    EXPECT_EQ(z1, z2);
+    EXPECT_EQ(n1, n2);
+    std::vector<double> p1 = L.x, q1(L.x.size(), 0.0), d1(L.fine.ny), p2 = L.x, q2 = q1, d2(L.fine.ny);
+    update_direction_and_apply_texels_reference(L.fine, L.bits.data(), L.b.data(), beta, p1.data(), q1.data(), d1.data());
+    update_direction_and_apply_texels(L.fine, L.bits.data(), L.b.data(), beta, p2.data(), q2.data(), d2.data(), ex);
+    EXPECT_EQ(p1, p2);
+    EXPECT_EQ(q1, q2);
+    EXPECT_EQ(d1, d2);
+  }
+}
+
+TEST_P(MultigridKernels, RedBlackTransfersMatchReferencesAndFullForms) {
+  omp_set_num_threads(2);
+  TwoLevels L(make_laplace_domain(GetParam(), 96));
+  for (int color = 0; color < 2; ++color) {
+    std::vector<double> r1(L.x.size(), 0.0), r2 = r1, full = r1;
+    residual_texels_color_reference(L.fine, L.bits.data(), L.b.data(), L.x.data(), r1.data(), color);
+    residual_texels_color(L.fine, L.bits.data(), L.b.data(), L.x.data(), r2.data(), color);
+    EXPECT_EQ(r1, r2);
+    residual_texels_reference(L.fine, L.bits.data(), L.b.data(), L.x.data(), full.data(), nullptr);
+    for (int j = 0; j < L.fine.ny; ++j)
+      for (int i = 0; i < L.fine.nx; ++i)
+        EXPECT_EQ(r1[L.fine.at(i, j)], (i + j) % 2 == color ? full[L.fine.at(i, j)] : 0.0);
+  }
+  // Restriction of a red-only vector: equal to P^T of that vector (round-off: other order).
+  std::vector<double> red = L.x;
+  for (int j = 0; j < L.fine.ny; ++j)
+    for (int i = 0; i < L.fine.nx; ++i)
+      if ((i + j) % 2) red[L.fine.at(i, j)] = 0.0;
+  std::vector<double> b1(L.xc.size(), 0.0), b2 = b1, b3 = b1;
+  restrict_red_residual_reference(L.fine, L.coarse, L.P().view(), red.data(), b1.data());
+  restrict_red_residual(L.fine, L.coarse, L.P().view(), red.data(), b2.data());
+  restrict_residual_reference(L.fine, L.coarse, L.P().view(), red.data(), b3.data());
+  EXPECT_EQ(b1, b2);
+  for (std::size_t t = 0; t < b1.size(); ++t) EXPECT_NEAR(b1[t], b3[t], 1e-13);
+  // Prolongation to red nodes: the full prolongation's values there, black untouched.
+  std::vector<std::uint8_t> active(L.bits.size());
+  for (std::size_t t = 0; t < active.size(); ++t) active[t] = (L.bits[t] & is_unknown) ? 1 : 0;
+  std::vector<double> x1 = L.x, x2 = L.x, x3 = L.x;
+  prolong_correction_red_reference(L.fine, L.coarse, L.P().view(), L.xc.data(), active.data(), x1.data());
+  prolong_correction_red(L.fine, L.coarse, L.P().view(), L.xc.data(), active.data(), x2.data());
+  prolong_correction_reference(L.fine, L.coarse, L.P().view(), L.xc.data(), active.data(), x3.data());
+  EXPECT_EQ(x1, x2);
+  for (int j = 0; j < L.fine.ny; ++j)
+    for (int i = 0; i < L.fine.nx; ++i)
+      EXPECT_EQ(x1[L.fine.at(i, j)], (i + j) % 2 == 0 ? x3[L.fine.at(i, j)] : L.x[L.fine.at(i, j)]);
+}
+
+TEST_P(MultigridKernels, FastClassificationEqualsFloodFillReference) {
+  omp_set_num_threads(2);
+  for (TexelElementShape shape : {TexelElementShape::quad, TexelElementShape::tri}) {
+    const TexelTile tile = make_laplace_domain(GetParam(), 80, shape);
+    std::vector<std::uint8_t> ref, serial, parallel;
+    const int zr = classify_laplace_texels_reference(tile, ref);
+    EXPECT_EQ(classify_laplace_texels(tile, serial, Execution::serial), zr);
+    EXPECT_EQ(classify_laplace_texels(tile, parallel, Execution::parallel), zr);
+    EXPECT_EQ(ref, serial);
+    EXPECT_EQ(ref, parallel);
+    const GridShape g{tile.width, tile.height};
+    std::vector<std::uint8_t> padded(g.padded_size(), 0xff);
+    EXPECT_EQ(classify_laplace_texels_padded(tile, padded.data()), zr);
+    for (int j = -1; j <= g.ny; ++j)
+      for (int i = -1; i <= g.nx; ++i) {
+        const bool inside = i >= 0 && j >= 0 && i < g.nx && j < g.ny;
+        EXPECT_EQ(padded[g.at(i, j)], inside ? ref[tile.index(i, j)] : 0);
+      }
+  }
+}
+
+TEST(MultigridClassification, RandomTilesWithIsolatedComponentsEqualReference) {
+  // Random walls, Dirichlet and inactive texels: many components, some without data.
+  std::mt19937 rng(7);
+  for (int k = 0; k < 300; ++k) {
+    TexelTile tile(1 + static_cast<int>(rng() % 37), 1 + static_cast<int>(rng() % 37));
+    for (auto& f : tile.flags) {
+      f = static_cast<std::uint8_t>(rng() & (wall_east | wall_north));
+      if (rng() % 7 == 0) f |= dirichlet;
+      if (rng() % 9 == 0) f |= inactive;
+    }
+    std::vector<std::uint8_t> ref, fast;
+    const int zr = classify_laplace_texels_reference(tile, ref);
+    EXPECT_EQ(classify_laplace_texels(tile, fast, Execution::serial), zr);
+    EXPECT_EQ(ref, fast) << "tile " << k << " (" << tile.width << "x" << tile.height << ")";
+  }
 }
 
 INSTANTIATE_TEST_SUITE_P(Domains, MultigridKernels,

@@ -345,9 +345,9 @@ TEST(RenderCutPlate, SeveralEnrichmentsPerElementSplitIntoPieces) {
         EXPECT_TRUE(test::is_background(image, static_cast<int>(x), static_cast<int>(y), s.background));
       }
   }
-  {  // kMaxEnrichmentsPerElement = 4 cuts at 1/4 and 3/4 in both directions: 9 pieces
+  {  // 4 cuts at 1/4 and 3/4 in both directions: 9 pieces
     const ShellState state = multiply_cut_square({{0, 0.25}, {0, 0.75}, {1, 0.25}, {1, 0.75}}, 0.08);
-    ASSERT_EQ(static_cast<int>(state.enrichments.size()), kMaxEnrichmentsPerElement);
+    ASSERT_EQ(static_cast<int>(state.enrichments.size()), 4);
     const Image image = renderer().render(state, s);
     dump(image, "four_cuts");
     EXPECT_EQ(test::count_components(image, s.background), 9);

@@ -41,7 +41,7 @@ bool write_chart(const std::string& path, const std::string& title, const std::v
          << "set format y '10^{%L}'\nset key outside right\nplot ";
   for (std::size_t k = 0; k < series.size(); ++k)
     script << (k ? ", " : "") << "'" << data_path << "' index " << k << " with linespoints title '" << series[k].solver
-           << "'";
+           << "' noenhanced";
   script << "\n";
   script.close();
   const std::string command = "gnuplot '" + script_path + "' 2>/dev/null";
@@ -57,14 +57,15 @@ int bench_laplace_command(int argc, char** argv) {
   CLI::App app{"Time the harmonic-enrichment Laplace solvers to a common relative residual", "dgtex bench laplace"};
   std::vector<int> sizes = {128, 256, 512, 1024};
   std::vector<std::string> domains = {"open", "slit", "spiral", "accordion", "chad", "one_ring"};
-  std::vector<std::string> solvers = {"multigrid", "cholmod", "cholmod_solve", "eigen_ichol_cg", "boomeramg"};
+  std::vector<std::string> solvers = {"multigrid", "multigrid_robust", "cholmod", "cholmod_solve", "eigen_ichol_cg",
+                                      "boomeramg"};
   std::string json_path, chart_path, chart_domain = "slit";
   int chart_size = 512, repeat = 3;
   double tolerance = 1e-6;
   long max_other_unknowns = 2'000'000;
   app.add_option("--sizes", sizes, "texels per element side T")->delimiter(',');
   app.add_option("--domains", domains, "open, slit, spiral, accordion, chad, one_ring")->delimiter(',');
-  app.add_option("--solvers", solvers, "multigrid, cholmod, cholmod_solve, eigen_ichol_cg, boomeramg")->delimiter(',');
+  app.add_option("--solvers", solvers, "multigrid, multigrid_robust, cholmod, cholmod_solve, eigen_ichol_cg, boomeramg")->delimiter(',');
   app.add_option("--json", json_path, "write the results as JSON");
   app.add_option("--chart", chart_path, "write residual against time (SVG, or PNG if FILE ends in .png)");
   app.add_option("--chart-domain", chart_domain, "domain of the chart")->capture_default_str();
@@ -88,7 +89,8 @@ int bench_laplace_command(int argc, char** argv) {
 
     nlohmann::json cases = nlohmann::json::array();
     std::vector<ChartSeries> chart;
-    std::printf("%-10s %5s %9s  %-15s %10s %10s %6s\n", "domain", "T", "unknowns", "solver", "ms", "residual", "iters");
+    std::printf("%-10s %5s %9s  %-15s %10s %10s %6s %9s\n", "domain", "T", "unknowns", "solver", "ms", "residual", "iters",
+                "setup_ms");
     for (LaplaceDomain domain : domain_list)
       for (int T : sizes) {
         const kernels::TexelTile problem = make_laplace_domain(domain, T);
@@ -97,21 +99,43 @@ int bench_laplace_command(int argc, char** argv) {
         const bool chart_case = !chart_path.empty() && laplace_domain_name(domain) == chart_domain && T == chart_size;
         for (LaplaceBenchSolver solver : solver_list) {
           const std::string name = laplace_bench_solver_name(solver);
-          if (solver != LaplaceBenchSolver::multigrid && unknowns > max_other_unknowns) {
+          const bool is_multigrid = solver == LaplaceBenchSolver::multigrid || solver == LaplaceBenchSolver::multigrid_robust;
+          if (!is_multigrid && unknowns > max_other_unknowns) {
             std::printf("%-10s %5d %9ld  %-15s %10s (skipped: over --max-other-unknowns)\n",
                         laplace_domain_name(domain).c_str(), T, unknowns, name.c_str(), "-");
             continue;
           }
           const LaplaceBenchRun run = run_laplace_bench_solver(solver, problem, system, tolerance, repeat, chart_case);
-          std::printf("%-10s %5d %9ld  %-15s %10.2f %10.2e %6d\n", laplace_domain_name(domain).c_str(), T, unknowns,
+          std::printf("%-10s %5d %9ld  %-15s %10.2f %10.2e %6d", laplace_domain_name(domain).c_str(), T, unknowns,
                       name.c_str(), run.ms, run.residual, run.iterations);
+          if (is_multigrid) std::printf(" %9.2f", run.setup_ms);
+          std::printf("\n");
           std::fflush(stdout);
           cases.push_back({{"domain", laplace_domain_name(domain)}, {"size", T}, {"unknowns", unknowns},
                            {"solver", name}, {"ms", run.ms}, {"residual", run.residual},
-                           {"iterations", run.iterations}});
+                           {"iterations", run.iterations}, {"setup_ms", run.setup_ms}});
           if (chart_case) chart.push_back({name, run.history});
         }
       }
+    // Speed-up of the multigrid over the other solvers, case by case, from this run.
+    nlohmann::json ratios = nlohmann::json::array();
+    for (const auto& mg : cases) {
+      if (mg["solver"] != "multigrid") continue;
+      nlohmann::json row = {{"domain", mg["domain"]}, {"size", mg["size"]}};
+      std::string line;
+      for (const auto& other : cases) {
+        if (other["solver"] == "multigrid" || other["domain"] != mg["domain"] || other["size"] != mg["size"]) continue;
+        const double ratio = other["ms"].get<double>() / mg["ms"].get<double>();
+        row[other["solver"].get<std::string>()] = ratio;
+        char buffer[64];
+        std::snprintf(buffer, sizeof buffer, "  %s %.1fx", other["solver"].get<std::string>().c_str(), ratio);
+        line += buffer;
+      }
+      if (line.empty()) continue;
+      std::printf("speed-up of multigrid, %s T=%d:%s\n", mg["domain"].get<std::string>().c_str(), mg["size"].get<int>(),
+                  line.c_str());
+      ratios.push_back(row);
+    }
     const int bandwidth_size = *std::max_element(sizes.begin(), sizes.end());
     const SmootherBandwidth bw = measure_smoother_bandwidth(bandwidth_size, std::max(5, repeat));
     std::printf("smoother (red-black sweep, T=%d): %.2f GB/s; array copy: %.2f GB/s; ratio %.0f%%\n", bandwidth_size,
@@ -121,6 +145,7 @@ int bench_laplace_command(int argc, char** argv) {
       if (!out) throw std::runtime_error("cannot write --json file '" + json_path + "'");
       out << nlohmann::json{{"tolerance", tolerance},
                             {"cases", cases},
+                            {"speedup_of_multigrid", ratios},
                             {"smoother_bandwidth", {{"size", bandwidth_size},
                                                     {"smoother_gb_per_s", bw.smoother_gb_per_s},
                                                     {"copy_gb_per_s", bw.copy_gb_per_s}}}}

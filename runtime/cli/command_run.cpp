@@ -10,12 +10,13 @@
 #include <omp.h>
 
 #include "commands.h"
+#include "dgtex/cut_surface_export.h"
+#include "dgtex/frame_writer.h"
 #include "dgtex/mesh_error.h"
 #include "dgtex/mesh_output.h"
 #include "dgtex/model_error.h"
 #include "dgtex/scene_io.h"
-#include "dgtex/scene_model.h"
-#include "dgtex/shell_simulation.h"
+#include "dgtex/scene_run.h"
 #include "dgtex/surface_point.h"
 
 namespace dgtex::cli {
@@ -52,6 +53,11 @@ int run_command(int argc, char** argv) {
   app.add_option("--out", out_dir, "output folder (created if missing)")->required();
   app.add_option("--threads", threads, "OpenMP threads (default: all cores)")->check(CLI::Range(1, 1024));
   app.add_flag("--quiet", quiet, "no progress line");
+  bool no_render = false, cut_surface_obj = false, save_textures = false;
+  app.add_flag("--no-render", no_render, "write no PNG frames even if the scene has a render block");
+  app.add_flag("--obj", cut_surface_obj, "also write the final cut surface (split along cuts) to DIR/cut_surface.obj");
+  app.add_flag("--save-textures", save_textures,
+               "write the enrichment textures and cut walls of the final state to DIR/textures/enrichment.vdb");
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -60,53 +66,67 @@ int run_command(int argc, char** argv) {
   if (threads > 0) omp_set_num_threads(threads);
 
   Scene scene;
-  Mesh mesh;
-  SceneModel setup;
+  std::unique_ptr<SceneRun> run;
   try {
     scene = load_scene(scene_path);
-    if (!scene.cuts.empty())
-      throw SceneError(scene.source_name, "cuts",
-                       "cuts (enrichment textures) are not available in this version of dgtex yet", "", "an empty list");
-    mesh = build_scene_mesh(scene);
-    setup = build_scene_model(scene, mesh);
+    run = std::make_unique<SceneRun>(scene);
   } catch (const SceneError& e) {
     std::fprintf(stderr, "dgtex run: %s\n", e.what());
     return 2;
   } catch (const MeshError& e) {
     std::fprintf(stderr, "dgtex run: %s: mesh: %s\n", scene_path.c_str(), e.what());
     return 2;
+  } catch (const ModelError& e) {
+    std::fprintf(stderr, "dgtex run: %s: %s\n", scene_path.c_str(), e.what());
+    return 2;
+  } catch (const std::invalid_argument& e) {  // a cut the mesh cannot take (names cuts[i])
+    std::fprintf(stderr, "dgtex run: %s: %s\n", scene_path.c_str(), e.what());
+    return 2;
   }
-  const ShellModel& model = *setup.model;
-  ShellSimulation sim(model, setup.fixed, setup.external_force);
-  std::vector<fs::path> frames;
+  const Mesh& mesh = run->mesh();
+  // PNG frames (dgtex/frame_writer.h). The EGL context opens before the run, so a machine
+  // without one fails here with one line and writes nothing.
+  std::unique_ptr<FrameWriter> png_frames;
+  if (scene.render && !no_render) {
+    try {
+      png_frames = std::make_unique<FrameWriter>(*scene.render, (fs::path(out_dir) / "frames").string());
+    } catch (const EglUnavailableError& e) {
+      std::fprintf(stderr, "dgtex run: %s\n", e.what());
+      return 1;
+    }
+  }
   const fs::path out(out_dir);
+  auto write_frame = [&](int index) {
+    write_vtu((out / "frames" / frame_name(index)).string(), mesh, run->displacement().data());
+    if (png_frames) png_frames->write(run->state(), index);
+  };
   try {
     fs::create_directories(out / "frames");
     if (!scene.analysis.is_dynamic()) {
-      sim.solve_static();
+      run->solve_static();
+      if (png_frames) png_frames->write(run->state(), 0);
     } else {
-      DynamicsOptions options;
-      options.time_step = scene.analysis.time_step;
-      options.corotational = scene.analysis.corotational;
-      options.mass_damping = scene.analysis.damping.mass;
-      options.stiffness_damping = scene.analysis.damping.stiffness;
       const int every = scene.render ? scene.render->every_steps : 10;
       const bool progress = !quiet && isatty(fileno(stderr));
-      write_vtu((out / "frames" / frame_name(0)).string(), mesh, sim.displacement().data());
+      write_frame(0);
       for (int step = 1; step <= scene.analysis.steps; ++step) {
-        sim.step(options);
-        if (!all_finite(sim.displacement()))
-          throw ModelError("analysis: the solution diverged at step " + std::to_string(step) +
-                           " (time step " + std::to_string(options.time_step) + " too large?)");
-        if (step % every == 0 || step == scene.analysis.steps)
-          write_vtu((out / "frames" / frame_name(step)).string(), mesh, sim.displacement().data());
-        if (progress)
-          std::fprintf(stderr, "\rdgtex run: step %d/%d  t = %.4g  %.1f ms/step", step, scene.analysis.steps,
-                       sim.time(), (sim.timings().at("solve").total_ms + (sim.timings().count("assembly") ? sim.timings().at("assembly").total_ms : 0)) / step);
+        run->step();
+        if (!all_finite(run->displacement()))
+          throw ModelError("analysis: the solution diverged at step " + std::to_string(step) + " (time step " +
+                           std::to_string(scene.analysis.time_step) + " too large?)");
+        if (step % every == 0 || step == scene.analysis.steps) write_frame(step);
+        if (progress) {
+          double ms = 0;
+          for (const auto& [stage, stats] : run->timings()) ms += stats.total_ms;
+          std::fprintf(stderr, "\rdgtex run: step %d/%d  t = %.4g  %.1f ms/step  enrichments %d   ", step,
+                       scene.analysis.steps, run->time(), ms / step, static_cast<int>(run->model().enrichments().size()));
+        }
       }
       if (progress) std::fprintf(stderr, "\n");
     }
-    write_vtu((out / "deformed.vtu").string(), mesh, sim.displacement().data());
+    write_vtu((out / "deformed.vtu").string(), mesh, run->displacement().data());
+    if (cut_surface_obj) export_cut_surface_obj((out / "cut_surface.obj").string(), run->state());
+    if (save_textures && run->cuts()) run->cuts()->save_textures((out / "textures").string());
   } catch (const ModelError& e) {
     std::fprintf(stderr, "dgtex run: %s: %s\n", scene_path.c_str(), e.what());
     return 2;
@@ -115,6 +135,9 @@ int run_command(int argc, char** argv) {
     return 1;
   }
 
+  const ShellModel& model = run->model();
+  const ShellSimulation& sim = run->simulation();
+  const StageTimings timings = run->timings();
   nlohmann::json report;
   report["scene"] = scene_path;
   report["analysis"] = scene.analysis.is_dynamic() ? "dynamic" : "static";
@@ -122,22 +145,31 @@ int run_command(int argc, char** argv) {
   report["counts"] = {{"elements", mesh.num_elements()},
                       {"nodes", mesh.num_nodes()},
                       {"dofs", model.num_dofs()},
+                      {"enriched_dofs", model.num_enriched_dofs()},
                       {"free_dofs", sim.system().size()},
                       {"nonzeros", 2 * lower - sim.system().size()},
                       {"factor_nonzeros", sim.factor_nonzeros()},
                       {"interior_edges", model.num_interior_edges()},
                       {"clamped_edges", model.num_clamped_edges()},
                       {"quadrature_points", model.num_quadrature_points()},
-                      {"enrichments", 0}};
-  report["timings_ms"] = {{"assembly", stage_json(sim.timings(), "assembly")},
-                          {"solve", stage_json(sim.timings(), "solve")}};
-  report["time"] = sim.time();
+                      {"enriched_elements", model.num_enriched_elements()},
+                      {"enriched_quadrature_points", model.num_enriched_element_quadrature_points() +
+                                                         model.num_enriched_edge_quadrature_points()},
+                      {"enrichments", static_cast<int>(model.enrichments().size())},
+                      {"texture_resolution", run->cuts() ? run->cuts()->texture_resolution() : 0},
+                      {"basis_changes", run->basis_changes()}};
+  report["timings_ms"] = {{"enrichment", stage_json(timings, "enrichment")},
+                          {"projection", stage_json(timings, "projection")},
+                          {"assembly", stage_json(timings, "assembly")},
+                          {"solve", stage_json(timings, "solve")}};
+  if (png_frames) report["timings_ms"]["render"] = stage_json(png_frames->timings(), "render");
+  report["time"] = run->time();
   report["threads"] = omp_get_max_threads();
   nlohmann::json probes = nlohmann::json::object();
   for (const Probe& probe : scene.probes) {
     const SurfacePoint p = closest_surface_point(mesh, probe.position.data());
     double u[3];
-    model.interpolate(sim.displacement(), p.element, p.xi, u);
+    model.interpolate(run->displacement(), p.element, p.xi, u);
     probes[probe.name] = {{"displacement", {u[0], u[1], u[2]}},
                           {"surface_point", {p.position[0], p.position[1], p.position[2]}},
                           {"element", p.element}};

@@ -8,5 +8,6 @@ int run_command(int argc, char** argv);            // dgtex run SCENE --out DIR
 int render_command(int argc, char** argv);         // dgtex render STATE --out DIR
 int bench_laplace_command(int argc, char** argv);  // dgtex bench laplace
 int bench_shell_command(int argc, char** argv);    // dgtex bench shell
+int bench_render_command(int argc, char** argv);   // dgtex bench render
 
 }  // namespace dgtex::cli

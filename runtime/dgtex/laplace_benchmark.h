@@ -11,7 +11,9 @@
 
 namespace dgtex {
 
-enum class LaplaceBenchSolver { multigrid, cholmod, cholmod_solve, eigen_ichol_cg, boomeramg };
+// multigrid: default options; multigrid_robust: coarse_solve_tolerance = 0.02 (level 1 solved
+// by inner CG in every cycle, see LaplaceMultigridOptions).
+enum class LaplaceBenchSolver { multigrid, multigrid_robust, cholmod, cholmod_solve, eigen_ichol_cg, boomeramg };
 
 std::string laplace_bench_solver_name(LaplaceBenchSolver solver);
 // Throws std::invalid_argument listing the valid names.
@@ -22,6 +24,7 @@ struct LaplaceBenchRun {
   double ms = 0;            // best of the repeats (cholmod_solve: the solve after a factorisation)
   double residual = 0;      // relative residual of the result, measured on `system`
   int iterations = 0;
+  double setup_ms = 0;      // multigrid: hierarchy setup within ms (of the best run); else 0
   std::vector<LaplaceConvergencePoint> history;  // residual against time (if requested)
 };
 
@@ -32,9 +35,10 @@ LaplaceBenchRun run_laplace_bench_solver(LaplaceBenchSolver solver, const kernel
                                          const TexelLaplaceSystem& system, double tolerance, int repeat,
                                          bool record_history);
 
-// Achieved memory bandwidth (GB/s) of one red-black sweep of the texel smoother on an
-// open T x T tile (bytes: x read + written, b and flag bytes read) and of a plain array
-// copy of the same size (bytes read + written), in the same run.
+// Achieved memory bandwidth (GB/s) of one red-black sweep of the texel smoother as the
+// multigrid runs it (kernels::smooth_texels_sweep, one streaming pass) on an open T x T
+// tile (bytes: x read + written, b and flag bytes read) and of a plain array copy of the
+// same size (bytes read + written), in the same run.
 struct SmootherBandwidth {
   double smoother_gb_per_s = 0;
   double copy_gb_per_s = 0;

@@ -1,9 +1,10 @@
 #pragma once
 // Geometric multigrid for the harmonic texel problem (dgtex/kernels/multigrid_unknowns.h):
-// red-black Gauss-Seidel on the texel level, black-box (operator-dependent, Galerkin)
-// coarse levels that keep cuts as walls, a dense Cholesky on the coarsest level, used as
-// V/F-cycles or as the preconditioner of conjugate gradients (the default: see
-// laplace_multigrid.cpp for the measurements behind it).
+// red-black Gauss-Seidel on the texel level (5-point operator applied straight from one
+// flag byte per texel, nothing stored), black-box (operator-dependent, Galerkin) 9-point
+// coarse levels that keep cuts as walls, a dense (small) or CHOLMOD (large) Cholesky on
+// the coarsest level, used as V/F-cycles or as the preconditioner of conjugate gradients
+// (the default: see laplace_multigrid.cpp for the measurements behind it).
 #include <memory>
 #include <vector>
 
@@ -24,6 +25,11 @@ struct LaplaceMultigridOptions {
   bool use_as_cg_preconditioner = true;  // one symmetric V-cycle per CG iteration
   bool warm_start = true;         // initial guess = tile.values of the unknowns (else 0)
   kernels::Execution execution = kernels::Execution::parallel;
+  // Robust cycle for domains with features narrower than the coarse grids (a 2-texel
+  // bridge, narrow channels): > 0 solves level 1 in every cycle by conjugate gradients
+  // preconditioned with its own V-cycle, to this relative residual (at most 50 iterations);
+  // the outer CG then uses the flexible (Polak-Ribiere) update. See laplace_multigrid.cpp.
+  double coarse_solve_tolerance = 0;
   int coarsest_nodes = 64;        // coarsen until a level has at most this many nodes ...
   int max_orphans = 0;            // ... or until coarsening would leave more active nodes
                                   // without interpolation (channels narrower than the coarse

@@ -4,10 +4,22 @@
 // blocks. Owns its mesh copy and all precomputed patterns; not thread-safe for concurrent
 // calls on one instance (each call uses all OpenMP threads itself).
 //
-// DOFs: 3 per node (x, y, z displacement), DOF 3*n + c. Units: those of the scene.
+// DOFs: 3 per node (x, y, z displacement), DOF 3*n + c. With enrichments (thesis §5.3-5.5,
+// set_enrichments) every enriched basis function (H_i - H_i(xi^a)) N^a adds a "virtual
+// node" after the mesh nodes: one per (function i, node a in N_i), in order of i then N_i;
+// virtual node num_nodes() + slot has DOFs 3*num_nodes() + 3*slot + c. Its rest value is 0.
+// Elements touched by an enrichment and the edges next to them are integrated by the
+// enriched kernels (texel-resolving quadrature, enriched_quadrature.h); all others by the
+// standard ones. Without enrichments everything is exactly the plain DG shell.
+// Units: those of the scene.
+#include <functional>
 #include <vector>
 
 #include "dgtex/block_assembly.h"
+#include "dgtex/enrichment_function.h"
+#include "dgtex/kernels/enriched_edge_kernel.h"
+#include "dgtex/kernels/enriched_element_kernel.h"
+#include "dgtex/kernels/enriched_quadrature.h"
 #include "dgtex/kernels/shell_edge_kernel.h"
 #include "dgtex/kernels/shell_element_kernel.h"
 #include "dgtex/mesh.h"
@@ -18,6 +30,12 @@ namespace dgtex {
 struct ShellModelOptions {
   double penalty = 10;             // eta of the interior-penalty terms (report eq. 15)
   int edge_quadrature_points = 3;  // Gauss points per edge
+  // Quadrature of enriched elements and edges: adaptive merging of texel cells where every
+  // enrichment is one quadratic (enriched_quadrature.h), or per-texel everywhere.
+  kernels::EnrichedQuadratureOptions enrichment_quadrature;
+  // Enriched DOFs whose basis function has less mass than this fraction of its node's own
+  // (a cut clipping the support by a few texels) are dropped (set_enrichments); 0 keeps all.
+  double min_enrichment_mass_ratio = 1e-3;
 };
 
 class ShellModel {
@@ -28,31 +46,70 @@ class ShellModel {
 
   const Mesh& mesh() const { return mesh_; }
   int num_nodes() const { return mesh_.num_nodes(); }
-  int num_dofs() const { return 3 * mesh_.num_nodes(); }
+  int num_dofs() const { return 3 * (mesh_.num_nodes() + num_enriched_nodes()); }
   int num_edges() const { return static_cast<int>(edges_.size() / 4); }
   int num_interior_edges() const { return num_interior_edges_; }
   int num_clamped_edges() const { return num_edges() - num_interior_edges_; }
-  std::int64_t num_quadrature_points() const;  // element + edge points
+  std::int64_t num_quadrature_points() const;  // element + edge points (enriched ones included)
   const BlockAssembly& pattern() const { return assembly_; }
   const ShellModelOptions& options() const { return options_; }
   const std::vector<kernels::ShellSection>& sections() const { return sections_; }
 
-  // Global stiffness blocks (pattern().num_blocks() x 9). With current node positions
-  // (#nodes x 3), the model is corotated per quadrature point and `corrective` (#dofs)
-  // receives the right-hand-side term of report eq. 48; without, it is the linear model.
+  // --- Enrichment ---------------------------------------------------------------------
+  // Replaces the enrichment functions (an empty list is clear_enrichments()) and rebuilds
+  // pattern, mass and load weights. Node shifts H_i(xi^a) are the mean over the elements
+  // of Omega_i incident to a of the texture sampled at the node (enriched_basis.h rule).
+  // Throws std::invalid_argument naming the function, element or node for: textures not
+  // all T x T (T >= 1) or with non-finite values, unsorted/duplicate/out-of-range nodes or
+  // elements, an element incident to an enriched node that has no texture of that
+  // function, or more than kernels::max_enrichments_per_element functions on one element.
+  // Enriched nodes below options().min_enrichment_mass_ratio are dropped (and functions
+  // left without nodes), so enrichments() may hold less than was given.
+  void set_enrichments(std::vector<EnrichmentFunction> functions);
+  int num_pruned_enriched_nodes() const { return pruned_enriched_nodes_; }
+  void clear_enrichments() { set_enrichments({}); }
+  const std::vector<EnrichmentFunction>& enrichments() const { return enrichments_; }
+  int num_enriched_nodes() const { return static_cast<int>(virtual_node_function_.size()); }  // virtual nodes
+  int num_enriched_dofs() const { return 3 * num_enriched_nodes(); }
+  // Virtual node of (function i, mesh node a), or -1 if a is not in N_i.
+  int virtual_node(int function, int node) const;
+  // Mesh node a and function i of virtual node v (v >= num_nodes()).
+  int virtual_node_mesh_node(int virtual_node) const { return virtual_node_mesh_node_[virtual_node - num_nodes()]; }
+  int virtual_node_function(int virtual_node) const { return virtual_node_function_[virtual_node - num_nodes()]; }
+  // H_i(xi^a) of virtual node v (offset by num_nodes(): v = num_nodes() + slot).
+  double node_shift(int virtual_node) const { return virtual_node_shift_[virtual_node - num_nodes()]; }
+  int num_enriched_elements() const { return static_cast<int>(enriched_elements_.size()); }
+  int num_enriched_edges() const { return static_cast<int>(enriched_edges_.size() / 4); }
+  std::int64_t num_enriched_element_quadrature_points() const { return element_qp_start_.empty() ? 0 : element_qp_start_.back(); }
+  std::int64_t num_enriched_edge_quadrature_points() const { return edge_qp_start_.empty() ? 0 : edge_qp_start_.back(); }
+  // Rest state (#dofs): node positions, then 0 for every enriched DOF. A current state for
+  // assemble_stiffness is rest_state() + u.
+  const std::vector<double>& rest_state() const { return rest_state_; }
+
+  // Global stiffness blocks (pattern().num_blocks() x 9). With a current state (#dofs:
+  // current node positions, then the current enriched DOF values), the model is corotated
+  // per quadrature point and `corrective` (#dofs) receives the right-hand-side term of
+  // report eq. 48; without, it is the linear model.
   void assemble_stiffness(const double* current_positions, std::vector<double>& blocks,
                           std::vector<double>* corrective, kernels::Execution execution = kernels::Execution::parallel) const;
 
   // Consistent mass blocks (same pattern), assembled at construction.
   const std::vector<double>& mass_blocks() const { return mass_blocks_; }
 
-  // Load vectors (#dofs): body force per unit mass (gravity), force per unit area, and a
+  // Load vectors (#dofs, enriched functions included): body force per unit mass (gravity), force per unit area, and a
   // point force at a parametric point of an element (distributed by the basis functions).
   void add_gravity(const double acceleration[3], std::vector<double>& f) const;
   void add_area_force(const double force_per_area[3], std::vector<double>& f) const;
   void add_point_force(int element, const double xi[2], const double force[3], std::vector<double>& f) const;
 
-  // Displacement at a parametric point of an element.
+  // Mass-weighted moments of a vector field g over the surface, with this model's basis and
+  // quadrature (texel-resolving in enriched elements): out[3A + c] = int rho h N_A g_c dA
+  // (#dofs). g(element, xi, value[3]) is called once per quadrature point, serially in
+  // element order. The right-hand side of the L2 projection onto this basis.
+  std::vector<double> mass_weighted_moments(
+      const std::function<void(int element, const double xi[2], double value[3])>& g) const;
+
+  // Displacement at a parametric point of an element (enriched functions included).
   void interpolate(const std::vector<double>& u, int element, const double xi[2], double out[3]) const;
 
  private:
@@ -64,10 +121,47 @@ class ShellModel {
   int num_interior_edges_ = 0;
   BlockAssembly assembly_;
   std::vector<double> mass_blocks_;
-  std::vector<double> area_weights_, mass_weights_;  // #elements x npe
+  std::vector<double> rest_state_;
 
+  // Plain (not enriched) elements and edges, compacted; all of them without enrichments.
+  std::vector<int> plain_connectivity_;                // #plain elements x npe
+  std::vector<kernels::ShellSection> plain_sections_;  // per plain element
+  std::vector<int> plain_edges_;                       // #plain edges x 4
+  std::vector<double> plain_edge_size_;
+  std::vector<double> area_weights_, mass_weights_;    // #plain elements x npe
+
+  // Enrichment state (see set_enrichments); textures_ point into enrichments_.
+  std::vector<EnrichmentFunction> enrichments_;
+  int resolution_ = 0;
+  std::vector<int> function_slot_start_;    // per function: its first slot (#functions + 1)
+  std::vector<int> virtual_node_function_;  // per virtual node: function i
+  std::vector<int> virtual_node_mesh_node_; // per virtual node: node a
+  std::vector<double> virtual_node_shift_;  // per virtual node: H_i(xi^a)
+  std::vector<int> enriched_elements_;      // mesh element of each enriched element
+  std::vector<int> enriched_index_;         // per mesh element: index in enriched_elements_ or -1
+  std::vector<int> enrichment_start_;       // CSR over element enrichments
+  std::vector<kernels::TextureView> textures_;
+  std::vector<int> enriched_node_;          // per element enrichment x npe
+  std::vector<double> enriched_shift_;      // per element enrichment x npe
+  int width_ = 0;                           // padded local basis size of enriched elements
+  std::vector<int> enriched_global_nodes_;  // #enriched elements x width
+  std::vector<std::int64_t> element_qp_start_;
+  std::vector<double> element_qp_;
+  std::vector<int> enriched_edges_;         // #enriched edges x 4
+  std::vector<double> enriched_edge_size_;
+  std::vector<std::int64_t> edge_qp_start_;
+  std::vector<double> edge_qp_;
+  std::vector<double> enriched_area_weights_, enriched_mass_weights_;  // #enriched elements x width
+
+  int pruned_enriched_nodes_ = 0;
+  void install_enrichments(std::vector<EnrichmentFunction> functions);
+  void rebuild();
   kernels::ElementBatch element_batch() const;
   kernels::EdgeBatch edge_batch() const;
+  kernels::EnrichedElementBatch enriched_element_batch() const;
+  kernels::EnrichedEdgeBatch enriched_edge_batch(const kernels::EnrichedElementBatch& elements) const;
+  // Basis of an element at xi: global nodes and values (npe, or the enriched basis).
+  int basis_at(int element, const double xi[2], int* global, double* values) const;
 };
 
 // y = A x for block matrices in the pattern (deterministic, parallel over rows).

@@ -3,11 +3,17 @@
 //
 // Every element is drawn with one static tessellation of its parameter domain shared by
 // all elements (instanced). The vertex stage evaluates base and A_k of the deformed
-// position (dgtex/deformed_shell.h) from the DOFs and the enrichment textures; the
-// geometry stage duplicates each triangle with a cut edge (|H_i - H_j| > cut_threshold
-// and a sign change of H) once per side, extrapolating the vertices across the cut with
-// that side's value; the fragment stage discards the fragments of a copy whose texel lies
-// on the other side. At most kMaxEnrichmentsPerElement enrichments per element.
+// position (dgtex/deformed_shell.h) from the DOFs and the enrichment textures and passes
+// on only base, the position with the vertex's own H_k and the signs of H_k; the
+// geometry stage loops over the element's enrichment slots, finds those whose cut crosses
+// the triangle (|H_i - H_j| > cut_threshold and a sign change of H) and duplicates the
+// triangle once per combination of their sides, extrapolating the vertices across each
+// cut with that side's value (of the nearest texel on that side, a function of the vertex
+// alone, so neighbouring copies stay closed); the fragment stage discards the fragments
+// of a copy whose texel lies on the other side. At most kMaxEnrichmentsPerElement
+// enrichments per element; with the geometry-shader method a tessellation triangle
+// crossed by more than kMaxCutsPerTriangle cuts is not drawn (a hole where that many
+// cuts meet within one triangle; a finer tessellation separates them).
 #include <memory>
 #include <string>
 
@@ -17,7 +23,10 @@
 
 namespace dgtex {
 
-constexpr int kMaxEnrichmentsPerElement = 4;
+// Slot bit masks are 32-bit in the shaders; >= kernels::max_enrichments_per_element.
+constexpr int kMaxEnrichmentsPerElement = 32;
+// Cuts one tessellation triangle may cross (geometry-shader method): 2^k copies.
+constexpr int kMaxCutsPerTriangle = 4;
 
 struct RenderSettings {
   int width = 640, height = 480;
@@ -79,6 +88,11 @@ class ShellRenderer {
   double last_upload_ms() const { return last_upload_ms_; }
   double last_setup_ms() const { return last_setup_ms_; }
   double last_draw_ms() const { return last_draw_ms_; }
+  // Triangles of the last render: submitted (tessellation triangles x elements) and drawn
+  // (what the geometry stage emitted to the rasteriser, GL_PRIMITIVES_GENERATED: cut
+  // triangles count once per copy, dropped ones not at all).
+  long long last_triangles_submitted() const { return last_triangles_submitted_; }
+  long long last_triangles_drawn() const { return last_triangles_drawn_; }
 
   const EglContext& context() const { return *context_; }
 
@@ -87,6 +101,7 @@ class ShellRenderer {
   std::shared_ptr<EglContext> context_;
   std::unique_ptr<GlObjects> gl_;
   double last_upload_ms_ = 0, last_setup_ms_ = 0, last_draw_ms_ = 0;
+  long long last_triangles_submitted_ = 0, last_triangles_drawn_ = 0;
 };
 
 }  // namespace dgtex

@@ -5,9 +5,14 @@
 //      (M + dt D + dt^2 K) v+ = M v + dt (f - K u),   u+ = u + dt v+,
 //    optionally corotated per quadrature point (K -> R K R^T, f += R K (I - R^T) X0).
 // The CHOLMOD analysis is reused while the pattern is unchanged; a linear dynamic run
-// factorises once. Every stage's time is recorded ("assembly", "solve").
+// factorises once. A corotated run solves each step by conjugate gradients preconditioned
+// with the factor of an earlier step's matrix and refactorises only when that slows down
+// (FactorReusingSolver: same relative-residual bound as a direct solve, see there);
+// reuse_factorization = false factorises every step instead (the reference path).
+// Every stage's time is recorded ("assembly", "solve").
 #include <vector>
 
+#include "dgtex/factor_reusing_solver.h"
 #include "dgtex/free_dof_system.h"
 #include "dgtex/shell_model.h"
 #include "dgtex/sparse_cholesky.h"
@@ -20,6 +25,7 @@ struct DynamicsOptions {
   bool corotational = false;
   double mass_damping = 0;       // a in D = a M + b K
   double stiffness_damping = 0;  // b
+  bool reuse_factorization = true;  // corotated: PCG with a lagged factor (see above)
 };
 
 class ShellSimulation {
@@ -41,6 +47,9 @@ class ShellSimulation {
   const StageTimings& timings() const { return timings_; }
   const FreeDofSystem& system() const { return system_; }
   std::int64_t factor_nonzeros() const { return cholesky_.factor_nonzeros(); }
+  // Solver of the corotated steps: its tolerance and refactorisation policy, and counts.
+  void set_solver_options(const FactorReuseOptions& options);
+  const FactorReuseStatistics& solver_statistics() const { return solver_.statistics(); }
 
   double kinetic_energy() const;
   double linear_elastic_energy() const;  // 1/2 u^T K u with the linear K
@@ -56,6 +65,10 @@ class ShellSimulation {
   StageTimings timings_;
   std::vector<double> linear_k_;  // cached linear stiffness blocks
   double factorised_dt_ = -1;     // linear dynamics: the dt whose matrix is factorised
+  FactorReusingSolver solver_;
+  // Buffers reused by every step (no allocation per step).
+  std::vector<double> current_, corotated_k_, corrective_, mv_, ku_, rhs_full_, rhs_, v_new_, values_;
+  std::vector<double> previous_v_, guess_;  // velocity of the step before, PCG start
 
   const std::vector<double>& linear_stiffness();
 };

@@ -12,6 +12,25 @@
 // with piecewise-constant aggregation). Dirichlet texels are no unknowns: their
 // couplings only add to the diagonal, so interpolation decays towards them.
 //
+// Edge nodes (fine nodes on a coarse grid line) do not collapse their couplings to the two
+// cell-centre neighbours blindly: each such coupling is shared between the edge node's
+// two coarse neighbours in proportion to the cell centre's own couplings to them (as in
+// Ruge-Stueben interpolation), and collapsed only where the cell centre couples to
+// neither (always the case on the 5-point level, where this is plain black-box). Why:
+// at a gap in a wall (chad's 2-texel bridge) plain collapse puts the edge node half-way
+// between inside and outside although its other neighbours are inside; measured energy
+// of the disk's indicator on level 2 of chad T=128: 5.09 plain, 2.73 with this rule
+// (level 0: 2.0), per-cycle reduction of V(1,1)-CG at T=256: chad 0.367 -> 0.327, spiral
+// 0.436 -> 0.416, open/slit/accordion unchanged (0.085-0.094).
+// Known limit (measured, T=256, CG): with level 1 solved exactly the reduction is <= 0.082
+// on chad and spiral, with three levels 0.24-0.28, with the full hierarchy 0.33-0.42: the
+// coarse spaces from level 2 on cannot represent modes that live on sub-coarse-grid
+// features (a bridge or channel narrower than the coarse spacing). Tried and rejected:
+// Jacobi iteration of the edge/cell-centre weights within the compact pattern (chad 0.25,
+// spiral 0.32, but open/slit degrade from 0.085 to 0.11-0.18 through the boundary rows),
+// more coarse smoothing (16 sweeps on level 1: 3-level rate 0.92 -> 0.88). What works: the
+// robust cycle of LaplaceMultigridOptions::coarse_solve_tolerance (level 1 solved by inner CG).
+//
 // Both setup kernels write the coarse arrays (padded layout, ghosts must be zero on entry
 // and stay zero) for every coarse node and are gathers, so serial and parallel agree bitwise.
 #include <cstdint>

@@ -26,4 +26,33 @@ void smooth_stencil9_color(GridShape shape, Stencil9View a, const double* b, dou
                            Execution execution = Execution::parallel);
 void smooth_stencil9_color_reference(GridShape shape, Stencil9View a, const double* b, double* x, int color);
 
+// Whole sweeps in one streaming pass over the rows (what the multigrid runs). The second
+// colour(s) of row j - 1 are updated right after the first colour(s) of row j, so x, b and
+// the operator stream through the cache once per sweep instead of once per colour; rows at
+// the borders of the fixed 32-row blocks (the parallel work items) are finished in a second,
+// short pass. Every node sees exactly the inputs of the colour-by-colour order, so these are
+// bitwise equal to the colour kernels above run in order (forward: colours 0, 1 [, 2, 3];
+// backward: the reverse) for any thread count.
+// If row_dot is given, row_dot[j] = sum over row j of b * x after the sweep (left to right;
+// the preconditioned CG's r . z for free).
+void smooth_texels_sweep(GridShape shape, const std::uint8_t* bits, const double* b, double* x, bool forward,
+                         Execution execution = Execution::parallel, double* row_dot = nullptr);
+// A forward sweep from x = 0 (x need not be initialised): red unknowns get b / degree, black
+// unknowns their Gauss-Seidel update, every other node 0.
+void smooth_texels_sweep_from_zero(GridShape shape, const std::uint8_t* bits, const double* b, double* x,
+                                   Execution execution = Execution::parallel);
+void smooth_stencil9_sweep(GridShape shape, Stencil9View a, const double* b, double* x, bool forward,
+                           Execution execution = Execution::parallel);
+
+// Conjugate-gradient step fused with the first sweep of the next preconditioner application:
+// x += alpha p, r -= alpha q (row_norm2[j] = sum over row j of r^2, left to right), then
+// z = smooth_texels_sweep_from_zero with b = r. Bitwise equal to those two steps in turn;
+// saves one pass over r. The reference runs them in turn.
+void cg_update_and_smooth_texels_from_zero(GridShape shape, const std::uint8_t* bits, double alpha, const double* p,
+                                           const double* q, double* x, double* r, double* z, double* row_norm2,
+                                           Execution execution = Execution::parallel);
+void cg_update_and_smooth_texels_from_zero_reference(GridShape shape, const std::uint8_t* bits, double alpha,
+                                                     const double* p, const double* q, double* x, double* r, double* z,
+                                                     double* row_norm2);
+
 }  // namespace dgtex::kernels

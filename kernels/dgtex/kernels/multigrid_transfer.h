@@ -21,4 +21,18 @@ void prolong_correction(GridShape fine, GridShape coarse, InterpolationView p, c
 void prolong_correction_reference(GridShape fine, GridShape coarse, InterpolationView p, const double* x_coarse,
                                   const std::uint8_t* fine_active, double* x_fine);
 
+// Red-black forms for level 0 (red: (i + j) even = the coarse nodes (2I, 2J) and the cell
+// centres (2I+1, 2J+1)). restrict_red_residual is P^T r for an r that vanishes at black
+// nodes (after a forward red-black sweep, see residual_texels_color) and reads red entries
+// only. prolong_correction_red adds P x_coarse at red nodes only: the backward sweep that
+// follows starts with the black colour, whose update does not read the old black values.
+void restrict_red_residual(GridShape fine, GridShape coarse, InterpolationView p, const double* r_fine,
+                           double* b_coarse, Execution execution = Execution::parallel);
+void restrict_red_residual_reference(GridShape fine, GridShape coarse, InterpolationView p, const double* r_fine,
+                                     double* b_coarse);
+void prolong_correction_red(GridShape fine, GridShape coarse, InterpolationView p, const double* x_coarse,
+                            const std::uint8_t* fine_active, double* x_fine, Execution execution = Execution::parallel);
+void prolong_correction_red_reference(GridShape fine, GridShape coarse, InterpolationView p, const double* x_coarse,
+                                      const std::uint8_t* fine_active, double* x_fine);
+
 }  // namespace dgtex::kernels

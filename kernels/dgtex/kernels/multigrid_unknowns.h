@@ -11,6 +11,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "dgtex/kernels/forall.h"
 #include "dgtex/kernels/texel_grid.h"
 
 namespace dgtex::kernels {
@@ -37,9 +38,19 @@ inline bool texels_coupled_north(const TexelTile& tile, int i, int j) {
          !(tile.flags[tile.index(i, j + 1)] & inactive);
 }
 
-// Writes one LaplaceTexelBits byte per texel into `bits` (width * height). Flood fill
-// (serial: one pass over the tile with an explicit stack, deterministic). Returns the
+// Writes one LaplaceTexelBits byte per texel into `bits` (width * height). Returns the
 // number of free texels in components without Dirichlet data (not unknowns, value 0).
-int classify_laplace_texels(const TexelTile& tile, std::vector<std::uint8_t>& bits);
+// Couplings and degrees are per-texel gathers (parallel rows); the components of free
+// texels are found by union-find over runs of east-coupled free texels (serial, a few
+// operations per run and per north link), so setup costs a few passes over the flags
+// instead of a per-texel flood fill. The result does not depend on the execution.
+int classify_laplace_texels(const TexelTile& tile, std::vector<std::uint8_t>& bits,
+                            Execution execution = Execution::parallel);
+// The same bytes written into a padded grid (multigrid_grid.h layout: (width+2) x
+// (height+2), ghosts set to 0), the form the multigrid uses.
+int classify_laplace_texels_padded(const TexelTile& tile, std::uint8_t* padded_bits,
+                                   Execution execution = Execution::parallel);
+// Serial reference: a flood fill with an explicit stack from each free texel in index order.
+int classify_laplace_texels_reference(const TexelTile& tile, std::vector<std::uint8_t>& bits);
 
 }  // namespace dgtex::kernels

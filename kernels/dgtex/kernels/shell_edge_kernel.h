@@ -41,6 +41,10 @@ struct EdgeBatch {
 void shell_edge_stiffness(const EdgeBatch& batch, const double* rotations, double* blocks, double* forces,
                           Execution execution = Execution::parallel);
 
+// The plain serial reference form of shell_edge_stiffness (per point, block by block);
+// equal to it to round-off (~1e-15 relative), not bitwise.
+void shell_edge_stiffness_reference(const EdgeBatch& batch, const double* rotations, double* blocks, double* forces);
+
 // Rotation of the edge frame (tangent, averaged normal) from rest to current positions.
 void shell_edge_rotations(const EdgeBatch& batch, const double* current_positions, double* rotations,
                           Execution execution = Execution::parallel);

@@ -36,6 +36,11 @@ struct ElementBatch {
 void shell_element_stiffness(const ElementBatch& batch, const double* rotations, double* blocks, double* forces,
                              Execution execution = Execution::parallel);
 
+// The plain serial reference form of shell_element_stiffness (per point, block by block,
+// as the report writes it); equal to it to round-off (~1e-15 relative), not bitwise.
+void shell_element_stiffness_reference(const ElementBatch& batch, const double* rotations, double* blocks,
+                                       double* forces);
+
 // Deformation gradient F = [a1 a2 t][A1 A2 T0]^-1 at each quadrature point, from rest and
 // current node positions (#nodes x 3 each). Output #elements x nq x 9.
 void shell_element_deformation_gradients(const ElementBatch& batch, const double* current_positions, double* F,

@@ -1,0 +1,126 @@
+// Enriched assembly of one quad8 element with T = 256 enrichment textures: set-up
+// (adaptive quadrature + mass + pattern) and the stiffness assembly, linear and corotated,
+// for 1 and 6 enrichment functions, each for complete cuts (constant H: cells merge away
+// from the cuts) and partial cuts (harmonic H: texel-resolved near the cuts). Counters:
+// enriched DOFs and quadrature points. Argument pairs: (enrichments, partial?).
+#include <benchmark/benchmark.h>
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <memory>
+
+#include "dgtex/harmonic_enrichment.h"
+#include "dgtex/heaviside.h"
+#include "dgtex/kernels/cut_rasterization.h"
+#include "dgtex/mesh_generators.h"
+#include "dgtex/shell_model.h"
+#include "dgtex/topology.h"
+
+using namespace dgtex;
+
+namespace {
+
+constexpr int kResolution = 256;
+
+// Straight cuts in texel coordinates: complete ones cross the tile (parallel, so each is
+// complete); partial ones enter from the left or right border and stop inside.
+std::vector<std::vector<kernels::TexelPoint>> cut_lines(int count, bool partial) {
+  const double t = kResolution;
+  std::vector<std::vector<kernels::TexelPoint>> lines;
+  for (int k = 0; k < count; ++k) {
+    const double y = t * (k + 0.5) / count + 3;
+    if (!partial) lines.push_back({{0, y}, {t, y}});
+    else if (k % 2 == 0) lines.push_back({{0, y}, {0.45 * t, y}});
+    else lines.push_back({{t, y}, {0.55 * t, y}});
+  }
+  return lines;
+}
+
+std::vector<EnrichmentFunction> enrichments(int count, bool partial, const Mesh& mesh) {
+  kernels::TexelTile walls = kernels::make_element_tile(ElementType::quad8, kResolution);
+  std::vector<kernels::CutRaster> cuts;
+  for (const auto& line : cut_lines(count, partial)) cuts.push_back(kernels::rasterize_cut(line, walls));
+  std::vector<EnrichmentFunction> functions;
+  for (const auto& cut : cuts) {
+    EnrichmentFunction f;
+    for (int a = 0; a < 8; ++a) f.enriched_nodes.push_back(mesh.element_nodes(0)[a]);
+    std::sort(f.enriched_nodes.begin(), f.enriched_nodes.end());
+    f.elements.push_back({0, partial ? harmonic_enrichment(walls, cut).tile : complete_cut_heaviside(walls, cut)});
+    functions.push_back(std::move(f));
+  }
+  return functions;
+}
+
+struct Setup {
+  Mesh mesh = make_rectangle(1, 1, 1, 1, ElementType::quad8);
+  std::unique_ptr<ShellModel> model;
+  std::vector<EnrichmentFunction> functions;
+};
+
+Setup& setup(int count, bool partial) {
+  static std::map<std::pair<int, bool>, Setup> cache;
+  Setup& s = cache[{count, partial}];
+  if (!s.model) {
+    const Topology topology = build_topology(s.mesh);
+    s.model = std::make_unique<ShellModel>(s.mesh, topology, std::vector<kernels::ShellSection>(1, {1e6, 0.3, 0.01, 1000}),
+                                           std::vector<int>{}, ShellModelOptions{});
+    s.functions = enrichments(count, partial, s.mesh);
+    s.model->set_enrichments(s.functions);
+  }
+  return s;
+}
+
+void counters(benchmark::State& state, const ShellModel& model) {
+  state.counters["enriched_dofs"] = model.num_enriched_dofs();
+  state.counters["element_qp"] = static_cast<double>(model.num_enriched_element_quadrature_points());
+  state.counters["edge_qp"] = static_cast<double>(model.num_enriched_edge_quadrature_points());
+}
+
+void BM_EnrichedSetUp(benchmark::State& state) {
+  Setup& s = setup(static_cast<int>(state.range(0)), state.range(1) != 0);
+  for (auto _ : state) s.model->set_enrichments(s.functions);
+  counters(state, *s.model);
+}
+
+void BM_EnrichedStiffnessLinear(benchmark::State& state) {
+  Setup& s = setup(static_cast<int>(state.range(0)), state.range(1) != 0);
+  std::vector<double> K;
+  for (auto _ : state) s.model->assemble_stiffness(nullptr, K, nullptr);
+  counters(state, *s.model);
+}
+
+void BM_EnrichedStiffnessCorotated(benchmark::State& state) {
+  Setup& s = setup(static_cast<int>(state.range(0)), state.range(1) != 0);
+  std::vector<double> current = s.model->rest_state(), K, f;
+  for (size_t d = 0; d < current.size(); ++d) current[d] += 0.01 * std::sin(0.7 * d);
+  for (auto _ : state) s.model->assemble_stiffness(current.data(), K, &f);
+  counters(state, *s.model);
+}
+
+void BM_EnrichedStiffnessPerTexel(benchmark::State& state) {
+  // The dense reference: per-texel quadrature everywhere (no merging).
+  const int count = static_cast<int>(state.range(0));
+  const bool partial = state.range(1) != 0;
+  Setup& s = setup(count, partial);
+  ShellModelOptions options;
+  options.enrichment_quadrature.adaptive = false;
+  ShellModel dense(s.mesh, build_topology(s.mesh), std::vector<kernels::ShellSection>(1, {1e6, 0.3, 0.01, 1000}), {},
+                   options);
+  dense.set_enrichments(s.functions);
+  std::vector<double> K;
+  for (auto _ : state) dense.assemble_stiffness(nullptr, K, nullptr);
+  counters(state, dense);
+}
+
+void enriched_args(benchmark::internal::Benchmark* b) {
+  b->Args({1, 0})->Args({6, 0})->Args({1, 1})->Args({6, 1})->Unit(benchmark::kMillisecond);
+}
+BENCHMARK(BM_EnrichedSetUp)->Apply(enriched_args);
+BENCHMARK(BM_EnrichedStiffnessLinear)->Apply(enriched_args);
+BENCHMARK(BM_EnrichedStiffnessCorotated)->Apply(enriched_args);
+BENCHMARK(BM_EnrichedStiffnessPerTexel) ->Args({1, 1})->Args({6, 1})->Unit(benchmark::kMillisecond)->Iterations(1);
+
+}  // namespace
+
+BENCHMARK_MAIN();

@@ -1,0 +1,66 @@
+#pragma once
+// Edge terms of texture-enriched DG shells: the penalty, consistency and symmetry terms of
+// shell_edge_kernel.h on the hinge component g = dt(u) . nu, for edges where either side
+// (or both) carries enriched basis functions: interior edges inside Omega_i, edges on the
+// outer boundary of Omega_i (N^a vanishes there but its normal derivative does not, so
+// the enriched functions still enter the hinge term), and clamped boundary edges.
+//
+// Local basis of an edge: side s (0 plus, 1 minus) occupies slots [s W, s W + W) with the
+// side element's local basis (enriched_basis.h order; a non-enriched side has just its npe
+// standard functions), W = elements->width. Outputs: blocks #edges x (2W)^2 x 9, forces
+// #edges x 2W x 3, per-point rotations (one 3x3 per edge quadrature point).
+//
+// Edge quadrature (t in [-1, 1], in the plus element's direction): the edge is split into
+// T pieces of equal t-length (each piece lies on one border texel per side, the diagonal
+// texels for a tri6 hypotenuse) and a binary tree over the pieces merges a segment when
+// on both sides every enrichment's border texels of the segment share one quadratic
+// (texels_share_one_quadratic, same tolerance as the elements). A merged segment gets
+// `quadrature_points` Gauss points (a merged whole edge: exactly the standard edge rule);
+// a single unmerged piece gets 2 Gauss points. Points: (t, weight) pairs, weights summing
+// to 2 over an edge; concatenated per edge in order (start: #edges + 1).
+#include <cstdint>
+#include <vector>
+
+#include "dgtex/kernels/enriched_basis.h"
+#include "dgtex/kernels/enriched_quadrature.h"
+#include "dgtex/kernels/forall.h"
+#include "dgtex/kernels/shell_element_kernel.h"
+
+namespace dgtex::kernels {
+
+struct EnrichedEdgeBatch {
+  ElementType type;
+  std::int64_t count;
+  const int* edges;             // #edges x 4: plus element, plus local edge, minus element (-1), minus local edge
+  const double* edge_size;      // h^e
+  double penalty;               // eta; eta^e = eta / h^e
+  int quadrature_points;        // Gauss points per merged segment
+  const int* connectivity;      // #elements x npe
+  const double* positions;      // rest, #nodes x 3
+  const ShellSection* sections; // per element
+  const EnrichedElementBatch* elements;
+  const int* enriched_index;    // per mesh element: its index in *elements, or -1
+};
+
+struct EdgeQuadrature {
+  const std::int64_t* start;  // #edges + 1
+  const double* points;       // (t, weight) per point
+};
+
+void enriched_edge_quadrature(const EnrichedEdgeBatch& batch, const EnrichedQuadratureOptions& options,
+                              std::vector<std::int64_t>& start, std::vector<double>& points,
+                              Execution execution = Execution::parallel);
+
+// Global node of each local slot (2W entries, -1 for unused slots).
+void enriched_edge_global_nodes(const EnrichedEdgeBatch& batch, std::int64_t edge, int* global_nodes);
+
+void enriched_edge_stiffness(const EnrichedEdgeBatch& batch, const EdgeQuadrature& quadrature,
+                             const double* rotations, double* blocks, double* forces,
+                             Execution execution = Execution::parallel);
+
+// Rotation of the edge frame (tangent, averaged normal) from rest to current, the current
+// frame taken from each side's whole basis. current: #(nodes + virtual nodes) x 3.
+void enriched_edge_rotations(const EnrichedEdgeBatch& batch, const EdgeQuadrature& quadrature,
+                             const double* current, double* rotations, Execution execution = Execution::parallel);
+
+}  // namespace dgtex::kernels

@@ -1,0 +1,48 @@
+#pragma once
+// Quadrature of enriched elements that resolves the enrichment textures only where they
+// vary ("integrate densely only where the field demands it").
+//
+// Rule (a quadtree over the element's T x T texels, top cell = the whole tile):
+//  - A cell is a rectangle of texels; for tri6 it is either inside the triangle, or a square
+//    on the diagonal (i0 + j0 + L == T) of which only the lower-left triangle counts, or
+//    split further (cells outside the triangle are dropped).
+//  - A cell of more than one texel is *merged* when (adaptive only) no wall separates two
+//    of its texels and, for every enrichment H_k of the element, the texel polynomials of
+//    enriched_basis.h agree with the one of a reference texel c of the cell:
+//      |H_t - P_c(x_t)|,  L |g_t - grad P_c(x_t)|,  L^2 |S_t - S_c|   <= merge_tolerance
+//    for every texel t of the cell (L: cell size in texels). Constant H (complete cuts away
+//    from the cut) and quadratic H pass with tolerance 0. A merged cell gets the element's
+//    standard rule mapped onto it (quad8: 3x3 Gauss; tri6: Radon's 7 points on triangles,
+//    3x3 Gauss on squares inside the triangle); a merged top cell is exactly the standard
+//    element rule.
+//  - Otherwise the cell is split in halves; a single texel gets the per-texel rule: 2x2
+//    Gauss on a square texel, Radon's 7 points on a tri6 diagonal half-texel.
+//  - adaptive = false: every texel gets the per-texel rule (the dense reference).
+// Points are (xi1, xi2, weight) with weights including the reference area, as in
+// element_quadrature. Per-element point lists are concatenated in element order
+// (start: #elements + 1 offsets), so serial and parallel forms give identical arrays.
+#include <cstdint>
+#include <vector>
+
+#include "dgtex/kernels/enriched_basis.h"
+#include "dgtex/kernels/forall.h"
+
+namespace dgtex::kernels {
+
+struct EnrichedQuadratureOptions {
+  bool adaptive = true;
+  double merge_tolerance = 1e-4;  // in units of H (H is O(1): +-1 across a cut)
+};
+
+void enriched_element_quadrature(const EnrichedElementBatch& batch, const EnrichedQuadratureOptions& options,
+                                 std::vector<std::int64_t>& start, std::vector<double>& points,
+                                 Execution execution = Execution::parallel);
+
+// Deviation test of the rule above over an explicit list of texels (texel units; used by
+// the element cells and by the edge segments): true if every texture's polynomials at
+// `texels` (pairs i, j) agree with the one at `reference` within tolerance.
+bool texels_share_one_quadratic(ElementType type, int resolution, const TextureView* textures, int texture_count,
+                                const int* texels, int texel_count, const int reference[2], double size,
+                                double tolerance);
+
+}  // namespace dgtex::kernels

@@ -1,0 +1,162 @@
+#include "dgtex/kernels/enriched_quadrature.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "dgtex/kernels/texel_grid.h"
+
+namespace dgtex::kernels {
+namespace {
+
+// Whether texel t's polynomial agrees with the reference polynomial (rule of the header).
+inline bool agrees(const TexelDerivatives& ref, const TexelDerivatives& t, double d1, double d2, double size,
+                   double tol) {
+  const double p = ref.value + ref.g[0] * d1 + ref.g[1] * d2 + 0.5 * (ref.s[0] * d1 * d1 + ref.s[1] * d2 * d2) +
+                   ref.s[2] * d1 * d2;
+  if (!(std::abs(t.value - p) <= tol)) return false;
+  const double g1 = ref.g[0] + ref.s[0] * d1 + ref.s[2] * d2;
+  const double g2 = ref.g[1] + ref.s[2] * d1 + ref.s[1] * d2;
+  if (!(size * std::max(std::abs(t.g[0] - g1), std::abs(t.g[1] - g2)) <= tol)) return false;
+  const double ds = std::max({std::abs(t.s[0] - ref.s[0]), std::abs(t.s[1] - ref.s[1]), std::abs(t.s[2] - ref.s[2])});
+  return size * size * ds <= tol;
+}
+
+struct CellBuilder {
+  ElementType type;
+  int t;
+  const TextureView* textures;
+  int texture_count;
+  const EnrichedQuadratureOptions& options;
+  std::vector<TexelDerivatives> fields;  // texture_count x T x T (texels in the domain only)
+  std::vector<double>& out;
+
+  const TexelDerivatives& field(int k, int i, int j) const {
+    return fields[(static_cast<std::size_t>(k) * t + j) * t + i];
+  }
+
+  bool in_cell(int i, int j, int i0, int j0, int w, int h, bool triangle) const {
+    if (i < i0 || j < j0 || i >= i0 + w || j >= j0 + h) return false;
+    return !triangle || (i - i0) + (j - j0) <= w - 1;
+  }
+
+  bool uniform(int i0, int j0, int w, int h, bool triangle) const {
+    int ri = i0 + w / 2, rj = j0 + h / 2;
+    if (triangle) ri = i0 + w / 4, rj = j0 + h / 4;
+    const double size = std::max(w, h);
+    for (int j = j0; j < j0 + h; ++j)
+      for (int i = i0; i < i0 + w; ++i) {
+        if (!in_cell(i, j, i0, j0, w, h, triangle)) continue;
+        for (int k = 0; k < texture_count; ++k) {
+          const std::uint8_t* flags = textures[k].flags;
+          if (!texel_in_domain(type, t, flags, i, j)) return false;
+          const std::uint8_t f = flags[j * t + i];
+          if ((f & wall_east) && in_cell(i + 1, j, i0, j0, w, h, triangle)) return false;
+          if ((f & wall_north) && in_cell(i, j + 1, i0, j0, w, h, triangle)) return false;
+          if (!agrees(field(k, ri, rj), field(k, i, j), i - ri, j - rj, size, options.merge_tolerance)) return false;
+        }
+      }
+    return true;
+  }
+
+  // Texel-space point (x, y) and texel-space weight -> parametric point and weight.
+  void emit(double x, double y, double w) {
+    const double h = texel_size(type, t);
+    const double origin = type == ElementType::quad8 ? -1.0 : 0.0;
+    out.push_back(origin + x * h);
+    out.push_back(origin + y * h);
+    out.push_back(w * h * h);
+  }
+
+  void emit_rectangle(int i0, int j0, int w, int h, int n) {
+    const LineRule g = gauss_legendre(n);
+    for (int b = 0; b < g.count; ++b)
+      for (int a = 0; a < g.count; ++a)
+        emit(i0 + 0.5 * w * (1 + g.t[a]), j0 + 0.5 * h * (1 + g.t[b]), 0.25 * w * h * g.weight[a] * g.weight[b]);
+  }
+
+  void emit_triangle(int i0, int j0, int size) {
+    const QuadratureRule r = element_quadrature(ElementType::tri6);
+    for (int q = 0; q < r.count; ++q)
+      emit(i0 + size * r.xi1[q], j0 + size * r.xi2[q], size * size * r.weight[q]);
+  }
+
+  void visit(int i0, int j0, int w, int h) {
+    const bool tri = type == ElementType::tri6;
+    if (tri && i0 + j0 >= t) return;  // outside the triangle
+    const bool inside = !tri || i0 + w + j0 + h <= t;
+    const bool diagonal = tri && w == h && i0 + j0 + w == t;
+    if (inside || diagonal) {
+      if (w == 1 && h == 1) {
+        if (diagonal) emit_triangle(i0, j0, 1);
+        else emit_rectangle(i0, j0, 1, 1, 2);
+        return;
+      }
+      if (options.adaptive && uniform(i0, j0, w, h, diagonal)) {
+        if (diagonal) emit_triangle(i0, j0, w);
+        else emit_rectangle(i0, j0, w, h, 3);
+        return;
+      }
+    }
+    const int w1 = (w + 1) / 2, h1 = (h + 1) / 2;
+    visit(i0, j0, w1, h1);
+    if (w > w1) visit(i0 + w1, j0, w - w1, h1);
+    if (h > h1) visit(i0, j0 + h1, w1, h - h1);
+    if (w > w1 && h > h1) visit(i0 + w1, j0 + h1, w - w1, h - h1);
+  }
+};
+
+void element_points(const EnrichedElementBatch& b, std::int64_t e, const EnrichedQuadratureOptions& options,
+                    std::vector<double>& out) {
+  out.clear();
+  const int first = b.enrichment_start[e], count = b.enrichment_start[e + 1] - first;
+  const int t = b.resolution;
+  CellBuilder builder{b.type, t, b.textures + first, count, options, {}, out};
+  if (options.adaptive) {
+    builder.fields.resize(static_cast<std::size_t>(count) * t * t);
+    for (int k = 0; k < count; ++k)
+      for (int j = 0; j < t; ++j)
+        for (int i = 0; i < t; ++i)
+          if (texel_in_domain(b.type, t, b.textures[first + k].flags, i, j))
+            texel_derivatives(b.type, t, b.textures[first + k], i, j, builder.fields[(static_cast<std::size_t>(k) * t + j) * t + i]);
+    // The whole element merged: exactly the standard element rule.
+    const bool triangle = b.type == ElementType::tri6;
+    if (builder.uniform(0, 0, t, t, triangle)) {
+      const QuadratureRule r = element_quadrature(b.type);
+      for (int q = 0; q < r.count; ++q) out.insert(out.end(), {r.xi1[q], r.xi2[q], r.weight[q]});
+      return;
+    }
+  }
+  builder.visit(0, 0, t, t);
+}
+
+}  // namespace
+
+bool texels_share_one_quadratic(ElementType type, int t, const TextureView* textures, int texture_count,
+                                const int* texels, int texel_count, const int reference[2], double size,
+                                double tolerance) {
+  for (int k = 0; k < texture_count; ++k) {
+    TexelDerivatives ref;
+    texel_derivatives(type, t, textures[k], reference[0], reference[1], ref);
+    for (int n = 0; n < texel_count; ++n) {
+      const int i = texels[2 * n], j = texels[2 * n + 1];
+      TexelDerivatives d;
+      texel_derivatives(type, t, textures[k], i, j, d);
+      if (!agrees(ref, d, i - reference[0], j - reference[1], size, tolerance)) return false;
+    }
+  }
+  return true;
+}
+
+void enriched_element_quadrature(const EnrichedElementBatch& batch, const EnrichedQuadratureOptions& options,
+                                 std::vector<std::int64_t>& start, std::vector<double>& points, Execution execution) {
+  std::vector<std::vector<double>> per_element(static_cast<std::size_t>(batch.count));
+  forall(batch.count, [&](std::int64_t e) { element_points(batch, e, options, per_element[e]); }, execution);
+  start.assign(static_cast<std::size_t>(batch.count) + 1, 0);
+  for (std::int64_t e = 0; e < batch.count; ++e)
+    start[e + 1] = start[e] + static_cast<std::int64_t>(per_element[e].size() / 3);
+  points.resize(static_cast<std::size_t>(start[batch.count]) * 3);
+  forall(batch.count, [&](std::int64_t e) { std::copy(per_element[e].begin(), per_element[e].end(), points.begin() + start[e] * 3); },
+         execution);
+}
+
+}  // namespace dgtex::kernels

@@ -1,0 +1,323 @@
+#include "dgtex/cut_manager.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <set>
+#include <stdexcept>
+
+#include "dgtex/texel_storage.h"
+
+namespace dgtex {
+namespace {
+
+using kernels::CutLatticeEdge;
+using kernels::CutRaster;
+using kernels::TexelTile;
+
+// A lattice edge of a raster on the element's border (one side outside the element).
+struct BorderEdge {
+  int edge = -1, s = -1;
+  int inside_texel = -1;
+  int side = 0;  // +1: the inside texel is left of the cut's direction
+};
+
+bool classify_border(ElementType type, int t, const CutLatticeEdge& e, BorderEdge& out) {
+  if ((e.left_texel >= 0) == (e.right_texel >= 0)) return false;  // interior, or outside the element
+  out.inside_texel = e.left_texel >= 0 ? e.left_texel : e.right_texel;
+  out.side = e.left_texel >= 0 ? +1 : -1;
+  const int i = out.inside_texel % t, j = out.inside_texel / t;
+  if (e.dy == 0) {  // horizontal lattice edge at height e.y
+    if (e.y == 0) return out.edge = 0, out.s = i, true;
+    if (type == ElementType::quad8 && e.y == t) return out.edge = 2, out.s = t - 1 - i, true;
+  } else {  // vertical at e.x
+    if (e.x == 0) return out.edge = type == ElementType::quad8 ? 3 : 2, out.s = t - 1 - j, true;
+    if (type == ElementType::quad8 && e.x == t) return out.edge = 1, out.s = j, true;
+  }
+  if (type == ElementType::tri6 && i + j == t - 1) return out.edge = 1, out.s = j, true;  // hypotenuse staircase
+  return false;
+}
+
+std::uint64_t fnv(std::uint64_t h, const void* data, std::size_t bytes) {
+  const auto* p = static_cast<const unsigned char*>(data);
+  for (std::size_t k = 0; k < bytes; ++k) h = (h ^ p[k]) * 1099511628211ull;
+  return h;
+}
+constexpr std::uint64_t kFnvSeed = 1469598103934665603ull;
+
+double ms_since(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+}
+
+}  // namespace
+
+CutManager::CutManager(const Mesh& mesh, const Topology& topology, const std::vector<Cut>& cuts,
+                       const EnrichmentOptions& options, CutManagerOptions manager_options)
+    : mesh_(mesh),
+      adjacency_(mesh, topology),
+      cuts_(cuts),
+      options_(options),
+      manager_options_(manager_options),
+      resolution_(options.texture_resolution),
+      edge_walls_(options.texture_resolution) {
+  if (resolution_ < 2)
+    throw std::invalid_argument("enrichment.texture_resolution: must be at least 2, got " + std::to_string(resolution_));
+  for (std::size_t c = 0; c < cuts_.size(); ++c)
+    paths_.push_back(trace_cut_path(mesh, adjacency_, cuts_[c], resolution_, "cuts[" + std::to_string(c) + "]"));
+  // Boundaries closer than half a texel (of a mean-sized element) are merged.
+  const double texel = cut_point_tolerance(mesh) * 4.0 / resolution_;
+  boundaries_ = segment_cut_paths(paths_, cuts_, options_, 0.5 * texel);
+  node_elements_.assign(mesh.num_nodes(), {});
+  for (int e = 0; e < mesh.num_elements(); ++e)
+    for (int a = 0; a < mesh.nodes_per_element(); ++a) node_elements_[mesh.element_nodes(e)[a]].push_back(e);
+}
+
+int CutManager::total_segments() const {
+  int n = 0;
+  for (const auto& b : boundaries_) n += static_cast<int>(b.size()) - 1;
+  return n;
+}
+
+void CutManager::rasterize_visible(const std::vector<VisibleCutSegment>& visible,
+                                   std::vector<std::vector<std::pair<int, CutRaster>>>& rasters) {
+  walls_.clear();
+  edge_walls_ = MeshEdgeWalls(resolution_);
+  rasters.assign(visible.size(), {});
+  for (std::size_t v = 0; v < visible.size(); ++v) {
+    const std::vector<CutPathVertex> sub = sub_path(paths_[visible[v].cut], visible[v].begin, visible[v].end);
+    std::size_t run = 0;
+    while (run < sub.size()) {
+      std::size_t stop = run + 1;
+      while (stop < sub.size() && sub[stop].element == sub[run].element) ++stop;
+      if (stop - run >= 2) {
+        const int e = sub[run].element;
+        std::vector<kernels::TexelPoint> line;
+        for (std::size_t k = run; k < stop; ++k)
+          line.push_back(kernels::texel_point_from_parametric(mesh_.type, resolution_, sub[k].xi[0], sub[k].xi[1]));
+        auto it = walls_.find(e);
+        if (it == walls_.end()) it = walls_.emplace(e, kernels::make_element_tile(mesh_.type, resolution_)).first;
+        CutRaster raster = kernels::rasterize_cut(line, it->second);
+        if (!raster.edges.empty()) rasters[v].emplace_back(e, std::move(raster));
+      }
+      run = stop;
+    }
+  }
+  // Cuts along mesh edges cut the couplings between the two elements' boundary texels.
+  for (const auto& pieces : rasters)
+    for (const auto& [e, raster] : pieces)
+      for (const CutLatticeEdge& edge : raster.edges) {
+        BorderEdge b;
+        if (classify_border(mesh_.type, resolution_, edge, b) && adjacency_.neighbour(e, b.edge)[0] >= 0)
+          edge_walls_.block(e, b.edge, b.s, adjacency_);
+      }
+}
+
+bool CutManager::update(double time) {
+  const auto start = std::chrono::steady_clock::now();
+  last_ = CutUpdateStats{};
+  time_ = time;
+  std::vector<VisibleCutSegment> visible = visible_cut_segments(boundaries_, cuts_, time);
+  const auto same = [](const VisibleCutSegment& a, const VisibleCutSegment& b) {
+    return a.cut == b.cut && a.segment == b.segment && a.begin == b.begin && a.end == b.end;
+  };
+  if (updated_once_ && visible.size() == visible_.size() && std::equal(visible.begin(), visible.end(), visible_.begin(), same)) {
+    last_.ms = ms_since(start);
+    return false;
+  }
+  updated_once_ = true;
+  visible_ = visible;
+  std::vector<std::vector<std::pair<int, CutRaster>>> rasters;
+  rasterize_visible(visible, rasters);
+
+  const int t = resolution_;
+  std::map<int, std::uint64_t> wall_hash_cache;
+  auto wall_hash = [&](int e) {
+    auto it = wall_hash_cache.find(e);
+    if (it != wall_hash_cache.end()) return it->second;
+    std::uint64_t h = kFnvSeed;
+    const auto w = walls_.find(e);
+    if (w != walls_.end()) h = fnv(h, w->second.flags.data(), w->second.flags.size());
+    const std::vector<long long> keys = edge_walls_.keys_of_element(e);
+    if (!keys.empty()) h = fnv(h, keys.data(), keys.size() * sizeof(long long));
+    return wall_hash_cache[e] = h;
+  };
+
+  bool changed_any = false;
+  std::set<std::pair<int, int>> alive;
+  std::map<std::pair<int, int>, std::size_t> visible_index;
+  for (std::size_t v = 0; v < visible.size(); ++v) {
+    const std::pair<int, int> key{visible[v].cut, visible[v].segment};
+    visible_index[key] = v;
+    // Dirichlet data. Every traversal of a texel edge adds its side (+1 left, -1 right)
+    // to the two texels it separates (across a mesh edge: the texel on each side), summed
+    // per (texel, physical edge). A retrace (the path stepping past a snapped corner and
+    // back, inside an element or along a mesh edge from both elements) sums to 0 and is
+    // ignored; a texel's value is the mean of the signs of its remaining edges (so a
+    // texel left of one pass and right of another gets 0, as in set_cut_dirichlet).
+    std::map<std::pair<long long, long long>, int> net;  // ((element, texel), edge id) -> sum
+    const long long tt = static_cast<long long>(t) * t;
+    for (const auto& [e, raster] : rasters[v])
+      for (const CutLatticeEdge& edge : raster.edges) {
+        if (edge.left_texel >= 0 && edge.right_texel >= 0) {
+          const long long id = ((static_cast<long long>(e) * (t + 1) + std::min(edge.x, edge.x + edge.dx)) * (t + 1) +
+                                std::min(edge.y, edge.y + edge.dy)) * 2 + (edge.dy == 0);
+          net[{e * tt + edge.left_texel, id}] += 1;
+          net[{e * tt + edge.right_texel, id}] -= 1;
+          continue;
+        }
+        BorderEdge b;
+        if (!classify_border(mesh_.type, t, edge, b)) continue;
+        const auto nb = adjacency_.neighbour(e, b.edge);
+        if (nb[0] < 0) continue;  // along the free boundary: separates nothing
+        const long long here = (static_cast<long long>(e) * 4 + b.edge) * t + b.s;
+        const long long there = (static_cast<long long>(nb[0]) * 4 + nb[1]) * t + (t - 1 - b.s);
+        const long long id = -1 - std::min(here, there);
+        net[{e * tt + b.inside_texel, id}] += b.side;
+        net[{nb[0] * tt + edge_texel_index(mesh_.type, t, nb[1], t - 1 - b.s), id}] -= b.side;
+      }
+    std::map<int, std::map<int, std::pair<double, int>>> data;  // element -> texel -> (sum, count)
+    for (const auto& [key, sum] : net) {
+      if (sum == 0) continue;
+      auto& d = data[static_cast<int>(key.first / tt)][static_cast<int>(key.first % tt)];
+      d.first += sum > 0 ? 1.0 : -1.0;
+      d.second += 1;
+    }
+    if (data.empty()) continue;  // no texel edge: no enrichment
+    alive.insert(key);
+
+    // E_i, N_i, Omega_i.
+    std::set<int> nodes, omega;
+    for (const auto& [e, texels] : data)
+      for (int a = 0; a < mesh_.nodes_per_element(); ++a) nodes.insert(mesh_.element_nodes(e)[a]);
+    for (int n : nodes)
+      for (int e : node_elements_[n]) omega.insert(e);
+    std::map<int, std::uint64_t> data_hash;
+    for (int e : omega) {
+      std::uint64_t h = kFnvSeed;
+      const auto it = data.find(e);
+      if (it != data.end())
+        for (const auto& [texel, d] : it->second) {
+          const double value = d.first / d.second;
+          h = fnv(h, &texel, sizeof texel);
+          h = fnv(h, &value, sizeof value);
+        }
+      data_hash[e] = h;
+    }
+
+    auto state_it = states_.find(key);
+    const bool fresh = state_it == states_.end();
+    if (fresh) {
+      state_it = states_.emplace(key, SegmentState{}).first;
+      order_.push_back(key);
+    }
+    SegmentState& state = state_it->second;
+    std::set<int> changed;
+    for (int e : omega) {
+      const bool known = state.values.count(e) > 0;
+      if (!known || state.wall_hash[e] != wall_hash(e) || state.data_hash[e] != data_hash[e]) changed.insert(e);
+    }
+    bool omega_same = state.values.size() == omega.size();
+    if (omega_same)
+      for (const auto& [e, values] : state.values) omega_same = omega_same && omega.count(e) > 0;
+    if (changed.empty() && omega_same) continue;  // settled: keep H_i
+
+    std::set<int> solve;
+    if (fresh || !manager_options_.freeze_settled_elements) {
+      solve = omega;
+    } else {
+      for (int e : changed)
+        for (int a = 0; a < mesh_.nodes_per_element(); ++a)
+          for (int f : node_elements_[mesh_.element_nodes(e)[a]])
+            if (omega.count(f)) solve.insert(f);
+    }
+    std::vector<RegionTile> region;
+    for (int e : omega) {
+      RegionTile r;
+      r.element = e;
+      const auto w = walls_.find(e);
+      r.tile = w != walls_.end() ? w->second : kernels::make_element_tile(mesh_.type, t);
+      if (solve.count(e)) {
+        // previous H as the initial guess (used by the multigrid; CHOLMOD ignores it)
+        const auto previous = state.values.find(e);
+        if (previous != state.values.end()) r.tile.values = previous->second;
+        const auto it = data.find(e);
+        if (it != data.end())
+          for (const auto& [texel, d] : it->second) {
+            r.tile.flags[texel] |= kernels::dirichlet;
+            r.tile.values[texel] = d.first / d.second;
+          }
+      } else {
+        r.frozen = true;
+        r.tile.values = state.values.at(e);
+      }
+      region.push_back(std::move(r));
+    }
+    const LaplaceSolver solver =
+        options_.solver == EnrichmentOptions::Solver::multigrid ? LaplaceSolver::multigrid : LaplaceSolver::cholmod;
+    const MeshLaplaceStats stats = solve_mesh_texel_laplace(region, mesh_.type, adjacency_, edge_walls_, solver);
+    last_.solve_ms += stats.ms;
+    last_.solves += 1;
+    last_.unknowns += stats.unknowns;
+    last_.solved_tiles += stats.solved_tiles;
+    last_.frozen_tiles += stats.frozen_tiles;
+
+    state.values.clear();
+    state.wall_hash.clear();
+    state.data_hash = data_hash;
+    EnrichmentFunction& f = state.function;
+    f.enriched_nodes.clear();
+    for (const auto& [e, texels] : data)
+      for (int a = 0; a < mesh_.nodes_per_element(); ++a) f.enriched_nodes.push_back(mesh_.element_nodes(e)[a]);
+    std::sort(f.enriched_nodes.begin(), f.enriched_nodes.end());
+    f.enriched_nodes.erase(std::unique(f.enriched_nodes.begin(), f.enriched_nodes.end()), f.enriched_nodes.end());
+    f.elements.clear();
+    for (RegionTile& r : region) {  // region is sorted by element (omega is a set)
+      state.values[r.element] = r.tile.values;
+      state.wall_hash[r.element] = wall_hash(r.element);
+      ElementTexture texture;
+      texture.element = r.element;
+      texture.tile = std::move(r.tile);
+      for (auto& flag : texture.tile.flags) flag &= static_cast<std::uint8_t>(~kernels::dirichlet);
+      f.elements.push_back(std::move(texture));
+    }
+    changed_any = true;
+  }
+  // Segments no longer visible (time went back) lose their functions.
+  for (auto it = order_.begin(); it != order_.end();) {
+    if (alive.count(*it)) {
+      ++it;
+      continue;
+    }
+    states_.erase(*it);
+    it = order_.erase(it);
+    changed_any = true;
+  }
+  functions_.clear();
+  function_segments_.clear();
+  function_rasters_.clear();
+  for (const auto& key : order_) {
+    functions_.push_back(states_.at(key).function);
+    const VisibleCutSegment& v = visible[visible_index.at(key)];
+    function_segments_.push_back({v.cut, v.segment, v.begin, v.end});
+    function_rasters_.push_back(rasters[visible_index.at(key)]);
+  }
+  last_.ms = ms_since(start);
+  return changed_any;
+}
+
+void CutManager::save_textures(const std::string& dir) const {
+  std::error_code error;
+  std::filesystem::create_directories(dir, error);
+  if (error) throw std::runtime_error("save textures: cannot create folder " + dir + ": " + error.message());
+  TexelStorage storage(resolution_);
+  for (std::size_t f = 0; f < functions_.size(); ++f) {
+    char name[32];
+    std::snprintf(name, sizeof name, "enrichment_%03zu", f);
+    for (const ElementTexture& texture : functions_[f].elements) storage.copy_tile_in(name, texture.element, texture.tile);
+  }
+  for (const auto& [e, tile] : walls_) storage.copy_flags_in("cut_walls", e, tile);
+  storage.write_vdb((std::filesystem::path(dir) / "enrichment.vdb").string());
+}
+
+}  // namespace dgtex

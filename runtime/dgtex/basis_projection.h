@@ -1,0 +1,28 @@
+#pragma once
+// Carrying a state across a change of the enriched basis (a cut advanced, a new cut
+// segment started). The thesis swaps the enrichment functions between steps and keeps the
+// DOF values, which makes the shell pop (§5.7 names it as a limitation); dgtex instead
+// projects displacement and velocity onto the new basis in the mass-matrix (L2) norm:
+//   M_new x_new = int rho h N_new (field of x_old) dA,
+// with the fixed DOFs of the new basis held at zero. A field the new basis can represent
+// (e.g. one that was already in the old one where nothing changed) is kept exactly, and
+// the kinetic energy never grows: the projection is orthogonal in the M inner product.
+#include <vector>
+
+#include "dgtex/shell_model.h"
+
+namespace dgtex {
+
+struct ProjectedState {
+  std::vector<double> displacement;  // #dofs of the new model
+  std::vector<double> velocity;
+};
+
+// old_* are #dofs vectors of old_model; fixed flags the new model's held DOFs (#dofs of
+// new_model). Both models share the mesh. Throws NotPositiveDefinite if the new mass
+// matrix is singular on the free DOFs (an enriched function with no support).
+ProjectedState project_onto_basis(const ShellModel& old_model, const std::vector<double>& old_displacement,
+                                  const std::vector<double>& old_velocity, const ShellModel& new_model,
+                                  const std::vector<char>& fixed);
+
+}  // namespace dgtex

@@ -1,0 +1,130 @@
+#pragma once
+// From the scene's cuts to the harmonic enrichment functions of the whole mesh, over time
+// (thesis §5.5-5.6). Construction traces every cut across the mesh (cut_path.h) and fixes
+// its segments (cut_segments.h); update(time) then
+//  1. takes the visible part of every segment and rasterises it onto texel edges, per
+//     element (kernels::rasterize_cut): walls inside tiles, and cuts running along a mesh
+//     edge as blocked couplings between the two elements' boundary texels;
+//  2. for each visible segment c_i: Dirichlet +1 / -1 on the texels left / right of its
+//     texel edges (across a mesh edge: the texel on each side), E_i = elements holding such
+//     texels, N_i = their nodes, Omega_i = all elements incident to N_i;
+//  3. solves H_i on Omega_i as one texel graph (mesh_texel_laplace.h): zero Neumann on the
+//     walls of all other cuts and on Omega_i's outer boundary, 0 on components without data,
+//     C0 across element edges. While a cut advances only the one-ring of the elements whose
+//     data or walls changed is re-solved; the other elements of Omega_i keep their values
+//     (settled, thesis §5.5.3) and act as C0 Dirichlet data.
+// Degenerate cases and their remedies:
+//  - a cut along an element edge: the couplings across the edge are cut and the texels on
+//    both sides get +-1 (the path is traced in one of the two elements);
+//  - a cut through a node: the path passes from one element to the next through the corner
+//    lattice point; the couplings around the node are cut by the two elements' paths;
+//  - a cut ending exactly on the element (or mesh) boundary: its last lattice point lies on
+//    the border, so it separates like any complete cut;
+//  - a cut running along the mesh's free boundary separates nothing: those texel edges are
+//    dropped (a segment made only of them gets no enrichment);
+//  - a self-intersecting cut: split where it crosses its earlier part (cut_segments.h);
+//  - a fragment shorter than half a texel has no texel edge: no enrichment for it (its
+//    H would be 0 and its DOFs singular); fragments of a few texels work as any cut.
+#include <cstdint>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "dgtex/cut_path.h"
+#include "dgtex/cut_segments.h"
+#include "dgtex/enrichment_function.h"
+#include "dgtex/kernels/cut_rasterization.h"
+#include "dgtex/mesh.h"
+#include "dgtex/mesh_texel_laplace.h"
+#include "dgtex/scene.h"
+#include "dgtex/topology.h"
+
+namespace dgtex {
+
+struct CutManagerOptions {
+  // Re-solve only the one-ring of changed elements when a segment's data change (false:
+  // always the whole Omega_i).
+  bool freeze_settled_elements = true;
+};
+
+// Which segment an enrichment function belongs to.
+struct EnrichmentSegment {
+  int cut = -1;      // index into the scene's cuts
+  int segment = -1;  // segment index along that cut
+  double begin = 0, end = 0;  // visible arc range (rest length)
+};
+
+struct CutUpdateStats {
+  double ms = 0;        // the whole update
+  double solve_ms = 0;  // Laplace solves only
+  int solves = 0;       // functions (re)solved
+  int unknowns = 0;     // texel unknowns over those solves
+  int solved_tiles = 0, frozen_tiles = 0;
+};
+
+class CutManager {
+ public:
+  // mesh and topology must outlive the manager. Throws std::invalid_argument for a cut the
+  // mesh cannot take (messages name cuts[i].points[j]; see trace_cut_path).
+  CutManager(const Mesh& mesh, const Topology& topology, const std::vector<Cut>& cuts,
+             const EnrichmentOptions& options, CutManagerOptions manager_options = {});
+
+  // Brings the functions to `time`; true when they changed (added, removed or re-solved).
+  bool update(double time);
+
+  // One function per visible segment with texel data, in order of first appearance (a
+  // function keeps its index while its cut grows).
+  const std::vector<EnrichmentFunction>& functions() const { return functions_; }
+  const std::vector<EnrichmentSegment>& function_segments() const { return function_segments_; }
+
+  int texture_resolution() const { return resolution_; }
+  const std::vector<MeshCutPath>& paths() const { return paths_; }
+  // Per cut the segment boundaries 0 = b_0 < ... < b_n = length (all segments, visible or not).
+  const std::vector<std::vector<double>>& segment_boundaries() const { return boundaries_; }
+  int total_segments() const;
+  // Walls of all visible cuts in every element they touch (inactive tri6 texels flagged).
+  const std::map<int, kernels::TexelTile>& wall_tiles() const { return walls_; }
+  const MeshEdgeWalls& edge_walls() const { return edge_walls_; }
+  // Rasters of the visible segments: per function (same order) the (element, raster) pieces.
+  const std::vector<std::vector<std::pair<int, kernels::CutRaster>>>& rasters() const { return function_rasters_; }
+  const CutUpdateStats& last_update() const { return last_; }
+  double time() const { return time_; }
+
+  // Writes DIR/enrichment.vdb (DIR created if missing): field "enrichment_NNN" for function
+  // NNN (texel (i, j) of element e's tile in slot of e, see texel_storage.h) and field
+  // "cut_walls" with the wall flags. std::runtime_error naming the path on failure.
+  void save_textures(const std::string& dir) const;
+
+ private:
+  struct SegmentState {
+    std::map<int, std::uint64_t> wall_hash, data_hash;  // per element of Omega_i at the last solve
+    std::map<int, std::vector<double>> values;          // H_i per element of Omega_i
+    EnrichmentFunction function;
+  };
+  void rasterize_visible(const std::vector<VisibleCutSegment>& visible,
+                         std::vector<std::vector<std::pair<int, kernels::CutRaster>>>& rasters);
+
+  const Mesh& mesh_;
+  ElementAdjacency adjacency_;
+  std::vector<Cut> cuts_;
+  EnrichmentOptions options_;
+  CutManagerOptions manager_options_;
+  int resolution_ = 0;
+  std::vector<MeshCutPath> paths_;
+  std::vector<std::vector<double>> boundaries_;
+  std::vector<std::vector<int>> node_elements_;  // elements incident to each node
+
+  double time_ = -1;
+  bool updated_once_ = false;
+  std::vector<VisibleCutSegment> visible_;
+  std::map<int, kernels::TexelTile> walls_;
+  MeshEdgeWalls edge_walls_;
+  std::map<std::pair<int, int>, SegmentState> states_;
+  std::vector<std::pair<int, int>> order_;  // (cut, segment) by first appearance
+  std::vector<EnrichmentFunction> functions_;
+  std::vector<EnrichmentSegment> function_segments_;
+  std::vector<std::vector<std::pair<int, kernels::CutRaster>>> function_rasters_;
+  CutUpdateStats last_;
+};
+
+}  // namespace dgtex

@@ -1,0 +1,75 @@
+#pragma once
+// The harmonic texel problem over several element tiles (thesis §5.5.3), as one texel
+// graph: inside a tile the 5-point couplings of dgtex/kernels/multigrid_unknowns.h (walls
+// and inactive texels cut them), and across every mesh edge shared by two tiles of the
+// region, boundary texel s of local edge k of element e couples (weight 1) to boundary
+// texel T-1-s of the neighbour's local edge (the neighbour runs the edge backwards).
+// Boundary texels of an edge: quad8 edge 0 (s, 0), 1 (T-1, s), 2 (T-1-s, T-1),
+// 3 (0, T-1-s); tri6 edge 0 (s, 0), 1 (T-1-s, s) (the half-covered diagonal texels of
+// the hypotenuse), 2 (0, T-1-s). Unlike a planar block of tiles this handles unstructured
+// meshes, closed cylinders and spheres, and any mix of edge pairings. The cross-edge
+// couplings give C0 continuity of H to the order of one texel, like inside a tile.
+//
+// Tiles marked frozen are data: every active texel is a Dirichlet value for the texels of
+// solved tiles coupled to it (the C0 constraints from settled neighbouring enrichments of
+// §5.5.3). Elements outside the region leave zero Neumann. Free texels in a component
+// (connected through free-free couplings) with no data get 0; a component whose data are
+// all one value v gets exactly v without a solve; the rest are the unknowns of one SPD
+// system solved by CHOLMOD (or by the multigrid when the region is a single tile).
+#include <cstdint>
+#include <unordered_set>
+#include <vector>
+
+#include "dgtex/cut_path.h"
+#include "dgtex/kernels/texel_grid.h"
+#include "dgtex/laplace_solver.h"
+
+namespace dgtex {
+
+// Texel index (j * T + i) of boundary texel s of local edge k.
+int edge_texel_index(ElementType type, int resolution, int edge, int s);
+// The local edges (and positions s on them) a texel lies on; returns how many (0..2).
+int texel_edges(ElementType type, int resolution, int i, int j, int edges[2], int positions[2]);
+
+// Cross-edge couplings cut by a cut running along a mesh edge.
+class MeshEdgeWalls {
+ public:
+  explicit MeshEdgeWalls(int resolution = 0) : resolution_(resolution) {}
+  // Blocks boundary texel s of (element, edge) and its partner across the edge.
+  void block(int element, int edge, int s, const ElementAdjacency& adjacency);
+  bool blocked(int element, int edge, int s) const {
+    return !keys_.empty() && keys_.count(key(element, edge, s)) > 0;
+  }
+  bool empty() const { return keys_.empty(); }
+  // Blocked (element, edge, s) of one element, sorted (for change detection).
+  std::vector<long long> keys_of_element(int element) const;
+
+ private:
+  long long key(int element, int edge, int s) const { return (static_cast<long long>(element) * 4 + edge) * resolution_ + s; }
+  int resolution_;
+  std::unordered_set<long long> keys_;
+};
+
+struct RegionTile {
+  int element = -1;
+  kernels::TexelTile tile;  // T x T: walls, inactive, dirichlet bits with values as data
+  bool frozen = false;      // every active texel is data (a settled neighbour)
+};
+
+struct MeshLaplaceStats {
+  int unknowns = 0;
+  int solved_components = 0;    // components that needed the linear solve
+  int constant_components = 0;  // components set to their single data value
+  int solved_tiles = 0, frozen_tiles = 0;
+  double relative_residual = 0;
+  double ms = 0;  // wall time of the whole call
+};
+
+// Solves in place: free texels of non-frozen tiles get H; data texels keep their values.
+// All tiles must be T x T of the same T, elements distinct (std::invalid_argument
+// otherwise); std::runtime_error if CHOLMOD fails.
+MeshLaplaceStats solve_mesh_texel_laplace(std::vector<RegionTile>& tiles, ElementType type,
+                                          const ElementAdjacency& adjacency, const MeshEdgeWalls& edge_walls,
+                                          LaplaceSolver solver = LaplaceSolver::cholmod);
+
+}  // namespace dgtex

@@ -1,0 +1,120 @@
+#include "dgtex/scene_run.h"
+
+#include <algorithm>
+
+#include "dgtex/basis_projection.h"
+#include "dgtex/model_error.h"
+#include "dgtex/scene_model.h"
+#include "dgtex/topology.h"
+
+namespace dgtex {
+
+namespace {
+
+void merge(StageTimings& into, const StageTimings& from) {
+  for (const auto& [stage, stats] : from) {
+    StageStatistics& s = into[stage];
+    s.total_ms += stats.total_ms;
+    s.max_ms = std::max(s.max_ms, stats.max_ms);
+    s.count += stats.count;
+  }
+}
+
+}  // namespace
+
+SceneRun::SceneRun(const Scene& scene)
+    : scene_(scene), mesh_(build_scene_mesh(scene)), topology_(build_topology(mesh_)) {
+  SceneModel built = build_scene_model(scene, mesh_);
+  model_ = std::move(built.model);
+  if (scene.analysis.is_dynamic()) {
+    dynamics_.time_step = scene.analysis.time_step;
+    dynamics_.corotational = scene.analysis.corotational;
+    dynamics_.mass_damping = scene.analysis.damping.mass;
+    dynamics_.stiffness_damping = scene.analysis.damping.stiffness;
+  }
+  if (!scene.cuts.empty()) {
+    cuts_ = std::make_unique<CutManager>(mesh_, topology_, scene.cuts, scene.enrichment);
+    {
+      ScopedStage stage(timings_, "enrichment");
+      cuts_->update(0.0);
+    }
+    model_->set_enrichments(cuts_->functions());
+    built.fixed = scene_fixed_dofs(scene, *model_);
+    built.external_force = scene_external_force(scene, *model_);
+  }
+  simulation_ = std::make_unique<ShellSimulation>(*model_, std::move(built.fixed), std::move(built.external_force));
+  // A dynamic scene may leave rigid modes free (a falling shell); a static one may not.
+  if (!scene.analysis.is_dynamic()) simulation_->check_statically_constrained();
+}
+
+SceneRun::~SceneRun() = default;
+
+void SceneRun::solve_static() { simulation_->solve_static(); }
+
+void SceneRun::step() {
+  const double next = time_ + dynamics_.time_step;
+  if (cuts_) {
+    bool changed;
+    {
+      ScopedStage stage(timings_, "enrichment");
+      changed = cuts_->update(next);
+    }
+    if (changed) change_basis();
+  }
+  simulation_->step(dynamics_);
+  time_ = next;
+  ++steps_;
+}
+
+void SceneRun::change_basis() {
+  ScopedStage stage(timings_, "projection");
+  // The new model is a copy with the new functions (set_enrichments rebuilds everything
+  // that depends on them); the old one stays alive for the projection.
+  auto next = std::make_unique<ShellModel>(*model_);
+  next->set_enrichments(cuts_->functions());
+  std::vector<char> fixed = scene_fixed_dofs(scene_, *next);
+  std::vector<double> force = scene_external_force(scene_, *next);
+  ProjectedState projected =
+      project_onto_basis(*model_, simulation_->displacement(), simulation_->velocity(), *next, fixed);
+  auto simulation = std::make_unique<ShellSimulation>(*next, std::move(fixed), std::move(force));
+  simulation->set_state(std::move(projected.displacement), std::move(projected.velocity));
+  merge(timings_, simulation_->timings());
+  simulation_ = std::move(simulation);  // before model_: the old simulation refers to it
+  model_ = std::move(next);
+  ++basis_changes_;
+}
+
+StageTimings SceneRun::timings() const {
+  StageTimings all = timings_;
+  merge(all, simulation_->timings());
+  return all;
+}
+
+ShellState SceneRun::state() const {
+  ShellState state;
+  state.mesh = mesh_;
+  const std::vector<double>& u = simulation_->displacement();
+  state.displacement.assign(u.begin(), u.begin() + 3 * mesh_.num_nodes());
+  state.time = time_;
+  const int npe = mesh_.nodes_per_element();
+  const auto& functions = model_->enrichments();
+  for (int i = 0; i < static_cast<int>(functions.size()); ++i)
+    for (const ElementTexture& texture : functions[i].elements) {
+      ElementEnrichment e;
+      e.element = texture.element;
+      e.resolution = texture.tile.width;
+      e.values.assign(texture.tile.values.begin(), texture.tile.values.end());
+      e.node_values.assign(npe, 0.0f);
+      e.dofs.assign(3 * npe, 0.0);
+      for (int a = 0; a < npe; ++a) {
+        const int v = model_->virtual_node(i, mesh_.element_nodes(texture.element)[a]);
+        if (v < 0) continue;  // node not enriched by this function: its DOFs are zero
+        e.node_values[a] = static_cast<float>(model_->node_shift(v));
+        for (int c = 0; c < 3; ++c) e.dofs[3 * a + c] = u[3 * v + c];
+      }
+      state.enrichments.push_back(std::move(e));
+    }
+  return state;
+}
+
+}  // namespace dgtex
