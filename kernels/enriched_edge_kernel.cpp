@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "dgtex/kernels/shell_point.h"
+#include "dgtex/kernels/edge_frame.h"
 #include "dgtex/kernels/vec3.h"
 
 namespace dgtex::kernels {
@@ -57,24 +58,6 @@ void side_global_nodes(const EnrichedEdgeBatch& b, int element, int* out) {
   for (int a = 0; a < W; ++a) out[a] = a < npe ? b.connectivity[static_cast<std::int64_t>(element) * npe + a] : -1;
 }
 
-// Edge frame (unit tangent, in-plane normal, unit averaged normal) as matrix columns.
-void edge_frame(const double tangent[3], const double n_plus[3], const double* n_minus, double frame[9]) {
-  double f1[3] = {tangent[0], tangent[1], tangent[2]};
-  normalize3(f1);
-  double n[3] = {n_plus[0], n_plus[1], n_plus[2]};
-  if (n_minus)
-    for (int k = 0; k < 3; ++k) n[k] += n_minus[k];
-  const double nt = dot3(n, f1);
-  for (int k = 0; k < 3; ++k) n[k] -= nt * f1[k];
-  normalize3(n);
-  double f2[3];
-  cross3(n, f1, f2);
-  for (int k = 0; k < 3; ++k) {
-    frame[k * 3 + 0] = f1[k];
-    frame[k * 3 + 1] = f2[k];
-    frame[k * 3 + 2] = n[k];
-  }
-}
 
 // --- Quadrature ------------------------------------------------------------------------
 

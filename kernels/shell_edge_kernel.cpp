@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "dgtex/kernels/shell_point.h"
+#include "dgtex/kernels/edge_frame.h"
 #include "dgtex/kernels/vec3.h"
 #include "shell_point_rows.h"
 
@@ -25,25 +26,6 @@ void evaluate_side(const EdgeBatch& b, int element, int local_edge, double t, co
   tangent_along(s.point, dxi, s.tangent);
 }
 
-// Edge frame (unit tangent, unit averaged normal, in-plane normal) as matrix columns, from
-// the plus side's tangent dphi/dt and the sides' unit normals (minus_t0 null on boundaries).
-void edge_frame(const double tangent[3], const double plus_t0[3], const double* minus_t0, double frame[9]) {
-  double f1[3] = {tangent[0], tangent[1], tangent[2]};
-  normalize3(f1);
-  double n[3] = {plus_t0[0], plus_t0[1], plus_t0[2]};
-  if (minus_t0)
-    for (int k = 0; k < 3; ++k) n[k] += minus_t0[k];
-  const double nt = dot3(n, f1);
-  for (int k = 0; k < 3; ++k) n[k] -= nt * f1[k];
-  normalize3(n);
-  double f2[3];
-  cross3(n, f1, f2);
-  for (int k = 0; k < 3; ++k) {
-    frame[k * 3 + 0] = f1[k];
-    frame[k * 3 + 1] = f2[k];
-    frame[k * 3 + 2] = n[k];
-  }
-}
 
 // Most Gauss points per edge (gauss_legendre supports 1..5).
 constexpr int max_edge_points = 5;

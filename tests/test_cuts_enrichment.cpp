@@ -10,6 +10,7 @@
 #include <filesystem>
 #include <random>
 
+#include "cut_test_support.h"
 #include "dgtex/cut_manager.h"
 #include "dgtex/harmonic_enrichment.h"
 #include "dgtex/kernels/multigrid_unknowns.h"
@@ -18,23 +19,10 @@
 #include "dgtex/topology.h"
 
 using namespace dgtex;
+using namespace dgtex::testing_support;
 using kernels::TexelTile;
 
 namespace {
-
-Cut points_cut(std::vector<Vec3> points) {
-  Cut cut;
-  cut.kind = Cut::Kind::points;
-  cut.points = std::move(points);
-  return cut;
-}
-
-EnrichmentOptions with_resolution(int t) {
-  EnrichmentOptions o;
-  o.texture_resolution = t;
-  o.solver = EnrichmentOptions::Solver::cholmod;
-  return o;
-}
 
 // Rest position of texel (i, j)'s centre of element e.
 Vec3 texel_centre(const Mesh& mesh, int e, int t, int i, int j) {
@@ -114,7 +102,7 @@ void expect_exact_heaviside(const Mesh& mesh, const CutManager& m, int function,
 TEST(CutsEnrichment, CompleteCutAcrossQuadPlateIsExactlyPlusMinusOne) {
   const Mesh mesh = make_rectangle(3, 3, 3, 3, ElementType::quad8);
   const int t = 32;
-  CutManager m(mesh, build_topology(mesh), {points_cut({{0, 1.37, 0}, {1.7, 1.61, 0}, {3, 1.45, 0}})}, with_resolution(t));
+  CutManager m(mesh, build_topology(mesh), {points_cut({{0, 1.37, 0}, {1.7, 1.61, 0}, {3, 1.45, 0}})}, cholmod_enrichment(t));
   EXPECT_TRUE(m.update(0.0));
   ASSERT_EQ(m.functions().size(), 1u);
   const EnrichmentFunction& f = m.functions()[0];
@@ -132,7 +120,7 @@ TEST(CutsEnrichment, CompleteCutAcrossQuadPlateIsExactlyPlusMinusOne) {
 TEST(CutsEnrichment, CompleteCutAcrossTri6PlateIsExactlyPlusMinusOne) {
   const Mesh mesh = make_rectangle(3, 3, 3, 3, ElementType::tri6);
   const int t = 32;
-  CutManager m(mesh, build_topology(mesh), {points_cut({{0, 2.2, 0}, {3, 0.45, 0}})}, with_resolution(t));
+  CutManager m(mesh, build_topology(mesh), {points_cut({{0, 2.2, 0}, {3, 0.45, 0}})}, cholmod_enrichment(t));
   m.update(0.0);
   ASSERT_EQ(m.functions().size(), 1u);
   auto side = [](const Vec3& x) { return x[1] - (2.2 + (0.45 - 2.2) * x[0] / 3); };
@@ -144,13 +132,13 @@ TEST(CutsEnrichment, CutAlongElementEdgesAndThroughNodes) {
     const Mesh mesh = make_rectangle(3, 3, 3, 3, type);
     const int t = 16;
     // Along the element edges y = 1 (a straight line of mesh edges).
-    CutManager along(mesh, build_topology(mesh), {points_cut({{0, 1, 0}, {3, 1, 0}})}, with_resolution(t));
+    CutManager along(mesh, build_topology(mesh), {points_cut({{0, 1, 0}, {3, 1, 0}})}, cholmod_enrichment(t));
     along.update(0.0);
     ASSERT_EQ(along.functions().size(), 1u);
     // (tri6 hypotenuse texels have their centres on the edge: not checked)
     expect_exact_heaviside(mesh, along, 0, [](const Vec3& x) { return x[1] - 1; }, 1e-9);
     // Diagonal through the nodes (1, 1) and (2, 2) (for tri6 also along the cell diagonals).
-    CutManager diagonal(mesh, build_topology(mesh), {points_cut({{0, 0, 0}, {3, 3, 0}})}, with_resolution(t));
+    CutManager diagonal(mesh, build_topology(mesh), {points_cut({{0, 0, 0}, {3, 3, 0}})}, cholmod_enrichment(t));
     diagonal.update(0.0);
     ASSERT_EQ(diagonal.functions().size(), 1u);
     expect_exact_heaviside(mesh, diagonal, 0, [](const Vec3& x) { return x[1] - x[0]; }, 1.0 / t);
@@ -161,7 +149,7 @@ TEST(CutsEnrichment, ClosedRingAroundCylinderSeparatesExactly) {
   const Mesh mesh = make_cylinder(1.0, 2.0, 0, 360, 6, 3, ElementType::quad8);
   std::vector<Vec3> ring;
   for (int k = 0; k <= 36; ++k) ring.push_back({std::sin(2 * M_PI * k / 36), 0.9, std::cos(2 * M_PI * k / 36)});
-  CutManager m(mesh, build_topology(mesh), {points_cut(ring)}, with_resolution(16));
+  CutManager m(mesh, build_topology(mesh), {points_cut(ring)}, cholmod_enrichment(16));
   m.update(0.0);
   ASSERT_EQ(m.functions().size(), 1u);
   // The ring runs around the axis counter-clockwise seen from -y... either sign is fine:
@@ -176,7 +164,7 @@ TEST(CutsEnrichment, PartialCutIsC0AcrossElementEdgesAndMatchesTheBlockSolve) {
   // Enters at the left boundary, turns up and ends inside the centre element; lattice
   // coordinates are integers so the block raster is the same lattice path.
   const std::vector<Vec3> line{{0, 1.5, 0}, {1.5, 1.5, 0}, {1.5, 1.75, 0}};
-  CutManager m(mesh, build_topology(mesh), {points_cut(line)}, with_resolution(t));
+  CutManager m(mesh, build_topology(mesh), {points_cut(line)}, cholmod_enrichment(t));
   m.update(0.0);
   ASSERT_EQ(m.functions().size(), 1u);
   const EnrichmentFunction& f = m.functions()[0];
@@ -209,7 +197,7 @@ TEST(CutsEnrichment, PartialCutIsC0AcrossElementEdgesAndMatchesTheBlockSolve) {
 
 TEST(CutsEnrichment, PartialCutTri6IsC0) {
   const Mesh mesh = make_rectangle(3, 3, 3, 3, ElementType::tri6);
-  CutManager m(mesh, build_topology(mesh), {points_cut({{0, 1.3, 0}, {1.6, 1.45, 0}})}, with_resolution(32));
+  CutManager m(mesh, build_topology(mesh), {points_cut({{0, 1.3, 0}, {1.6, 1.45, 0}})}, cholmod_enrichment(32));
   m.update(0.0);
   ASSERT_EQ(m.functions().size(), 1u);
   const Jumps j = jumps(mesh, m, m.functions()[0]);
@@ -220,7 +208,7 @@ TEST(CutsEnrichment, PartialCutTri6IsC0) {
 TEST(CutsEnrichment, EnrichedNodesAndOmega) {
   const Mesh mesh = make_rectangle(4, 4, 4, 4, ElementType::quad8);
   // A short cut inside element 5 (x in [1,2], y in [1,2]) only.
-  CutManager m(mesh, build_topology(mesh), {points_cut({{1.2, 1.3, 0}, {1.7, 1.6, 0}})}, with_resolution(16));
+  CutManager m(mesh, build_topology(mesh), {points_cut({{1.2, 1.3, 0}, {1.7, 1.6, 0}})}, cholmod_enrichment(16));
   m.update(0.0);
   ASSERT_EQ(m.functions().size(), 1u);
   const EnrichmentFunction& f = m.functions()[0];
@@ -236,7 +224,7 @@ TEST(CutsEnrichment, EnrichedNodesAndOmega) {
 
 TEST(CutsEnrichment, SavedTexturesReadBack) {
   const Mesh mesh = make_rectangle(2, 1, 2, 1, ElementType::quad8);
-  CutManager m(mesh, build_topology(mesh), {points_cut({{0.3, 0.5, 0}, {1.6, 0.5, 0}})}, with_resolution(16));
+  CutManager m(mesh, build_topology(mesh), {points_cut({{0.3, 0.5, 0}, {1.6, 0.5, 0}})}, cholmod_enrichment(16));
   m.update(0.0);
   const std::string dir = std::filesystem::temp_directory_path() / "dgtex_test_cuts_vdb";
   m.save_textures(dir);
@@ -271,7 +259,7 @@ TEST(CutsEnrichment, RandomCompleteCutsAreExactHeavisides) {
         points.push_back({3, y, 0});
         if (trial % 2)
           for (auto& p : points) std::swap(p[0], p[1]);
-        CutManager m(mesh, topology, {points_cut(points)}, with_resolution(t));
+        CutManager m(mesh, topology, {points_cut(points)}, cholmod_enrichment(t));
         m.update(0.0);
         ASSERT_EQ(m.functions().size(), 1u);
         EXPECT_EQ(m.last_update().unknowns, 0) << "type " << int(type) << " T " << t << " trial " << trial;

@@ -5,21 +5,16 @@
 
 #include <cmath>
 
+#include "cut_test_support.h"
 #include "dgtex/cut_manager.h"
 #include "dgtex/cut_path.h"
 #include "dgtex/mesh_generators.h"
 #include "dgtex/topology.h"
 
 using namespace dgtex;
+using namespace dgtex::testing_support;
 
 namespace {
-
-Cut points_cut(std::vector<Vec3> points) {
-  Cut cut;
-  cut.kind = Cut::Kind::points;
-  cut.points = std::move(points);
-  return cut;
-}
 
 double distance(const Vec3& a, const Vec3& b) { return std::hypot(a[0] - b[0], a[1] - b[1], a[2] - b[2]); }
 

@@ -7,27 +7,15 @@
 #include <Eigen/Dense>
 #include <cmath>
 
+#include "cut_test_support.h"
 #include "dgtex/cut_manager.h"
 #include "dgtex/mesh_generators.h"
 #include "dgtex/topology.h"
 
 using namespace dgtex;
+using namespace dgtex::testing_support;
 
 namespace {
-
-Cut points_cut(std::vector<Vec3> points) {
-  Cut cut;
-  cut.kind = Cut::Kind::points;
-  cut.points = std::move(points);
-  return cut;
-}
-
-EnrichmentOptions options(int t) {
-  EnrichmentOptions o;
-  o.texture_resolution = t;
-  o.solver = EnrichmentOptions::Solver::cholmod;
-  return o;
-}
 
 std::vector<Vec3> spiral(double cx, double cy, double r0, double r1, double turns, int n) {
   std::vector<Vec3> p;
@@ -68,7 +56,7 @@ int span_rank(const CutManager& m, int e) {
 TEST(CutsProgressive, SpiralSegmentCountFollowsTheLengthThreshold) {
   const Mesh mesh = make_rectangle(1, 1, 1, 1, ElementType::quad8);
   const Cut cut = points_cut(spiral(0.5, 0.5, 0.05, 0.42, 2.0, 400));
-  EnrichmentOptions o = options(64);
+  EnrichmentOptions o = cholmod_enrichment(64);
   o.new_cut_length = 0.5;
   CutManager m(mesh, build_topology(mesh), {cut}, o);
   const double length = m.paths()[0].length();
@@ -89,7 +77,7 @@ TEST(CutsProgressive, TurningAngleThreshold) {
   const Mesh mesh = make_rectangle(1, 1, 1, 1, ElementType::quad8);
   // Four right-angle turns.
   const Cut cut = points_cut({{0.1, 0.1, 0}, {0.9, 0.1, 0}, {0.9, 0.9, 0}, {0.1, 0.9, 0}, {0.1, 0.2, 0}, {0.8, 0.2, 0}});
-  EnrichmentOptions o = options(32);
+  EnrichmentOptions o = cholmod_enrichment(32);
   o.new_cut_angle_deg = 135;  // 90 + 90 > 135: a new segment after every second turn
   EXPECT_EQ(CutManager(mesh, build_topology(mesh), {cut}, o).total_segments(), 3);
   o.new_cut_angle_deg = 80;  // every turn
@@ -105,7 +93,7 @@ TEST(CutsProgressive, CutGrowsMonotonicallyWithTime) {
   cut.has_schedule = true;
   cut.start_time = 0.5;
   cut.speed = 1.0;
-  EnrichmentOptions o = options(16);
+  EnrichmentOptions o = cholmod_enrichment(16);
   o.new_cut_length = 1.0;
   CutManager m(mesh, build_topology(mesh), {cut}, o);
   const double length = m.paths()[0].length();
@@ -135,7 +123,7 @@ TEST(CutsProgressive, CrossingCutIsSplitButTJunctionIsNot) {
   const Mesh mesh = make_rectangle(1, 1, 1, 1, ElementType::quad8);
   const Cut horizontal = points_cut({{0, 0.4, 0}, {1, 0.4, 0}});
   {  // X: the later cut (higher index, both static) splits at the crossing
-    CutManager m(mesh, build_topology(mesh), {horizontal, points_cut({{0.6, 0, 0}, {0.6, 1, 0}})}, options(32));
+    CutManager m(mesh, build_topology(mesh), {horizontal, points_cut({{0.6, 0, 0}, {0.6, 1, 0}})}, cholmod_enrichment(32));
     EXPECT_EQ(m.segment_boundaries()[0].size(), 2u);
     ASSERT_EQ(m.segment_boundaries()[1].size(), 3u);
     EXPECT_NEAR(m.segment_boundaries()[1][1], 0.4, 1e-12);
@@ -146,7 +134,7 @@ TEST(CutsProgressive, CrossingCutIsSplitButTJunctionIsNot) {
       for (double v : f.elements[0].tile.values) EXPECT_TRUE(v == 1.0 || v == -1.0 || v == 0.0) << v;
   }
   {  // T: the second cut ends on the first: no split, three components, rank 3
-    CutManager m(mesh, build_topology(mesh), {horizontal, points_cut({{0.6, 1, 0}, {0.6, 0.4, 0}})}, options(32));
+    CutManager m(mesh, build_topology(mesh), {horizontal, points_cut({{0.6, 1, 0}, {0.6, 0.4, 0}})}, cholmod_enrichment(32));
     EXPECT_EQ(m.total_segments(), 2);
     m.update(0);
     EXPECT_EQ(m.functions().size(), 2u);
@@ -156,7 +144,7 @@ TEST(CutsProgressive, CrossingCutIsSplitButTJunctionIsNot) {
     Cut late = points_cut({{0.6, 0, 0}, {0.6, 1, 0}});
     late.has_schedule = true;
     late.speed = 0.5;
-    CutManager m(mesh, build_topology(mesh), {late, horizontal}, options(32));
+    CutManager m(mesh, build_topology(mesh), {late, horizontal}, cholmod_enrichment(32));
     EXPECT_EQ(m.segment_boundaries()[0].size(), 3u);
     EXPECT_EQ(m.segment_boundaries()[1].size(), 2u);
   }
@@ -166,7 +154,7 @@ TEST(CutsProgressive, SelfIntersectingCutSplitsAtItsOwnCrossing) {
   const Mesh mesh = make_rectangle(2, 2, 2, 2, ElementType::tri6);
   // A loop that crosses its own beginning at (0.5, 1.0).
   const Cut loop = points_cut({{0.2, 1.0, 0}, {1.5, 1.0, 0}, {1.5, 1.6, 0}, {0.5, 1.6, 0}, {0.5, 0.3, 0}});
-  CutManager m(mesh, build_topology(mesh), {loop}, options(16));
+  CutManager m(mesh, build_topology(mesh), {loop}, cholmod_enrichment(16));
   ASSERT_EQ(m.total_segments(), 2);
   EXPECT_NEAR(m.segment_boundaries()[0][1], 1.3 + 0.6 + 1.0 + 0.6, 1e-9);
   m.update(0);
@@ -179,11 +167,11 @@ TEST(CutsProgressive, SelfIntersectingCutSplitsAtItsOwnCrossing) {
 TEST(CutsProgressive, TinyFragments) {
   const Mesh mesh = make_rectangle(1, 1, 1, 1, ElementType::quad8);
   // Shorter than half a texel (T = 32: texel 1/32): no texel edge, no enrichment.
-  CutManager none(mesh, build_topology(mesh), {points_cut({{0.503, 0.5, 0}, {0.512, 0.5, 0}})}, options(32));
+  CutManager none(mesh, build_topology(mesh), {points_cut({{0.503, 0.5, 0}, {0.512, 0.5, 0}})}, cholmod_enrichment(32));
   EXPECT_FALSE(none.update(0));
   EXPECT_TRUE(none.functions().empty());
   // Three texels: a regular (partial) enrichment with +-1 on the 6 incident texels.
-  CutManager three(mesh, build_topology(mesh), {points_cut({{0.5, 0.5, 0}, {0.5 + 3.0 / 32, 0.5, 0}})}, options(32));
+  CutManager three(mesh, build_topology(mesh), {points_cut({{0.5, 0.5, 0}, {0.5 + 3.0 / 32, 0.5, 0}})}, cholmod_enrichment(32));
   three.update(0);
   ASSERT_EQ(three.functions().size(), 1u);
   const auto& tile = three.functions()[0].elements[0].tile;
@@ -200,8 +188,8 @@ TEST(CutsProgressive, FreezingBoundsTheSolvedRegion) {
   cut.speed = 1.0;
   CutManagerOptions frozen_options, full_options;
   full_options.freeze_settled_elements = false;
-  CutManager frozen(mesh, build_topology(mesh), {cut}, options(16), frozen_options);
-  CutManager full(mesh, build_topology(mesh), {cut}, options(16), full_options);
+  CutManager frozen(mesh, build_topology(mesh), {cut}, cholmod_enrichment(16), frozen_options);
+  CutManager full(mesh, build_topology(mesh), {cut}, cholmod_enrichment(16), full_options);
   int max_frozen_tiles = 0;
   for (double t = 0.25; t <= 4.5; t += 0.25) {
     frozen.update(t);
@@ -231,7 +219,7 @@ TEST(CutsProgressive, FreezingBoundsTheSolvedRegion) {
 TEST(CutsProgressive, SingleElementMultigridMatchesCholmod) {
   const Mesh mesh = make_rectangle(1, 1, 1, 1, ElementType::quad8);
   const Cut cut = points_cut({{0, 0.45, 0}, {0.6, 0.55, 0}});
-  EnrichmentOptions mg = options(64), direct = options(64);
+  EnrichmentOptions mg = cholmod_enrichment(64), direct = cholmod_enrichment(64);
   mg.solver = EnrichmentOptions::Solver::multigrid;
   CutManager a(mesh, build_topology(mesh), {cut}, mg), b(mesh, build_topology(mesh), {cut}, direct);
   a.update(0);
@@ -246,11 +234,11 @@ TEST(CutsProgressive, SingleElementMultigridMatchesCholmod) {
 
 TEST(CutsProgressive, CutAlongTheFreeBoundarySeparatesNothing) {
   const Mesh mesh = make_rectangle(3, 3, 3, 3, ElementType::quad8);
-  CutManager m(mesh, build_topology(mesh), {points_cut({{0.2, 0, 0}, {2.5, 0, 0}})}, options(16));
+  CutManager m(mesh, build_topology(mesh), {points_cut({{0.2, 0, 0}, {2.5, 0, 0}})}, cholmod_enrichment(16));
   EXPECT_FALSE(m.update(0));
   EXPECT_TRUE(m.functions().empty());
   // ... but the part that leaves the boundary does.
-  CutManager n(mesh, build_topology(mesh), {points_cut({{0.2, 0, 0}, {1.5, 0, 0}, {1.5, 0.8, 0}})}, options(16));
+  CutManager n(mesh, build_topology(mesh), {points_cut({{0.2, 0, 0}, {1.5, 0, 0}, {1.5, 0.8, 0}})}, cholmod_enrichment(16));
   n.update(0);
   ASSERT_EQ(n.functions().size(), 1u);
   EXPECT_EQ(n.functions()[0].enriched_nodes.size(), 8u);  // element 1 only
@@ -260,7 +248,7 @@ TEST(CutsProgressive, Tri6CylinderRingIsComplete) {
   const Mesh mesh = make_cylinder(1.0, 2.0, 0, 360, 5, 2, ElementType::tri6);
   std::vector<Vec3> ring;
   for (int k = 0; k <= 40; ++k) ring.push_back({std::sin(2 * M_PI * k / 40), 1.3, std::cos(2 * M_PI * k / 40)});
-  CutManager m(mesh, build_topology(mesh), {points_cut(ring)}, options(16));
+  CutManager m(mesh, build_topology(mesh), {points_cut(ring)}, cholmod_enrichment(16));
   m.update(0);
   ASSERT_EQ(m.functions().size(), 1u);
   EXPECT_EQ(m.last_update().unknowns, 0);  // every component constant: a complete cut
