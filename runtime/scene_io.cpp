@@ -587,7 +587,7 @@ class SceneReader {
   }
 
   EnrichmentOptions read_enrichment(const json& v, const std::string& path) const {
-    check_keys(v, path, {"texture_resolution", "solver", "new_cut_length", "new_cut_angle_deg"});
+    check_keys(v, path, {"texture_resolution", "solver", "new_cut_length", "new_cut_angle_deg", "quadrature_tolerance"});
     EnrichmentOptions e;
     if (const json* r = find(v, "texture_resolution")) {
       const std::string p = child(path, "texture_resolution");
@@ -600,6 +600,8 @@ class SceneReader {
                                                                                   : EnrichmentOptions::Solver::cholmod;
     if (const json* l = find(v, "new_cut_length")) e.new_cut_length = positive(*l, child(path, "new_cut_length"));
     if (const json* a = find(v, "new_cut_angle_deg")) e.new_cut_angle_deg = positive(*a, child(path, "new_cut_angle_deg"));
+    if (const json* q = find(v, "quadrature_tolerance"))
+      e.quadrature_tolerance = positive(*q, child(path, "quadrature_tolerance"));
     return e;
   }
 
@@ -859,6 +861,7 @@ std::string scene_to_json_text(const Scene& scene) {
                        {"solver", e.solver == EnrichmentOptions::Solver::multigrid ? "multigrid" : "cholmod"}};
   if (e.new_cut_length) out["enrichment"]["new_cut_length"] = *e.new_cut_length;
   if (e.new_cut_angle_deg) out["enrichment"]["new_cut_angle_deg"] = *e.new_cut_angle_deg;
+  out["enrichment"]["quadrature_tolerance"] = e.quadrature_tolerance;
   if (scene.render) {
     const RenderOptions& r = *scene.render;
     json camera = {{"up", to_json(r.camera_up)}, {"fov_deg", r.fov_deg}};

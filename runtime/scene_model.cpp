@@ -40,6 +40,7 @@ SceneModel build_scene_model(const Scene& scene, const Mesh& mesh) {
       mesh.num_elements(), {mat.youngs_modulus, mat.poisson_ratio, mat.thickness, mat.density});
   ShellModelOptions options;
   options.penalty = scene.penalty;
+  options.enrichment_quadrature.merge_tolerance = scene.enrichment.quadrature_tolerance;
   SceneModel out;
   out.model = std::make_unique<ShellModel>(mesh, topology, sections, clamped, options);
   out.fixed = scene_fixed_dofs(scene, *out.model);

@@ -136,6 +136,10 @@ struct EnrichmentOptions {
   // turning angle exceeds these thresholds (thesis §5.5). Empty: never (default).
   std::optional<double> new_cut_length;     // > 0
   std::optional<double> new_cut_angle_deg;  // > 0
+  // Texel cells of an enriched element share one quadrature rule where every enrichment
+  // deviates from one quadratic by at most this (in units of H, which is O(1)); default
+  // 1e-2, > 0. Larger is faster and less accurate (ShellModelOptions::enrichment_quadrature).
+  double quadrature_tolerance = 1e-2;
 };
 
 // "render" (optional block; without it no frames are written).

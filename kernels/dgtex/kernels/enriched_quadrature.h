@@ -31,7 +31,10 @@ namespace dgtex::kernels {
 
 struct EnrichedQuadratureOptions {
   bool adaptive = true;
-  double merge_tolerance = 1e-4;  // in units of H (H is O(1): +-1 across a cut)
+  // In units of H (H is O(1): +-1 across a cut). 1e-2: on a T = 256 spiral cut it takes
+  // 9k points instead of 71k at 1e-4 (assembly 7x faster) and moves the displacements by
+  // 1e-5 relative.
+  double merge_tolerance = 1e-2;
 };
 
 void enriched_element_quadrature(const EnrichedElementBatch& batch, const EnrichedQuadratureOptions& options,
