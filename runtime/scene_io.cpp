@@ -175,8 +175,8 @@ class SceneReader {
     scene.base_dir = base_dir_;
     if (!root.is_object()) fail("(root)", "the scene must be a JSON object", root, "{\"mesh\": {...}, \"material\": {...}, ...}");
     check_keys(root, "",
-               {"mesh", "material", "penalty", "boundary", "loads", "analysis", "probes", "cuts", "enrichment", "render",
-                "output"});
+               {"mesh", "material", "penalty", "boundary", "loads", "analysis", "probes", "cuts", "creases", "enrichment", "render",
+                "output", "material_textures"});
     scene.mesh = read_mesh(require(root, "", "mesh", "a generator object or {\"file\": ...}"), "mesh");
     scene.material = read_material(require(root, "", "material", "an object with youngs_modulus, poisson_ratio, thickness"),
                                    "material");
@@ -195,9 +195,20 @@ class SceneReader {
     if (const json* v = find(root, "cuts")) {
       for_each_item(*v, "cuts", [&](const json& e, const std::string& p) { scene.cuts.push_back(read_cut(e, p)); });
     }
+    if (const json* v = find(root, "creases")) {  // creases: the cut point forms, never progressive
+      for_each_item(*v, "creases", [&](const json& e, const std::string& p) {
+        check_keys(e, p, {"points", "surface_points"});
+        scene.creases.push_back(read_cut(e, p));
+      });
+    }
     if (const json* v = find(root, "enrichment")) scene.enrichment = read_enrichment(*v, "enrichment");
     if (const json* v = find(root, "render")) scene.render = read_render(*v, "render");
     if (const json* v = find(root, "output")) scene.output = read_output(*v, "output");
+    if (const json* v = find(root, "material_textures")) {
+      for_each_item(*v, "material_textures", [&](const json& e, const std::string& p) {
+        scene.material_textures.push_back(read_material_texture(e, p, scene.mesh));
+      });
+    }
     check_combinations(root, scene);
     return scene;
   }
@@ -506,6 +517,40 @@ class SceneReader {
     return load;
   }
 
+  // "material_textures[i]": field, image (must exist), elements (optional), range.
+  MaterialTexture read_material_texture(const json& v, const std::string& path, const MeshSpec& mesh) const {
+    check_keys(v, path, {"field", "image", "elements", "range"});
+    MaterialTexture t;
+    t.field = static_cast<MaterialTexture::Field>(
+        choice(require(v, path, "field", "\"thickness\" or \"youngs_modulus\""), child(path, "field"), {"thickness", "youngs_modulus"}));
+    const json& image = require(v, path, "image", "the path of a PNG file");
+    const std::string name = string(image, child(path, "image"));
+    std::filesystem::path resolved(name);
+    if (resolved.is_relative() && !base_dir_.empty()) resolved = std::filesystem::path(base_dir_) / resolved;
+    t.image = resolved.lexically_normal().string();
+    std::error_code error;
+    if (name.empty() || !std::filesystem::is_regular_file(t.image, error))
+      fail(child(path, "image"), "no such file (resolved to " + t.image + ")", image,
+           "a grayscale or RGB PNG; relative paths are resolved against the scene file's folder");
+    t.range = numbers<2>(require(v, path, "range", "[min, max]"), child(path, "range"));
+    for (int k = 0; k < 2; ++k)
+      if (!(t.range[k] > 0)) fail(item(child(path, "range"), k), "must be positive", v["range"][k], "expected a number > 0");
+    if (const json* elements = find(v, "elements")) {
+      const std::string ep = child(path, "elements");
+      if (!elements->is_array() || elements->empty()) fail(ep, "expected a non-empty array of element indices", *elements, "e.g. [0, 2]; leave the key out for all elements");
+      long long count = 1LL << 30;
+      if (mesh.source != MeshSource::file)
+        count = static_cast<long long>(mesh.divisions[0]) * mesh.divisions[1] * (mesh.element == ElementType::tri6 ? 2 : 1);
+      for (size_t k = 0; k < elements->size(); ++k) {
+        const int e = integer((*elements)[k], item(ep, k), 0, count - 1);
+        if (std::find(t.elements.begin(), t.elements.end(), e) != t.elements.end())
+          fail(item(ep, k), "duplicate element", (*elements)[k], "list each element once");
+        t.elements.push_back(e);
+      }
+    }
+    return t;
+  }
+
   Probe read_probe(const json& v, const std::string& path) const {
     check_keys(v, path, {"name", "position"});
     Probe probe;
@@ -686,6 +731,9 @@ class SceneReader {
       }
       if (cut.kind == Cut::Kind::surface_points) check_surface_points(cut, cut_json, path, scene.mesh);
     }
+    for (size_t i = 0; i < scene.creases.size(); ++i)
+      if (scene.creases[i].kind == Cut::Kind::surface_points)
+        check_surface_points(scene.creases[i], root["creases"][i], item("creases", i), scene.mesh);
   }
 
   // Parametric coordinates must lie in the reference element (when the element type is
@@ -855,6 +903,31 @@ std::string scene_to_json_text(const Scene& scene) {
     if (cut.has_schedule) c["start_time"] = cut.start_time;
     if (cut.speed) c["speed"] = *cut.speed;
     out["cuts"].push_back(c);
+  }
+  if (!scene.creases.empty()) {
+    out["creases"] = json::array();
+    for (const Cut& crease : scene.creases) {
+      json c;
+      if (crease.kind == Cut::Kind::points) {
+        c["points"] = json::array();
+        for (const Vec3& p : crease.points) c["points"].push_back(to_json(p));
+      } else {
+        c["surface_points"] = json::array();
+        for (const CutSurfacePoint& sp : crease.surface_points)
+          c["surface_points"].push_back({{"element", sp.element}, {"xi", {sp.xi[0], sp.xi[1]}}});
+      }
+      out["creases"].push_back(c);
+    }
+  }
+  if (!scene.material_textures.empty()) {
+    out["material_textures"] = json::array();
+    for (const MaterialTexture& t : scene.material_textures) {
+      json m = {{"field", t.field == MaterialTexture::Field::thickness ? "thickness" : "youngs_modulus"},
+                {"image", t.image},
+                {"range", {t.range[0], t.range[1]}}};
+      if (!t.elements.empty()) m["elements"] = t.elements;
+      out["material_textures"].push_back(m);
+    }
   }
   const EnrichmentOptions& e = scene.enrichment;
   out["enrichment"] = {{"texture_resolution", e.texture_resolution},

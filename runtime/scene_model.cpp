@@ -1,6 +1,7 @@
 #include "dgtex/scene_model.h"
 
 #include "dgtex/boundary_selection.h"
+#include "dgtex/material_texture.h"
 #include "dgtex/mesh_generators.h"
 #include "dgtex/obj_import.h"
 #include "dgtex/scene_mesh_checks.h"
@@ -43,6 +44,7 @@ SceneModel build_scene_model(const Scene& scene, const Mesh& mesh) {
   options.enrichment_quadrature.merge_tolerance = scene.enrichment.quadrature_tolerance;
   SceneModel out;
   out.model = std::make_unique<ShellModel>(mesh, topology, sections, clamped, options);
+  if (!scene.material_textures.empty()) out.model->set_material_textures(scene_material_textures(scene, mesh));
   out.fixed = scene_fixed_dofs(scene, *out.model);
   out.external_force = scene_external_force(scene, *out.model);
   return out;

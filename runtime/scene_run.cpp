@@ -3,6 +3,7 @@
 #include <algorithm>
 
 #include "dgtex/basis_projection.h"
+#include "dgtex/crease_enrichment.h"
 #include "dgtex/model_error.h"
 #include "dgtex/scene_model.h"
 #include "dgtex/topology.h"
@@ -32,13 +33,16 @@ SceneRun::SceneRun(const Scene& scene)
     dynamics_.mass_damping = scene.analysis.damping.mass;
     dynamics_.stiffness_damping = scene.analysis.damping.stiffness;
   }
-  if (!scene.cuts.empty()) {
-    cuts_ = std::make_unique<CutManager>(mesh_, topology_, scene.cuts, scene.enrichment);
+  if (!scene.cuts.empty() || !scene.creases.empty()) {
     {
       ScopedStage stage(timings_, "enrichment");
-      cuts_->update(0.0);
+      if (!scene.cuts.empty()) {
+        cuts_ = std::make_unique<CutManager>(mesh_, topology_, scene.cuts, scene.enrichment);
+        cuts_->update(0.0);
+      }
+      creases_ = build_crease_functions(mesh_, topology_, scene.creases, scene.enrichment.texture_resolution);
     }
-    model_->set_enrichments(cuts_->functions());
+    model_->set_enrichments(enrichment_functions());
     built.fixed = scene_fixed_dofs(scene, *model_);
     built.external_force = scene_external_force(scene, *model_);
   }
@@ -48,6 +52,13 @@ SceneRun::SceneRun(const Scene& scene)
 }
 
 SceneRun::~SceneRun() = default;
+
+std::vector<EnrichmentFunction> SceneRun::enrichment_functions() const {
+  std::vector<EnrichmentFunction> all;
+  if (cuts_) all = cuts_->functions();
+  all.insert(all.end(), creases_.begin(), creases_.end());  // static: after the cuts' functions
+  return all;
+}
 
 void SceneRun::solve_static() { simulation_->solve_static(); }
 
@@ -71,7 +82,7 @@ void SceneRun::change_basis() {
   // The new model is a copy with the new functions (set_enrichments rebuilds everything
   // that depends on them); the old one stays alive for the projection.
   auto next = std::make_unique<ShellModel>(*model_);
-  next->set_enrichments(cuts_->functions());
+  next->set_enrichments(enrichment_functions());
   std::vector<char> fixed = scene_fixed_dofs(scene_, *next);
   std::vector<double> force = scene_external_force(scene_, *next);
   ProjectedState projected =

@@ -44,10 +44,11 @@ void ShellModel::rebuild() {
   const int ne = mesh_.num_elements();
   const int npe = mesh_.nodes_per_element();
   const bool enriched = !enriched_elements_.empty();
+  const bool textured = !textured_index_.empty();
   plain_connectivity_.clear();
   plain_sections_.clear();
   for (int e = 0; e < ne; ++e)
-    if (!enriched || enriched_index_[e] < 0) {
+    if ((!enriched || enriched_index_[e] < 0) && (!textured || textured_index_[e] < 0)) {
       plain_connectivity_.insert(plain_connectivity_.end(), mesh_.element_nodes(e), mesh_.element_nodes(e) + npe);
       plain_sections_.push_back(sections_[e]);
     }
@@ -64,6 +65,38 @@ void ShellModel::rebuild() {
   }
   const int num_plain = static_cast<int>(plain_sections_.size());
   const int num_plain_edges = static_cast<int>(plain_edge_size_.size());
+  sided_edges_.clear();
+  sided_connectivity_.clear();
+  sided_sections_.clear();
+  if (textured) {
+    // Each plain edge side becomes its own pseudo-element carrying the section seen along
+    // that edge: the element's own, or for a textured element the mean E and h of the
+    // texels along the local edge (quad8 edges 0..3: bottom row, right column, top row,
+    // left column of the image).
+    for (int k = 0; k < num_plain_edges; ++k)
+      for (int side = 0; side < 2; ++side) {
+        const int element = plain_edges_[4 * k + 2 * side], local = plain_edges_[4 * k + 2 * side + 1];
+        sided_edges_.insert(sided_edges_.end(), {element < 0 ? -1 : 2 * k + side, local});
+        const int source = element < 0 ? plain_edges_[4 * k] : element;
+        sided_connectivity_.insert(sided_connectivity_.end(), mesh_.element_nodes(source), mesh_.element_nodes(source) + npe);
+        kernels::ShellSection section = sections_[source];
+        if (element >= 0 && textured_index_[element] >= 0) {
+          const ElementMaterialTexture& t = material_textures_[textured_index_[element]];
+          const bool row = local == 0 || local == 2;
+          const int n = row ? t.width : t.height;
+          double e_sum = 0, h_sum = 0;
+          for (int m = 0; m < n; ++m) {
+            const int x = row ? m : (local == 1 ? t.width - 1 : 0);
+            const int y = row ? (local == 0 ? t.height - 1 : 0) : m;
+            e_sum += t.youngs_modulus[static_cast<size_t>(y) * t.width + x];
+            h_sum += t.thickness[static_cast<size_t>(y) * t.width + x];
+          }
+          section.youngs_modulus = e_sum / n;
+          section.thickness = h_sum / n;
+        }
+        sided_sections_.push_back(section);
+      }
+  }
 
   std::vector<BlockSourceFamily> families;
   families.push_back({num_plain, npe, plain_connectivity_});
@@ -93,6 +126,7 @@ void ShellModel::rebuild() {
     edge_qp_start_.clear();
     edge_qp_.clear();
   }
+  if (textured) families.push_back({num_textured_elements(), npe, textured_connectivity_});
   assembly_ = BlockAssembly(mesh_.num_nodes() + num_enriched_nodes(), families);
 
   // Mass and load weights depend on the rest geometry only.
@@ -111,6 +145,15 @@ void ShellModel::rebuild() {
       for (int d = 0; d < 3; ++d) enriched_mass_local[i * 9 + d * 4] = mass[i];
     locals.insert(locals.end(), {enriched_mass_local.data(), nullptr});
   }
+  std::vector<double> textured_mass_local;
+  if (textured) {
+    std::vector<double> mass(static_cast<size_t>(num_textured_elements()) * npe * npe);
+    kernels::point_section_mass(textured_batch(), mass.data());
+    textured_mass_local.assign(mass.size() * 9, 0.0);
+    for (size_t i = 0; i < mass.size(); ++i)
+      for (int d = 0; d < 3; ++d) textured_mass_local[i * 9 + d * 4] = mass[i];
+    locals.push_back(textured_mass_local.data());
+  }
   mass_blocks_.resize(assembly_.num_blocks() * 9);
   assembly_.assemble_matrix(locals, mass_blocks_.data());
   area_weights_.resize(static_cast<size_t>(num_plain) * npe);
@@ -121,8 +164,66 @@ void ShellModel::rebuild() {
   if (enriched)
     kernels::enriched_element_load_weights(eb, {element_qp_start_.data(), element_qp_.data()},
                                            enriched_area_weights_.data(), enriched_mass_weights_.data());
+  textured_area_weights_.assign(static_cast<size_t>(num_textured_elements()) * npe, 0.0);
+  textured_mass_weights_.assign(textured_area_weights_.size(), 0.0);
+  if (textured)
+    kernels::point_section_load_weights(textured_batch(), textured_area_weights_.data(), textured_mass_weights_.data());
   rest_state_ = mesh_.positions;
   rest_state_.resize(num_dofs(), 0.0);
+}
+
+void ShellModel::set_material_textures(std::vector<ElementMaterialTexture> textures) {
+  const int ne = mesh_.num_elements();
+  const int npe = mesh_.nodes_per_element();
+  std::sort(textures.begin(), textures.end(),
+            [](const ElementMaterialTexture& a, const ElementMaterialTexture& b) { return a.element < b.element; });
+  auto fail = [](int e, const std::string& what) {
+    throw std::invalid_argument("material texture of element " + std::to_string(e) + ": " + what);
+  };
+  for (size_t k = 0; k < textures.size(); ++k) {
+    const ElementMaterialTexture& t = textures[k];
+    if (t.element < 0 || t.element >= ne) fail(t.element, "no such element (the mesh has " + std::to_string(ne) + ")");
+    if (k > 0 && textures[k - 1].element == t.element) fail(t.element, "given twice");
+    if (mesh_.type != ElementType::quad8) fail(t.element, "material textures need quad8 elements");
+    const size_t size = static_cast<size_t>(std::max(t.width, 0)) * std::max(t.height, 0);
+    if (t.width < 1 || t.height < 1 || t.youngs_modulus.size() != size || t.thickness.size() != size)
+      fail(t.element, "expected W x H >= 1x1 values of E and h, got " + std::to_string(t.width) + "x" +
+                          std::to_string(t.height) + " with " + std::to_string(t.youngs_modulus.size()) + " and " +
+                          std::to_string(t.thickness.size()) + " values");
+    for (size_t i = 0; i < size; ++i)
+      if (!(t.youngs_modulus[i] > 0) || !(t.thickness[i] > 0) || !std::isfinite(t.youngs_modulus[i]) ||
+          !std::isfinite(t.thickness[i]))
+        fail(t.element, "E and h must be finite and positive (texel " + std::to_string(i) + ")");
+    if (!enriched_index_.empty() && enriched_index_[t.element] >= 0)
+      fail(t.element, "the element is enriched (cut); material textures on enriched elements are not supported");
+  }
+  material_textures_ = std::move(textures);
+  textured_index_.clear();
+  textured_connectivity_.clear();
+  textured_qp_start_.clear();
+  textured_qp_.clear();
+  textured_qp_sections_.clear();
+  if (!material_textures_.empty()) {
+    textured_index_.assign(ne, -1);
+    std::vector<kernels::MaterialTextureView> views;
+    std::vector<kernels::ShellSection> base;
+    for (size_t k = 0; k < material_textures_.size(); ++k) {
+      const ElementMaterialTexture& t = material_textures_[k];
+      textured_index_[t.element] = static_cast<int>(k);
+      textured_connectivity_.insert(textured_connectivity_.end(), mesh_.element_nodes(t.element),
+                                    mesh_.element_nodes(t.element) + npe);
+      views.push_back({t.width, t.height, t.youngs_modulus.data(), t.thickness.data()});
+      base.push_back(sections_[t.element]);
+    }
+    kernels::material_texture_quadrature(mesh_.type, static_cast<std::int64_t>(views.size()), views.data(), base.data(),
+                                         textured_qp_start_, textured_qp_, textured_qp_sections_);
+  }
+  rebuild();
+}
+
+kernels::PointSectionBatch ShellModel::textured_batch() const {
+  return {mesh_.type, num_textured_elements(), textured_connectivity_.data(), mesh_.positions.data(),
+          textured_qp_start_.data(), textured_qp_.data(), textured_qp_sections_.data()};
 }
 
 void ShellModel::install_enrichments(std::vector<EnrichmentFunction> functions) {
@@ -225,6 +326,9 @@ void ShellModel::install_enrichments(std::vector<EnrichmentFunction> functions) 
   enriched_shift_.clear();
   for (int e = 0; e < ne; ++e) {
     if (per_element[e].empty()) continue;
+    if (!textured_index_.empty() && textured_index_[e] >= 0)
+      throw std::invalid_argument("enrichment: element " + std::to_string(e) +
+                                  " has a material texture; cuts through material-textured elements are not supported");
     if (static_cast<int>(per_element[e].size()) > kernels::max_enrichments_per_element)
       throw std::invalid_argument("enrichment: element " + std::to_string(e) + " carries " +
                                   std::to_string(per_element[e].size()) + " enrichment functions; at most " +
@@ -262,6 +366,12 @@ kernels::ElementBatch ShellModel::element_batch() const {
 }
 
 kernels::EdgeBatch ShellModel::edge_batch() const {
+  if (!textured_index_.empty())
+    return {mesh_.type,       static_cast<std::int64_t>(plain_edge_size_.size()),
+            sided_edges_.data(), plain_edge_size_.data(),
+            options_.penalty, options_.edge_quadrature_points,
+            sided_connectivity_.data(), mesh_.positions.data(),
+            sided_sections_.data()};
   return {mesh_.type,       static_cast<std::int64_t>(plain_edge_size_.size()),
           plain_edges_.data(), plain_edge_size_.data(),
           options_.penalty, options_.edge_quadrature_points,
@@ -290,7 +400,8 @@ kernels::EnrichedEdgeBatch ShellModel::enriched_edge_batch(const kernels::Enrich
 std::int64_t ShellModel::num_quadrature_points() const {
   return static_cast<std::int64_t>(plain_sections_.size()) * kernels::element_quadrature(mesh_.type).count +
          static_cast<std::int64_t>(plain_edge_size_.size()) * options_.edge_quadrature_points +
-         num_enriched_element_quadrature_points() + num_enriched_edge_quadrature_points();
+         num_enriched_element_quadrature_points() + num_enriched_edge_quadrature_points() +
+         num_textured_quadrature_points();
 }
 
 void ShellModel::assemble_stiffness(const double* current, std::vector<double>& blocks, std::vector<double>* corrective,
@@ -354,6 +465,24 @@ void ShellModel::assemble_stiffness(const double* current, std::vector<double>& 
     matrix_locals.insert(matrix_locals.end(), {enriched_blocks.data(), enriched_edge_blocks.data()});
     vector_locals.insert(vector_locals.end(), {enriched_forces.data(), enriched_edge_forces.data()});
   }
+  // Material-textured elements: rotations per (texel-resolving) quadrature point.
+  std::vector<double> textured_blocks, textured_forces;
+  if (!textured_index_.empty()) {
+    const kernels::PointSectionBatch tb = textured_batch();
+    std::vector<double> rotations;
+    if (current) {
+      std::vector<double> gradients(static_cast<size_t>(num_textured_quadrature_points()) * 9);
+      rotations.resize(gradients.size());
+      kernels::point_section_deformation_gradients(tb, current, gradients.data(), execution);
+      kernels::polar_decomposition_batch(num_textured_quadrature_points(), gradients.data(), rotations.data(), execution);
+    }
+    textured_blocks.resize(static_cast<size_t>(num_textured_elements()) * npe * npe * 9);
+    if (current && corrective) textured_forces.resize(static_cast<size_t>(num_textured_elements()) * npe * 3);
+    kernels::point_section_stiffness(tb, current ? rotations.data() : nullptr, textured_blocks.data(),
+                                     textured_forces.empty() ? nullptr : textured_forces.data(), execution);
+    matrix_locals.push_back(textured_blocks.data());
+    vector_locals.push_back(textured_forces.data());
+  }
   blocks.resize(assembly_.num_blocks() * 9);
   const bool parallel = execution == Execution::parallel;
   assembly_.assemble_matrix(matrix_locals, blocks.data(), parallel);
@@ -372,6 +501,8 @@ void ShellModel::add_gravity(const double g[3], std::vector<double>& f) const {
   for (size_t i = 0; i < enriched_global_nodes_.size(); ++i)
     if (enriched_global_nodes_[i] >= 0)
       for (int c = 0; c < 3; ++c) f[3 * enriched_global_nodes_[i] + c] += enriched_mass_weights_[i] * g[c];
+  for (size_t i = 0; i < textured_connectivity_.size(); ++i)
+    for (int c = 0; c < 3; ++c) f[3 * textured_connectivity_[i] + c] += textured_mass_weights_[i] * g[c];
 }
 
 void ShellModel::add_area_force(const double q[3], std::vector<double>& f) const {
@@ -383,6 +514,8 @@ void ShellModel::add_area_force(const double q[3], std::vector<double>& f) const
   for (size_t i = 0; i < enriched_global_nodes_.size(); ++i)
     if (enriched_global_nodes_[i] >= 0)
       for (int c = 0; c < 3; ++c) f[3 * enriched_global_nodes_[i] + c] += enriched_area_weights_[i] * q[c];
+  for (size_t i = 0; i < textured_connectivity_.size(); ++i)
+    for (int c = 0; c < 3; ++c) f[3 * textured_connectivity_[i] + c] += textured_area_weights_[i] * q[c];
 }
 
 void ShellModel::set_enrichments(std::vector<EnrichmentFunction> functions) {
@@ -467,12 +600,11 @@ std::vector<double> ShellModel::mass_weighted_moments(
   const kernels::QuadratureRule standard = kernels::element_quadrature(mesh_.type);
   int global[kernels::max_enriched_basis];
   double values[kernels::max_enriched_basis];
-  auto accumulate = [&](int e, const double xi[2], double weight) {
+  auto accumulate = [&](int e, const double xi[2], double weight, const kernels::ShellSection& section) {
     kernels::ShapeValues shape;
     kernels::evaluate_shape(mesh_.type, xi[0], xi[1], shape);
     kernels::RestPoint rest;
     kernels::evaluate_rest_point(shape, mesh_.element_nodes(e), mesh_.positions.data(), rest);
-    const kernels::ShellSection& section = sections_[e];
     const double w = weight * rest.j0 * section.density * section.thickness;
     double value[3];
     g(e, xi, value);
@@ -482,15 +614,21 @@ std::vector<double> ShellModel::mass_weighted_moments(
   };
   for (int e = 0; e < mesh_.num_elements(); ++e) {
     const int index = enriched_index_.empty() ? -1 : enriched_index_[e];
-    if (index < 0) {
+    const int textured = textured_index_.empty() ? -1 : textured_index_[e];
+    if (textured >= 0) {
+      for (std::int64_t q = textured_qp_start_[textured]; q < textured_qp_start_[textured + 1]; ++q) {
+        const double xi[2] = {textured_qp_[3 * q], textured_qp_[3 * q + 1]};
+        accumulate(e, xi, textured_qp_[3 * q + 2], textured_qp_sections_[q]);
+      }
+    } else if (index < 0) {
       for (int q = 0; q < standard.count; ++q) {
         const double xi[2] = {standard.xi1[q], standard.xi2[q]};
-        accumulate(e, xi, standard.weight[q]);
+        accumulate(e, xi, standard.weight[q], sections_[e]);
       }
     } else {
       for (std::int64_t q = element_qp_start_[index]; q < element_qp_start_[index + 1]; ++q) {
         const double xi[2] = {element_qp_[3 * q], element_qp_[3 * q + 1]};
-        accumulate(e, xi, element_qp_[3 * q + 2]);
+        accumulate(e, xi, element_qp_[3 * q + 2], sections_[e]);
       }
     }
   }

@@ -38,8 +38,10 @@ void ShellSimulation::check_statically_constrained() const {
   Eigen::Vector3d centre = Eigen::Vector3d::Zero();
   for (int i = 0; i < n; ++i) centre += Eigen::Map<const Eigen::Vector3d>(mesh.node(i));
   centre /= n;
-  // Rigid modes: 3 translations, 3 rotations about the centroid.
-  Eigen::MatrixXd modes = Eigen::MatrixXd::Zero(3 * n, 6);
+  // Rigid modes: 3 translations, 3 rotations about the centroid (standard DOFs; the
+  // enriched DOFs of a rigid motion are zero).
+  const int ndofs = model_.num_dofs();
+  Eigen::MatrixXd modes = Eigen::MatrixXd::Zero(ndofs, 6);
   for (int i = 0; i < n; ++i) {
     const Eigen::Vector3d x = Eigen::Map<const Eigen::Vector3d>(mesh.node(i)) - centre;
     for (int c = 0; c < 3; ++c) {
@@ -61,14 +63,14 @@ void ShellSimulation::check_statically_constrained() const {
   for (int k = 0; k < 6; ++k)
     if (k >= svd.singularValues().size() || svd.singularValues()(k) <= 1e-9 * scale) free_modes.push_back(k);
   if (free_modes.empty()) return;
-  Eigen::MatrixXd motions(3 * n, free_modes.size());
+  Eigen::MatrixXd motions(ndofs, free_modes.size());
   for (size_t k = 0; k < free_modes.size(); ++k) motions.col(k) = modes * svd.matrixV().col(free_modes[k]);
   // Clamped edges may still hold them: check the energy the stiffness gives these motions.
   std::vector<double> K;
   model_.assemble_stiffness(nullptr, K, nullptr);
   double kmax = 0;
   for (double value : K) kmax = std::max(kmax, std::abs(value));
-  Eigen::MatrixXd KW(3 * n, free_modes.size());
+  Eigen::MatrixXd KW(ndofs, free_modes.size());
   for (size_t k = 0; k < free_modes.size(); ++k) block_multiply(model_.pattern(), K.data(), motions.col(k).data(), KW.col(k).data());
   const Eigen::MatrixXd energy = motions.transpose() * KW;
   const Eigen::MatrixXd norm = motions.transpose() * motions;

@@ -156,7 +156,7 @@ int run_command(int argc, char** argv) {
                       {"enriched_quadrature_points", model.num_enriched_element_quadrature_points() +
                                                          model.num_enriched_edge_quadrature_points()},
                       {"enrichments", static_cast<int>(model.enrichments().size())},
-                      {"texture_resolution", run->cuts() ? run->cuts()->texture_resolution() : 0},
+                      {"texture_resolution", model.enrichments().empty() ? 0 : scene.enrichment.texture_resolution},
                       {"basis_changes", run->basis_changes()}};
   report["timings_ms"] = {{"enrichment", stage_json(timings, "enrichment")},
                           {"projection", stage_json(timings, "projection")},

@@ -162,6 +162,16 @@ struct OutputOptions {
   std::string report = "report.json";  // file name inside the output folder; default: report.json
 };
 
+// "material_textures[]" (thesis §5.6, Fig. 5.20): one field per texel of chosen elements,
+// the image covering each element's parameter square (material_texture.h).
+struct MaterialTexture {
+  enum class Field { thickness, youngs_modulus };
+  Field field = Field::thickness;
+  std::string image;              // PNG path, resolved against the scene's folder; exists
+  std::vector<int> elements;      // default: empty = all elements; >= 0, unique
+  std::array<double, 2> range{};  // [min, max], both > 0: value = min + (max - min) * gray
+};
+
 struct Scene {
   std::string source_name;  // the file (or name) the scene was read from, for messages
   std::string base_dir;     // folder relative paths were resolved against
@@ -173,8 +183,12 @@ struct Scene {
   Analysis analysis;                        // default: static
   std::vector<Probe> probes;                // default: none
   std::vector<Cut> cuts;                    // default: none
+  // "creases[]": polylines in the cut point forms (no start_time/speed): each keeps the
+  // shell C0 but lets its slope jump along the line (crease_enrichment.h). default: none
+  std::vector<Cut> creases;
   EnrichmentOptions enrichment;             // default: see EnrichmentOptions
   std::optional<RenderOptions> render;      // default: no rendering
+  std::vector<MaterialTexture> material_textures;  // default: none
   OutputOptions output;
 };
 

@@ -1,7 +1,8 @@
 #pragma once
 // One simulation of a scene from start to end, the way `dgtex run` (and the scene
 // benchmarks) drive it: the mesh and shell model, the cuts and their enrichment functions
-// (dgtex/cut_manager.h), and the solver state, advanced step by step.
+// (dgtex/cut_manager.h), the creases' functions (dgtex/crease_enrichment.h), and the
+// solver state, advanced step by step.
 //
 // Each dynamic step first brings the cuts to the step's end time; when the enrichment
 // functions change, the model takes the new basis and displacement and velocity are
@@ -53,12 +54,15 @@ class SceneRun {
 
  private:
   void change_basis();
+  // The cuts' current functions followed by the creases' (fixed) ones.
+  std::vector<EnrichmentFunction> enrichment_functions() const;
 
   const Scene& scene_;
   Mesh mesh_;
   Topology topology_;  // the cut manager refers to it
   std::unique_ptr<ShellModel> model_;
   std::unique_ptr<CutManager> cuts_;
+  std::vector<EnrichmentFunction> creases_;  // one per scene crease (crease_enrichment.h)
   std::unique_ptr<ShellSimulation> simulation_;
   DynamicsOptions dynamics_;
   StageTimings timings_;  // own stages and those of replaced simulations

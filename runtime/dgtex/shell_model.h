@@ -22,6 +22,8 @@
 #include "dgtex/kernels/enriched_quadrature.h"
 #include "dgtex/kernels/shell_edge_kernel.h"
 #include "dgtex/kernels/shell_element_kernel.h"
+#include "dgtex/kernels/material_texture_kernel.h"
+#include "dgtex/element_material_texture.h"
 #include "dgtex/mesh.h"
 #include "dgtex/topology.h"
 
@@ -54,6 +56,19 @@ class ShellModel {
   const BlockAssembly& pattern() const { return assembly_; }
   const ShellModelOptions& options() const { return options_; }
   const std::vector<kernels::ShellSection>& sections() const { return sections_; }
+
+  // --- Material textures (thesis §5.6) -----------------------------------------------
+  // Per-texel E and h on chosen elements (material_texture_kernel.h): those elements are
+  // integrated with the texel-resolving rule of material_texture_quadrature, mass and load
+  // weights with rho h(x); the DG edge terms next to them use, per side, the mean E and h
+  // of the texels along that edge. Rebuilds pattern, mass and load weights. Throws
+  // std::invalid_argument for: element out of range or listed twice, sizes that do not
+  // match W x H, non-positive or non-finite values, a tri6 mesh, or an element that is
+  // also enriched (not supported). An empty list restores the plain model exactly.
+  void set_material_textures(std::vector<ElementMaterialTexture> textures);
+  const std::vector<ElementMaterialTexture>& material_textures() const { return material_textures_; }
+  int num_textured_elements() const { return static_cast<int>(material_textures_.size()); }
+  std::int64_t num_textured_quadrature_points() const { return textured_qp_start_.empty() ? 0 : textured_qp_start_.back(); }
 
   // --- Enrichment ---------------------------------------------------------------------
   // Replaces the enrichment functions (an empty list is clear_enrichments()) and rebuilds
@@ -152,6 +167,21 @@ class ShellModel {
   std::vector<std::int64_t> edge_qp_start_;
   std::vector<double> edge_qp_;
   std::vector<double> enriched_area_weights_, enriched_mass_weights_;  // #enriched elements x width
+
+  // Material textures (set_material_textures), sorted by element.
+  std::vector<ElementMaterialTexture> material_textures_;
+  std::vector<int> textured_index_;                    // per mesh element: index or -1 (empty: none)
+  std::vector<int> textured_connectivity_;             // #textured x npe
+  std::vector<std::int64_t> textured_qp_start_;
+  std::vector<double> textured_qp_;
+  std::vector<kernels::ShellSection> textured_qp_sections_;
+  std::vector<double> textured_area_weights_, textured_mass_weights_;  // #textured x npe
+  // With textures, the plain edges see one pseudo-element per edge side (2k, 2k + 1) whose
+  // section is the side's edge mean; without, the edge batch is the mesh itself.
+  std::vector<int> sided_edges_;
+  std::vector<int> sided_connectivity_;
+  std::vector<kernels::ShellSection> sided_sections_;
+  kernels::PointSectionBatch textured_batch() const;
 
   int pruned_enriched_nodes_ = 0;
   void install_enrichments(std::vector<EnrichmentFunction> functions);

@@ -1,0 +1,66 @@
+#pragma once
+// Material textures (thesis §5.6, Fig. 5.20): elements whose Young's modulus and
+// thickness vary per texel over the element's parameter square. Values are taken at the
+// nearest texel (piecewise constant), so a quadrature that gives every texel cell of
+// constant material its own mapped element rule integrates them as exactly as the
+// standard rule integrates a uniform element.
+//
+// Texture layout: W x H texels, rows top to bottom (row 0 at xi2 = +1), columns along xi1
+// (column 0 at xi1 = -1): texel (i, j) covers xi1 in [-1 + 2i/W, -1 + 2(i+1)/W] and
+// xi2 in [1 - 2(j+1)/H, 1 - 2j/H]. quad8 only.
+//
+// Shapes: connectivity #elements x npe; points (xi1, xi2, reference weight) per point,
+// per-element lists concatenated (start: #elements + 1); sections one per point; blocks
+// #elements x npe x npe x 9, forces #elements x npe x 3, mass #elements x npe x npe,
+// weights #elements x npe, rotations and F one 3x3 (row-major) per point. One element per
+// work item, so the parallel forms equal the serial ones (Execution::serial) bitwise.
+#include <cstdint>
+#include <vector>
+
+#include "dgtex/kernels/forall.h"
+#include "dgtex/kernels/shape_functions.h"
+#include "dgtex/kernels/shell_element_kernel.h"
+
+namespace dgtex::kernels {
+
+// Per-texel material of one element (absolute values, row-major as above).
+struct MaterialTextureView {
+  int width;
+  int height;
+  const double* youngs_modulus;  // #W*H
+  const double* thickness;       // #W*H
+};
+
+// Quadrature of textured elements: a quadtree over the texels (top cell = the element);
+// a cell whose texels all share E and h gets the 3x3 Gauss rule mapped onto it (a uniform
+// texture gives exactly the standard element rule), any other cell is split in halves
+// along each side longer than one texel. Appends to start/points/sections; `base` gives
+// each element's Poisson ratio and density (E and h come from the texture).
+void material_texture_quadrature(ElementType type, std::int64_t count, const MaterialTextureView* textures,
+                                 const ShellSection* base, std::vector<std::int64_t>& start,
+                                 std::vector<double>& points, std::vector<ShellSection>& sections);
+
+struct PointSectionBatch {
+  ElementType type;
+  std::int64_t count;
+  const int* connectivity;      // #elements x npe
+  const double* positions;      // rest, #nodes x 3
+  const std::int64_t* start;    // #elements + 1
+  const double* points;         // (xi1, xi2, weight) per point
+  const ShellSection* sections; // per point
+};
+
+// Membrane + bending stiffness with D evaluated per point (E h / (1 - nu^2) and
+// E h^3 / (12 (1 - nu^2))); with rotations R K R^T per point and the corrective force of
+// shell report eq. 48, as shell_element_stiffness.
+void point_section_stiffness(const PointSectionBatch& batch, const double* rotations, double* blocks, double* forces,
+                             Execution execution = Execution::parallel);
+void point_section_deformation_gradients(const PointSectionBatch& batch, const double* current_positions, double* F,
+                                         Execution execution = Execution::parallel);
+// rho h(x) integral N^a N^b dA.
+void point_section_mass(const PointSectionBatch& batch, double* mass, Execution execution = Execution::parallel);
+// Integral of N^a dA and of rho h(x) N^a dA.
+void point_section_load_weights(const PointSectionBatch& batch, double* area_weights, double* mass_weights,
+                                Execution execution = Execution::parallel);
+
+}  // namespace dgtex::kernels

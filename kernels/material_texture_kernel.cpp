@@ -1,0 +1,249 @@
+#include "dgtex/kernels/material_texture_kernel.h"
+
+#include <stdexcept>
+
+#include "dgtex/kernels/shell_point.h"
+#include "shell_point_rows.h"
+
+namespace dgtex::kernels {
+namespace {
+
+// Emits the quadtree cells of texels [i0, i1) x [j0, j1) in a fixed order.
+void emit_cells(const MaterialTextureView& t, const ShellSection& base, int i0, int i1, int j0, int j1,
+                std::vector<double>& points, std::vector<ShellSection>& sections) {
+  const double e0 = t.youngs_modulus[j0 * t.width + i0], h0 = t.thickness[j0 * t.width + i0];
+  bool uniform = true;
+  for (int j = j0; j < j1 && uniform; ++j)
+    for (int i = i0; i < i1 && uniform; ++i)
+      uniform = t.youngs_modulus[j * t.width + i] == e0 && t.thickness[j * t.width + i] == h0;
+  if (!uniform) {
+    const int im = i1 - i0 > 1 ? (i0 + i1) / 2 : i1;
+    const int jm = j1 - j0 > 1 ? (j0 + j1) / 2 : j1;
+    for (int jj = 0; jj < 2; ++jj)
+      for (int ii = 0; ii < 2; ++ii) {
+        const int a0 = ii ? im : i0, a1 = ii ? i1 : im, b0 = jj ? jm : j0, b1 = jj ? j1 : jm;
+        if (a0 < a1 && b0 < b1) emit_cells(t, base, a0, a1, b0, b1, points, sections);
+      }
+    return;
+  }
+  // Cell in xi: [x0, x1] x [y0, y1]; the whole element maps with mid 0, half 1 exactly.
+  const double x0 = -1 + 2.0 * i0 / t.width, x1 = -1 + 2.0 * i1 / t.width;
+  const double y1 = 1 - 2.0 * j0 / t.height, y0 = 1 - 2.0 * j1 / t.height;
+  const double mx = 0.5 * (x0 + x1), hx = 0.5 * (x1 - x0), my = 0.5 * (y0 + y1), hy = 0.5 * (y1 - y0);
+  const QuadratureRule rule = element_quadrature(ElementType::quad8);
+  for (int q = 0; q < rule.count; ++q) {
+    points.insert(points.end(), {mx + hx * rule.xi1[q], my + hy * rule.xi2[q], rule.weight[q] * hx * hy});
+    sections.push_back({e0, base.poisson_ratio, h0, base.density});
+  }
+}
+
+inline void apply_plane_stress(double nu, double scale, const double in[3], double out[3]) {
+  out[0] = scale * (in[0] + nu * in[1]);
+  out[1] = scale * (nu * in[0] + in[1]);
+  out[2] = scale * 0.5 * (1 - nu) * in[2];
+}
+
+// B R^T for a 3x3 row block.
+inline void rotate_rows(double B[9], const double R[9]) {
+  double out[9];
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c)
+      out[r * 3 + c] = B[r * 3 + 0] * R[c * 3 + 0] + B[r * 3 + 1] * R[c * 3 + 1] + B[r * 3 + 2] * R[c * 3 + 2];
+  for (int i = 0; i < 9; ++i) B[i] = out[i];
+}
+
+void element_stiffness(const PointSectionBatch& b, std::int64_t e, const double* rotations, double* blocks,
+                       double* forces) {
+  const int npe = nodes_per_element(b.type);
+  const int* nodes = b.connectivity + e * npe;
+  double* K = blocks + e * npe * npe * 9;
+  for (int i = 0; i < npe * npe * 9; ++i) K[i] = 0;
+  double* f = forces ? forces + e * npe * 3 : nullptr;
+  if (f)
+    for (int i = 0; i < npe * 3; ++i) f[i] = 0;
+  for (std::int64_t q = b.start[e]; q < b.start[e + 1]; ++q) {
+    const double* pt = b.points + 3 * q;
+    const ShellSection& sec = b.sections[q];
+    const double nu = sec.poisson_ratio;
+    const double dn = membrane_rigidity(sec.youngs_modulus, nu, sec.thickness);
+    const double dm = bending_rigidity(sec.youngs_modulus, nu, sec.thickness);
+    ShapeValues s;
+    evaluate_shape(b.type, pt[0], pt[1], s);
+    RestPoint p;
+    evaluate_rest_point(s, nodes, b.positions, p);
+    double e1[3], e2[3];
+    frame_along(p, p.a1, e1, e2);
+    const double w = pt[2] * p.j0;
+    double Bm[max_element_nodes][9], Bb[max_element_nodes][9];
+    fast_rows::PointFrame frame;
+    fast_rows::make_point_frame(p, e1, e2, frame);
+    for (int a = 0; a < npe; ++a) {
+      double T[9];
+      fast_rows::membrane(frame, s.dN[a], Bm[a]);
+      fast_rows::normal_change(p, frame, s.dN[a], T);
+      fast_rows::bending(p, frame, s.d2N[a], T, Bb[a]);
+    }
+    const double* R = rotations ? rotations + q * 9 : nullptr;
+    if (R && f) {
+      // Corrective term: B^T D B (X0 - R^T X0), B rotated afterwards (eq. 48).
+      double strain_m[3] = {0, 0, 0}, strain_b[3] = {0, 0, 0};
+      for (int a = 0; a < npe; ++a) {
+        const double* x = b.positions + 3 * static_cast<long>(nodes[a]);
+        double d[3];
+        for (int k = 0; k < 3; ++k) d[k] = x[k] - (R[0 * 3 + k] * x[0] + R[1 * 3 + k] * x[1] + R[2 * 3 + k] * x[2]);
+        for (int r = 0; r < 3; ++r)
+          for (int k = 0; k < 3; ++k) {
+            strain_m[r] += Bm[a][r * 3 + k] * d[k];
+            strain_b[r] += Bb[a][r * 3 + k] * d[k];
+          }
+      }
+      double sm[3], sb[3];
+      apply_plane_stress(nu, dn, strain_m, sm);
+      apply_plane_stress(nu, dm, strain_b, sb);
+      for (int a = 0; a < npe; ++a) {
+        double Rm[9], Rb[9];
+        for (int i = 0; i < 9; ++i) Rm[i] = Bm[a][i], Rb[i] = Bb[a][i];
+        rotate_rows(Rm, R);
+        rotate_rows(Rb, R);
+        for (int i = 0; i < 3; ++i) {
+          double v = 0;
+          for (int r = 0; r < 3; ++r) v += Rm[r * 3 + i] * sm[r] + Rb[r * 3 + i] * sb[r];
+          f[a * 3 + i] += w * v;
+        }
+      }
+    }
+    if (R)
+      for (int a = 0; a < npe; ++a) rotate_rows(Bm[a], R), rotate_rows(Bb[a], R);
+    // K_ab += w (Bm_a^T Dn Bm_b + Bb_a^T Dm Bb_b), upper block triangle, mirrored below.
+    for (int bb = 0; bb < npe; ++bb) {
+      double DBm[9], DBb[9];  // D times the rows of node b, column by column
+      for (int c = 0; c < 3; ++c) {
+        const double vm[3] = {Bm[bb][c], Bm[bb][3 + c], Bm[bb][6 + c]};
+        const double vb[3] = {Bb[bb][c], Bb[bb][3 + c], Bb[bb][6 + c]};
+        double om[3], ob[3];
+        apply_plane_stress(nu, w * dn, vm, om);
+        apply_plane_stress(nu, w * dm, vb, ob);
+        for (int r = 0; r < 3; ++r) DBm[r * 3 + c] = om[r], DBb[r * 3 + c] = ob[r];
+      }
+      for (int a = 0; a <= bb; ++a)
+        for (int i = 0; i < 3; ++i)
+          for (int j = 0; j < 3; ++j) {
+            double v = 0;
+            for (int r = 0; r < 3; ++r) v += Bm[a][r * 3 + i] * DBm[r * 3 + j] + Bb[a][r * 3 + i] * DBb[r * 3 + j];
+            K[(a * npe + bb) * 9 + i * 3 + j] += v;
+          }
+    }
+  }
+  for (int a = 0; a < npe; ++a)
+    for (int bb = a + 1; bb < npe; ++bb)
+      for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j) K[(bb * npe + a) * 9 + j * 3 + i] = K[(a * npe + bb) * 9 + i * 3 + j];
+}
+
+inline void invert3(const double m[9], double inv[9]) {
+  const double c00 = m[4] * m[8] - m[5] * m[7], c01 = m[5] * m[6] - m[3] * m[8], c02 = m[3] * m[7] - m[4] * m[6];
+  const double det = m[0] * c00 + m[1] * c01 + m[2] * c02;
+  inv[0] = c00 / det;
+  inv[3] = c01 / det;
+  inv[6] = c02 / det;
+  inv[1] = (m[2] * m[7] - m[1] * m[8]) / det;
+  inv[4] = (m[0] * m[8] - m[2] * m[6]) / det;
+  inv[7] = (m[1] * m[6] - m[0] * m[7]) / det;
+  inv[2] = (m[1] * m[5] - m[2] * m[4]) / det;
+  inv[5] = (m[2] * m[3] - m[0] * m[5]) / det;
+  inv[8] = (m[0] * m[4] - m[1] * m[3]) / det;
+}
+
+}  // namespace
+
+void material_texture_quadrature(ElementType type, std::int64_t count, const MaterialTextureView* textures,
+                                 const ShellSection* base, std::vector<std::int64_t>& start,
+                                 std::vector<double>& points, std::vector<ShellSection>& sections) {
+  if (type != ElementType::quad8) throw std::invalid_argument("material textures: only quad8 elements are supported");
+  if (start.empty()) start.push_back(0);
+  for (std::int64_t e = 0; e < count; ++e) {
+    const MaterialTextureView& t = textures[e];
+    if (t.width < 1 || t.height < 1) throw std::invalid_argument("material textures: empty texture");
+    emit_cells(t, base[e], 0, t.width, 0, t.height, points, sections);
+    start.push_back(static_cast<std::int64_t>(sections.size()));
+  }
+}
+
+void point_section_stiffness(const PointSectionBatch& batch, const double* rotations, double* blocks, double* forces,
+                             Execution execution) {
+  forall(batch.count, [&](std::int64_t e) { element_stiffness(batch, e, rotations, blocks, forces); }, execution);
+}
+
+void point_section_deformation_gradients(const PointSectionBatch& b, const double* current, double* F,
+                                         Execution execution) {
+  const int npe = nodes_per_element(b.type);
+  forall(
+      b.count,
+      [&](std::int64_t e) {
+        const int* nodes = b.connectivity + e * npe;
+        for (std::int64_t q = b.start[e]; q < b.start[e + 1]; ++q) {
+          ShapeValues s;
+          evaluate_shape(b.type, b.points[3 * q], b.points[3 * q + 1], s);
+          fast_rows::SurfaceFrame p0, p;
+          fast_rows::evaluate_surface_frame(s, nodes, b.positions, p0);
+          fast_rows::evaluate_surface_frame(s, nodes, current, p);
+          const double rest[9] = {p0.a1[0], p0.a2[0], p0.t0[0], p0.a1[1], p0.a2[1], p0.t0[1],
+                                  p0.a1[2], p0.a2[2], p0.t0[2]};
+          const double cur[9] = {p.a1[0], p.a2[0], p.t0[0], p.a1[1], p.a2[1], p.t0[1], p.a1[2], p.a2[2], p.t0[2]};
+          double inv[9];
+          invert3(rest, inv);
+          double* out = F + q * 9;
+          for (int i = 0; i < 3; ++i)
+            for (int j = 0; j < 3; ++j)
+              out[i * 3 + j] = cur[i * 3 + 0] * inv[0 * 3 + j] + cur[i * 3 + 1] * inv[1 * 3 + j] + cur[i * 3 + 2] * inv[2 * 3 + j];
+        }
+      },
+      execution);
+}
+
+void point_section_mass(const PointSectionBatch& b, double* mass, Execution execution) {
+  const int npe = nodes_per_element(b.type);
+  forall(
+      b.count,
+      [&](std::int64_t e) {
+        const int* nodes = b.connectivity + e * npe;
+        double* m = mass + e * npe * npe;
+        for (int i = 0; i < npe * npe; ++i) m[i] = 0;
+        for (std::int64_t q = b.start[e]; q < b.start[e + 1]; ++q) {
+          ShapeValues s;
+          evaluate_shape(b.type, b.points[3 * q], b.points[3 * q + 1], s);
+          RestPoint p;
+          evaluate_rest_point(s, nodes, b.positions, p);
+          const double w = b.points[3 * q + 2] * p.j0 * b.sections[q].density * b.sections[q].thickness;
+          for (int a = 0; a < npe; ++a)
+            for (int c = 0; c < npe; ++c) m[a * npe + c] += w * s.N[a] * s.N[c];
+        }
+      },
+      execution);
+}
+
+void point_section_load_weights(const PointSectionBatch& b, double* area_weights, double* mass_weights,
+                                Execution execution) {
+  const int npe = nodes_per_element(b.type);
+  forall(
+      b.count,
+      [&](std::int64_t e) {
+        const int* nodes = b.connectivity + e * npe;
+        for (int a = 0; a < npe; ++a) area_weights[e * npe + a] = mass_weights[e * npe + a] = 0;
+        for (std::int64_t q = b.start[e]; q < b.start[e + 1]; ++q) {
+          ShapeValues s;
+          evaluate_shape(b.type, b.points[3 * q], b.points[3 * q + 1], s);
+          RestPoint p;
+          evaluate_rest_point(s, nodes, b.positions, p);
+          const double w = b.points[3 * q + 2] * p.j0;
+          const double rho_h = b.sections[q].density * b.sections[q].thickness;
+          for (int a = 0; a < npe; ++a) {
+            area_weights[e * npe + a] += w * s.N[a];
+            mass_weights[e * npe + a] += w * rho_h * s.N[a];
+          }
+        }
+      },
+      execution);
+}
+
+}  // namespace dgtex::kernels

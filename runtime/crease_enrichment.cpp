@@ -1,0 +1,130 @@
+#include "dgtex/crease_enrichment.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <set>
+#include <stdexcept>
+#include <string>
+
+#include "dgtex/cut_path.h"
+#include "dgtex/kernels/cut_rasterization.h"
+#include "dgtex/kernels/enriched_basis.h"
+#include "dgtex/kernels/fast_marching.h"
+
+namespace dgtex {
+
+namespace {
+
+double norm3(const Vec3& a) { return std::sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]); }
+
+double point_segment_distance(const Vec3& p, const Vec3& a, const Vec3& b) {
+  const Vec3 ab{b[0] - a[0], b[1] - a[1], b[2] - a[2]};
+  const Vec3 ap{p[0] - a[0], p[1] - a[1], p[2] - a[2]};
+  const double len2 = ab[0] * ab[0] + ab[1] * ab[1] + ab[2] * ab[2];
+  double t = len2 > 0 ? (ap[0] * ab[0] + ap[1] * ab[1] + ap[2] * ab[2]) / len2 : 0.0;
+  t = std::clamp(t, 0.0, 1.0);
+  return norm3({ap[0] - t * ab[0], ap[1] - t * ab[1], ap[2] - t * ab[2]});
+}
+
+double polyline_distance(const Vec3& p, const std::vector<Vec3>& line) {
+  double d = std::numeric_limits<double>::infinity();
+  for (std::size_t s = 0; s + 1 < line.size(); ++s) d = std::min(d, point_segment_distance(p, line[s], line[s + 1]));
+  return d;
+}
+
+// Lengths of one texel step along xi1 and xi2 at the element centre.
+void texel_spacing(const Mesh& mesh, int element, int resolution, double& hx, double& hy) {
+  const bool quad = mesh.type == kernels::ElementType::quad8;
+  const double c = quad ? 0.0 : 1.0 / 3.0, eps = quad ? 1e-3 : 5e-4;
+  const double dxi = kernels::texel_size(mesh.type, resolution);
+  double spacing[2];
+  for (int axis = 0; axis < 2; ++axis) {
+    double lo[2] = {c, c}, hi[2] = {c, c};
+    lo[axis] -= eps, hi[axis] += eps;
+    Vec3 a, b, n;
+    element_surface_point(mesh, element, lo, a, n);
+    element_surface_point(mesh, element, hi, b, n);
+    spacing[axis] = norm3({b[0] - a[0], b[1] - a[1], b[2] - a[2]}) / (2 * eps) * dxi;  // exact for quadratic x(xi)
+  }
+  hx = spacing[0], hy = spacing[1];
+}
+
+kernels::TexelTile crease_distance_tile(const Mesh& mesh, int element, int resolution, const std::vector<Vec3>& line,
+                                        double scale) {
+  kernels::TexelTile tile = kernels::make_element_tile(mesh.type, resolution);
+  double hx, hy;
+  texel_spacing(mesh, element, resolution, hx, hy);
+  if (!(hx > 0 && hy > 0))
+    throw std::invalid_argument("creases: element " + std::to_string(element) + " is degenerate (zero metric)");
+  const double band = 1.5 * std::max(hx, hy);
+  const int t = resolution;
+  const bool tri = mesh.type == kernels::ElementType::tri6;
+  std::vector<std::uint8_t> seeded(tile.values.size(), 0);
+  std::vector<double> chordal(tile.values.size(), 0.0);
+  for (int j = 0; j < t; ++j)
+    for (int i = 0; i < t; ++i) {
+      const int k = tile.index(i, j);
+      if (tile.flags[k] & kernels::inactive) continue;
+      double xi[2];
+      kernels::texel_centre(mesh.type, resolution, i, j, xi);
+      Vec3 x, n;
+      element_surface_point(mesh, element, xi, x, n);
+      chordal[k] = polyline_distance(x, line);
+      const bool border = i == 0 || j == 0 || i == t - 1 || j == t - 1 || (tri && i + j == t - 1);
+      if (border || chordal[k] <= band) {
+        seeded[k] = 1;
+        tile.values[k] = chordal[k];
+      }
+    }
+  kernels::fast_marching_reference(tile, seeded, hx, hy);
+  for (std::size_t k = 0; k < tile.values.size(); ++k) {
+    if (tile.flags[k] & kernels::inactive) {
+      tile.values[k] = 0;
+      continue;
+    }
+    tile.values[k] *= scale;  // every active texel is reached: the tiles have no walls
+  }
+  return tile;
+}
+
+}  // namespace
+
+std::vector<EnrichmentFunction> build_crease_functions(const Mesh& mesh, const Topology& topology,
+                                                       const std::vector<Cut>& creases, int resolution) {
+  std::vector<EnrichmentFunction> functions;
+  if (creases.empty()) return functions;
+  const ElementAdjacency adjacency(mesh, topology);
+  const int npe = mesh.nodes_per_element();
+  std::vector<std::vector<int>> node_elements(mesh.num_nodes());
+  for (int e = 0; e < mesh.num_elements(); ++e)
+    for (int a = 0; a < npe; ++a) node_elements[mesh.element_nodes(e)[a]].push_back(e);
+  const double scale = 1.0 / (4.0 * cut_point_tolerance(mesh));  // 1 / mean element edge length
+
+  for (std::size_t c = 0; c < creases.size(); ++c) {
+    const std::string name = "creases[" + std::to_string(c) + "]";
+    const MeshCutPath path = trace_cut_path(mesh, adjacency, creases[c], resolution, name);
+    std::set<int> touched;
+    std::vector<Vec3> line;
+    for (std::size_t v = 0; v < path.vertices.size(); ++v) {
+      const CutPathVertex& p = path.vertices[v];
+      line.push_back(p.position);
+      if (v == 0) continue;
+      const CutPathVertex& q = path.vertices[v - 1];
+      if (q.element == p.element && (q.xi[0] != p.xi[0] || q.xi[1] != p.xi[1])) touched.insert(p.element);
+    }
+    if (touched.empty())
+      throw std::invalid_argument(name + ": the crease passes through no element (zero length on the surface)");
+    std::set<int> nodes, omega;
+    for (int e : touched)
+      for (int a = 0; a < npe; ++a) nodes.insert(mesh.element_nodes(e)[a]);
+    for (int n : nodes) omega.insert(node_elements[n].begin(), node_elements[n].end());
+    EnrichmentFunction f;
+    f.enriched_nodes.assign(nodes.begin(), nodes.end());
+    for (int e : omega) f.elements.push_back({e, crease_distance_tile(mesh, e, resolution, line, scale)});
+    functions.push_back(std::move(f));
+  }
+  return functions;
+}
+
+}  // namespace dgtex

@@ -1,0 +1,43 @@
+#pragma once
+// Creases (thesis §5.6, Fig. 5.21): the shell stays C0 across a crease line but its slope
+// may jump there. Each scene crease becomes one EnrichmentFunction WITHOUT walls whose
+// texture H is the distance from the crease line divided by the mesh's mean element edge
+// length (so H = O(1)): H has a kink along the crease, and the enriched basis
+// (H - H(xi^a)) N^a (enrichment_function.h) then represents displacement fields whose
+// first derivatives jump across the crease.
+//
+// What is built, per crease:
+//   - the crease is traced across the mesh like a cut (trace_cut_path, same point forms and
+//     validation, messages name creases[i]);
+//   - N_i: the nodes of every element the crease passes through (a segment of positive
+//     length inside it); Omega_i: every element incident to one of those nodes (one ring);
+//   - per element of Omega_i, a fast-marching distance (kernels/fast_marching.h) in the
+//     element's own parameter space scaled by its metric at the element centre (texel
+//     steps |dx/dxi1| dxi and |dx/dxi2| dxi: an affine, orthogonal approximation). Seeds,
+//     with the exact 3D distance to the crease polyline (the traced path's rest points):
+//     the texels within 1.5 texels of the crease, and every texel on the tile's border, so
+//     neighbouring elements agree along their shared edge (H is C0 across elements up to
+//     the half-texel offset of the texel centres from the edge).
+// Limits: on a flat mesh the result is the exact Euclidean (= geodesic) distance up to the
+// first-order fast-marching error O(texel) away from the seeds. On a curved mesh the seeds
+// use the chordal 3D distance, which underestimates the geodesic one by O(kappa^2 d^3), and
+// the metric is taken constant per element. Crease textures carry no cut walls: a cut
+// crossing a creased element does not split the crease's enrichment. Creases are static
+// (no start_time/speed). A crease tip inside an element gives distance-to-endpoint (a cone),
+// so the slope jump fades out around the tip as the kink does.
+#include <vector>
+
+#include "dgtex/enrichment_function.h"
+#include "dgtex/mesh.h"
+#include "dgtex/scene.h"
+#include "dgtex/topology.h"
+
+namespace dgtex {
+
+// One function per crease, in order. resolution: texels per element side (T, as for cuts).
+// Throws std::invalid_argument naming creases[i] for a crease the mesh cannot take (see
+// trace_cut_path) or one that passes through no element with positive length.
+std::vector<EnrichmentFunction> build_crease_functions(const Mesh& mesh, const Topology& topology,
+                                                       const std::vector<Cut>& creases, int resolution);
+
+}  // namespace dgtex

@@ -1,0 +1,66 @@
+#include "dgtex/material_texture.h"
+
+#include <map>
+#include <string>
+
+#include "dgtex/png_io.h"
+#include "dgtex/scene_io.h"
+
+namespace dgtex {
+
+std::vector<ElementMaterialTexture> scene_material_textures(const Scene& scene, const Mesh& mesh) {
+  std::map<int, ElementMaterialTexture> per_element;
+  const int ne = mesh.num_elements();
+  for (size_t i = 0; i < scene.material_textures.size(); ++i) {
+    const MaterialTexture& t = scene.material_textures[i];
+    const std::string path = "material_textures[" + std::to_string(i) + "]";
+    if (mesh.type != ElementType::quad8)
+      throw SceneError(scene.source_name, path, "material textures need quad8 elements", "",
+                       "use \"element\": \"quad8\" in the mesh");
+    Image image;
+    try {
+      image = read_png(t.image);
+    } catch (const std::exception& error) {
+      throw SceneError(scene.source_name, path + ".image", std::string("unreadable image: ") + error.what(),
+                       "\"" + t.image + "\"", "a grayscale or RGB PNG file");
+    }
+    // Gray per texel: RGB mean (a grayscale PNG arrives with R = G = B).
+    std::vector<double> values(static_cast<size_t>(image.width) * image.height);
+    for (int y = 0; y < image.height; ++y)
+      for (int x = 0; x < image.width; ++x) {
+        const std::uint8_t* p = image.pixel(x, y);
+        const double gray = (p[0] + p[1] + p[2]) / (3.0 * 255.0);
+        values[static_cast<size_t>(y) * image.width + x] = t.range[0] + (t.range[1] - t.range[0]) * gray;
+      }
+    std::vector<int> elements = t.elements;
+    if (elements.empty())
+      for (int e = 0; e < ne; ++e) elements.push_back(e);
+    for (size_t k = 0; k < elements.size(); ++k) {
+      const int e = elements[k];
+      if (e < 0 || e >= ne)
+        throw SceneError(scene.source_name, path + ".elements[" + std::to_string(k) + "]", "no such element",
+                         std::to_string(e), "the mesh has elements 0.." + std::to_string(ne - 1));
+      auto [it, fresh] = per_element.try_emplace(e);
+      ElementMaterialTexture& m = it->second;
+      if (fresh) {
+        m.element = e;
+        m.width = image.width;
+        m.height = image.height;
+        m.youngs_modulus.assign(values.size(), scene.material.youngs_modulus);
+        m.thickness.assign(values.size(), scene.material.thickness);
+      } else if (m.width != image.width || m.height != image.height) {
+        throw SceneError(scene.source_name, path + ".image",
+                         "is " + std::to_string(image.width) + "x" + std::to_string(image.height) + " but element " +
+                             std::to_string(e) + " already has a " + std::to_string(m.width) + "x" +
+                             std::to_string(m.height) + " material texture",
+                         "\"" + t.image + "\"", "textures of one element must have the same size");
+      }
+      (t.field == MaterialTexture::Field::thickness ? m.thickness : m.youngs_modulus) = values;
+    }
+  }
+  std::vector<ElementMaterialTexture> out;
+  for (auto& [e, m] : per_element) out.push_back(std::move(m));
+  return out;
+}
+
+}  // namespace dgtex
