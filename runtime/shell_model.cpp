@@ -522,22 +522,31 @@ void ShellModel::set_enrichments(std::vector<EnrichmentFunction> functions) {
   install_enrichments(std::move(functions));
   pruned_enriched_nodes_ = 0;
   if (options_.min_enrichment_mass_ratio <= 0 || num_enriched_nodes() == 0) return;
-  // A cut that clips a node's support by a few texels leaves (H - H(xi^a)) N^a with almost
-  // no support: its mass and stiffness are tiny next to the node's own, the system loses
-  // definiteness to round-off (thesis §5.6 has no remedy). As in XFEM practice, such
-  // enriched DOFs are dropped: their diagonal mass block over the node's own is below
-  // min_enrichment_mass_ratio. The pieces they would have freed are a few texels wide
-  // and stay attached; the cut still separates everything else.
+  // A cut that leaves a fragment a few texels wide makes enriched functions that are almost
+  // dependent: (H - H(xi^a)) N^a either has almost no support (a node beyond the fragment)
+  // or equals a multiple of N^a except on the fragment (a node on the fragment's side).
+  // Either way the system loses definiteness to round-off (the thesis has no remedy). As
+  // in XFEM practice such enriched DOFs are dropped: the part of the function's mass that
+  // N^a does not already carry, M_vv - M_av^2 / M_aa, is below min_enrichment_mass_ratio
+  // times M_aa. The fragment stays attached where its DOFs were dropped; the cut still
+  // separates everything else.
   std::vector<double> diagonal(pattern().num_nodes(), 0.0);
   for (int r = 0; r < pattern().num_nodes(); ++r)
     for (std::int64_t k = pattern().row_start()[r]; k < pattern().row_start()[r + 1]; ++k)
       if (pattern().column()[k] == r) diagonal[r] = mass_blocks_[9 * k];
+  auto coupling = [&](int row, int column) {
+    for (std::int64_t k = pattern().row_start()[row]; k < pattern().row_start()[row + 1]; ++k)
+      if (pattern().column()[k] == column) return mass_blocks_[9 * k];
+    return 0.0;
+  };
   std::vector<EnrichmentFunction> kept = enrichments_;
   for (auto& f : kept) f.enriched_nodes.clear();
   int pruned = 0;
   for (int v = num_nodes(); v < pattern().num_nodes(); ++v) {
     const int node = virtual_node_mesh_node(v);
-    if (diagonal[v] < options_.min_enrichment_mass_ratio * diagonal[node]) ++pruned;
+    const double m_av = coupling(v, node);
+    const double independent = diagonal[v] - m_av * m_av / diagonal[node];
+    if (independent < options_.min_enrichment_mass_ratio * diagonal[node]) ++pruned;
     else kept[virtual_node_function(v)].enriched_nodes.push_back(node);
   }
   if (pruned == 0) return;

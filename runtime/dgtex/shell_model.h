@@ -35,8 +35,9 @@ struct ShellModelOptions {
   // Quadrature of enriched elements and edges: adaptive merging of texel cells where every
   // enrichment is one quadratic (enriched_quadrature.h), or per-texel everywhere.
   kernels::EnrichedQuadratureOptions enrichment_quadrature;
-  // Enriched DOFs whose basis function has less mass than this fraction of its node's own
-  // (a cut clipping the support by a few texels) are dropped (set_enrichments); 0 keeps all.
+  // Enriched DOFs whose basis function adds less independent mass than this fraction of
+  // its node's own, M_vv - M_av^2 / M_aa < ratio M_aa (fragments a few texels wide), are
+  // dropped (set_enrichments); 0 keeps all.
   double min_enrichment_mass_ratio = 1e-3;
 };
 
