@@ -32,6 +32,13 @@ void ShellSimulation::set_state(std::vector<double> u, std::vector<double> v) {
   previous_v_.clear();
 }
 
+std::string ShellSimulation::enrichment_hint() const {
+  if (model_.num_enriched_dofs() == 0) return "";
+  // Known cause with cuts: two cuts that only share an end point (a bent crack written as
+  // two cuts) give enrichment functions that depend on each other.
+  return "; with cuts, also check for cuts that share an end point: write a bent crack as one polyline";
+}
+
 void ShellSimulation::check_statically_constrained() const {
   const Mesh& mesh = model_.mesh();
   const int n = mesh.num_nodes();
@@ -99,7 +106,7 @@ void ShellSimulation::solve_static() {
       cholesky_.factorize(values);
     } catch (const NotPositiveDefinite& e) {
       throw ModelError("stiffness not positive definite (penalty too low?): penalty = " +
-                       std::to_string(model_.options().penalty) + "; " + e.what());
+                       std::to_string(model_.options().penalty) + "; " + e.what() + enrichment_hint());
     }
     system_.restrict_vector(f_ext_, rhs);
     cholesky_.solve(rhs, x);
@@ -165,7 +172,7 @@ void ShellSimulation::step(const DynamicsOptions& o) {
     }
   } catch (const NotPositiveDefinite& e) {
     throw ModelError("dynamic system matrix not positive definite (penalty too low?): penalty = " +
-                     std::to_string(model_.options().penalty) + "; " + e.what());
+                     std::to_string(model_.options().penalty) + "; " + e.what() + enrichment_hint());
   }
   for (int d = 0; d < ndofs; ++d) u_[d] += dt * v_[d];
   time_ += dt;

@@ -10,6 +10,7 @@
 // (FactorReusingSolver: same relative-residual bound as a direct solve, see there);
 // reuse_factorization = false factorises every step instead (the reference path).
 // Every stage's time is recorded ("assembly", "solve").
+#include <string>
 #include <vector>
 
 #include "dgtex/factor_reusing_solver.h"
@@ -71,6 +72,7 @@ class ShellSimulation {
   std::vector<double> previous_v_, guess_;  // velocity of the step before, PCG start
 
   const std::vector<double>& linear_stiffness();
+  std::string enrichment_hint() const;  // appended to "not positive definite" errors
 };
 
 }  // namespace dgtex
