@@ -26,9 +26,9 @@ namespace dgtex {
 
 class SceneRun {
  public:
-  // Builds everything and brings the cuts to time 0. Throws MeshError / SceneError (bad
-  // mesh or scene), std::invalid_argument (a cut the mesh cannot take, naming cuts[i]),
-  // ModelError (statically unconstrained model).
+  // Builds everything and brings the cuts to time 0; `scene` must outlive the run.
+  // Throws MeshError / SceneError (bad mesh or scene), std::invalid_argument (a cut the
+  // mesh cannot take, naming cuts[i]), ModelError (statically unconstrained model).
   explicit SceneRun(const Scene& scene);
   ~SceneRun();
 
