@@ -147,14 +147,7 @@ void enriched_element_deformation_gradients(const EnrichedElementBatch& b, const
           cross3(a1, a2, t);
           normalize3(t);
           const RestPoint& r = p.rest;
-          const double rest[9] = {r.a1[0], r.a2[0], r.t0[0], r.a1[1], r.a2[1], r.t0[1], r.a1[2], r.a2[2], r.t0[2]};
-          const double cur[9] = {a1[0], a2[0], t[0], a1[1], a2[1], t[1], a1[2], a2[2], t[2]};
-          double inv[9];
-          invert3(rest, inv);
-          double* out = F + 9 * q;
-          for (int i = 0; i < 3; ++i)
-            for (int j = 0; j < 3; ++j)
-              out[i * 3 + j] = cur[i * 3 + 0] * inv[0 * 3 + j] + cur[i * 3 + 1] * inv[1 * 3 + j] + cur[i * 3 + 2] * inv[2 * 3 + j];
+          surface_deformation_gradient(r.a1, r.a2, r.t0, a1, a2, t, F + 9 * q);
         }
       },
       execution);

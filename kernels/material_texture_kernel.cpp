@@ -175,15 +175,7 @@ void point_section_deformation_gradients(const PointSectionBatch& b, const doubl
           fast_rows::SurfaceFrame p0, p;
           fast_rows::evaluate_surface_frame(s, nodes, b.positions, p0);
           fast_rows::evaluate_surface_frame(s, nodes, current, p);
-          const double rest[9] = {p0.a1[0], p0.a2[0], p0.t0[0], p0.a1[1], p0.a2[1], p0.t0[1],
-                                  p0.a1[2], p0.a2[2], p0.t0[2]};
-          const double cur[9] = {p.a1[0], p.a2[0], p.t0[0], p.a1[1], p.a2[1], p.t0[1], p.a1[2], p.a2[2], p.t0[2]};
-          double inv[9];
-          invert3(rest, inv);
-          double* out = F + q * 9;
-          for (int i = 0; i < 3; ++i)
-            for (int j = 0; j < 3; ++j)
-              out[i * 3 + j] = cur[i * 3 + 0] * inv[0 * 3 + j] + cur[i * 3 + 1] * inv[1 * 3 + j] + cur[i * 3 + 2] * inv[2 * 3 + j];
+          surface_deformation_gradient(p0.a1, p0.a2, p0.t0, p.a1, p.a2, p.t0, F + q * 9);
         }
       },
       execution);

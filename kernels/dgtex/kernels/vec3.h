@@ -1,5 +1,5 @@
 #pragma once
-// Small 3-vector helpers on raw double[3] arrays, shared by the shell kernels.
+// Small 3-vector and 3x3 helpers on raw double arrays, shared by the shell kernels.
 #include <cmath>
 
 namespace dgtex::kernels {
@@ -28,6 +28,19 @@ inline void invert3(const double m[9], double inv[9]) {
   inv[2] = (m[1] * m[5] - m[2] * m[4]) / det;
   inv[5] = (m[2] * m[3] - m[0] * m[5]) / det;
   inv[8] = (m[0] * m[4] - m[1] * m[3]) / det;
+}
+
+// Deformation gradient F = [a1 a2 t][A1 A2 T0]^-1 (row-major) of a mid-surface point, from
+// its rest tangents and normal (A1, A2, T0) and its current ones (a1, a2, t).
+inline void surface_deformation_gradient(const double A1[3], const double A2[3], const double T0[3],
+                                         const double a1[3], const double a2[3], const double t[3], double F[9]) {
+  const double rest[9] = {A1[0], A2[0], T0[0], A1[1], A2[1], T0[1], A1[2], A2[2], T0[2]};
+  const double cur[9] = {a1[0], a2[0], t[0], a1[1], a2[1], t[1], a1[2], a2[2], t[2]};
+  double inv[9];
+  invert3(rest, inv);
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j)
+      F[i * 3 + j] = cur[i * 3 + 0] * inv[0 * 3 + j] + cur[i * 3 + 1] * inv[1 * 3 + j] + cur[i * 3 + 2] * inv[2 * 3 + j];
 }
 
 }  // namespace dgtex::kernels
