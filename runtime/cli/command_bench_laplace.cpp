@@ -7,10 +7,12 @@
 #include <fstream>
 #include <iostream>
 #include <nlohmann/json.hpp>
+#include <sstream>
 #include <string>
 #include <vector>
 
 #include "commands.h"
+#include "gnuplot_chart.h"
 #include "dgtex/laplace_benchmark.h"
 #include "dgtex/laplace_domains.h"
 
@@ -22,33 +24,24 @@ struct ChartSeries {
   std::vector<LaplaceConvergencePoint> points;
 };
 
-// Writes a residual-against-time chart with gnuplot (SVG terminal); returns false if gnuplot failed.
+// Residual against time, one line per solver (PNG if the path ends in .png, else SVG).
 bool write_chart(const std::string& path, const std::string& title, const std::vector<ChartSeries>& series) {
-  const std::string data_path = path + ".dat", script_path = path + ".gp";
-  {
-    std::ofstream data(data_path);
-    for (const ChartSeries& s : series) {
-      data << "# " << s.solver << "\n";
-      for (const LaplaceConvergencePoint& p : s.points)
-        data << std::max(p.ms, 1e-3) << " " << std::max(p.relative_residual, 1e-16) << "\n";
-      data << "\n\n";
-    }
+  std::ostringstream data;
+  for (const ChartSeries& s : series) {
+    data << "# " << s.solver << "\n";
+    for (const LaplaceConvergencePoint& p : s.points)
+      data << std::max(p.ms, 1e-3) << " " << std::max(p.relative_residual, 1e-16) << "\n";
+    data << "\n\n";
   }
-  std::ofstream script(script_path);
-  const bool png = path.size() > 4 && path.substr(path.size() - 4) == ".png";
-  script << "set terminal " << (png ? "png size 900,600" : "svg size 900,600") << "\nset output '" << path << "'\n"
-         << "set title '" << title << "'\nset logscale xy\nset xlabel 'time (ms)'\nset ylabel 'relative residual'\n"
-         << "set format y '10^{%L}'\nset key outside right\nplot ";
-  for (std::size_t k = 0; k < series.size(); ++k)
-    script << (k ? ", " : "") << "'" << data_path << "' index " << k << " with linespoints title '" << series[k].solver
-           << "' noenhanced";
-  script << "\n";
-  script.close();
-  const std::string command = "gnuplot '" + script_path + "' 2>/dev/null";
-  const bool ok = std::system(command.c_str()) == 0;
-  std::remove(script_path.c_str());
-  std::remove(data_path.c_str());
-  return ok;
+  return draw_gnuplot_chart(path, 900, 600, data.str(), [&](const std::string& data_file) {
+    std::ostringstream script;
+    script << "set title '" << title << "'\nset logscale xy\nset xlabel 'time (ms)'\nset ylabel 'relative residual'\n"
+           << "set format y '10^{%L}'\nset key outside right\nplot ";
+    for (std::size_t k = 0; k < series.size(); ++k)
+      script << (k ? ", " : "") << "'" << data_file << "' index " << k << " with linespoints title '"
+             << series[k].solver << "' noenhanced";
+    return script.str();
+  });
 }
 
 }  // namespace

@@ -9,10 +9,12 @@
 #include <cstdlib>
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <sstream>
 #include <string>
 #include <vector>
 
 #include "commands.h"
+#include "gnuplot_chart.h"
 #include "dgtex/render_benchmark.h"
 
 namespace dgtex::cli {
@@ -23,56 +25,38 @@ constexpr double kErrorFloor = 0.05;  // texels; zero errors are drawn here on t
 // Error (texels) against triangles drawn, one line per method, the 1-texel target and
 // 1/16 of the per-texel triangles as guides. PNG if the path ends in .png, else SVG.
 bool write_chart(const std::string& path, const RenderBenchResult& r) {
-  const std::string data_path = path + ".dat", script_path = path + ".gp";
   const std::vector<std::string> series = {"per-texel", "geometry-shader", "drop-triangles", "kill-pixels"};
   double per_texel_triangles = 0;
-  {
-    std::ofstream data(data_path);
-    for (const std::string& name : series) {
-      data << "# " << name << "\n";
-      for (const RenderBenchCase& c : r.cases)
-        if (c.method == name) {
-          data << c.triangles_drawn << " " << std::max(c.error_texels, kErrorFloor) << " " << c.tessellation << "\n";
-          if (name == "per-texel") per_texel_triangles = static_cast<double>(c.triangles_drawn);
-        }
-      data << "\n\n";
-    }
+  std::ostringstream data;
+  for (const std::string& name : series) {
+    data << "# " << name << "\n";
+    for (const RenderBenchCase& c : r.cases)
+      if (c.method == name) {
+        data << c.triangles_drawn << " " << std::max(c.error_texels, kErrorFloor) << " " << c.tessellation << "\n";
+        if (name == "per-texel") per_texel_triangles = static_cast<double>(c.triangles_drawn);
+      }
+    data << "\n\n";
   }
   char texel[32];
   std::snprintf(texel, sizeof texel, "%.2f", r.texel_pixels);
-  std::ofstream script(script_path);
-  const bool png = path.size() > 4 && path.substr(path.size() - 4) == ".png";
-  script << "set terminal " << (png ? "pngcairo size 1000,650" : "svg size 1000,650") << "\nset output '" << path
-         << "'\n"
-         << "set title 'cut-boundary error against triangles drawn (T = " << r.resolution << ", " << r.width << "x"
-         << r.height << ", texel = " << texel << " px" << (r.partial_cut ? "" : ", complete cut only") << ")'\n"
-         << "set logscale xy\nset xlabel 'triangles drawn'\nset ylabel 'max boundary error (texels)'\n"
-         << "set key outside right\nset grid\n"
-         << "set arrow from graph 0, first 1 to graph 1, first 1 nohead dashtype 2 lc rgb 'gray40'\n";
-  if (per_texel_triangles > 0)
-    script << "set arrow from first " << per_texel_triangles / 16 << ", graph 0 to first " << per_texel_triangles / 16
-           << ", graph 1 nohead dashtype 3 lc rgb 'gray40'\n"
-           << "set label '1/16 of per-texel' at first " << per_texel_triangles / 16 << ", graph 0.95 offset 0.5,0\n";
-  script << "plot '" << data_path << "' index 0 with points pt 7 ps 2 title 'per-texel tessellation', '" << data_path
-         << "' index 1 using 1:2 with linespoints pt 5 title 'geometry shader', '' index 1 using 1:2:(sprintf('%d', $3))"
-            " with labels offset 0,1 notitle, '"
-         << data_path << "' index 2 with linespoints pt 9 title 'triangle removal', '" << data_path
-         << "' index 3 with linespoints pt 13 title 'pixel killing'\n";
-  script.close();
-  // pngcairo may be missing from gnuplot-nox builds: fall back to the plain png terminal.
-  std::string command = "gnuplot '" + script_path + "' 2>/dev/null";
-  bool ok = std::system(command.c_str()) == 0;
-  if (!ok && png) {
-    std::ifstream in(script_path);
-    std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-    in.close();
-    text.replace(text.find("pngcairo"), 8, "png");
-    std::ofstream(script_path) << text;
-    ok = std::system(command.c_str()) == 0;
-  }
-  std::remove(script_path.c_str());
-  std::remove(data_path.c_str());
-  return ok;
+  return draw_gnuplot_chart(path, 1000, 650, data.str(), [&](const std::string& data_file) {
+    std::ostringstream script;
+    script << "set title 'cut-boundary error against triangles drawn (T = " << r.resolution << ", " << r.width << "x"
+           << r.height << ", texel = " << texel << " px" << (r.partial_cut ? "" : ", complete cut only") << ")'\n"
+           << "set logscale xy\nset xlabel 'triangles drawn'\nset ylabel 'max boundary error (texels)'\n"
+           << "set key outside right\nset grid\n"
+           << "set arrow from graph 0, first 1 to graph 1, first 1 nohead dashtype 2 lc rgb 'gray40'\n";
+    if (per_texel_triangles > 0)
+      script << "set arrow from first " << per_texel_triangles / 16 << ", graph 0 to first "
+             << per_texel_triangles / 16 << ", graph 1 nohead dashtype 3 lc rgb 'gray40'\n"
+             << "set label '1/16 of per-texel' at first " << per_texel_triangles / 16 << ", graph 0.95 offset 0.5,0\n";
+    script << "plot '" << data_file << "' index 0 with points pt 7 ps 2 title 'per-texel tessellation', '" << data_file
+           << "' index 1 using 1:2 with linespoints pt 5 title 'geometry shader', '' index 1 using 1:2:(sprintf('%d', $3))"
+              " with labels offset 0,1 notitle, '"
+           << data_file << "' index 2 with linespoints pt 9 title 'triangle removal', '" << data_file
+           << "' index 3 with linespoints pt 13 title 'pixel killing'";
+    return script.str();
+  });
 }
 
 }  // namespace

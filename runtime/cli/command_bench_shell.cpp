@@ -9,10 +9,12 @@
 #include <cstdlib>
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <sstream>
 #include <string>
 #include <vector>
 
 #include "commands.h"
+#include "gnuplot_chart.h"
 #include "dgtex/mesh_error.h"
 #include "dgtex/scene_io.h"
 #include "dgtex/shell_benchmark.h"
@@ -35,33 +37,25 @@ nlohmann::json stage_json(const StageStatistics& s, const std::vector<double>& p
 
 // Milliseconds per step (assembly and solve, one line per thread count) with gnuplot.
 bool write_chart(const std::string& path, const std::vector<ShellBenchRun>& runs) {
-  const std::string data_path = path + ".dat", script_path = path + ".gp";
-  {
-    std::ofstream data(data_path);
-    for (const ShellBenchRun& r : runs) {
-      data << "# threads " << r.threads << "\n";
-      for (std::size_t s = 0; s < r.assembly_ms.size(); ++s)
-        data << s + 1 << " " << r.assembly_ms[s] << " " << r.solve_ms[s] << "\n";
-      data << "\n\n";
+  std::ostringstream data;
+  for (const ShellBenchRun& r : runs) {
+    data << "# threads " << r.threads << "\n";
+    for (std::size_t s = 0; s < r.assembly_ms.size(); ++s)
+      data << s + 1 << " " << r.assembly_ms[s] << " " << r.solve_ms[s] << "\n";
+    data << "\n\n";
+  }
+  return draw_gnuplot_chart(path, 900, 600, data.str(), [&](const std::string& data_file) {
+    std::ostringstream script;
+    script << "set title 'dgtex bench shell: time per step'\nset xlabel 'step'\nset ylabel 'ms'\nset logscale y\n"
+           << "set key outside right\nplot ";
+    for (std::size_t k = 0; k < runs.size(); ++k) {
+      const std::string t = std::to_string(runs[k].threads);
+      script << (k ? ", " : "") << "'" << data_file << "' index " << k << " using 1:2 with lines title 'assembly, " << t
+             << " threads', '" << data_file << "' index " << k << " using 1:3 with lines title 'solve, " << t
+             << " threads'";
     }
-  }
-  std::ofstream script(script_path);
-  const bool png = path.size() > 4 && path.substr(path.size() - 4) == ".png";
-  script << "set terminal " << (png ? "png size 900,600" : "svg size 900,600") << "\nset output '" << path << "'\n"
-         << "set title 'dgtex bench shell: time per step'\nset xlabel 'step'\nset ylabel 'ms'\nset logscale y\n"
-         << "set key outside right\nplot ";
-  for (std::size_t k = 0; k < runs.size(); ++k) {
-    const std::string t = std::to_string(runs[k].threads);
-    script << (k ? ", " : "") << "'" << data_path << "' index " << k << " using 1:2 with lines title 'assembly, " << t
-           << " threads', '" << data_path << "' index " << k << " using 1:3 with lines title 'solve, " << t << " threads'";
-  }
-  script << "\n";
-  script.close();
-  const std::string command = "gnuplot '" + script_path + "' 2>/dev/null";
-  const bool ok = std::system(command.c_str()) == 0;
-  std::remove(script_path.c_str());
-  std::remove(data_path.c_str());
-  return ok;
+    return script.str();
+  });
 }
 
 }  // namespace

@@ -1,0 +1,15 @@
+#pragma once
+// Charts of the bench commands, drawn by gnuplot (Debian gnuplot-nox).
+#include <functional>
+#include <string>
+
+namespace dgtex::cli {
+
+// Draws into `path`: PNG if it ends in .png (pngcairo, or the plain png terminal where the
+// gnuplot build lacks cairo), else SVG, width x height pixels. `data` goes to a temporary
+// PATH.dat; `commands(data_file)` returns the settings and plot commands, referring to the
+// data by that file name. The temporary files are removed. False if gnuplot failed.
+bool draw_gnuplot_chart(const std::string& path, int width, int height, const std::string& data,
+                        const std::function<std::string(const std::string& data_file)>& commands);
+
+}  // namespace dgtex::cli
