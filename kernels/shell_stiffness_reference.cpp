@@ -146,7 +146,8 @@ void edge_stiffness_reference(const EdgeBatch& b, std::int64_t e, const double* 
   const double dm_plus = bending_rigidity(sp.youngs_modulus, sp.poisson_ratio, sp.thickness);
   const double dm_minus = bending_rigidity(sm.youngs_modulus, sm.poisson_ratio, sm.thickness);
   const double penalty = b.penalty / b.edge_size[e] * (interior ? 0.5 * (dm_plus + dm_minus) : dm_plus);
-  const double average = interior ? 0.5 : 1.0;
+  // Penalty-only coupling drops the moment rows M (consistency and symmetry terms).
+  const double average = b.penalty_only ? 0.0 : (interior ? 0.5 : 1.0);
   const LineRule rule = gauss_legendre(b.quadrature_points);
 
   for (int q = 0; q < rule.count; ++q) {

@@ -371,12 +371,12 @@ kernels::EdgeBatch ShellModel::edge_batch() const {
             sided_edges_.data(), plain_edge_size_.data(),
             options_.penalty, options_.edge_quadrature_points,
             sided_connectivity_.data(), mesh_.positions.data(),
-            sided_sections_.data()};
+            sided_sections_.data(),  options_.penalty_only_edges};
   return {mesh_.type,       static_cast<std::int64_t>(plain_edge_size_.size()),
           plain_edges_.data(), plain_edge_size_.data(),
           options_.penalty, options_.edge_quadrature_points,
           mesh_.elements.data(), mesh_.positions.data(),
-          sections_.data()};
+          sections_.data(),      options_.penalty_only_edges};
 }
 
 kernels::EnrichedElementBatch ShellModel::enriched_element_batch() const {

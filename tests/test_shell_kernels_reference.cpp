@@ -67,7 +67,7 @@ struct DeformedCylinder {
   }
   kernels::EdgeBatch edge_batch() const {
     return {mesh.type, static_cast<std::int64_t>(edge_size.size()), edges.data(), edge_size.data(), 10.0, 3,
-            mesh.elements.data(), mesh.positions.data(), sections.data()};
+            mesh.elements.data(), mesh.positions.data(), sections.data(), false};
   }
 };
 

@@ -9,5 +9,8 @@ int render_command(int argc, char** argv);         // dgtex render STATE --out D
 int bench_laplace_command(int argc, char** argv);  // dgtex bench laplace
 int bench_shell_command(int argc, char** argv);    // dgtex bench shell
 int bench_render_command(int argc, char** argv);   // dgtex bench render
+int bench_scenes_command(int argc, char** argv);   // dgtex bench scenes
+int bench_scaling_command(int argc, char** argv);  // dgtex bench scaling
+int bench_accuracy_command(int argc, char** argv); // dgtex bench accuracy
 
 }  // namespace dgtex::cli

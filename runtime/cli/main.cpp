@@ -19,6 +19,9 @@ void print_usage(std::FILE* to) {
                "  bench laplace [options]      Laplace solvers on texel domains (multigrid, CHOLMOD, ...)\n"
                "  bench shell [options]        shell assembly and solve throughput\n"
                "  bench render [options]       cut-boundary error against triangles drawn, frame times\n"
+               "  bench scenes [options]       the thesis Table 5.1 scenes: per-step stage timings, steps/s\n"
+               "  bench scaling [options]      thread scaling per kernel family, batch throughput\n"
+               "  bench accuracy [options]     error against time charts (plate, quadrature, T, tolerance)\n"
                "Run 'dgtex <command> --help' for the options of one command.\n");
 }
 
@@ -46,7 +49,12 @@ int main(int argc, char** argv) {
     if (what == "laplace") return dgtex::cli::bench_laplace_command(argc - 2, argv + 2);
     if (what == "shell") return dgtex::cli::bench_shell_command(argc - 2, argv + 2);
     if (what == "render") return dgtex::cli::bench_render_command(argc - 2, argv + 2);
-    std::fprintf(stderr, "dgtex bench: unknown benchmark '%s' (valid: laplace, shell, render)\n", what.c_str());
+    if (what == "scenes") return dgtex::cli::bench_scenes_command(argc - 2, argv + 2);
+    if (what == "scaling") return dgtex::cli::bench_scaling_command(argc - 2, argv + 2);
+    if (what == "accuracy") return dgtex::cli::bench_accuracy_command(argc - 2, argv + 2);
+    std::fprintf(stderr,
+                 "dgtex bench: unknown benchmark '%s' (valid: laplace, shell, render, scenes, scaling, accuracy)\n",
+                 what.c_str());
     return 2;
   }
   std::fprintf(stderr, "dgtex: unknown command '%s'\n", command.c_str());

@@ -31,6 +31,8 @@ namespace dgtex {
 
 struct ShellModelOptions {
   double penalty = 10;             // eta of the interior-penalty terms (report eq. 15)
+  // Penalty-only edge coupling (no consistency/symmetry terms): for comparison only.
+  bool penalty_only_edges = false;
   int edge_quadrature_points = 3;  // Gauss points per edge
   // Quadrature of enriched elements and edges: adaptive merging of texel cells where every
   // enrichment is one quadratic (enriched_quadrature.h), or per-texel everywhere.

@@ -36,6 +36,10 @@ struct EdgeBatch {
   const int* connectivity;      // #elements x npe
   const double* positions;      // rest, #nodes x 3
   const ShellSection* sections; // per element
+  // Penalty-only coupling (Babuska-Zlamal style): drop the consistency and symmetry terms
+  // and keep only the penalty on the jump. Not consistent: converges only as the penalty
+  // grows, at the price of conditioning (README, failure modes). The default keeps them.
+  bool penalty_only;
 };
 
 void shell_edge_stiffness(const EdgeBatch& batch, const double* rotations, double* blocks, double* forces,
