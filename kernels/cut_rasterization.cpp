@@ -124,6 +124,8 @@ void mark_walls(const std::vector<CutLatticeEdge>& edges, TexelTile& tile) {
 
 }  // namespace
 
+void mark_cut_walls(const CutRaster& cut, TexelTile& tile) { mark_walls(cut.edges, tile); }
+
 int CutRaster::interior_edge_count() const {
   int n = 0;
   for (const CutLatticeEdge& e : edges) n += (e.left_texel >= 0 && e.right_texel >= 0);

@@ -112,6 +112,11 @@ void sample_texture_in_texel(ElementType type, int t, const TextureView& tex, in
                              TextureSample& out) {
   TexelDerivatives fd;
   texel_derivatives(type, t, tex, i, j, fd);
+  sample_texel_polynomial(type, t, fd, i, j, xi1, xi2, out);
+}
+
+void sample_texel_polynomial(ElementType type, int t, const TexelDerivatives& fd, int i, int j, double xi1, double xi2,
+                             TextureSample& out) {
   double x[2];
   texel_coordinates(type, t, xi1, xi2, x);
   const double d1 = x[0] - (i + 0.5), d2 = x[1] - (j + 0.5);

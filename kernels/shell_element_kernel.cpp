@@ -36,8 +36,27 @@ constexpr int max_element_dofs = 3 * max_element_nodes;
 // computed; block (b, a) is written as the transpose of (a, b), which keeps K exactly
 // symmetric and halves the work (flops per element: 2 * (6 nq) * 3 npe * (3 npe + 3) / 2,
 // i.e. 17.5k multiply-adds for quad8).
-void element_stiffness(const ElementBatch& b, std::int64_t e, const double* rotations, double* blocks,
-                       double* forces) {
+// Upper block triangle of K = Bs^T DBs (fast_rows::symmetric_stacked_product), compiled
+// for AVX-512, AVX2 and baseline x86-64 and chosen at run time (portable). This file is
+// compiled with -ffp-contract=off (cmake/areas/shell_performance.cmake), so every clone
+// gives bitwise the same K.
+__attribute__((target_clones("avx512f", "avx2", "default")))
+void stacked_product(int npe, int nk, const double (*Bs)[max_element_dofs], const double (*DBs)[max_element_dofs],
+                     double* K) {
+  fast_rows::symmetric_stacked_product<max_element_dofs>(npe, nk, Bs, DBs, npe, K);
+}
+
+// Shape values of every quadrature point of an element rule: the same for all elements.
+struct ElementRuleShapes {
+  QuadratureRule rule;
+  ShapeValues shape[max_element_points];
+  explicit ElementRuleShapes(ElementType type) : rule(element_quadrature(type)) {
+    for (int q = 0; q < rule.count; ++q) evaluate_shape(type, rule.xi1[q], rule.xi2[q], shape[q]);
+  }
+};
+
+void element_stiffness(const ElementBatch& b, const ElementRuleShapes& shapes, std::int64_t e, const double* rotations,
+                       double* blocks, double* forces) {
   const int npe = nodes_per_element(b.type);
   const int ndof = 3 * npe;
   const int* nodes = b.connectivity + e * npe;
@@ -45,7 +64,7 @@ void element_stiffness(const ElementBatch& b, std::int64_t e, const double* rota
   const double nu = sec.poisson_ratio;
   const double dn = membrane_rigidity(sec.youngs_modulus, nu, sec.thickness);
   const double dm = bending_rigidity(sec.youngs_modulus, nu, sec.thickness);
-  const QuadratureRule rule = element_quadrature(b.type);
+  const QuadratureRule& rule = shapes.rule;
   const int nk = rule.count * rows_per_point;
 
   double* f = forces ? forces + e * npe * 3 : nullptr;
@@ -54,9 +73,11 @@ void element_stiffness(const ElementBatch& b, std::int64_t e, const double* rota
 
   alignas(64) double Bs[max_element_points * rows_per_point][max_element_dofs];
   alignas(64) double DBs[max_element_points * rows_per_point][max_element_dofs];
+  if (ndof < max_element_dofs)  // tri6: the product's last tile reads the padding columns
+    for (int k = 0; k < nk; ++k)
+      for (int c = ndof; c < max_element_dofs; ++c) Bs[k][c] = DBs[k][c] = 0;
   for (int q = 0; q < rule.count; ++q) {
-    ShapeValues s;
-    evaluate_shape(b.type, rule.xi1[q], rule.xi2[q], s);
+    const ShapeValues& s = shapes.shape[q];
     RestPoint p;
     evaluate_rest_point(s, nodes, b.positions, p);
     double e1[3], e2[3];
@@ -125,23 +146,7 @@ void element_stiffness(const ElementBatch& b, std::int64_t e, const double* rota
     }
   }
 
-  double* K = blocks + e * npe * npe * 9;
-  for (int a = 0; a < npe; ++a)
-    for (int i = 0; i < 3; ++i) {
-      const int row = 3 * a + i;
-      const int first = 3 * a;  // the diagonal block and those right of it
-      alignas(64) double sum[max_element_dofs] = {};
-      for (int k = 0; k < nk; ++k) {
-        const double s = Bs[k][row];
-        const double* d = DBs[k];
-        for (int c = first; c < ndof; ++c) sum[c] += s * d[c];
-      }
-      for (int bb = a; bb < npe; ++bb)
-        for (int j = 0; j < 3; ++j) {
-          K[(a * npe + bb) * 9 + i * 3 + j] = sum[3 * bb + j];
-          if (bb != a) K[(bb * npe + a) * 9 + j * 3 + i] = sum[3 * bb + j];
-        }
-    }
+  stacked_product(npe, nk, Bs, DBs, blocks + e * npe * npe * 9);
 }
 
 
@@ -149,7 +154,8 @@ void element_stiffness(const ElementBatch& b, std::int64_t e, const double* rota
 
 void shell_element_stiffness(const ElementBatch& batch, const double* rotations, double* blocks, double* forces,
                              Execution execution) {
-  forall(batch.count, [&](std::int64_t e) { element_stiffness(batch, e, rotations, blocks, forces); }, execution);
+  const ElementRuleShapes shapes(batch.type);
+  forall(batch.count, [&](std::int64_t e) { element_stiffness(batch, shapes, e, rotations, blocks, forces); }, execution);
 }
 
 void shell_element_deformation_gradients(const ElementBatch& b, const double* current, double* F,

@@ -6,6 +6,7 @@
 // divisions become multiplications, and the normal-change operator T that the bending
 // rows need is computed once and shared with the edge terms. Results agree with the
 // shell_point.h forms to round-off (~1e-16 relative), not bitwise.
+#include <algorithm>
 #include <cmath>
 
 #include "dgtex/kernels/shell_point.h"
@@ -93,6 +94,45 @@ inline void evaluate_surface_frame(const ShapeValues& s, const int* nodes, const
   cross3(f.a1, f.a2, n);
   const double j = std::sqrt(dot3(n, n));
   for (int d = 0; d < 3; ++d) f.t0[d] = n[d] / j;
+}
+
+// K = L^T R over nk stacked rows for a symmetric K (n nodes, 3 n DOFs): only the upper
+// block triangle is computed and mirrored, so K is exactly symmetric. Register tiles of
+// 3 rows (one node's x, y, z) by 8 columns are summed over k in order; tiles start at the
+// 8-column boundary at or left of the diagonal block (the few entries left of it are
+// dropped). Columns 3 n up to the next multiple of 8 must be finite (zero padding).
+// Block (a, b) goes to K + (a * block_stride + b) * 9. Inlined into callers compiled with
+// target_clones: no sum is reassociated, so every instruction set rounds the same (with
+// FMA contraction off).
+constexpr int product_tile_columns = 8;
+template <int Columns>
+__attribute__((always_inline)) inline void symmetric_stacked_product(int n, int nk, const double (*L)[Columns],
+                                                                     const double (*R)[Columns], int block_stride,
+                                                                     double* K) {
+  static_assert(Columns % product_tile_columns == 0, "rows are padded to whole tiles");
+  const int ndof = 3 * n;
+  for (int a = 0; a < n; ++a) {
+    const int row = 3 * a;
+    for (int c0 = row / product_tile_columns * product_tile_columns; c0 < ndof; c0 += product_tile_columns) {
+      alignas(64) double acc[3][product_tile_columns] = {};
+      for (int k = 0; k < nk; ++k) {
+        const double s0 = L[k][row], s1 = L[k][row + 1], s2 = L[k][row + 2];
+        const double* d = R[k] + c0;
+        for (int c = 0; c < product_tile_columns; ++c) {
+          acc[0][c] += s0 * d[c];
+          acc[1][c] += s1 * d[c];
+          acc[2][c] += s2 * d[c];
+        }
+      }
+      for (int c = std::max(c0, row); c < std::min(c0 + product_tile_columns, ndof); ++c) {
+        const int b = c / 3, j = c % 3;
+        for (int i = 0; i < 3; ++i) {
+          K[(a * block_stride + b) * 9 + i * 3 + j] = acc[i][c - c0];
+          if (b != a) K[(b * block_stride + a) * 9 + j * 3 + i] = acc[i][c - c0];
+        }
+      }
+    }
+  }
 }
 
 }  // namespace dgtex::kernels::fast_rows

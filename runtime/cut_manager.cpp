@@ -7,6 +7,7 @@
 #include <set>
 #include <stdexcept>
 
+#include "dgtex/enrichment_span.h"
 #include "dgtex/texel_storage.h"
 
 namespace dgtex {
@@ -50,7 +51,91 @@ double ms_since(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
 }
 
+// Two segments that share an end point P (a cut starting where another ends, a V, the
+// next segment of one cut) can both reach P's lattice point over the same lattice edge:
+// P snaps to the nearest lattice point, and each staircase walks to it from its own side
+// (in one element, or from the two sides of a mesh edge along it). The union of the two
+// paths then has a spur, a wall with a free end, whose texels get the left/right data of
+// both segments, which contradicts the sides of the crack (at a V's tip the texel beside
+// the spur gets +1 of one arm though it lies outside the wedge, so the wedge stays
+// attached there). Within one segment such a retrace cancels in the data; across
+// segments the shared edges are dropped from both, at most kMaxSpurEdges per pair
+// (snapping moves P by at most half a texel per axis; a longer overlap is a crack drawn
+// twice and stays).
+constexpr int kMaxSpurEdges = 2;
+
+using RasterPieces = std::vector<std::pair<int, CutRaster>>;
+
+// Lattice coordinate along a border edge of a lattice point on it, in the numbering of
+// classify_border's s (texel s spans [q, q + 1]); -1 on the tri6 hypotenuse staircase.
+int border_coordinate(ElementType type, int t, int edge, int x, int y) {
+  if (edge == 0) return x;
+  if (type == ElementType::quad8) {
+    if (edge == 1) return y;
+    if (edge == 2) return t - x;
+    return t - y;
+  }
+  return edge == 2 ? t - y : -1;
+}
+
 }  // namespace
+
+// Physical identity of a segment's terminal: (edge id, terminal point), the same from
+// both sides of a mesh edge; false where it has none (a free-boundary edge, the tri6
+// hypotenuse).
+bool CutManager::terminal_key(const std::vector<std::pair<int, CutRaster>>& pieces, bool at_end,
+                              std::pair<long long, long long>& key) const {
+  const int t = resolution_;
+  const int e = at_end ? pieces.back().first : pieces.front().first;
+  const CutLatticeEdge& edge = at_end ? pieces.back().second.edges.back() : pieces.front().second.edges.front();
+  const int px = at_end ? edge.x + edge.dx : edge.x, py = at_end ? edge.y + edge.dy : edge.y;
+  if (edge.left_texel >= 0 && edge.right_texel >= 0) {
+    key.first = ((static_cast<long long>(e) * (t + 1) + std::min(edge.x, edge.x + edge.dx)) * (t + 1) +
+                 std::min(edge.y, edge.y + edge.dy)) * 2 + (edge.dy == 0);
+    key.second = static_cast<long long>(px) * (t + 1) + py;
+    return true;
+  }
+  BorderEdge b;
+  if (!classify_border(mesh_.type, t, edge, b)) return false;
+  const auto nb = adjacency_.neighbour(e, b.edge);
+  const int q = border_coordinate(mesh_.type, t, b.edge, px, py);
+  if (nb[0] < 0 || q < 0) return false;
+  const long long here = (static_cast<long long>(e) * 4 + b.edge) * t + b.s;
+  const long long there = (static_cast<long long>(nb[0]) * 4 + nb[1]) * t + (t - 1 - b.s);
+  key = here <= there ? std::pair<long long, long long>{-1 - here, q} : std::pair<long long, long long>{-1 - there, t - q};
+  return true;
+}
+
+void CutManager::trim_shared_end_spurs(std::vector<std::vector<std::pair<int, CutRaster>>>& rasters) const {
+  struct SegmentEnd {
+    std::size_t segment;
+    bool at_end;  // the end of the segment's path (else its start)
+  };
+  std::vector<SegmentEnd> ends;
+  for (std::size_t v = 0; v < rasters.size(); ++v)
+    if (!rasters[v].empty()) ends.push_back({v, false}), ends.push_back({v, true});
+  auto pop = [](RasterPieces& pieces, bool at_end) {
+    auto& edges = (at_end ? pieces.back() : pieces.front()).second.edges;
+    if (at_end) edges.pop_back();
+    else edges.erase(edges.begin());
+    if (!edges.empty()) return;
+    if (at_end) pieces.pop_back();
+    else pieces.erase(pieces.begin());
+  };
+  for (std::size_t i = 0; i < ends.size(); ++i)
+    for (std::size_t j = i + 1; j < ends.size(); ++j) {
+      const SegmentEnd a = ends[i], b = ends[j];
+      if (a.segment == b.segment) continue;  // a closed loop: its retrace cancels in the data
+      RasterPieces &pa = rasters[a.segment], &pb = rasters[b.segment];
+      for (int trimmed = 0; trimmed < kMaxSpurEdges && !pa.empty() && !pb.empty(); ++trimmed) {
+        std::pair<long long, long long> ka, kb;
+        if (!terminal_key(pa, a.at_end, ka) || !terminal_key(pb, b.at_end, kb) || ka != kb) break;
+        pop(pa, a.at_end);
+        pop(pb, b.at_end);
+      }
+    }
+}
+
 
 CutManager::CutManager(const Mesh& mesh, const Topology& topology, const std::vector<Cut>& cuts,
                        const EnrichmentOptions& options, CutManagerOptions manager_options)
@@ -84,6 +169,7 @@ void CutManager::rasterize_visible(const std::vector<VisibleCutSegment>& visible
   walls_.clear();
   edge_walls_ = MeshEdgeWalls(resolution_);
   rasters.assign(visible.size(), {});
+  const TexelTile blank = kernels::make_element_tile(mesh_.type, resolution_);
   for (std::size_t v = 0; v < visible.size(); ++v) {
     const std::vector<CutPathVertex> sub = sub_path(paths_[visible[v].cut], visible[v].begin, visible[v].end);
     std::size_t run = 0;
@@ -95,14 +181,17 @@ void CutManager::rasterize_visible(const std::vector<VisibleCutSegment>& visible
         std::vector<kernels::TexelPoint> line;
         for (std::size_t k = run; k < stop; ++k)
           line.push_back(kernels::texel_point_from_parametric(mesh_.type, resolution_, sub[k].xi[0], sub[k].xi[1]));
-        auto it = walls_.find(e);
-        if (it == walls_.end()) it = walls_.emplace(e, kernels::make_element_tile(mesh_.type, resolution_)).first;
-        CutRaster raster = kernels::rasterize_cut(line, it->second);
+        if (walls_.find(e) == walls_.end()) walls_.emplace(e, blank);
+        TexelTile scratch = blank;  // walls are marked below, after the spurs are trimmed
+        CutRaster raster = kernels::rasterize_cut(line, scratch);
         if (!raster.edges.empty()) rasters[v].emplace_back(e, std::move(raster));
       }
       run = stop;
     }
   }
+  trim_shared_end_spurs(rasters);
+  for (const auto& pieces : rasters)
+    for (const auto& [e, raster] : pieces) kernels::mark_cut_walls(raster, walls_.at(e));
   // Cuts along mesh edges cut the couplings between the two elements' boundary texels.
   for (const auto& pieces : rasters)
     for (const auto& [e, raster] : pieces)
@@ -293,14 +382,24 @@ bool CutManager::update(double time) {
     it = order_.erase(it);
     changed_any = true;
   }
+  // Nodes where a function repeats the earlier ones (a crack continued by the next
+  // segment or cut crosses the node's support completely: both are the same Heaviside)
+  // keep only the earlier enrichment (enrichment_span.h); without it M and K are singular.
+  std::vector<EnrichmentFunction> all;
+  for (const auto& key : order_) all.push_back(states_.at(key).function);
+  const std::vector<std::vector<int>> independent = independent_enriched_nodes(node_elements_, all);
   functions_.clear();
   function_segments_.clear();
   function_rasters_.clear();
-  for (const auto& key : order_) {
-    functions_.push_back(states_.at(key).function);
-    const VisibleCutSegment& v = visible[visible_index.at(key)];
+  dependent_nodes_ = 0;
+  for (std::size_t k = 0; k < order_.size(); ++k) {
+    dependent_nodes_ += static_cast<int>(all[k].enriched_nodes.size() - independent[k].size());
+    if (independent[k].empty()) continue;  // the whole function repeats earlier ones
+    if (independent[k].size() == all[k].enriched_nodes.size()) functions_.push_back(std::move(all[k]));
+    else functions_.push_back(restrict_enriched_nodes(mesh_, all[k], independent[k]));
+    const VisibleCutSegment& v = visible[visible_index.at(order_[k])];
     function_segments_.push_back({v.cut, v.segment, v.begin, v.end});
-    function_rasters_.push_back(rasters[visible_index.at(key)]);
+    function_rasters_.push_back(rasters[visible_index.at(order_[k])]);
   }
   last_.ms = ms_since(start);
   return changed_any;

@@ -128,9 +128,15 @@ void FactorReusingSolver::multiply(const ScaledBlockSum& A, const std::vector<do
 }
 
 int FactorReusingSolver::pcg(const ScaledBlockSum& A, const std::vector<double>& b, std::vector<double>& x,
-                             const SparseCholesky& cholesky, double& relative_residual) {
+                             const SparseCholesky& cholesky, double& relative_residual,
+                             const std::vector<double>* kx) {
   const size_t n = b.size();
-  multiply(A, x, q_);
+  if (kx) {  // A x from the given K x: the same arithmetic as multiply()
+    multiply_mass(x, q_);
+    for (size_t d = 0; d < n; ++d) q_[d] = free_[d] ? A.mass_scale * q_[d] + A.stiffness_scale * (*kx)[d] : 0.0;
+  } else {
+    multiply(A, x, q_);
+  }
   r_.resize(n);
   b_free_.resize(n);
   for (size_t d = 0; d < n; ++d) {
@@ -176,7 +182,7 @@ int FactorReusingSolver::pcg(const ScaledBlockSum& A, const std::vector<double>&
 }
 
 void FactorReusingSolver::solve(const ScaledBlockSum& A, const std::vector<double>& b, std::vector<double>& x,
-                                SparseCholesky& cholesky) {
+                                SparseCholesky& cholesky, const std::vector<double>* stiffness_times_x) {
   ++stats_.solves;
   for (size_t d = 0; d < x.size(); ++d)
     if (!free_[d]) x[d] = 0;
@@ -188,14 +194,14 @@ void FactorReusingSolver::solve(const ScaledBlockSum& A, const std::vector<doubl
   if (!factor_current_) factorize(A, cholesky);
   guess_ = x;
   double residual = 0;
-  int iterations = pcg(A, b, x, cholesky, residual);
+  int iterations = pcg(A, b, x, cholesky, residual, stiffness_times_x);
   int wasted = 0;
   if (iterations < 0) {
     // The old factor no longer preconditions well enough: factorise this matrix.
     wasted = options_.max_iterations;
     factorize(A, cholesky);
     x = guess_;
-    iterations = pcg(A, b, x, cholesky, residual);
+    iterations = pcg(A, b, x, cholesky, residual, stiffness_times_x);  // x is the guess again
     if (iterations < 0)
       throw std::runtime_error("FactorReusingSolver: no convergence to relative residual " +
                                std::to_string(options_.relative_tolerance) + " even with a fresh factor (residual " +

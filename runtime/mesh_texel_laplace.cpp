@@ -65,6 +65,13 @@ std::vector<long long> MeshEdgeWalls::keys_of_element(int element) const {
   return out;
 }
 
+std::vector<char> MeshEdgeWalls::flags(int num_elements) const {
+  std::vector<char> out(static_cast<size_t>(num_elements) * 4 * resolution_, 0);
+  for (long long k : keys_)
+    if (k >= 0 && k < static_cast<long long>(out.size())) out[static_cast<size_t>(k)] = 1;
+  return out;
+}
+
 namespace {
 
 using kernels::TexelTile;
@@ -98,6 +105,12 @@ class TexelGraph {
   }
 
   int nodes() const { return static_cast<int>(tiles_.size()) * tt_; }
+  // Whether boundary texel s of local edge `edge` of tile l couples to the tile across it.
+  bool couples_across(int l, int edge, int s) const {
+    const auto nb = across_[4 * l + edge];
+    return nb[0] >= 0 && !walls_.blocked(tiles_[l].element, edge, s) &&
+           !walls_.blocked(tiles_[nb[0]].element, nb[1], t_ - 1 - s);
+  }
   bool active(int node) const { return !(flags(node) & kernels::inactive); }
   bool data(int node) const {
     return active(node) && (tiles_[node / tt_].frozen || (flags(node) & kernels::dirichlet));
@@ -134,6 +147,60 @@ class TexelGraph {
   std::vector<std::array<int, 2>> across_;
 };
 
+// Where each region tile sits in one planar texel tile (quad8 only): tile l covers texels
+// [T * x[l], T * (x[l] + 1)) x [T * y[l], T * (y[l] + 1)) of the patch. Exact when every
+// coupling of the texel graph is a 5-point coupling of the patch and vice versa: every mesh
+// edge shared by two region tiles pairs edge k with edge (k + 2) % 4 (the neighbour keeps the
+// orientation) and joins tiles that sit side by side across that edge; side-by-side tiles
+// that are not neighbours through those edges get a wall. Fails (returns false) for tri6,
+// regions that turn (a flipped neighbour), close up (a cylinder ring) or fall apart.
+struct PatchPlacement {
+  std::vector<int> x, y;
+  int columns = 0, rows = 0;
+};
+
+bool place_region_in_plane(const std::vector<RegionTile>& tiles, ElementType type, const ElementAdjacency& adjacency,
+                           PatchPlacement& placement) {
+  if (type != ElementType::quad8) return false;
+  const int count = static_cast<int>(tiles.size());
+  std::unordered_map<int, int> local;
+  for (int l = 0; l < count; ++l) local.emplace(tiles[l].element, l);
+  constexpr int dx[4] = {0, 1, 0, -1}, dy[4] = {-1, 0, 1, 0};  // quad8 local edges: south, east, north, west
+  std::vector<int> x(count, 0), y(count, 0);
+  std::vector<char> placed(count, 0);
+  std::vector<int> queue = {0};
+  placed[0] = 1;
+  for (std::size_t q = 0; q < queue.size(); ++q) {
+    const int l = queue[q];
+    for (int k = 0; k < 4; ++k) {
+      const auto nb = adjacency.neighbour(tiles[l].element, k);
+      if (nb[0] < 0) continue;
+      const auto it = local.find(nb[0]);
+      if (it == local.end()) continue;
+      const int m = it->second;
+      if (nb[1] != (k + 2) % 4) return false;  // the neighbour is turned: no planar 5-point patch
+      if (placed[m]) {
+        if (x[m] != x[l] + dx[k] || y[m] != y[l] + dy[k]) return false;  // the region closes up
+        continue;
+      }
+      placed[m] = 1, x[m] = x[l] + dx[k], y[m] = y[l] + dy[k];
+      queue.push_back(m);
+    }
+  }
+  if (static_cast<int>(queue.size()) != count) return false;  // not edge-connected
+  const int x0 = *std::min_element(x.begin(), x.end()), y0 = *std::min_element(y.begin(), y.end());
+  std::unordered_map<long long, int> at;
+  for (int l = 0; l < count; ++l) {
+    x[l] -= x0, y[l] -= y0;
+    if (!at.emplace(static_cast<long long>(x[l]) << 32 | static_cast<unsigned>(y[l]), l).second) return false;
+  }
+  placement.columns = *std::max_element(x.begin(), x.end()) + 1;
+  placement.rows = *std::max_element(y.begin(), y.end()) + 1;
+  placement.x = std::move(x);
+  placement.y = std::move(y);
+  return true;
+}
+
 int find_root(std::vector<int>& parent, int x) {
   while (parent[x] != x) x = parent[x] = parent[parent[x]];
   return x;
@@ -143,7 +210,7 @@ int find_root(std::vector<int>& parent, int x) {
 
 MeshLaplaceStats solve_mesh_texel_laplace(std::vector<RegionTile>& tiles, ElementType type,
                                           const ElementAdjacency& adjacency, const MeshEdgeWalls& edge_walls,
-                                          LaplaceSolver solver) {
+                                          LaplaceSolver solver, const LaplaceMultigridOptions& options) {
   const auto start = std::chrono::steady_clock::now();
   MeshLaplaceStats stats;
   if (tiles.empty()) return stats;
@@ -195,15 +262,56 @@ MeshLaplaceStats solve_mesh_texel_laplace(std::vector<RegionTile>& tiles, Elemen
   stats.unknowns = static_cast<int>(node_of.size());
 
   if (!node_of.empty()) {
-    if (solver == LaplaceSolver::multigrid && tiles.size() == 1) {
-      // One tile, no neighbours: the tile multigrid, with the settled texels as data.
-      TexelTile tile = tiles.front().tile;
-      for (int v = 0; v < n; ++v)
-        if (graph.free(v) && unknown_of[v] < 0) tile.flags[v] |= kernels::dirichlet, tile.values[v] = graph.value(v);
-      const LaplaceSolveStats s = solve_laplace(tile, LaplaceSolver::multigrid);
-      stats.relative_residual = s.relative_residual;
-      for (int v : node_of) graph.value(v) = tile.values[v];
-    } else {
+    // The multigrid where the region allows it; CHOLMOD otherwise, and as the safety net
+    // should the multigrid not reach its tolerance (it throws std::runtime_error then).
+    PatchPlacement placement;
+    if (solver == LaplaceSolver::multigrid && tiles.size() > 1 &&
+        place_region_in_plane(tiles, type, adjacency, placement)) {
+      try {
+        // The region is a planar block of tiles: one patch tile, the tile multigrid, the
+        // same discrete problem (every texel-graph coupling is a 5-point coupling there).
+        const int t = tiles.front().tile.width, tt = t * t, w = t * placement.columns;
+        TexelTile patch(w, t * placement.rows);
+        std::fill(patch.flags.begin(), patch.flags.end(), static_cast<std::uint8_t>(kernels::inactive));
+        auto patch_index = [&](int l, int i, int j) { return (t * placement.y[l] + j) * w + t * placement.x[l] + i; };
+        for (int l = 0; l < static_cast<int>(tiles.size()); ++l) {
+          const std::vector<std::uint8_t>& flags = tiles[l].tile.flags;
+          for (int j = 0; j < t; ++j)
+            for (int i = 0; i < t; ++i) {
+              const int v = l * tt + j * t + i;
+              if (!graph.active(v)) continue;
+              std::uint8_t f = flags[j * t + i] & (kernels::wall_east | kernels::wall_north);
+              if (i == t - 1) f = (f & ~kernels::wall_east) | (graph.couples_across(l, 1, j) ? 0 : kernels::wall_east);
+              if (j == t - 1)
+                f = (f & ~kernels::wall_north) | (graph.couples_across(l, 2, t - 1 - i) ? 0 : kernels::wall_north);
+              if (unknown_of[v] < 0) f |= kernels::dirichlet;
+              const int g = patch_index(l, i, j);
+              patch.flags[g] = f;
+              patch.values[g] = graph.value(v);  // data, or the initial guess (the previous H)
+            }
+        }
+        const LaplaceSolveStats s = solve_laplace(patch, LaplaceSolver::multigrid, options);
+        stats.relative_residual = s.relative_residual;
+        stats.multigrid = true;
+        for (int v : node_of) graph.value(v) = patch.values[patch_index(v / tt, v % tt % t, v % tt / t)];
+      } catch (const std::runtime_error&) {
+        stats.multigrid = false;
+      }
+    } else if (solver == LaplaceSolver::multigrid && tiles.size() == 1) {
+      try {
+        // One tile, no neighbours: the tile multigrid, with the settled texels as data.
+        TexelTile tile = tiles.front().tile;
+        for (int v = 0; v < n; ++v)
+          if (graph.free(v) && unknown_of[v] < 0) tile.flags[v] |= kernels::dirichlet, tile.values[v] = graph.value(v);
+        const LaplaceSolveStats s = solve_laplace(tile, LaplaceSolver::multigrid, options);
+        stats.relative_residual = s.relative_residual;
+        stats.multigrid = true;
+        for (int v : node_of) graph.value(v) = tile.values[v];
+      } catch (const std::runtime_error&) {
+        stats.multigrid = false;
+      }
+    }
+    if (!stats.multigrid) {
       // Lower triangle, column by column (rows in increasing order: cheap inserts).
       const int m = stats.unknowns;
       Eigen::SparseMatrix<double> a(m, m);

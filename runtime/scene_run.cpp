@@ -42,6 +42,7 @@ SceneRun::SceneRun(const Scene& scene)
       }
       creases_ = build_crease_functions(mesh_, topology_, scene.creases, scene.enrichment.texture_resolution);
     }
+    if (cuts_) model_->set_cut_edge_texels(cuts_->edge_walls().resolution(), cuts_->edge_walls().flags(mesh_.num_elements()));
     model_->set_enrichments(enrichment_functions());
     built.fixed = scene_fixed_dofs(scene, *model_);
     built.external_force = scene_external_force(scene, *model_);
@@ -82,6 +83,7 @@ void SceneRun::change_basis() {
   // The new model is a copy with the new functions (set_enrichments rebuilds everything
   // that depends on them); the old one stays alive for the projection.
   auto next = std::make_unique<ShellModel>(*model_);
+  next->set_cut_edge_texels(cuts_->edge_walls().resolution(), cuts_->edge_walls().flags(mesh_.num_elements()));
   next->set_enrichments(enrichment_functions());
   std::vector<char> fixed = scene_fixed_dofs(scene_, *next);
   std::vector<double> force = scene_external_force(scene_, *next);

@@ -34,9 +34,10 @@ void ShellSimulation::set_state(std::vector<double> u, std::vector<double> v) {
 
 std::string ShellSimulation::enrichment_hint() const {
   if (model_.num_enriched_dofs() == 0) return "";
-  // Known cause with cuts: two cuts that only share an end point (a bent crack written as
-  // two cuts) give enrichment functions that depend on each other.
-  return "; with cuts, also check for cuts that share an end point: write a bent crack as one polyline";
+  // Exact dependencies between cuts' functions are removed by the cut manager
+  // (enrichment_span.h); what remains are near dependencies: slivers between cuts that
+  // almost touch, or a cut passing a node at a fraction of a texel.
+  return "; with cuts, also check for cuts that almost touch each other or a node (slivers narrower than a texel)";
 }
 
 void ShellSimulation::check_statically_constrained() const {
@@ -139,22 +140,31 @@ void ShellSimulation::step(const DynamicsOptions& o) {
   ku_.resize(ndofs);
   rhs_full_.resize(ndofs);
   solver_.multiply_mass(v_, mv_);  // M's scalar diagonal: 1/9 of the traffic
-  block_multiply(model_.pattern(), K->data(), u_.data(), ku_.data());
+  const bool reuse = o.corotational && o.reuse_factorization;
+  if (reuse) {
+    // Initial guess: the velocity extrapolated linearly from the last two steps (it
+    // starts PCG ~10x closer than v itself; v alone right after set_state). K u and K
+    // times the guess share one pass over K.
+    guess_ = v_;
+    if (previous_v_.size() == v_.size())
+      for (int d = 0; d < ndofs; ++d) guess_[d] = 2 * v_[d] - previous_v_[d];
+    for (int d = 0; d < ndofs; ++d)
+      if (fixed_[d]) guess_[d] = 0;  // as the solver would set them
+    k_guess_.resize(ndofs);
+    block_multiply_pair(model_.pattern(), K->data(), u_.data(), guess_.data(), ku_.data(), k_guess_.data());
+  } else {
+    block_multiply(model_.pattern(), K->data(), u_.data(), ku_.data());
+  }
   for (int d = 0; d < ndofs; ++d) {
     const double correction = corrective_.empty() ? 0.0 : corrective_[d];
     rhs_full_[d] = mv_[d] + dt * (f_ext_[d] + correction - ku_[d]);
   }
   try {
-    if (o.corotational && o.reuse_factorization) {
+    if (reuse) {
       // A = (1 + dt a) M + (dt b + dt^2) K, never formed (ScaledBlockSum).
       const ScaledBlockSum A{mass_scale, K, stiffness_scale};
-      // Initial guess: the velocity extrapolated linearly from the last two steps (it
-      // starts PCG ~10x closer than v itself; v alone right after set_state).
-      guess_ = v_;
-      if (previous_v_.size() == v_.size())
-        for (int d = 0; d < ndofs; ++d) guess_[d] = 2 * v_[d] - previous_v_[d];
       previous_v_ = v_;
-      solver_.solve(A, rhs_full_, guess_, cholesky_);
+      solver_.solve(A, rhs_full_, guess_, cholesky_, &k_guess_);
       v_.swap(guess_);
       factorised_dt_ = -1;
     } else {

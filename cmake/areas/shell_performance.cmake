@@ -2,3 +2,11 @@
 # (sgemv_, strsv_) directly; Debian's libblas is the same OpenBLAS CHOLMOD uses.
 find_library(DGTEX_BLAS_LIBRARY NAMES blas openblas REQUIRED)
 target_link_libraries(dgtex PRIVATE ${DGTEX_BLAS_LIBRARY})
+
+# The shell stiffness kernels compile their hot products for several instruction sets
+# (target_clones, chosen at run time). Without contraction into FMA every clone rounds
+# exactly like baseline x86-64, so K does not depend on the machine's vector unit.
+set_source_files_properties(
+  ${CMAKE_CURRENT_SOURCE_DIR}/kernels/shell_element_kernel.cpp
+  ${CMAKE_CURRENT_SOURCE_DIR}/kernels/shell_edge_kernel.cpp
+  PROPERTIES COMPILE_OPTIONS -ffp-contract=off)

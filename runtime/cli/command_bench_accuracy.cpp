@@ -1,13 +1,188 @@
-// dgtex bench accuracy: placeholder until its implementation lands.
+// dgtex bench accuracy: speed against accuracy (dgtex/accuracy_benchmark.h). Writes, into
+// --out DIR, one chart per sweep (accuracy_<name>.png or .svg: error against ms, log-log,
+// one line per series, machine and command in the title), accuracy.json and accuracy.md.
+#include <CLI/CLI.hpp>
+
+#include <omp.h>
+
+#include <algorithm>
+#include <chrono>
 #include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
 
 #include "commands.h"
+#include "dgtex/accuracy_benchmark.h"
+#include "gnuplot_chart.h"
 
 namespace dgtex::cli {
+namespace {
 
-int bench_accuracy_command(int, char**) {
-  std::fprintf(stderr, "dgtex bench accuracy: not implemented yet\n");
-  return 1;
+// A gnuplot double-quoted string (newlines become line breaks there).
+std::string gnuplot_quoted(const std::string& text) {
+  std::string out = "\"";
+  for (char c : text) {
+    if (c == '\n') {
+      out += "\\n";
+      continue;
+    }
+    if (c == '"' || c == '\\') out += '\\';
+    out += c;
+  }
+  return out + "\"";
+}
+
+// Error against time per series; reference points (error 0) become dashed vertical lines.
+bool write_chart(const std::string& path, const AccuracyChart& chart, const std::string& machine,
+                 const std::string& command) {
+  const std::vector<std::string> series = chart.series();
+  std::ostringstream data;
+  for (const std::string& s : series) {
+    data << "# " << s << "\n";
+    for (const AccuracyPoint& p : chart.points)
+      if (p.series == s && p.error > 0) data << std::max(p.ms, 1e-3) << " " << p.error << " " << gnuplot_quoted(p.label) << "\n";
+    data << "\n\n";
+  }
+  return draw_gnuplot_chart(path, 960, 640, data.str(), [&](const std::string& data_file) {
+    std::ostringstream g;
+    g << "set title " << gnuplot_quoted(chart.title + "\n" + machine + "\n" + command) << " noenhanced font ',10'\n"
+      << "set logscale xy\nset xlabel " << gnuplot_quoted(chart.time_label) << " noenhanced\n"
+      << "set ylabel " << gnuplot_quoted(chart.error_label) << " noenhanced font ',9'\n"
+      << "set format y '10^{%L}'\nset grid\nset key outside bottom center horizontal noenhanced\n"
+      << "set offsets graph 0.05, graph 0.12, graph 0.1, graph 0.1\n";
+    int arrow = 0;
+    for (std::size_t k = 0; k < series.size(); ++k)
+      for (const AccuracyPoint& p : chart.points)
+        if (p.series == series[k] && p.error == 0) {
+          ++arrow;
+          g << "set arrow " << arrow << " from " << std::max(p.ms, 1e-3) << ", graph 0 to " << std::max(p.ms, 1e-3)
+            << ", graph 1 nohead dt 2 lt " << k + 1 << "\n"
+            << "set label " << arrow << " " << gnuplot_quoted("reference: " + p.label + " (" + series[k] + ")")
+            << " at " << std::max(p.ms, 1e-3) << ", graph 0.03 rotate by 90 left offset -0.7, 0 noenhanced font ',8' tc lt "
+            << k + 1 << "\n";
+        }
+    g << "plot ";
+    bool first = true;
+    for (std::size_t k = 0; k < series.size(); ++k) {
+      const bool has_points = std::any_of(chart.points.begin(), chart.points.end(),
+                                          [&](const AccuracyPoint& p) { return p.series == series[k] && p.error > 0; });
+      if (!has_points) continue;
+      g << (first ? "" : ", ") << "'" << data_file << "' index " << k << " using 1:2 with linespoints lt " << k + 1
+        << " pt 7 title " << gnuplot_quoted(series[k]) << ", '' index " << k
+        << " using 1:2:3 with labels offset 0.6, 0.6 left font ',8' noenhanced notitle";
+      first = false;
+    }
+    if (first) g << "1/0 notitle";
+    return g.str();
+  });
+}
+
+std::vector<std::string> split_names(const std::vector<std::string>& names) {
+  static const std::vector<std::string> valid = {"plate", "quadrature", "texture", "tolerance"};
+  for (const std::string& n : names)
+    if (std::find(valid.begin(), valid.end(), n) == valid.end())
+      throw std::invalid_argument("--charts: unknown chart '" + n + "'; valid: plate, quadrature, texture, tolerance");
+  return names;
+}
+
+}  // namespace
+
+int bench_accuracy_command(int argc, char** argv) {
+  CLI::App app{"Speed against accuracy: error against time for mesh refinement, enriched quadrature, texture "
+               "resolution and solver tolerance",
+               "dgtex bench accuracy"};
+  std::vector<std::string> charts = {"plate", "quadrature", "texture", "tolerance"};
+  std::string out_dir = "accuracy", format = "png", clock = "cpu";
+  int threads = 1, repeat = 3;
+  PlateAccuracyOptions plate;
+  QuadratureAccuracyOptions quadrature;
+  TextureAccuracyOptions texture;
+  ToleranceAccuracyOptions tolerance;
+  app.add_option("--charts", charts, "plate, quadrature, texture, tolerance")->delimiter(',')->capture_default_str();
+  app.add_option("--out", out_dir, "output folder (charts, accuracy.json, accuracy.md)")->capture_default_str();
+  app.add_option("--format", format, "chart format: png or svg")->capture_default_str()->check(CLI::IsMember({"png", "svg"}));
+  app.add_option("--clock", clock, "cpu (process CPU time; robust on a shared machine with 1 thread) or wall")
+      ->capture_default_str()->check(CLI::IsMember({"cpu", "wall"}));
+  app.add_option("--threads", threads, "OpenMP threads for every sweep")->capture_default_str()->check(CLI::PositiveNumber);
+  app.add_option("--repeat", repeat, "runs per cheap case; the best time counts")->capture_default_str()->check(CLI::PositiveNumber);
+  app.add_option("--plate-divisions", plate.divisions, "plate meshes n x n (even n)")->delimiter(',')->capture_default_str();
+  app.add_option("--quadrature-resolution", quadrature.resolution, "texels per element side T of the quadrature sweep")
+      ->capture_default_str();
+  app.add_option("--quadrature-tolerances", quadrature.tolerances, "merge tolerances (the per-texel rule always runs)")
+      ->delimiter(',')->capture_default_str();
+  app.add_option("--quadrature-elements", quadrature.elements, "quad8, tri6")->delimiter(',')->capture_default_str();
+  app.add_option("--texture-sizes", texture.resolutions, "texture resolutions T")->delimiter(',')->capture_default_str();
+  app.add_option("--shell-scene", tolerance.shell_scene, "dynamic corotated scene of the shell PCG tolerance sweep")
+      ->capture_default_str();
+  app.add_option("--shell-steps", tolerance.shell_steps, "steps per shell run")->capture_default_str();
+  app.add_option("--shell-tolerances", tolerance.shell_tolerances, "PCG relative tolerances")->delimiter(',')
+      ->capture_default_str();
+  app.add_option("--multigrid-size", tolerance.multigrid_resolution, "T of the multigrid tolerance sweep (slit domain)")
+      ->capture_default_str();
+  app.add_option("--multigrid-tolerances", tolerance.multigrid_tolerances, "multigrid relative tolerances")
+      ->delimiter(',')->capture_default_str();
+  app.add_flag("!--no-shell", tolerance.shell, "tolerance chart without the shell PCG series");
+  app.add_flag("!--no-multigrid", tolerance.multigrid, "tolerance chart without the multigrid series");
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e) == 0 ? 0 : 2;
+  }
+  std::string command = "dgtex bench";
+  for (int k = 0; k < argc; ++k) command += std::string(" ") + argv[k];
+  try {
+    split_names(charts);
+    plate.repeat = quadrature.repeat = texture.repeat = tolerance.repeat = repeat;
+    const AccuracyClock which = clock == "cpu" ? AccuracyClock::cpu : AccuracyClock::wall;
+    plate.clock = quadrature.clock = texture.clock = tolerance.clock = which;
+    omp_set_num_threads(threads);
+    std::filesystem::create_directories(out_dir);
+    const std::string machine = describe_machine();
+    const auto start = std::chrono::steady_clock::now();
+    const AccuracyProgress progress = [&](const std::string& line) {
+      const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      std::fprintf(stderr, "[%6.1f s] %s\n", s, line.c_str());
+      std::fflush(stderr);
+    };
+    std::fprintf(stderr, "dgtex bench accuracy on %s\n", machine.c_str());
+    std::vector<AccuracyChart> results;
+    for (const std::string& name : charts) {
+      if (name == "plate") results.push_back(run_plate_accuracy(plate, progress));
+      if (name == "quadrature") results.push_back(run_quadrature_accuracy(quadrature, progress));
+      if (name == "texture") results.push_back(run_texture_accuracy(texture, progress));
+      if (name == "tolerance") results.push_back(run_tolerance_accuracy(tolerance, progress));
+    }
+    const std::filesystem::path dir(out_dir);
+    {
+      std::ofstream json(dir / "accuracy.json");
+      json << accuracy_charts_json(results, machine, command);
+      if (!json) throw std::runtime_error("cannot write " + (dir / "accuracy.json").string());
+      std::ofstream md(dir / "accuracy.md");
+      md << accuracy_charts_markdown(results, machine, command);
+      if (!md) throw std::runtime_error("cannot write " + (dir / "accuracy.md").string());
+    }
+    int failed = 0;
+    for (const AccuracyChart& chart : results) {
+      const std::string path = (dir / ("accuracy_" + chart.name + "." + format)).string();
+      if (write_chart(path, chart, machine, command))
+        std::printf("chart: %s\n", path.c_str());
+      else {
+        std::fprintf(stderr, "dgtex bench accuracy: gnuplot could not draw %s (is gnuplot installed?)\n", path.c_str());
+        ++failed;
+      }
+    }
+    std::printf("data: %s, table: %s\n", (dir / "accuracy.json").string().c_str(), (dir / "accuracy.md").string().c_str());
+    return failed ? 1 : 0;
+  } catch (const std::invalid_argument& e) {
+    std::fprintf(stderr, "dgtex bench accuracy: %s\n", e.what());
+    return 2;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "dgtex bench accuracy: %s\n", e.what());
+    return 1;
+  }
 }
 
 }  // namespace dgtex::cli

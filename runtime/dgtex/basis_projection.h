@@ -7,6 +7,8 @@
 // with the fixed DOFs of the new basis held at zero. A field the new basis can represent
 // (e.g. one that was already in the old one where nothing changed) is kept exactly, and
 // the kinetic energy never grows: the projection is orthogonal in the M inner product.
+// Pure function: reads the models and the old state, returns the new state (keeps
+// nothing). Units: those of the model (SI: m, m/s).
 #include <vector>
 
 #include "dgtex/shell_model.h"

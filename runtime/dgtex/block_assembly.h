@@ -5,6 +5,9 @@
 // node of every local basis function. The pattern is built once; then every global block
 // sums its contributions in a fixed order (by source, then local position), in parallel
 // over global blocks, so the result is bitwise identical for any thread count.
+// BlockAssembly owns its pattern (index arrays only, no references to the sources or to
+// the values). Const, so one instance may assemble from several threads; each call with
+// parallel = true uses all OpenMP threads. Values carry whatever units the caller's do.
 #include <cstdint>
 #include <vector>
 

@@ -1,5 +1,6 @@
 #pragma once
 // Which mesh nodes a boundary condition's "select" picks (scene file, boundary[].select).
+// Pure functions of the mesh and the selection (thread-safe); lengths in the mesh's unit (SI: m).
 #include <vector>
 
 #include "dgtex/mesh.h"

@@ -25,6 +25,8 @@
 // crossing a creased element does not split the crease's enrichment. Creases are static
 // (no start_time/speed). A crease tip inside an element gives distance-to-endpoint (a cone),
 // so the slope jump fades out around the tip as the kink does.
+// Pure function: returns the EnrichmentFunctions by value (keeps nothing; thread-safe).
+// H is dimensionless (distance / mean edge length); lengths in the mesh's unit (SI: m).
 #include <vector>
 
 #include "dgtex/enrichment_function.h"

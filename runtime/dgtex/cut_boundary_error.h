@@ -8,6 +8,7 @@
 // to pixel centre) to the nearest pixel where the truth has the rendered value: a boundary
 // rendered k pixels off gives k, a missing or extra sliver of width w gives about w/2 to
 // w. Coverages are width x height bytes, row-major from the top, 1 = covered.
+// Pure functions (thread-safe); errors in pixels.
 #include <cstdint>
 #include <vector>
 

@@ -25,6 +25,16 @@
 //  - a self-intersecting cut: split where it crosses its earlier part (cut_segments.h);
 //  - a fragment shorter than half a texel has no texel edge: no enrichment for it (its
 //    H would be 0 and its DOFs singular); fragments of a few texels work as any cut.
+//  - segments continuing one crack (the next segment of a cut, a cut starting or ending
+//    where another ends, a V of two cuts): on nodes whose support the crack crosses
+//    completely both are the same +-1 Heaviside; the later one drops those nodes
+//    (enrichment_span.h), else M and K are singular. Where both segments' texel paths
+//    end on the same lattice edge (the shared point snaps to one lattice point and each
+//    staircase walks to it from its side), that spur is dropped from both (at most 2
+//    edges), else its texels get contradicting +-1 data and a V's wedge stays attached.
+// CutManager owns its paths, segments, wall tiles and enrichment functions; it keeps a
+// reference to the mesh (the mesh and topology must outlive it). Not thread-safe; update()
+// uses all OpenMP threads. Times in the scene's unit (SI: s), lengths in the mesh's (m).
 #include <cstdint>
 #include <map>
 #include <string>
@@ -73,8 +83,12 @@ class CutManager {
   bool update(double time);
 
   // One function per visible segment with texel data, in order of first appearance (a
-  // function keeps its index while its cut grows).
+  // function keeps its index while its cut grows). N_i holds only the nodes where H_i adds
+  // to the span of the earlier functions (enrichment_span.h); a segment that adds nowhere
+  // (it only continues an earlier one's crack) has no function.
   const std::vector<EnrichmentFunction>& functions() const { return functions_; }
+  // Enriched nodes dropped at the last update because their function repeated earlier ones.
+  int dependent_nodes() const { return dependent_nodes_; }
   const std::vector<EnrichmentSegment>& function_segments() const { return function_segments_; }
 
   int texture_resolution() const { return resolution_; }
@@ -103,6 +117,10 @@ class CutManager {
   };
   void rasterize_visible(const std::vector<VisibleCutSegment>& visible,
                          std::vector<std::vector<std::pair<int, kernels::CutRaster>>>& rasters);
+  // Drops the lattice edges that two segments sharing an end point both end on (a spur).
+  void trim_shared_end_spurs(std::vector<std::vector<std::pair<int, kernels::CutRaster>>>& rasters) const;
+  bool terminal_key(const std::vector<std::pair<int, kernels::CutRaster>>& pieces, bool at_end,
+                    std::pair<long long, long long>& key) const;
 
   const Mesh& mesh_;
   ElementAdjacency adjacency_;
@@ -124,6 +142,7 @@ class CutManager {
   std::vector<EnrichmentFunction> functions_;
   std::vector<EnrichmentSegment> function_segments_;
   std::vector<std::vector<std::pair<int, kernels::CutRaster>>> function_rasters_;
+  int dependent_nodes_ = 0;
   CutUpdateStats last_;
 };
 

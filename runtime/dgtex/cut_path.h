@@ -14,6 +14,8 @@
 //
 // Arc length and turning angles are measured on the rest surface with the unsnapped
 // crossing points, so they do not depend on the texture resolution.
+// Value types and pure functions (thread-safe): a MeshCutPath owns its vertices.
+// Lengths and arc lengths in the mesh's unit (SI: m); xi are element parameters.
 #include <array>
 #include <string>
 #include <vector>

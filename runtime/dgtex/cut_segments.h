@@ -15,6 +15,8 @@
 //    point becomes a path vertex of both cuts so their texel paths meet at one lattice
 //    point. A cut merely ending on another (T-junction) is not split: splitting there
 //    would add an enrichment that is linearly dependent on the others (App. A.2).
+// Pure functions over value types (thread-safe). Lengths in the mesh's unit (SI: m),
+// times in the scene's (s), angles in degrees.
 #include <vector>
 
 #include "dgtex/cut_path.h"

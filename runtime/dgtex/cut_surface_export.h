@@ -16,6 +16,8 @@
 // boundary (an element has several vertices there) nothing is welded, so the sides stay
 // apart. Texel grids and tessellations of neighbouring elements meet only where their
 // vertices coincide (T-junctions elsewhere).
+// Pure function: reads the state, returns a CutSurfaceMesh that owns its vertices and
+// faces (keeps nothing; thread-safe). Positions in the mesh's length unit (SI: m).
 #include <string>
 #include <vector>
 

@@ -7,6 +7,9 @@
 //   base  = sum_a N^a (X^a + u^a) - sum_k sum_a N^a H_k(xi^a) q_k^a,   A_k = sum_a N^a q_k^a,
 // where h_k = H_k(xi) for the true surface, or the value of one side of a cut when a cut
 // triangle is extrapolated across it.
+// DeformedShell keeps a reference to the ShellState (which must outlive it) and owns only
+// its per-element index lists; const functions are thread-safe. Positions in the mesh's
+// length unit (SI: m).
 #include <array>
 #include <vector>
 

@@ -12,6 +12,8 @@
 //
 // The context is made current on the constructing thread; call make_current() before
 // using it from another thread (one thread at a time).
+// EglContext owns the EGL display connection and context (released by the destructor;
+// not copyable); share it between renderers through std::shared_ptr.
 #include <stdexcept>
 #include <string>
 

@@ -3,6 +3,8 @@
 // ShellModel::set_material_textures. Layout as in kernels/material_texture_kernel.h:
 // W x H texels covering the element's parameter square, row-major, rows top to bottom
 // (row 0 at xi2 = +1), nearest-texel values.
+// A value type that owns its texel arrays. Units: Young's modulus in Pa, thickness in m
+// (consistent units in general).
 #include <vector>
 
 namespace dgtex {

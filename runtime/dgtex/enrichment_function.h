@@ -18,6 +18,8 @@
 // tile.values holds H_i at texel centres; tile.flags holds the walls of *all* cuts in the
 // element (so finite differences never reach across any cut) and the inactive bits; the
 // dirichlet bits carry no meaning here.
+// Value types that own their node lists and texture tiles (copies, no references).
+// H is dimensionless (+-1 across a complete cut).
 #include <vector>
 
 #include "dgtex/kernels/texel_grid.h"

@@ -22,6 +22,10 @@
 // and the dot products (fixed chunking, summed in a fixed order) do not depend on the
 // number of threads, and neither does the refactorisation decision, so x is bitwise
 // identical for any thread count.
+// FactorReusingSolver owns its work vectors and statistics and keeps references to the
+// pattern, the free-DOF system and the mass blocks (all must outlive it); the Cholesky
+// factor is the caller's, passed to each solve. Not thread-safe; a solve uses all OpenMP
+// threads. Units: those of the system (SI: kg, N/m, N).
 #include <cstdint>
 #include <stdexcept>
 #include <vector>
@@ -40,7 +44,10 @@ struct FactorReuseOptions {
   // (50 steps, 1 thread; `dgtex bench shell --refactor-after N`): N = 6: 8 factorisations +
   // 208 iterations, solve 45 ms/step; 8: 5 + 249, 37 ms; 12: 3 + 310, 35 ms; 16: 2 + 365,
   // 38 ms. One factorisation costs ~60 preconditioner applications, so 8-12 is the optimum.
-  int refactor_after_iterations = 8;
+  // Over 100 steps (the buckling develops) N = 8: 18 factorisations + 546 iterations; 12:
+  // 11 + 730; 16: 7 + 910; 24: 5 + 1180. At ~150 ms per factorisation and ~3.3 ms per
+  // iteration (1 thread) 12 and 16 cost ~10% less than 8, 24 more: 12.
+  int refactor_after_iterations = 12;
   int max_iterations = 40;            // beyond this, factorise the current system now
   // Apply the preconditioner with a float copy of L (SparseCholesky::solve_single_precision):
   // half the memory traffic per iteration; the residual bound is unchanged (the PCG
@@ -77,7 +84,10 @@ class FactorReusingSolver {
   // b: #dofs (fixed entries ignored). x: #dofs, in: initial guess, out: solution with
   // fixed entries zero. `cholesky` is the factorisation it reuses and refreshes (analysed
   // on first use). Throws NotPositiveDefinite from a factorisation.
-  void solve(const ScaledBlockSum& A, const std::vector<double>& b, std::vector<double>& x, SparseCholesky& cholesky);
+  // stiffness_times_x (optional): K times the initial guess x, when the caller has it (e.g.
+  // from block_multiply_pair): saves one pass over K; the result is bitwise the same.
+  void solve(const ScaledBlockSum& A, const std::vector<double>& b, std::vector<double>& x, SparseCholesky& cholesky,
+             const std::vector<double>* stiffness_times_x = nullptr);
 
   // y = M x (the mass of the constructor), through its scalar diagonal when isotropic.
   void multiply_mass(const std::vector<double>& x, std::vector<double>& y) const;
@@ -104,8 +114,9 @@ class FactorReusingSolver {
   // y = A x over free DOFs (fixed entries of y set to zero).
   void multiply(const ScaledBlockSum& A, const std::vector<double>& x, std::vector<double>& y) const;
   // Runs PCG from x; returns iterations used, or -1 if max_iterations did not suffice.
+  // kx: K x for the initial x, or null (then computed).
   int pcg(const ScaledBlockSum& A, const std::vector<double>& b, std::vector<double>& x,
-          const SparseCholesky& cholesky, double& relative_residual);
+          const SparseCholesky& cholesky, double& relative_residual, const std::vector<double>* kx);
 };
 
 // Sum of x[i] * y[i] in a fixed order, independent of the thread count.

@@ -6,6 +6,8 @@
 // The camera is fixed once, on the first frame, so an animation does not jump: a missing
 // camera position or target is filled in by framing that first state's bounding box
 // (see resolve_scene_camera).
+// FrameWriter owns its renderer (and shares the EGL context by std::shared_ptr); not
+// thread-safe, use it from one thread. Scene positions in m, image sizes in pixels.
 #include <memory>
 #include <string>
 

@@ -3,6 +3,8 @@
 // displacement) are eliminated, and the lower triangle is laid out in compressed-column
 // form for CHOLMOD. The map from block entries to column slots is built once; each slot
 // is written by exactly one block entry, so filling is deterministic in parallel.
+// FreeDofSystem owns its index maps only (no reference to the pattern after construction);
+// const functions are thread-safe, gather uses all OpenMP threads. Values keep the caller's units.
 #include <cstdint>
 #include <vector>
 

@@ -22,6 +22,8 @@
 // triangles across the hypotenuse. Neighbour tiles placed as `dirichlet_neighbour`
 // contribute only their texels coupled to region texels, as Dirichlet data with their
 // stored values (C0 constraints); absent neighbours leave zero Neumann.
+// Pure functions over caller-owned tiles (thread-safe on distinct tiles; a solve may use
+// all OpenMP threads). H is dimensionless; positions in texel units.
 #include <array>
 #include <functional>
 #include <vector>

@@ -9,6 +9,8 @@
 //    and the "Neumann-only components are 0" rule of §5.5.2). This is exactly the
 //    harmonic enrichment of a complete cut, obtained without a solve.
 // Values are written into tile.values of tiles that copy the input's flags.
+// Pure functions over caller-owned tiles (thread-safe on distinct tiles). Values are
+// dimensionless (+-1, 0).
 #include <vector>
 
 #include "dgtex/kernels/cut_rasterization.h"

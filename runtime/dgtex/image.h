@@ -1,5 +1,6 @@
 #pragma once
 // An 8-bit RGBA image, rows top to bottom, 4 bytes per pixel: rgba[4 * (y * width + x) + c].
+// A value type that owns its pixels (width x height x 4 bytes).
 #include <cstddef>
 #include <cstdint>
 #include <vector>

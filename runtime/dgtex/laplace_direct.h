@@ -1,6 +1,8 @@
 #pragma once
 // Direct (CHOLMOD supernodal Cholesky) solve of the harmonic texel problem: the reference
 // for the multigrid, and the assembly of the reduced SPD system for other sparse solvers.
+// Pure functions: TexelLaplaceSystem owns its matrix and vectors (Eigen, by value);
+// nothing is kept between calls (thread-safe on distinct tiles). Values are dimensionless.
 #include <cstddef>
 #include <vector>
 

@@ -17,6 +17,7 @@
 //             3T/2 + 1 with +1 / -1 Dirichlet texels along its north / south sides, a second
 //             (Neumann) cut runs from the south border up to 3T/2 at x = 5T/3; zero-Neumann
 //             elsewhere (quad only).
+// Pure functions returning tiles by value (thread-safe). Positions in texel units.
 #include <string>
 #include <vector>
 

@@ -5,6 +5,9 @@
 // coarse levels that keep cuts as walls, a dense (small) or CHOLMOD (large) Cholesky on
 // the coarsest level, used as V/F-cycles or as the preconditioner of conjugate gradients
 // (the default: see laplace_multigrid.cpp for the measurements behind it).
+// LaplaceMultigrid owns its level hierarchy (built from the tile at construction, no
+// reference kept to it). Not thread-safe per instance; solve() uses all OpenMP threads.
+// Values dimensionless, times in ms.
 #include <memory>
 #include <vector>
 

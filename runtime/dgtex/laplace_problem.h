@@ -4,6 +4,7 @@
 // measured the same way so solvers compare at equal accuracy: relative residual
 // ||b - A x||_2 / ||b||_2 of the reduced SPD system (unknowns = free texels of components
 // with Dirichlet data, b = sum of coupled Dirichlet neighbours' values).
+// Value types and pure functions (thread-safe). Residuals are dimensionless, times in ms.
 #include <cstddef>  // texel_grid.h uses size_t without including it
 #include <cstdint>
 #include <vector>

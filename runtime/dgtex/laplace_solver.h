@@ -1,6 +1,8 @@
 #pragma once
 // One entry point for the harmonic enrichment's Laplace solves: the multigrid (default,
 // warm-started from tile.values) or CHOLMOD (the reference).
+// A pure function over a caller-owned tile (thread-safe on distinct tiles; uses all OpenMP
+// threads). Values dimensionless.
 #include <string>
 
 #include "dgtex/kernels/texel_grid.h"

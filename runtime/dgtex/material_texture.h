@@ -3,6 +3,8 @@
 // chosen elements, from grayscale/RGB images of the scene ("material_textures").
 // Texture layout per element: kernels/material_texture_kernel.h (the image covers the
 // element's parameter square, row 0 at xi2 = +1; nearest-texel values).
+// Functions that read the scene's images and return value types (nothing kept;
+// thread-safe). Young's modulus in Pa, thickness in m (the scene's consistent units).
 #include <vector>
 
 #include "dgtex/element_material_texture.h"

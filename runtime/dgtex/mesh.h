@@ -5,6 +5,7 @@
 //              dgtex/kernels/shape_functions.h (corners counter-clockwise seen from the
 //              side the normal points to, then midsides).
 // Displacements are C0: neighbouring elements share their edge's three nodes.
+// A value type that owns its arrays (copying copies the mesh); const use is thread-safe.
 #include <cstddef>
 #include <vector>
 

@@ -3,6 +3,7 @@
 // closest-point queries, mesh output). The message names the offending element, edge,
 // node or file:line; elements() lists the element indices involved (possibly empty) so
 // callers such as the OBJ importer can translate them back to their own numbering.
+// An exception value type (owns its message and element list).
 #include <sstream>
 #include <stdexcept>
 #include <string>

@@ -8,6 +8,8 @@
 // into two tri6; the diagonal's midside node is the cell-centre node.
 // Node numbering: row by row in the second parameter, first parameter fastest, on the
 // half-step grid (quad8 skips the cell centres). Invalid arguments throw MeshError.
+// Pure functions returning a Mesh by value (thread-safe). Lengths in the scene's unit
+// (SI: m), angles in degrees.
 #include "dgtex/mesh.h"
 #include "dgtex/mesh_error.h"
 

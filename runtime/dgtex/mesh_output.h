@@ -1,5 +1,7 @@
 #pragma once
 // Mesh files for viewing results: VTK XML (ParaView) and OBJ (any viewer).
+// Functions that write files and keep nothing; safe from several threads for distinct files.
+// Positions and displacements in the mesh's length unit (SI: m).
 #include <string>
 #include <utility>
 #include <vector>

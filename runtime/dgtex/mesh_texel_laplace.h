@@ -15,7 +15,13 @@
 // §5.5.3). Elements outside the region leave zero Neumann. Free texels in a component
 // (connected through free-free couplings) with no data get 0; a component whose data are
 // all one value v gets exactly v without a solve; the rest are the unknowns of one SPD
-// system solved by CHOLMOD (or by the multigrid when the region is a single tile).
+// system. With LaplaceSolver::multigrid (the enrichment's default) a single tile, or a quad8
+// region whose tiles lie side by side in the plane without turning or closing up (e.g.
+// blocks of a rectangle mesh: chad's 2x2), is solved by the tile multigrid on one patch tile
+// holding the same couplings (options: tolerance, warm start from the tiles' values); other
+// regions (tri6, cylinder rings, turned neighbours) and LaplaceSolver::cholmod use CHOLMOD.
+// Value types that own their data (MeshEdgeWalls its key set, RegionTile its tile) and
+// functions that keep nothing; a solve may use all OpenMP threads. Values dimensionless.
 #include <cstdint>
 #include <unordered_set>
 #include <vector>
@@ -43,6 +49,9 @@ class MeshEdgeWalls {
   bool empty() const { return keys_.empty(); }
   // Blocked (element, edge, s) of one element, sorted (for change detection).
   std::vector<long long> keys_of_element(int element) const;
+  int resolution() const { return resolution_; }
+  // Every (element, edge, s) as one flag, index (element * 4 + edge) * resolution + s.
+  std::vector<char> flags(int num_elements) const;
 
  private:
   long long key(int element, int edge, int s) const { return (static_cast<long long>(element) * 4 + edge) * resolution_ + s; }
@@ -62,6 +71,7 @@ struct MeshLaplaceStats {
   int constant_components = 0;  // components set to their single data value
   int solved_tiles = 0, frozen_tiles = 0;
   double relative_residual = 0;
+  bool multigrid = false;  // solved by the tile multigrid (else CHOLMOD, or nothing to solve)
   double ms = 0;  // wall time of the whole call
 };
 
@@ -70,6 +80,7 @@ struct MeshLaplaceStats {
 // otherwise); std::runtime_error if CHOLMOD fails.
 MeshLaplaceStats solve_mesh_texel_laplace(std::vector<RegionTile>& tiles, ElementType type,
                                           const ElementAdjacency& adjacency, const MeshEdgeWalls& edge_walls,
-                                          LaplaceSolver solver = LaplaceSolver::cholmod);
+                                          LaplaceSolver solver = LaplaceSolver::cholmod,
+                                          const LaplaceMultigridOptions& options = {});
 
 }  // namespace dgtex

@@ -1,5 +1,6 @@
 #pragma once
 // Checks that a mesh is usable by the shell solver, and per-element measures.
+// Pure functions (thread-safe). Lengths in the mesh's unit (SI: m), areas in its square (m^2).
 #include "dgtex/mesh.h"
 #include "dgtex/mesh_error.h"
 

@@ -2,6 +2,7 @@
 // A problem with the model a user set up (not a bug and not an I/O failure): unconstrained
 // statics, a penalty too low for a positive definite stiffness, a load or probe that
 // cannot be placed. The dgtex tool maps it to exit code 2.
+// An exception value type (owns its message).
 #include <stdexcept>
 #include <string>
 

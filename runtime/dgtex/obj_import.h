@@ -1,5 +1,7 @@
 #pragma once
 // Wavefront OBJ import of a shell surface.
+// Functions that read a file and return a Mesh by value (thread-safe). Positions in the
+// OBJ's length unit (the scene's, SI: m).
 #include <string>
 
 #include "dgtex/mesh.h"

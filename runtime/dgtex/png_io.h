@@ -1,5 +1,6 @@
 #pragma once
 // PNG files through libpng. Errors throw std::runtime_error naming the file.
+// Functions that read/write one file and keep nothing (thread-safe for distinct files).
 #include <string>
 
 #include "dgtex/image.h"

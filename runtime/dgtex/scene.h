@@ -4,6 +4,8 @@
 // numbers are finite and in range, vectors that must be unit are unit, names are unique.
 // Lengths, forces and times are in the scene's own consistent units; angles in degrees.
 // Defaults of optional keys are written next to each field ("default: ...").
+// Plain value types (copying copies everything; no references). Quantities per field in
+// the scene's consistent units; dgtex's examples use SI: m, kg, s, Pa, N, kg/m^3, m/s^2.
 #include <array>
 #include <optional>
 #include <string>

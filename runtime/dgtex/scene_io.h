@@ -7,6 +7,7 @@
 //
 // Checks that need the mesh (empty boundary selections, statically unconstrained models,
 // surface points outside the mesh) live in scene_mesh_checks.h.
+// Pure functions returning a Scene by value (thread-safe); load_scene reads one file.
 #include <stdexcept>
 #include <string>
 

@@ -2,6 +2,7 @@
 // Scene checks that need the mesh, run once the mesh has been generated or loaded. They
 // throw SceneError (one line, with the JSON path) like the parser, so `dgtex run` reports
 // them the same way (exit code 2).
+// Pure functions (thread-safe).
 #include "dgtex/mesh.h"
 #include "dgtex/scene.h"
 

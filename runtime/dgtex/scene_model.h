@@ -1,6 +1,8 @@
 #pragma once
 // Builds the simulation inputs a scene describes: the mesh (generator or OBJ), the shell
 // model (sections, clamped edges, penalty), fixed DOFs and the external load vector.
+// Functions that return owning values (SceneModel owns its ShellModel through unique_ptr;
+// nothing refers back to the scene). Units: those of the scene (SI: m, kg, s, N).
 #include <memory>
 #include <vector>
 

@@ -10,6 +10,8 @@
 // step: "enrichment" (cut update and Laplace solves), "projection" (only steps where the
 // basis changed), "assembly" and "solve" (dgtex/shell_simulation.h).
 // Not thread-safe; each call uses all OpenMP threads itself.
+// SceneRun owns the mesh, topology, model, cut manager and simulation; it keeps a reference
+// to the Scene (which must outlive it). Units: those of the scene (SI: m, kg, s, N).
 #include <memory>
 #include <vector>
 

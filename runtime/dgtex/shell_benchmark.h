@@ -4,6 +4,8 @@
 // per step split into assembly and solve, quadrature points per second and the achieved
 // GFLOP/s of the assembly (counted with shell_assembly_flops, below), next to an Eigen
 // dense matrix product measured in the same process as the attainable reference.
+// Plain functions that return their measurements (nothing kept); they set the OpenMP
+// thread count themselves, so run one at a time. Times in ms, rates per second.
 #include <cstdint>
 #include <string>
 #include <vector>

@@ -12,6 +12,7 @@
 // enriched kernels (texel-resolving quadrature, enriched_quadrature.h); all others by the
 // standard ones. Without enrichments everything is exactly the plain DG shell.
 // Units: those of the scene.
+// Keeps no reference to the topology or sections it was built from.
 #include <functional>
 #include <vector>
 
@@ -84,6 +85,15 @@ class ShellModel {
   // Enriched nodes below options().min_enrichment_mass_ratio are dropped (and functions
   // left without nodes), so enrichments() may hold less than was given.
   void set_enrichments(std::vector<EnrichmentFunction> functions);
+  // Texel segments of mesh edges that a cut runs along (MeshEdgeWalls::flags: index
+  // (element * 4 + local edge) * resolution + s, s along the element's local edge, either
+  // side's entry counts). The pieces on the two sides are separate there, so the edge terms
+  // (penalty on the rotation jump) are not integrated over those segments: otherwise they
+  // would tie the pieces' rotations. Takes effect at the next set_enrichments; empty: none.
+  void set_cut_edge_texels(int resolution, std::vector<char> flags) {
+    cut_edge_resolution_ = resolution;
+    cut_edge_texels_ = std::move(flags);
+  }
   int num_pruned_enriched_nodes() const { return pruned_enriched_nodes_; }
   void clear_enrichments() { set_enrichments({}); }
   const std::vector<EnrichmentFunction>& enrichments() const { return enrichments_; }
@@ -167,7 +177,11 @@ class ShellModel {
   std::vector<double> element_qp_;
   std::vector<int> enriched_edges_;         // #enriched edges x 4
   std::vector<double> enriched_edge_size_;
+  // Removes enriched edge quadrature points on cut texel segments (set_cut_edge_texels).
+  void drop_cut_edge_points();
   std::vector<std::int64_t> edge_qp_start_;
+  int cut_edge_resolution_ = 0;
+  std::vector<char> cut_edge_texels_;  // set_cut_edge_texels
   std::vector<double> edge_qp_;
   std::vector<double> enriched_area_weights_, enriched_mass_weights_;  // #enriched elements x width
 
@@ -186,6 +200,17 @@ class ShellModel {
   std::vector<kernels::ShellSection> sided_sections_;
   kernels::PointSectionBatch textured_batch() const;
 
+  // Buffers of assemble_stiffness's plain elements and edges, kept between calls (the
+  // calls on one instance are not concurrent, see above). A copy starts empty.
+  struct AssemblyWorkspace {
+    std::vector<double> gradients, element_rotations, edge_rotations;
+    std::vector<double> element_blocks, edge_blocks, element_forces, edge_forces;
+    AssemblyWorkspace() = default;
+    AssemblyWorkspace(const AssemblyWorkspace&) {}
+    AssemblyWorkspace& operator=(const AssemblyWorkspace&) { return *this; }
+  };
+  mutable AssemblyWorkspace workspace_;
+
   int pruned_enriched_nodes_ = 0;
   void install_enrichments(std::vector<EnrichmentFunction> functions);
   void rebuild();
@@ -199,5 +224,8 @@ class ShellModel {
 
 // y = A x for block matrices in the pattern (deterministic, parallel over rows).
 void block_multiply(const BlockAssembly& pattern, const double* blocks, const double* x, double* y);
+// y1 = A x1 and y2 = A x2 in one pass over A (bitwise equal to two block_multiply calls).
+void block_multiply_pair(const BlockAssembly& pattern, const double* blocks, const double* x1, const double* x2,
+                         double* y1, double* y2);
 
 }  // namespace dgtex

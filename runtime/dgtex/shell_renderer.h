@@ -14,6 +14,9 @@
 // enrichments per element; with the geometry-shader method a tessellation triangle
 // crossed by more than kMaxCutsPerTriangle cuts is not drawn (a hole where that many
 // cuts meet within one triangle; a finer tessellation separates them).
+// ShellRenderer owns its OpenGL objects and shares the EglContext (std::shared_ptr); not
+// thread-safe: use it from the thread its context is current on. Positions in the mesh's
+// length unit (SI: m); images in pixels.
 #include <memory>
 #include <string>
 

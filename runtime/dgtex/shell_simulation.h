@@ -10,6 +10,9 @@
 // (FactorReusingSolver: same relative-residual bound as a direct solve, see there);
 // reuse_factorization = false factorises every step instead (the reference path).
 // Every stage's time is recorded ("assembly", "solve").
+// ShellSimulation owns its state (u, v), free-DOF system and Cholesky factor and keeps a
+// reference to the ShellModel (which must outlive it). Not thread-safe; each call uses all
+// OpenMP threads. Units: those of the model (SI: m, m/s, s, N, kg).
 #include <string>
 #include <vector>
 
@@ -70,6 +73,7 @@ class ShellSimulation {
   // Buffers reused by every step (no allocation per step).
   std::vector<double> current_, corotated_k_, corrective_, mv_, ku_, rhs_full_, rhs_, v_new_, values_;
   std::vector<double> previous_v_, guess_;  // velocity of the step before, PCG start
+  std::vector<double> k_guess_;             // K guess_
 
   const std::vector<double>& linear_stiffness();
   std::string enrichment_hint() const;  // appended to "not positive definite" errors

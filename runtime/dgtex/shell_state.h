@@ -6,6 +6,8 @@
 //   x(xi) = sum_a N^a(xi) (X^a + u^a) + sum_{enrichments k of e} sum_a N^a(xi) (H_k(xi) - H_k(xi^a)) q_k^a
 // with N^a the basis of dgtex/kernels/shape_functions.h, X^a the rest positions
 // (mesh.positions), u^a the displacement, H_k the enrichment texture and q_k^a its DOFs.
+// Plain value types that own their arrays (a copy of the mesh included). Positions and
+// displacements in the mesh's length unit (SI: m), time in s; H dimensionless.
 #include <string>
 #include <vector>
 

@@ -4,6 +4,8 @@
 // factorisation with the same pattern, as in a time loop.
 //
 // Matrices are given as the LOWER triangle in compressed-column form (n x n, 0-based).
+// SparseCholesky owns the CHOLMOD workspace, analysis and factor (not copyable). Not
+// thread-safe for concurrent calls on one instance; distinct instances are independent.
 #include <cstdint>
 #include <memory>
 #include <stdexcept>

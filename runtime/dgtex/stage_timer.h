@@ -1,5 +1,7 @@
 #pragma once
 // Per-stage wall-clock statistics (mean and max over calls), in milliseconds.
+// Value types; ScopedStage keeps a reference to its StageTimings entry (which must outlive
+// it). Not thread-safe: time stages from one thread. Times in milliseconds.
 #include <chrono>
 #include <map>
 #include <string>

@@ -1,6 +1,7 @@
 #pragma once
 // Closest point on the curved (quadratic) mesh surface: probes and cut paths given as
 // rest-configuration points are projected with this.
+// A pure function (thread-safe). Positions and distances in the mesh's length unit (SI: m).
 #include "dgtex/mesh.h"
 #include "dgtex/mesh_error.h"
 

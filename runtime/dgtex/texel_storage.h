@@ -16,6 +16,7 @@
 // with openvdb::tools::copyToDense / copyFromDense (serial copies, so callers may run one
 // copy per element from an OpenMP loop). Values are stored as float.
 // Thread safety: const member functions may run concurrently; mutating ones may not.
+// TexelStorage owns its OpenVDB grids. Texel values are stored as given (dimensionless H).
 #include <cstddef>
 #include <cstdint>
 #include <map>

@@ -1,6 +1,7 @@
 #pragma once
 // Edge connectivity of a shell mesh: which elements meet across each edge, for the DG
 // interface terms (interior edges) and the clamped/free boundary terms (boundary edges).
+// A value type that owns its edge arrays (no reference to the mesh); const use is thread-safe.
 #include <vector>
 
 #include "dgtex/mesh.h"

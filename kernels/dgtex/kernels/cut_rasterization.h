@@ -22,6 +22,9 @@
 //    fragment shorter than half a texel vanishes).
 //  - Lattice edges are reported in path order, repeated if the path revisits them
 //    (self-intersections and retraced cuts keep every traversal).
+// Kernel conventions (dgtex/kernels/forall.h): arrays are the caller's, batch/view structs
+// only point into them, nothing is kept after a call; thread-safe on distinct outputs.
+// CutRaster owns its edge list. Positions in texel units (texel (i, j) is [i, i+1] x [j, j+1]).
 #include <array>
 #include <cstdint>
 #include <vector>
@@ -78,6 +81,10 @@ CutRaster rasterize_cut(const std::vector<TexelPoint>& polyline, TexelTile& tile
 // `cut` when nothing is met). A path scan, O(edges), serial only.
 std::vector<CutRaster> split_cut_at_crossings(const CutRaster& cut, const TexelTile& earlier_walls);
 
+// Sets the wall_east / wall_north bits of every edge of `cut` that lies between two texels
+// of the tile (what rasterize_cut does for its own path): for rasters the caller edited,
+// e.g. with a dangling end trimmed. Serial only.
+void mark_cut_walls(const CutRaster& cut, TexelTile& tile);
 // Element parameter coordinates -> continuous texel coordinates of a T x T tile:
 // quad8: x = (xi1 + 1) T / 2, y = (xi2 + 1) T / 2; tri6: x = xi1 T, y = xi2 T (the tri6
 // triangle is the lower-left half of the tile).

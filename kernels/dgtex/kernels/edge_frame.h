@@ -3,6 +3,9 @@
 // unit tangent, in-plane normal and unit averaged normal as the columns of a row-major 3x3
 // matrix, from the plus side's tangent dphi/dt and the sides' unit normals (minus_t0 null
 // on a boundary edge). Corotation takes the edge's rotation from this frame.
+// Kernel conventions (dgtex/kernels/forall.h): arrays are the caller's, batch/view structs
+// only point into them, nothing is kept after a call; thread-safe on distinct outputs.
+// Dimensionless (unit vectors).
 #include "dgtex/kernels/vec3.h"
 
 namespace dgtex::kernels {

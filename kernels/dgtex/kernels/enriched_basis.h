@@ -21,6 +21,9 @@
 // walls). A point on a texel edge belongs to the texel with the larger index, clamped into
 // the tile, and for tri6 moved down in j into the active triangle (see containing_texel);
 // the node shifts H_k(xi^a) are sampled by this same rule.
+// Kernel conventions (dgtex/kernels/forall.h): arrays are the caller's, batch/view structs
+// only point into them, nothing is kept after a call; thread-safe on distinct outputs.
+// H is dimensionless; derivatives are per unit of the element parameters xi.
 #include <cstdint>
 
 #include "dgtex/kernels/shape_functions.h"
@@ -64,6 +67,10 @@ void sample_texture_in_texel(ElementType type, int resolution, const TextureView
                              double xi2, TextureSample& out);
 void sample_texture(ElementType type, int resolution, const TextureView& texture, double xi1, double xi2,
                     TextureSample& out);
+// The same polynomial from already computed texel derivatives (sample_texture_in_texel is
+// texel_derivatives followed by this; kernels cache the derivatives per texel).
+void sample_texel_polynomial(ElementType type, int resolution, const TexelDerivatives& fd, int i, int j, double xi1,
+                             double xi2, TextureSample& out);
 
 // ---------------------------------------------------------------------------------------
 // Elements carrying enriched basis functions. An "element enrichment" is one texture H_k on

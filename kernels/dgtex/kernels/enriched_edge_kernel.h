@@ -18,6 +18,9 @@
 // `quadrature_points` Gauss points (a merged whole edge: exactly the standard edge rule);
 // a single unmerged piece gets 2 Gauss points. Points: (t, weight) pairs, weights summing
 // to 2 over an edge; concatenated per edge in order (start: #edges + 1).
+// Kernel conventions (dgtex/kernels/forall.h): arrays are the caller's, batch/view structs
+// only point into them, nothing is kept after a call; thread-safe on distinct outputs.
+// Units: consistent (SI: positions m, E Pa, h m, density kg/m^3; blocks N/m, forces N, mass kg).
 #include <cstdint>
 #include <vector>
 

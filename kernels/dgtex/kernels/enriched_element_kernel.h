@@ -12,8 +12,10 @@
 //   (row-major) per quadrature point in the order of the point list. Padding slots are 0.
 // current (deformation gradients): #(nodes + virtual nodes) x 3, indexed by the global
 // nodes of enriched_global_nodes: current positions of nodes, then the current values of
-// the enriched DOFs. One element per work item: the parallel form equals the serial one
-// bitwise.
+// the enriched DOFs. The parallel forms equal the serial ones bitwise (fixed work items).
+// Kernel conventions (dgtex/kernels/forall.h): arrays are the caller's, batch/view structs
+// only point into them, nothing is kept after a call; thread-safe on distinct outputs.
+// Units: consistent (SI: positions m, E Pa, h m, density kg/m^3; blocks N/m, forces N, mass kg).
 #include <cstdint>
 
 #include "dgtex/kernels/enriched_basis.h"
@@ -26,9 +28,24 @@ struct EnrichedQuadrature {
   const double* points;       // (xi1, xi2, reference weight) per point
 };
 
+// Stiffness blocks and corrective forces. Fast form: a texture whose gradient and Hessian
+// (parametric units, over the point's texel) are both at most enriched_flat_tolerance is
+// locally constant there, so its enriched functions are the multiples (H_k - H_k(xi^a)) N^a
+// of standard ones; such points only need the rows of the standard functions and of the
+// textures that vary there. Points with the same varying textures and the same constant
+// values (within the tolerance) form a group whose small matrix sum_q S_q^T S_q is mapped
+// onto the element's basis once (K += T^T G T). Complete cuts' +-1 are exact; harmonic
+// tails below the tolerance move K by about that much relative (1e-10, far below the
+// quadrature's merge tolerance). Work items are fixed chunks of enriched_chunk_points
+// points, summed per element in chunk order: bitwise independent of the thread count.
 void enriched_element_stiffness(const EnrichedElementBatch& batch, const EnrichedQuadrature& quadrature,
                                 const double* rotations, double* blocks, double* forces,
                                 Execution execution = Execution::parallel);
+// Plain per-point form (every basis function at every point; serial): the reference.
+void enriched_element_stiffness_reference(const EnrichedElementBatch& batch, const EnrichedQuadrature& quadrature,
+                                          const double* rotations, double* blocks, double* forces);
+constexpr double enriched_flat_tolerance = 1e-10;
+constexpr std::int64_t enriched_chunk_points = 2048;
 
 void enriched_element_deformation_gradients(const EnrichedElementBatch& batch, const EnrichedQuadrature& quadrature,
                                             const double* current, double* F,

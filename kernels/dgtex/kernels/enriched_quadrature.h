@@ -21,6 +21,9 @@
 // Points are (xi1, xi2, weight) with weights including the reference area, as in
 // element_quadrature. Per-element point lists are concatenated in element order
 // (start: #elements + 1 offsets), so serial and parallel forms give identical arrays.
+// Kernel conventions (dgtex/kernels/forall.h): arrays are the caller's, batch/view structs
+// only point into them, nothing is kept after a call; thread-safe on distinct outputs.
+// Points are element parameters (dimensionless); merge_tolerance is in units of H (O(1)).
 #include <cstdint>
 #include <vector>
 

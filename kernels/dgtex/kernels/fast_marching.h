@@ -17,6 +17,8 @@
 // are accepted one by one in order of distance from a heap); its cost is
 // O(n log n) for n texels, small against the Laplace solves of cuts.
 // Deterministic: heap ties are broken by texel index.
+// Kernel conventions (dgtex/kernels/forall.h): arrays are the caller's, batch/view structs
+// only point into them, nothing is kept after a call; thread-safe on distinct outputs.
 #include <cstdint>
 #include <vector>
 

@@ -8,6 +8,8 @@
 // Canonical labels: components are numbered 0, 1, ... in the order of their smallest
 // texel index (j * width + i); inactive texels get -1. Both forms below produce exactly
 // these labels, so they agree bitwise and do not depend on the thread count.
+// Kernel conventions (dgtex/kernels/forall.h): arrays are the caller's, batch/view structs
+// only point into them, nothing is kept after a call; thread-safe on distinct outputs.
 #include <vector>
 
 #include "dgtex/kernels/forall.h"

@@ -3,6 +3,11 @@
 // an index so the same code runs serially (the reference) or with OpenMP (and later on a
 // device). Static scheduling keeps each index's work on a fixed thread per count, but
 // kernels never rely on that: each index writes only its own outputs.
+// Conventions of every dgtex::kernels header: arrays (structure of arrays) belong to the
+// caller; *Batch / *View structs only point into them and must outlive the call; a kernel
+// keeps nothing and has no global state, so calls on distinct outputs are thread-safe.
+// Execution::parallel uses all OpenMP threads of the calling thread, Execution::serial one;
+// both give the same result (bitwise where documented).
 #include <cstdint>
 
 namespace dgtex::kernels {

@@ -14,6 +14,9 @@
 // #elements x npe x npe x 9, forces #elements x npe x 3, mass #elements x npe x npe,
 // weights #elements x npe, rotations and F one 3x3 (row-major) per point. One element per
 // work item, so the parallel forms equal the serial ones (Execution::serial) bitwise.
+// Kernel conventions (dgtex/kernels/forall.h): arrays are the caller's, batch/view structs
+// only point into them, nothing is kept after a call; thread-safe on distinct outputs.
+// Units: consistent (SI: positions m, E Pa, h m, density kg/m^3; blocks N/m, forces N, mass kg).
 #include <cstdint>
 #include <vector>
 

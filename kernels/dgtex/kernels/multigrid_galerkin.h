@@ -33,6 +33,9 @@
 //
 // Both setup kernels write the coarse arrays (padded layout, ghosts must be zero on entry
 // and stay zero) for every coarse node and are gathers, so serial and parallel agree bitwise.
+// Kernel conventions (dgtex/kernels/forall.h): arrays are the caller's, batch/view structs
+// only point into them, nothing is kept after a call; thread-safe on distinct outputs.
+// Values and coefficients are dimensionless (texel units).
 #include <cstdint>
 
 #include "dgtex/kernels/forall.h"

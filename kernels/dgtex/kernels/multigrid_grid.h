@@ -6,6 +6,9 @@
 // LaplaceTexelBits byte per node (see multigrid_unknowns.h). Coarse levels are vertex
 // coarsenings (coarse node (I, J) = fine node (2I, 2J)) with Galerkin operators P^T A P:
 // symmetric 9-point stencils stored as five coefficient arrays.
+// Kernel conventions (dgtex/kernels/forall.h): arrays are the caller's, batch/view structs
+// only point into them, nothing is kept after a call; thread-safe on distinct outputs.
+// Value types that describe layouts (GridShape) or point into caller arrays (*View).
 #include <cstddef>
 #include <cstdint>
 

@@ -2,6 +2,9 @@
 // Multigrid residuals r = b - A x (0 at nodes without unknown). Each also writes the sum
 // of r^2 of every grid row into row_norm2[j] (summed left to right), so callers form
 // ||r||^2 by adding the rows in order: a norm that does not depend on the thread count.
+// Kernel conventions (dgtex/kernels/forall.h): arrays are the caller's, batch/view structs
+// only point into them, nothing is kept after a call; thread-safe on distinct outputs.
+// Values are dimensionless.
 #include <cstdint>
 
 #include "dgtex/kernels/forall.h"

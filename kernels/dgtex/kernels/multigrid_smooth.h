@@ -6,6 +6,9 @@
 // 1/4 vs 0.6 for damped Jacobi at the same memory traffic per sweep), four colours
 // ((i mod 2, j mod 2)) on the 9-point coarse levels. A symmetric cycle runs the colours in
 // reverse order after the coarse correction.
+// Kernel conventions (dgtex/kernels/forall.h): arrays are the caller's, batch/view structs
+// only point into them, nothing is kept after a call; thread-safe on distinct outputs.
+// Values are dimensionless.
 #include <cstdint>
 
 #include "dgtex/kernels/forall.h"

@@ -3,6 +3,9 @@
 // interpolation P (multigrid_grid.h): restriction b_coarse = P^T r_fine and prolongation
 // x_fine += P x_coarse. Both are gathers (each output written by one index), so the
 // parallel forms equal the serial ones bit for bit.
+// Kernel conventions (dgtex/kernels/forall.h): arrays are the caller's, batch/view structs
+// only point into them, nothing is kept after a call; thread-safe on distinct outputs.
+// Values are dimensionless.
 #include <cstdint>
 
 #include "dgtex/kernels/forall.h"

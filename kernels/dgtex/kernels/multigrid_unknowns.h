@@ -7,6 +7,9 @@
 // A component of free texels (connected through couplings between free texels) that
 // touches no Dirichlet texel has no data: its value is defined to be 0 (thesis §5.5.2)
 // and it is not an unknown, so the remaining system is symmetric positive definite.
+// Kernel conventions (dgtex/kernels/forall.h): arrays are the caller's, batch/view structs
+// only point into them, nothing is kept after a call; thread-safe on distinct outputs.
+// Values are dimensionless (texel units).
 #include <cstddef>  // texel_grid.h uses size_t without including it
 #include <cstdint>
 #include <vector>

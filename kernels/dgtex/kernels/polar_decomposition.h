@@ -4,6 +4,9 @@
 // R is the closest proper rotation to F (det R = +1 even for inverted F): a scaled Newton
 // iteration for det F > 0 (the corotated shell's case), else from a 3x3 SVD; each matrix
 // is independent, so the parallel batch is bitwise equal to the serial one.
+// Kernel conventions (dgtex/kernels/forall.h): arrays are the caller's, batch/view structs
+// only point into them, nothing is kept after a call; thread-safe on distinct outputs.
+// Dimensionless (deformation gradients and rotations).
 #include <cstdint>
 
 #include "dgtex/kernels/forall.h"

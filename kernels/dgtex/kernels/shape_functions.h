@@ -7,6 +7,9 @@
 // Local edge k runs from corner k through its midside node to corner k+1 (mod corners),
 // parameterised by t in [-1,1]; the element lies on the left of its own edges when seen
 // from the side its normal points to.
+// Kernel conventions (dgtex/kernels/forall.h): arrays are the caller's, batch/view structs
+// only point into them, nothing is kept after a call; thread-safe on distinct outputs.
+// ShapeValues, QuadratureRule and LineRule are value types; xi and t are dimensionless.
 namespace dgtex::kernels {
 
 enum class ElementType : int { quad8 = 0, tri6 = 1 };

@@ -7,6 +7,9 @@
 // rotations (optional) #elements x nq x 9 (row-major R per quadrature point, nq from
 // element_quadrature(type)); blocks #elements x npe x npe x 9 (block (a,b) at
 // (a*npe+b)*9, row-major 3x3); forces #elements x npe x 3.
+// Kernel conventions (dgtex/kernels/forall.h): arrays are the caller's, batch/view structs
+// only point into them, nothing is kept after a call; thread-safe on distinct outputs.
+// Units: consistent (SI: positions m, E Pa, h m, density kg/m^3; blocks N/m, forces N, mass kg).
 #include <cstdint>
 
 #include "dgtex/kernels/forall.h"

@@ -9,6 +9,9 @@
 //   C = [[1, nu, 0], [nu, 1, 0], [0, 0, (1-nu)/2]]   (Voigt: [xx, yy, 2xy]),
 // scaled by E h / (1 - nu^2) (membrane) and E h^3 / (12 (1 - nu^2)) (bending; report eq. 9,
 // not the typo of eq. 31).
+// Kernel conventions (dgtex/kernels/forall.h): arrays are the caller's, batch/view structs
+// only point into them, nothing is kept after a call; thread-safe on distinct outputs.
+// Units: consistent (SI: positions m, E Pa, h m, density kg/m^3; blocks N/m, forces N, mass kg).
 #include "dgtex/kernels/shape_functions.h"
 
 namespace dgtex::kernels {

@@ -2,6 +2,8 @@
 // Accumulates A = sum_r v_r v_r^T (v_r: rows of length n) in chunks of rows, upper
 // triangle only, so the result is exactly symmetric. The summation order depends only on the row sequence, so
 // equal inputs give bitwise equal results on any thread.
+// SymmetricAccumulator owns its n x n sum and a chunk of rows; one instance per thread
+// (not thread-safe). Values keep the units of the rows' products.
 #include <algorithm>
 #include <vector>
 

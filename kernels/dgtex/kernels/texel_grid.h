@@ -6,6 +6,7 @@
 // and (i+1, j) is cut; wall_north the edge between (i, j) and (i, j+1). A wall on the tile
 // border means a zero-Neumann boundary there. inactive texels lie outside the domain
 // (e.g. the upper half of a tri6 element's square). dirichlet texels hold a fixed value.
+// TexelTile is a value type that owns its flags and values. Positions in texel units.
 #include <cstddef>
 #include <cstdint>
 #include <vector>

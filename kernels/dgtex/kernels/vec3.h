@@ -1,5 +1,6 @@
 #pragma once
 // Small 3-vector and 3x3 helpers on raw double arrays, shared by the shell kernels.
+// Inline pure functions on caller arrays (thread-safe); results in the inputs' units.
 #include <cmath>
 
 namespace dgtex::kernels {

@@ -1,0 +1,64 @@
+# CTest case InstallConsumer.FindPackageBuildRun (registered in cmake/areas/install_consumer.cmake):
+# proves that dgtex links as a runtime from a clean project. Run in script mode (cmake -P):
+#   1. cmake --install <DGTEX_BUILD_DIR> --prefix <WORK_DIR>/prefix, and start the installed
+#      dgtex tool from there,
+#   2. configure examples/consumer against that prefix only (CMAKE_PREFIX_PATH), check that
+#      find_package(dgtex) found the package there and not some other installed copy,
+#   3. build it, with a translation unit that includes every installed header (-Werror),
+#   4. run the cut_plate program (it checks its own results).
+# Any failing step fails the test with that step's output.
+# Inputs: DGTEX_BUILD_DIR, CONSUMER_SOURCE_DIR, WORK_DIR, GENERATOR, MAKE_PROGRAM,
+#         CXX_COMPILER, CXX_COMPILER_LAUNCHER (may be empty).
+foreach(var DGTEX_BUILD_DIR CONSUMER_SOURCE_DIR WORK_DIR GENERATOR CXX_COMPILER)
+  if(NOT DEFINED ${var} OR "${${var}}" STREQUAL "")
+    message(FATAL_ERROR "install_consumer_test.cmake: -D${var}=... is required")
+  endif()
+endforeach()
+
+set(prefix ${WORK_DIR}/prefix)
+set(consumer_build ${WORK_DIR}/consumer-build)
+# Start from nothing so that a stale install or cache can never make the test pass.
+file(REMOVE_RECURSE ${WORK_DIR})
+file(MAKE_DIRECTORY ${WORK_DIR})
+
+# Runs one step; on failure prints its output and stops with the step's name.
+function(run_step name)
+  string(TIMESTAMP start "%s")
+  execute_process(COMMAND ${ARGN} RESULT_VARIABLE result OUTPUT_VARIABLE out ERROR_VARIABLE out)
+  string(TIMESTAMP stop "%s")
+  math(EXPR seconds "${stop} - ${start}")
+  if(NOT result EQUAL 0)
+    string(REPLACE ";" " " command "${ARGN}")
+    message(FATAL_ERROR "${name} failed (exit ${result}):\n  ${command}\n${out}")
+  endif()
+  message(STATUS "${name}: ok (${seconds} s)")
+  set(step_output "${out}" PARENT_SCOPE)
+endfunction()
+
+run_step("install dgtex" ${CMAKE_COMMAND} --install ${DGTEX_BUILD_DIR} --prefix ${prefix})
+# The installed tool must start from the prefix (it finds libdgtex.so through its RUNPATH).
+run_step("installed dgtex --help" ${prefix}/bin/dgtex --help)
+
+set(configure_args -S ${CONSUMER_SOURCE_DIR} -B ${consumer_build} -G ${GENERATOR}
+    -DCMAKE_BUILD_TYPE=Release -DCMAKE_PREFIX_PATH=${prefix} -DCMAKE_CXX_COMPILER=${CXX_COMPILER}
+    -DCMAKE_FIND_USE_PACKAGE_REGISTRY=OFF -DDGTEX_CONSUMER_HEADER_CHECK=ON)
+if(MAKE_PROGRAM)
+  list(APPEND configure_args -DCMAKE_MAKE_PROGRAM=${MAKE_PROGRAM})
+endif()
+if(CXX_COMPILER_LAUNCHER)
+  list(APPEND configure_args -DCMAKE_CXX_COMPILER_LAUNCHER=${CXX_COMPILER_LAUNCHER})
+endif()
+run_step("configure consumer" ${CMAKE_COMMAND} ${configure_args})
+
+file(STRINGS ${consumer_build}/CMakeCache.txt dgtex_dir_line REGEX "^dgtex_DIR:")
+string(REGEX REPLACE "^dgtex_DIR:[A-Z]+=" "" dgtex_dir "${dgtex_dir_line}")
+file(REAL_PATH "${dgtex_dir}" dgtex_dir)
+file(REAL_PATH "${prefix}" real_prefix)
+string(FIND "${dgtex_dir}/" "${real_prefix}/" at)
+if(NOT at EQUAL 0)
+  message(FATAL_ERROR "find_package(dgtex) used ${dgtex_dir}, not the package installed under ${prefix}")
+endif()
+
+run_step("build consumer" ${CMAKE_COMMAND} --build ${consumer_build})
+run_step("run consumer" ${consumer_build}/cut_plate)
+message("${step_output}")

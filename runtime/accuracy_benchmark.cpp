@@ -1,0 +1,105 @@
+// Reporting of the speed-against-accuracy sweeps: machine description, JSON and Markdown.
+#include "dgtex/accuracy_benchmark.h"
+
+#include <omp.h>
+#include <time.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <thread>
+
+namespace dgtex {
+
+double accuracy_clock_ms(AccuracyClock clock) {
+  if (clock == AccuracyClock::wall)
+    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now().time_since_epoch()).count();
+  timespec t{};
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+  return t.tv_sec * 1e3 + t.tv_nsec * 1e-6;
+}
+
+std::string accuracy_clock_name(AccuracyClock clock) { return clock == AccuracyClock::cpu ? "CPU" : "wall"; }
+
+std::vector<std::string> AccuracyChart::series() const {
+  std::vector<std::string> out;
+  for (const AccuracyPoint& p : points)
+    if (std::find(out.begin(), out.end(), p.series) == out.end()) out.push_back(p.series);
+  return out;
+}
+
+std::string describe_machine() {
+  std::string model = "unknown CPU";
+  std::ifstream cpuinfo("/proc/cpuinfo");
+  for (std::string line; std::getline(cpuinfo, line);)
+    if (line.rfind("model name", 0) == 0) {
+      const auto colon = line.find(':');
+      if (colon != std::string::npos) model = line.substr(line.find_first_not_of(" \t", colon + 1));
+      break;
+    }
+  std::ostringstream out;
+  out << model << ", " << std::thread::hardware_concurrency() << " cores, " << omp_get_max_threads()
+      << (omp_get_max_threads() == 1 ? " thread" : " threads");
+  return out.str();
+}
+
+std::string accuracy_charts_json(const std::vector<AccuracyChart>& charts, const std::string& machine,
+                                 const std::string& command) {
+  nlohmann::json list = nlohmann::json::array();
+  for (const AccuracyChart& chart : charts) {
+    nlohmann::json points = nlohmann::json::array();
+    for (const AccuracyPoint& p : chart.points) {
+      nlohmann::json point = {{"series", p.series}, {"label", p.label}, {"ms", p.ms}, {"error", p.error}};
+      for (const auto& [key, value] : p.extra) point[key] = value;
+      points.push_back(point);
+    }
+    list.push_back({{"name", chart.name},
+                    {"title", chart.title},
+                    {"time_label", chart.time_label},
+                    {"error_label", chart.error_label},
+                    {"points", points}});
+  }
+  return nlohmann::json{{"machine", machine}, {"command", command}, {"charts", list}}.dump(2) + "\n";
+}
+
+std::string accuracy_charts_markdown(const std::vector<AccuracyChart>& charts, const std::string& machine,
+                                     const std::string& command) {
+  std::ostringstream out;
+  out << "Machine: " << machine << "  \nCommand: `" << command << "`\n";
+  char number[64];
+  for (const AccuracyChart& chart : charts) {
+    std::vector<std::string> extra_keys;
+    for (const AccuracyPoint& p : chart.points)
+      for (const auto& kv : p.extra)
+        if (std::find(extra_keys.begin(), extra_keys.end(), kv.first) == extra_keys.end()) extra_keys.push_back(kv.first);
+    out << "\n### " << chart.name << ": " << chart.title << "\n\ntime: " << chart.time_label
+        << "; error: " << chart.error_label << "\n\n| series | case | ms | error |";
+    for (const std::string& k : extra_keys) out << " " << k << " |";
+    out << "\n|---|---|---|---|";
+    for (std::size_t k = 0; k < extra_keys.size(); ++k) out << "---|";
+    out << "\n";
+    for (const AccuracyPoint& p : chart.points) {
+      out << "| " << p.series << " | " << p.label << " | ";
+      std::snprintf(number, sizeof number, "%.3g", p.ms);
+      out << number << " | ";
+      std::snprintf(number, sizeof number, "%.3g", p.error);
+      out << (p.error == 0 ? std::string("0 (reference)") : std::string(number)) << " |";
+      for (const std::string& key : extra_keys) {
+        const auto it = std::find_if(p.extra.begin(), p.extra.end(), [&](const auto& kv) { return kv.first == key; });
+        if (it == p.extra.end()) {
+          out << " |";
+          continue;
+        }
+        std::snprintf(number, sizeof number, "%.4g", it->second);
+        out << " " << number << " |";
+      }
+      out << "\n";
+    }
+  }
+  return out.str();
+}
+
+}  // namespace dgtex

@@ -1,0 +1,127 @@
+#pragma once
+// Speed against accuracy (dgtex bench accuracy): four sweeps, each a list of (time, error)
+// points in one or more series, for charts of error against milliseconds.
+//  - plate:      simply supported square plate under uniform load, quad8 and tri6, n x n
+//                meshes; relative error of the centre deflection against the Navier series;
+//                time of the static assembly + solve (accuracy_plate.cpp).
+//  - quadrature: a plate with a curved partial cut (enriched elements); merge tolerance of
+//                the enriched quadrature swept; relative error of the compliance f.u of a
+//                fixed load against the per-texel rule; time of one stiffness assembly
+//                (accuracy_quadrature.cpp).
+//  - texture:    texture resolution T; harmonic enrichment of a straight partial cut to the
+//                element centre with +-sqrt(r) data against sqrt(r) sin(theta/2); time of
+//                the Laplace solve, CHOLMOD and multigrid (accuracy_texture.cpp).
+//  - tolerance:  relative tolerance of the corotated dynamic step's PCG (cylinder scene,
+//                against factorising every step) and of the texel multigrid (against
+//                CHOLMOD); solve time (accuracy_tolerance.cpp).
+// Times are milliseconds of the chosen clock (AccuracyClock), best of `repeat` runs where a
+// case is cheap enough to repeat. All sweeps run with the current OpenMP thread count.
+// Plain functions that return their results (nothing kept); each sweep uses all OpenMP
+// threads, so run one at a time. Units: times in ms, errors relative (dimensionless).
+#include <functional>
+#include <string>
+#include <vector>
+
+namespace dgtex {
+
+// cpu: the process's CPU time (all threads summed): with one thread it approximates the
+// time on an idle core and moves little when other jobs share the machine; wall: elapsed
+// (steady_clock), the figure for several threads on an otherwise idle machine.
+enum class AccuracyClock { cpu, wall };
+double accuracy_clock_ms(AccuracyClock clock);  // from an arbitrary fixed origin
+std::string accuracy_clock_name(AccuracyClock clock);  // "CPU" or "wall"
+
+// One measured case. `extra` carries case-specific numbers (quadrature points, iterations,
+// DOFs, ...) that go to the JSON as they are.
+struct AccuracyPoint {
+  std::string series;  // line of the chart ("quad8", "CHOLMOD", ...)
+  std::string label;   // the swept value ("n=8", "T=128", "tol=1e-4", ...)
+  double ms = 0;       // time of the measured stage (see the chart's time_label)
+  double error = 0;    // relative error (see the chart's error_label); 0 = the reference itself
+  std::vector<std::pair<std::string, double>> extra;
+};
+
+struct AccuracyChart {
+  std::string name;         // plate, quadrature, texture, tolerance
+  std::string title;
+  std::string time_label;   // what `ms` measures
+  std::string error_label;  // what `error` measures
+  std::vector<AccuracyPoint> points;
+  std::vector<std::string> series() const;  // distinct series in order of first appearance
+};
+
+// Progress lines (one per case) for the caller to print; may be empty.
+using AccuracyProgress = std::function<void(const std::string& line)>;
+
+struct PlateAccuracyOptions {
+  std::vector<int> divisions = {2, 4, 6, 8, 12, 16, 24, 32};  // n (even: a node at the centre)
+  double penalty = 0.8;
+  int repeat = 3;
+  AccuracyClock clock = AccuracyClock::cpu;
+};
+// std::invalid_argument for odd or non-positive n.
+AccuracyChart run_plate_accuracy(const PlateAccuracyOptions& options, const AccuracyProgress& progress = {});
+
+// Navier double series for the centre deflection of a simply supported a x b plate under
+// uniform load q with bending rigidity D (terms m, n odd up to `terms`).
+double navier_plate_centre_deflection(double a, double b, double q, double D, int terms = 399);
+
+struct QuadratureAccuracyOptions {
+  int resolution = 128;  // texels per element side T
+  // Merge tolerances of the adaptive rule; the per-texel rule is always run (the reference).
+  std::vector<double> tolerances = {1.0, 0.1, 3e-2, 1e-2, 3e-3, 1e-3, 1e-4};
+  std::vector<std::string> elements = {"quad8", "tri6"};
+  int repeat = 3;
+  AccuracyClock clock = AccuracyClock::cpu;
+};
+// Points carry extra "quadrature_points" (enriched element points), "rule_ms" (building
+// the rule and the enriched model) and "compliance". std::invalid_argument for a bad
+// element name, T < 8 or a non-positive tolerance.
+AccuracyChart run_quadrature_accuracy(const QuadratureAccuracyOptions& options, const AccuracyProgress& progress = {});
+
+struct TextureAccuracyOptions {
+  std::vector<int> resolutions = {16, 32, 64, 128, 256, 512};
+  // Annulus of the comparison, in element lengths (the tile is the unit square, the tip at
+  // its centre): max over texel centres with r_min <= r <= r_max of |H - f| / sqrt(r).
+  double r_min = 1.0 / 16, r_max = 1.0 / 4;
+  double multigrid_tolerance = 1e-10;
+  int repeat = 3;
+  AccuracyClock clock = AccuracyClock::cpu;
+};
+// Points carry extra "rms_error" (root mean square of the same ratio over the annulus),
+// "texels" (in the annulus) and "unknowns". std::invalid_argument for T < 16 or odd T.
+AccuracyChart run_texture_accuracy(const TextureAccuracyOptions& options, const AccuracyProgress& progress = {});
+
+// Largest relative error |H - f| / sqrt(r) of the +-sqrt(r) harmonic enrichment at one T
+// (CHOLMOD), as plotted by run_texture_accuracy; for tests.
+double crack_tip_texture_error(int resolution, double r_min = 1.0 / 16, double r_max = 1.0 / 4);
+
+struct ToleranceAccuracyOptions {
+  std::string shell_scene = "examples/scenes/cylinder_buckling.json";  // dynamic, corotated, no cuts
+  int shell_steps = 30;
+  std::vector<double> shell_tolerances = {1e-1, 1e-2, 1e-3, 1e-4, 1e-6, 1e-8, 1e-10};
+  int multigrid_resolution = 512;  // slit domain (dgtex/laplace_domains.h)
+  std::vector<double> multigrid_tolerances = {1e-1, 1e-2, 1e-3, 1e-4, 1e-6, 1e-8, 1e-10};
+  int repeat = 3;  // multigrid only; the shell runs are long and run once
+  bool shell = true, multigrid = true;
+  AccuracyClock clock = AccuracyClock::cpu;
+};
+// Shell: error = |u - u_ref| / |u_ref| of the final displacement against factorising every
+// step (direct solves), ms = assembly + solve time of all steps; extra "pcg_iterations",
+// "factorizations". Multigrid: error = max |H - H_ref| against CHOLMOD (H is O(1)), ms =
+// one solve from zero (setup included); extra "iterations". The references appear with
+// error 0. Throws what run_shell_benchmark throws for a bad scene.
+AccuracyChart run_tolerance_accuracy(const ToleranceAccuracyOptions& options, const AccuracyProgress& progress = {});
+
+// "MODEL NAME, N cores" from /proc/cpuinfo (or "unknown CPU"), plus the OpenMP threads.
+std::string describe_machine();
+
+// {"charts": [{"name", "title", "time_label", "error_label", "points": [{"series", "label",
+// "ms", "error", extra...}]}], "machine", "command"} as JSON text.
+std::string accuracy_charts_json(const std::vector<AccuracyChart>& charts, const std::string& machine,
+                                 const std::string& command);
+// One Markdown table per chart (series, label, ms, error, extra columns).
+std::string accuracy_charts_markdown(const std::vector<AccuracyChart>& charts, const std::string& machine,
+                                     const std::string& command);
+
+}  // namespace dgtex

@@ -1,0 +1,97 @@
+#include "dgtex/enrichment_span.h"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <stdexcept>
+#include <string>
+
+namespace dgtex {
+namespace {
+
+const kernels::TexelTile* texture_of(const EnrichmentFunction& f, int element) {
+  const auto it = std::lower_bound(f.elements.begin(), f.elements.end(), element,
+                                   [](const ElementTexture& t, int e) { return t.element < e; });
+  return it != f.elements.end() && it->element == element ? &it->tile : nullptr;
+}
+
+double dot(const std::vector<double>& a, const std::vector<double>& b) {
+  double s = 0;
+  for (std::size_t k = 0; k < a.size(); ++k) s += a[k] * b[k];
+  return s;
+}
+
+}  // namespace
+
+std::vector<std::vector<int>> independent_enriched_nodes(const std::vector<std::vector<int>>& node_elements,
+                                                         const std::vector<EnrichmentFunction>& functions,
+                                                         double tolerance) {
+  // Node -> the functions enriching it, in function order.
+  std::map<int, std::vector<int>> by_node;
+  for (int i = 0; i < static_cast<int>(functions.size()); ++i)
+    for (int a : functions[i].enriched_nodes) by_node[a].push_back(i);
+
+  std::vector<std::vector<int>> kept(functions.size());
+  std::vector<std::vector<double>> basis;  // orthonormal over the node's support texels
+  std::vector<double> column;
+  for (const auto& [a, list] : by_node) {
+    if (a < 0 || a >= static_cast<int>(node_elements.size()))
+      throw std::invalid_argument("enrichment function " + std::to_string(list[0]) + ": enriched node " +
+                                  std::to_string(a) + " out of range [0, " + std::to_string(node_elements.size()) + ")");
+    // The tiles of every function on every element incident to a.
+    std::vector<std::vector<const kernels::TexelTile*>> tiles(list.size());
+    for (std::size_t k = 0; k < list.size(); ++k)
+      for (int e : node_elements[a]) {
+        const kernels::TexelTile* tile = texture_of(functions[list[k]], e);
+        if (!tile)
+          throw std::invalid_argument("enrichment function " + std::to_string(list[k]) + ": element " + std::to_string(e) +
+                                      " is incident to enriched node " + std::to_string(a) + " but has no texture");
+        tiles[k].push_back(tile);
+      }
+    // Sample positions: the active texels of the support (flags are the same in every
+    // function: the walls of all cuts and the inactive bits).
+    std::size_t n = 0;
+    for (const kernels::TexelTile* tile : tiles[0])
+      for (std::uint8_t flag : tile->flags) n += !(flag & kernels::inactive);
+    if (n == 0) continue;
+    basis.assign(1, std::vector<double>(n, 1.0 / std::sqrt(static_cast<double>(n))));
+    for (std::size_t k = 0; k < list.size(); ++k) {
+      column.clear();
+      for (std::size_t t = 0; t < tiles[k].size(); ++t) {
+        const kernels::TexelTile& mask = *tiles[0][t];
+        for (std::size_t p = 0; p < mask.flags.size(); ++p)
+          if (!(mask.flags[p] & kernels::inactive)) column.push_back(tiles[k][t]->values[p]);
+      }
+      if (column.size() != n)
+        throw std::invalid_argument("enrichment function " + std::to_string(list[k]) + ": the textures around node " +
+                                    std::to_string(a) + " differ in size or active texels from function " +
+                                    std::to_string(list[0]) + "'s");
+      for (int pass = 0; pass < 2; ++pass)  // twice: classical Gram-Schmidt loses orthogonality once
+        for (const std::vector<double>& q : basis) {
+          const double c = dot(q, column);
+          for (std::size_t p = 0; p < n; ++p) column[p] -= c * q[p];
+        }
+      const double norm = std::sqrt(dot(column, column));
+      if (!(norm > tolerance * std::sqrt(static_cast<double>(n)))) continue;  // adds nothing at a
+      for (double& v : column) v /= norm;
+      basis.push_back(column);
+      kept[list[k]].push_back(a);
+    }
+  }
+  return kept;  // by_node is ordered by node, so each list is sorted
+}
+
+EnrichmentFunction restrict_enriched_nodes(const Mesh& mesh, const EnrichmentFunction& f, std::vector<int> nodes) {
+  EnrichmentFunction out;
+  out.enriched_nodes = std::move(nodes);
+  for (const ElementTexture& texture : f.elements) {
+    const int* element_nodes = mesh.element_nodes(texture.element);
+    bool touches = false;
+    for (int k = 0; k < mesh.nodes_per_element() && !touches; ++k)
+      touches = std::binary_search(out.enriched_nodes.begin(), out.enriched_nodes.end(), element_nodes[k]);
+    if (touches) out.elements.push_back(texture);
+  }
+  return out;
+}
+
+}  // namespace dgtex

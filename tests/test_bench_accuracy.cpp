@@ -1,0 +1,190 @@
+// dgtex bench accuracy (dgtex/accuracy_benchmark.h): a reduced run through the CLI, with
+// invariants that a broken sweep would violate (convergence with refinement and texture
+// resolution, the per-texel reference, error bounds of loose tolerances), the output files
+// and keys, and the rejection of bad arguments.
+#include <gtest/gtest.h>
+
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "dgtex/accuracy_benchmark.h"
+
+namespace {
+
+namespace fs = std::filesystem;
+
+// Points of one chart: series -> points in run order.
+std::map<std::string, std::vector<nlohmann::json>> by_series(const nlohmann::json& chart) {
+  std::map<std::string, std::vector<nlohmann::json>> out;
+  for (const auto& p : chart.at("points")) out[p.at("series").get<std::string>()].push_back(p);
+  return out;
+}
+
+// The reduced run (once per test process; gtest_discover_tests runs each TEST alone, so
+// all checks of it live in one TEST).
+struct ReducedRun {
+  fs::path dir;
+  int status = -1;
+  nlohmann::json json;
+  const nlohmann::json& chart(const std::string& name) const {
+    for (const auto& c : json.at("charts"))
+      if (c.at("name") == name) return c;
+    ADD_FAILURE() << "no chart " << name;
+    static const nlohmann::json empty = {{"points", nlohmann::json::array()}};
+    return empty;
+  }
+};
+
+ReducedRun run_reduced() {
+  ReducedRun run;
+  run.dir = fs::temp_directory_path() / ("dgtex_bench_accuracy_" + std::to_string(getpid()));
+  fs::remove_all(run.dir);
+  const std::string command =
+      std::string(DGTEX_CLI) +
+      " bench accuracy --threads 1 --repeat 1 --plate-divisions 4,8,16 --quadrature-resolution 32"
+      " --quadrature-tolerances 1,1e-2 --texture-sizes 16,32,64 --shell-scene " DGTEX_SOURCE_DIR
+      "/examples/scenes/cylinder_buckling.json --shell-steps 3 --shell-tolerances 1e-2,1e-8 --multigrid-size 64"
+      " --multigrid-tolerances 1e-1,1e-8 --out " +
+      run.dir.string() + " > " + (run.dir.string() + ".log") + " 2>&1";
+  run.status = std::system(command.c_str());
+  std::ifstream in(run.dir / "accuracy.json");
+  if (in) in >> run.json;
+  return run;
+}
+
+void check_WritesChartsJsonAndTable(const ReducedRun& run) {
+  SCOPED_TRACE("WritesChartsJsonAndTable");
+  for (const char* name : {"plate", "quadrature", "texture", "tolerance"}) {
+    EXPECT_TRUE(fs::exists(run.dir / (std::string("accuracy_") + name + ".png"))) << name;
+    const auto& c = run.chart(name);
+    for (const char* key : {"title", "time_label", "error_label", "points"}) EXPECT_TRUE(c.contains(key)) << name << key;
+    ASSERT_FALSE(c.at("points").empty()) << name;
+    for (const auto& p : c.at("points")) {
+      for (const char* key : {"series", "label", "ms", "error"}) EXPECT_TRUE(p.contains(key)) << name << " " << key;
+      EXPECT_GE(p.at("ms").get<double>(), 0.0);
+      EXPECT_TRUE(std::isfinite(p.at("error").get<double>()));
+    }
+  }
+  EXPECT_FALSE(run.json.at("machine").get<std::string>().empty());
+  EXPECT_NE(run.json.at("command").get<std::string>().find("dgtex bench accuracy"), std::string::npos);
+  EXPECT_TRUE(fs::exists(run.dir / "accuracy.md"));
+}
+
+// Simply supported plate: the centre deflection error falls with every refinement, at a
+// rate of at least 1.5 from n = 8 to 16 (measured: quad8 2.09, tri6 1.86).
+void check_PlateErrorConvergesWithRefinement(const ReducedRun& run) {
+  SCOPED_TRACE("PlateErrorConvergesWithRefinement");
+  const auto series = by_series(run.chart("plate"));
+  ASSERT_EQ(series.size(), 2u);
+  for (const auto& [name, points] : series) {
+    ASSERT_EQ(points.size(), 3u) << name;
+    for (std::size_t k = 1; k < points.size(); ++k)
+      EXPECT_LT(points[k].at("error").get<double>(), points[k - 1].at("error").get<double>()) << name;
+    const double rate = std::log2(points[1].at("error").get<double>() / points[2].at("error").get<double>());
+    EXPECT_GT(rate, 1.5) << name;
+    EXPECT_LT(points[2].at("error").get<double>(), name == "quad8" ? 5e-3 : 2e-2) << name;
+  }
+}
+
+// The per-texel rule is the reference (error exactly 0) and has the most points; a merge
+// tolerance of 1e-2 stays within 2 % of its compliance, even the loosest (1) within 10 %.
+void check_QuadratureReferenceAndBounds(const ReducedRun& run) {
+  SCOPED_TRACE("QuadratureReferenceAndBounds");
+  const auto series = by_series(run.chart("quadrature"));
+  ASSERT_EQ(series.size(), 2u);
+  for (const auto& [name, points] : series) {
+    ASSERT_EQ(points.size(), 3u) << name;
+    EXPECT_EQ(points[0].at("label"), "per-texel");
+    EXPECT_EQ(points[0].at("error").get<double>(), 0.0);
+    const double reference_points = points[0].at("quadrature_points").get<double>();
+    EXPECT_LT(points[1].at("quadrature_points").get<double>(), points[2].at("quadrature_points").get<double>()) << name;
+    EXPECT_LT(points[2].at("quadrature_points").get<double>(), reference_points) << name;
+    EXPECT_LT(points[1].at("error").get<double>(), 0.1) << name << " tol=1";
+    EXPECT_LT(points[2].at("error").get<double>(), 0.02) << name << " tol=1e-2";
+  }
+}
+
+// Crack tip: the error in the fixed annulus falls with T; CHOLMOD and the multigrid (to
+// 1e-10) give the same field, so the same error to 1e-6.
+void check_TipErrorFallsWithTextureResolution(const ReducedRun& run) {
+  SCOPED_TRACE("TipErrorFallsWithTextureResolution");
+  const auto series = by_series(run.chart("texture"));
+  ASSERT_EQ(series.size(), 2u);
+  for (const auto& [name, points] : series) {
+    ASSERT_EQ(points.size(), 3u) << name;
+    for (std::size_t k = 1; k < points.size(); ++k)
+      EXPECT_LT(points[k].at("error").get<double>(), 0.8 * points[k - 1].at("error").get<double>()) << name;
+  }
+  const auto& cholmod = series.at("CHOLMOD");
+  const auto& multigrid = series.at("multigrid");
+  for (std::size_t k = 0; k < cholmod.size(); ++k)
+    EXPECT_NEAR(cholmod[k].at("error").get<double>(), multigrid[k].at("error").get<double>(), 1e-6);
+}
+
+// Tolerances: the references have error 0; the shell's loosest PCG tolerance (1e-2, 3
+// steps) stays within 1e-3 of factorising every step and the default-class one (1e-8)
+// within 1e-6; the multigrid at 1e-1 is within 0.1 of CHOLMOD (H in [-1, 1]) and at 1e-8
+// within 1e-6.
+void check_ToleranceErrorsWithinBounds(const ReducedRun& run) {
+  SCOPED_TRACE("ToleranceErrorsWithinBounds");
+  const auto series = by_series(run.chart("tolerance"));
+  ASSERT_EQ(series.size(), 2u);
+  for (const auto& [name, points] : series) {
+    ASSERT_EQ(points.size(), 3u) << name;
+    EXPECT_EQ(points[0].at("error").get<double>(), 0.0) << name;
+    const bool shell = name.rfind("shell", 0) == 0;
+    EXPECT_LT(points[1].at("error").get<double>(), shell ? 1e-3 : 0.1) << name;
+    EXPECT_LT(points[2].at("error").get<double>(), 1e-6) << name;
+    EXPECT_LE(points[2].at("error").get<double>(), points[1].at("error").get<double>()) << name;
+  }
+}
+
+TEST(BenchAccuracy, ReducedRunMeetsInvariants) {
+  const ReducedRun run = run_reduced();
+  ASSERT_EQ(run.status, 0) << "see " << run.dir.string() << ".log";
+  check_WritesChartsJsonAndTable(run);
+  check_PlateErrorConvergesWithRefinement(run);
+  check_QuadratureReferenceAndBounds(run);
+  check_TipErrorFallsWithTextureResolution(run);
+  check_ToleranceErrorsWithinBounds(run);
+  fs::remove_all(run.dir);
+  fs::remove(run.dir.string() + ".log");
+}
+
+TEST(BenchAccuracyArguments, BadValuesAreRejectedWithExitCode2) {
+  const std::string cli = DGTEX_CLI;
+  const std::string out = (fs::temp_directory_path() / ("dgtex_bench_accuracy_bad_" + std::to_string(getpid()))).string();
+  EXPECT_EQ(WEXITSTATUS(std::system((cli + " bench accuracy --charts plate,bogus --out " + out + " 2>/dev/null").c_str())), 2);
+  EXPECT_EQ(WEXITSTATUS(std::system((cli + " bench accuracy --charts plate --plate-divisions 3 --out " + out +
+                                     " 2>/dev/null").c_str())), 2);
+  EXPECT_EQ(WEXITSTATUS(std::system((cli + " bench accuracy --charts texture --texture-sizes 8 --out " + out +
+                                     " 2>/dev/null").c_str())), 2);
+  fs::remove_all(out);
+}
+
+// The Navier series gives Timoshenko's 0.00406 q a^4 / D for the square plate (nu-free).
+TEST(BenchAccuracyNavier, SquarePlateCoefficient) {
+  const double D = 2.0, q = -3.0, a = 1.5;
+  const double w = dgtex::navier_plate_centre_deflection(a, a, q, D);
+  EXPECT_NEAR(w * D / (q * std::pow(a, 4)), 0.0040623527, 1e-9);
+  // A 2:1 rectangle: Timoshenko Table 8 gives 0.01013 for b = 2a.
+  EXPECT_NEAR(dgtex::navier_plate_centre_deflection(1, 2, 1, 1), 0.01013, 5e-5);
+}
+
+// The texture error helper used by the chart: falls with T (2.7e-2 at T = 16).
+TEST(BenchAccuracyTexture, HelperErrorFallsWithResolution) {
+  const double e16 = dgtex::crack_tip_texture_error(16), e32 = dgtex::crack_tip_texture_error(32);
+  EXPECT_LT(e16, 0.05);
+  EXPECT_LT(e32, 0.8 * e16);
+  EXPECT_THROW(dgtex::crack_tip_texture_error(15), std::invalid_argument);
+}
+
+}  // namespace

@@ -1,0 +1,118 @@
+// dgtex bench scaling (dgtex/scaling_benchmark.h): kernel results do not depend on the
+// thread count, independent scenes run at once in one process end where a run alone ends,
+// and the command writes its JSON (every family, every thread count) and its chart.
+#include <gtest/gtest.h>
+
+#include <omp.h>
+#include <unistd.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "dgtex/scaling_benchmark.h"
+#include "dgtex/scene_io.h"
+#include "dgtex/scene_run.h"
+
+namespace fs = std::filesystem;
+using namespace dgtex;
+
+namespace {
+
+const std::string kScenes = std::string(DGTEX_SOURCE_DIR) + "/examples/scenes";
+
+struct Result {
+  int exit_code;
+  std::string stderr_text;
+};
+
+Result run_cli(const std::string& args, const fs::path& workdir) {
+  const fs::path err = workdir / "stderr.txt";
+  const std::string command = std::string(DGTEX_CLI) + " " + args + " 2> " + err.string() + " > /dev/null";
+  const int status = std::system(command.c_str());
+  std::ifstream in(err);
+  return {WEXITSTATUS(status), std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>())};
+}
+
+fs::path fresh_dir(const std::string& name) {
+  const fs::path dir = fs::temp_directory_path() / ("dgtex_bench_scaling_" + name + "_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  return dir;
+}
+
+}  // namespace
+
+TEST(BenchScaling, KernelResultsAreBitwiseEqualForEveryThreadCount) {
+  const std::vector<int> threads = {1, 2, 3};
+  const KernelScaling polar = scale_polar_decomposition(5000, threads, 1);
+  EXPECT_EQ(polar.family, "polar_decomposition");
+  ASSERT_EQ(polar.ms.size(), 3u);
+  EXPECT_TRUE(polar.identical_across_threads);
+  for (double ms : polar.ms) EXPECT_GT(ms, 0);
+
+  const KernelScaling assembly = scale_assembly(load_scene(kScenes + "/spiral1.json"), true, threads, 1);
+  EXPECT_TRUE(assembly.identical_across_threads);
+  EXPECT_NE(assembly.workload.find("1 complete-cut enrichments"), std::string::npos) << assembly.workload;
+
+  const KernelScaling steps = scale_scene_steps(load_scene(kScenes + "/spiral1.json"), 1, {1, 2});
+  EXPECT_TRUE(steps.identical_across_threads);
+  ASSERT_EQ(steps.ms.size(), 2u);
+
+  const KernelScaling enrichment = scale_enrichment_solve(load_scene(kScenes + "/spiral1.json"), {1, 2}, 1);
+  ASSERT_EQ(enrichment.ms.size(), 2u);
+  EXPECT_NE(enrichment.workload.find("1 solves"), std::string::npos) << enrichment.workload;
+  EXPECT_THROW(scale_enrichment_solve(load_scene(kScenes + "/cylinder_buckling.json"), {1}, 1), std::invalid_argument);
+  EXPECT_THROW(scale_polar_decomposition(10, {0}, 1), std::invalid_argument);
+}
+
+// spiral1 (a 39-unknown shell system, a one-element multigrid Laplace solve): every run,
+// alone with two threads or two at once with one thread each, ends in bitwise the same
+// state as a plain SceneRun.
+TEST(BenchScaling, BatchMembersEndExactlyWhereARunAloneEnds) {
+  const Scene scene = load_scene(kScenes + "/spiral1.json");
+  const BatchThroughput b = measure_batch_throughput(scene, 2, 2, 2);
+  EXPECT_EQ(b.runs, 2);
+  EXPECT_GT(b.solo_ms, 0);
+  EXPECT_GT(b.batch_ms, 0);
+  EXPECT_TRUE(b.identical);
+  EXPECT_EQ(b.max_relative_difference, 0.0);
+  omp_set_num_threads(1);
+  SceneRun alone(scene);
+  for (int s = 0; s < 2; ++s) alone.step();
+  EXPECT_EQ(b.displacement, alone.displacement());
+  EXPECT_THROW(measure_batch_throughput(scene, 0, 1, 1), std::invalid_argument);
+}
+
+TEST(BenchScaling, CommandWritesJsonForEveryThreadCountAndAChart) {
+  const fs::path dir = fresh_dir("cli");
+  const fs::path json = dir / "scaling.json", chart = dir / "scaling.png";
+  const Result r = run_cli("bench scaling --threads-list 1,2 --families polar_decomposition,batch --polar-count 20000 "
+                           "--repeats 1 --batch-scenes " + kScenes + "/spiral1.json --batch-steps 1 --batch-runs 2 --json " +
+                               json.string() + " --chart " + chart.string(),
+                           dir);
+  ASSERT_EQ(r.exit_code, 0) << r.stderr_text;
+  std::ifstream in(json);
+  const nlohmann::json j = nlohmann::json::parse(in);
+  ASSERT_EQ(j["kernels"].size(), 1u);
+  EXPECT_EQ(j["kernels"][0]["family"], "polar_decomposition");
+  ASSERT_EQ(j["kernels"][0]["cases"].size(), 2u);
+  EXPECT_EQ(j["kernels"][0]["cases"][1]["threads"], 2);
+  EXPECT_DOUBLE_EQ(j["kernels"][0]["cases"][0]["speedup"].get<double>(), 1.0);
+  ASSERT_EQ(j["batch"].size(), 1u);
+  EXPECT_EQ(j["batch"][0]["runs"], 2);
+  EXPECT_EQ(j["batch"][0]["identical"], true);
+  const double solo = j["batch"][0]["solo_scenes_per_second"], solo_ms = j["batch"][0]["solo_ms"];
+  EXPECT_NEAR(solo * solo_ms, 2e3, 1e-6);  // 2 scenes in solo_ms
+  // A PNG file (gnuplot is a dependency of the project).
+  std::ifstream png(chart, std::ios::binary);
+  char signature[4] = {};
+  png.read(signature, 4);
+  EXPECT_EQ(std::string(signature + 1, 3), "PNG");
+
+  const Result bad = run_cli("bench scaling --families no_such_family", dir);
+  EXPECT_EQ(bad.exit_code, 2);
+  EXPECT_NE(bad.stderr_text.find("no_such_family"), std::string::npos) << bad.stderr_text;
+}

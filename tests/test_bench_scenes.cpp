@@ -1,0 +1,172 @@
+// dgtex bench scenes (dgtex/scene_benchmark.h): the JSON holds every requested scene with
+// the required keys, counts its steps, reports the same model sizes as `dgtex run`, and
+// the benchmark does not change the simulation it times. Few steps of cheap scenes only.
+#include <gtest/gtest.h>
+
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "dgtex/scene_benchmark.h"
+#include "dgtex/scene_io.h"
+#include "dgtex/scene_run.h"
+
+namespace fs = std::filesystem;
+using namespace dgtex;
+
+namespace {
+
+const std::string kScenes = std::string(DGTEX_SOURCE_DIR) + "/examples/scenes";
+
+struct Result {
+  int exit_code;
+  std::string stderr_text;
+};
+
+Result run_cli(const std::string& args, const fs::path& workdir) {
+  const fs::path err = workdir / "stderr.txt";
+  const std::string command = std::string(DGTEX_CLI) + " " + args + " 2> " + err.string() + " > /dev/null";
+  const int status = std::system(command.c_str());
+  std::ifstream in(err);
+  return {WEXITSTATUS(status), std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>())};
+}
+
+fs::path fresh_dir(const std::string& name) {
+  const fs::path dir = fs::temp_directory_path() / ("dgtex_bench_scenes_" + name + "_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  return dir;
+}
+
+nlohmann::json read_json(const fs::path& path) {
+  std::ifstream in(path);
+  return nlohmann::json::parse(in);
+}
+
+// spiral1 with its own step count set to `steps` and no render block, written to dir.
+fs::path short_spiral(const fs::path& dir, int steps) {
+  nlohmann::json scene = read_json(kScenes + "/spiral1.json");
+  scene["analysis"]["steps"] = steps;
+  scene.erase("render");
+  const fs::path path = dir / "spiral1.json";
+  std::ofstream(path) << scene.dump(2);
+  return path;
+}
+
+}  // namespace
+
+TEST(BenchScenes, JsonHasEveryRequestedSceneWithRequiredKeysAndThesisRatios) {
+  const fs::path dir = fresh_dir("json");
+  const Result r = run_cli("bench scenes --scene-dir " + kScenes + " --scenes spiral1,cylinder_buckling --steps 2 --json " +
+                               (dir / "out.json").string() + " --markdown " + (dir / "out.md").string() + " --quiet",
+                           dir);
+  ASSERT_EQ(r.exit_code, 0) << r.stderr_text;
+  const nlohmann::json j = read_json(dir / "out.json");
+  ASSERT_EQ(j["scenes"].size(), 2u);
+  EXPECT_EQ(j["scenes"][0]["name"], "spiral1");
+  EXPECT_EQ(j["scenes"][1]["name"], "cylinder_buckling");
+  for (const nlohmann::json& s : j["scenes"]) {
+    EXPECT_EQ(s["steps"], 2);
+    EXPECT_GT(s["steps_per_second"].get<double>(), 0);
+    for (const char* stage : {"enrichment", "assembly", "solve"}) {
+      ASSERT_TRUE(s["timings_ms"].contains(stage)) << stage;
+      const double mean = s["timings_ms"][stage]["mean"], max = s["timings_ms"][stage]["max"];
+      EXPECT_GE(mean, 0) << stage;
+      EXPECT_GE(max, mean) << stage;
+      EXPECT_EQ(s["per_step_ms"][stage].size(), 2u) << stage;
+    }
+    EXPECT_GT(s["timings_ms"]["assembly"]["mean"].get<double>(), 0);
+    EXPECT_GT(s["timings_ms"]["solve"]["mean"].get<double>(), 0);
+    // steps/s is the inverse of the mean whole-step time.
+    EXPECT_NEAR(s["steps_per_second"].get<double>() * s["timings_ms"]["step"]["mean"].get<double>(), 1e3, 1e-6);
+    for (const char* key : {"elements", "nodes", "dofs", "free_dofs", "nonzeros", "enrichments"})
+      EXPECT_TRUE(s["counts"].contains(key)) << key;
+  }
+  // spiral1: Table 5.1 "Spiral 1" (274 / 1.8 / 0.1 ms); ratio = thesis / ours.
+  const nlohmann::json& spiral = j["scenes"][0];
+  EXPECT_EQ(spiral["table_5_1"]["model"], "Spiral 1");
+  EXPECT_NEAR(spiral["ratio_to_table_5_1"]["enrichment"].get<double>() * spiral["timings_ms"]["enrichment"]["max"].get<double>(),
+              274.0, 1e-9);
+  EXPECT_NEAR(spiral["ratio_to_table_5_1"]["assembly"].get<double>() * spiral["timings_ms"]["assembly"]["mean"].get<double>(),
+              1.8, 1e-12);
+  EXPECT_NEAR(spiral["ratio_to_table_5_1"]["solve"].get<double>() * spiral["timings_ms"]["solve"]["mean"].get<double>(),
+              0.1, 1e-12);
+  EXPECT_EQ(spiral["counts"]["elements"], 1);
+  EXPECT_EQ(spiral["counts"]["nodes"], 8);
+  EXPECT_TRUE(j["scenes"][1]["table_5_1"].is_null());
+  EXPECT_TRUE(j["scenes"][1]["ratio_to_table_5_1"].is_null());
+  EXPECT_EQ(j["scenes"][1]["counts"]["enrichments"], 0);
+  EXPECT_TRUE(fs::file_size(dir / "out.md") > 0);
+}
+
+TEST(BenchScenes, CountsMatchTheReportOfDgtexRun) {
+  const fs::path dir = fresh_dir("counts");
+  const fs::path scene = short_spiral(dir, 3);
+  const Result run = run_cli("run " + scene.string() + " --out " + (dir / "run").string() + " --no-render --quiet", dir);
+  ASSERT_EQ(run.exit_code, 0) << run.stderr_text;
+  // --steps 0: the scene's own 3 steps, like `dgtex run`.
+  const Result bench = run_cli("bench scenes --scenes " + scene.string() + " --steps 0 --quiet --json " +
+                                   (dir / "bench.json").string(),
+                               dir);
+  ASSERT_EQ(bench.exit_code, 0) << bench.stderr_text;
+  const nlohmann::json report = read_json(dir / "run" / "report.json");
+  const nlohmann::json b = read_json(dir / "bench.json");
+  ASSERT_EQ(b["scenes"].size(), 1u);
+  EXPECT_EQ(b["scenes"][0]["steps"], 3);
+  EXPECT_EQ(b["scenes"][0]["counts"], report["counts"]);
+  EXPECT_GE(report["counts"]["enrichments"].get<int>(), 1);  // the cut is there after 3 steps
+}
+
+TEST(BenchScenes, TimingDoesNotChangeTheSimulationAndStagesFitInTheStep) {
+  const Scene scene = load_scene(kScenes + "/spiral1.json");
+  const SceneBenchResult r = run_scene_benchmark(scene, "spiral1", 3);
+  SceneRun plain(scene);
+  for (int s = 0; s < 3; ++s) plain.step();
+  EXPECT_EQ(r.displacement, plain.displacement());  // bitwise: same steps, same state
+  ASSERT_EQ(r.steps, 3);
+  const SceneStepTimes& t = r.times;
+  ASSERT_EQ(t.step.size(), 3u);
+  ASSERT_EQ(t.enrichment.size(), 3u);
+  for (std::size_t s = 0; s < 3; ++s) {
+    // The stages run inside the step (step 1 also carries the time-0 cut update on both sides).
+    const double stages = t.enrichment[s] + t.projection[s] + t.assembly[s] + t.solve[s];
+    EXPECT_LE(stages, t.step[s] + 1e-6) << "step " << s + 1;
+    EXPECT_GT(t.assembly[s], 0);
+  }
+  EXPECT_GT(t.enrichment[0], 0);  // the progressive cut is solved at time 0 and every step
+  EXPECT_EQ(r.counts.basis_changes, plain.basis_changes());
+  EXPECT_EQ(r.counts.elements, 1);
+}
+
+TEST(BenchScenes, ThesisTableRowsAreThoseOfTable51) {
+  const ThesisTable51Row* spiral6 = thesis_table_5_1_row("spiral6");
+  ASSERT_NE(spiral6, nullptr);
+  EXPECT_EQ(spiral6->enrichments, 6);
+  EXPECT_EQ(spiral6->enrichment_ms, 1701);
+  EXPECT_EQ(spiral6->assembly_ms, 38);
+  EXPECT_EQ(spiral6->solve_ms, 0.7);
+  const ThesisTable51Row* bunny = thesis_table_5_1_row("fracture");
+  ASSERT_NE(bunny, nullptr);
+  EXPECT_EQ(bunny->elements, 552);
+  EXPECT_EQ(bunny->solve_ms, 917);
+  EXPECT_EQ(thesis_table_5_1_row("cylinder_buckling"), nullptr);
+  EXPECT_EQ(bench_scene_names().size(), 7u);
+  for (const std::string& name : bench_scene_names()) EXPECT_TRUE(fs::exists(kScenes + "/" + name + ".json")) << name;
+}
+
+TEST(BenchScenes, BadInputExitsWithTwoAndNamesTheProblem) {
+  const fs::path dir = fresh_dir("bad");
+  const Result unknown = run_cli("bench scenes --scene-dir " + kScenes + " --scenes no_such_scene --quiet", dir);
+  EXPECT_EQ(unknown.exit_code, 2);
+  EXPECT_NE(unknown.stderr_text.find("no_such_scene"), std::string::npos) << unknown.stderr_text;
+  const Result static_scene =
+      run_cli("bench scenes --scenes " + kScenes + "/clamped_plate.json --steps 1 --quiet", dir);
+  EXPECT_EQ(static_scene.exit_code, 2);
+  EXPECT_NE(static_scene.stderr_text.find("static"), std::string::npos) << static_scene.stderr_text;
+  EXPECT_THROW(run_scene_benchmark(load_scene(kScenes + "/spiral1.json"), "spiral1", -1), std::invalid_argument);
+}

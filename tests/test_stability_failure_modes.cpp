@@ -1,0 +1,418 @@
+// Where shell methods fail and what dgtex does about it (README "Stability where methods
+// fail"): time steps far beyond the explicit limit, large rotations (linear vs corotated),
+// nearly incompressible materials, and cuts that run exactly along element edges.
+#include <gtest/gtest.h>
+
+#include <Eigen/Dense>
+#include <cmath>
+#include <cstdio>
+#include <memory>
+#include <random>
+
+#include "cut_test_support.h"
+#include "dgtex/cut_manager.h"
+#include "dgtex/kernels/shell_point.h"
+#include "dgtex/shell_simulation.h"
+#include "shell_test_support.h"
+
+using namespace dgtex;
+using namespace dgtex::testing_support;
+using TestMaterial = dgtex::testing_support::Material;
+
+namespace {
+
+// Dense free-DOF stiffness (linear) and mass (small meshes only); unknown[d] = row or -1.
+void dense_free_matrices(const ShellModel& model, const std::vector<char>& fixed, Eigen::MatrixXd& K, Eigen::MatrixXd& M,
+                         std::vector<int>& unknown) {
+  std::vector<double> blocks;
+  model.assemble_stiffness(nullptr, blocks, nullptr);
+  const BlockAssembly& p = model.pattern();
+  unknown.assign(model.num_dofs(), -1);
+  int count = 0;
+  for (int d = 0; d < model.num_dofs(); ++d)
+    if (!fixed[d]) unknown[d] = count++;
+  K = Eigen::MatrixXd::Zero(count, count);
+  M = Eigen::MatrixXd::Zero(count, count);
+  for (int r = 0; r < p.num_nodes(); ++r)
+    for (std::int64_t k = p.row_start()[r]; k < p.row_start()[r + 1]; ++k)
+      for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j) {
+          const int a = unknown[3 * r + i], b = unknown[3 * p.column()[k] + j];
+          if (a < 0 || b < 0) continue;
+          K(a, b) = blocks[k * 9 + i * 3 + j];
+          M(a, b) = model.mass_blocks()[k * 9 + i * 3 + j];
+        }
+}
+
+double total_energy(const ShellSimulation& sim) { return sim.kinetic_energy() + sim.linear_elastic_energy(); }
+
+// A strip L x b of n x 1 quad8 clamped at x = 0.
+struct ClampedStrip {
+  Mesh mesh;
+  std::unique_ptr<ShellModel> model;
+  std::vector<char> fixed;
+};
+
+ClampedStrip clamped_strip(int n, const TestMaterial& m, double length = 1.0, double width = 0.1) {
+  ClampedStrip s;
+  s.mesh = make_rectangle(length, width, n, 1, ElementType::quad8);
+  auto at_root = [](const double* x) { return std::abs(x[0]) < 1e-9; };
+  s.model = make_model(s.mesh, m, 1.0, at_root);
+  fix_nodes(s.mesh, at_root, true, true, true, s.fixed);
+  return s;
+}
+
+// ---------------------------------------------------------------------------------------
+// Very large time steps. Semi-implicit Euler, (M + dt^2 K) v+ = M v + dt (f - K u), damps
+// every mode by a factor in [1/(1 + w^2 dt^2), 1] per step (test_shell_dynamics), so it
+// cannot blow up at any dt; an explicit scheme on the same matrices blows up just above
+// dt = 2 / omega_max.
+TEST(LargeTimeSteps, EnergyNeverGrowsFarBeyondTheExplicitLimit) {
+  ClampedStrip s = clamped_strip(10, TestMaterial{});
+  const ShellModel& model = *s.model;
+  Eigen::MatrixXd K, M;
+  std::vector<int> unknown;
+  dense_free_matrices(model, s.fixed, K, M, unknown);
+  const Eigen::VectorXd w2 = Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::MatrixXd>(K, M, Eigen::EigenvaluesOnly).eigenvalues();
+  const double k_min = Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(K, Eigen::EigenvaluesOnly).eigenvalues()(0);
+  const double omega_max = std::sqrt(w2(w2.size() - 1)), explicit_limit = 2 / omega_max;
+
+  // A rough initial state: random displacements and velocities (fixed seed), every mode excited.
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> uniform(-1, 1);
+  std::vector<double> u0(model.num_dofs(), 0.0), v0(model.num_dofs(), 0.0);
+  for (int d = 0; d < model.num_dofs(); ++d)
+    if (!s.fixed[d]) u0[d] = 1e-3 * uniform(rng), v0[d] = 1e-2 * uniform(rng);
+  Eigen::VectorXd x0(K.rows()), y0(K.rows());
+  for (int d = 0; d < model.num_dofs(); ++d)
+    if (unknown[d] >= 0) x0(unknown[d]) = u0[d], y0(unknown[d]) = v0[d];
+
+  // Explicit (symplectic) Euler at 1.1x its limit: grows without bound.
+  {
+    const double dt = 1.1 * explicit_limit;
+    const Eigen::LDLT<Eigen::MatrixXd> mass(M);
+    Eigen::VectorXd x = x0, y = y0;
+    const double e0 = 0.5 * y.dot(M * y) + 0.5 * x.dot(K * x);
+    for (int step = 0; step < 200; ++step) {
+      y -= dt * mass.solve(K * x);
+      x += dt * y;
+    }
+    const double growth = (0.5 * y.dot(M * y) + 0.5 * x.dot(K * x)) / e0;
+    std::printf("explicit Euler, dt = 1.1 x 2/omega_max (omega_max %.4e): energy x%.3e after 200 steps\n", omega_max, growth);
+    EXPECT_GT(growth, 1e6);
+  }
+
+  for (double factor : {1.0, 1e2, 1e4, 1e6}) {
+    const double dt = factor * explicit_limit;
+    ShellSimulation sim(model, s.fixed, std::vector<double>(model.num_dofs(), 0.0));
+    sim.set_state(u0, v0);
+    DynamicsOptions options;
+    options.time_step = dt;
+    const double e0 = total_energy(sim);
+    double worst_growth = 0, u_max = 0;
+    for (int step = 0; step < 20; ++step) {
+      const double before = total_energy(sim);
+      sim.step(options);
+      const double after = total_energy(sim);
+      worst_growth = std::max(worst_growth, after / before - 1);
+      for (double x : sim.displacement()) u_max = std::max(u_max, std::abs(x));
+    }
+    // Energy bounds the displacement: 1/2 k_min |u|^2 <= 1/2 u^T K u <= E0.
+    const double bound = std::sqrt(2 * e0 / k_min);
+    std::printf("semi-implicit Euler, dt = %.0e x 2/omega_max: largest energy growth per step %.2e, "
+                "energy after 20 steps %.3e of the initial, max |u| %.3e (energy bound %.3e)\n",
+                factor, worst_growth, total_energy(sim) / e0, u_max, bound);
+    EXPECT_LE(worst_growth, 1e-9) << "dt factor " << factor;
+    EXPECT_LT(total_energy(sim), e0) << "dt factor " << factor;
+    EXPECT_LE(u_max, bound * (1 + 1e-9)) << "dt factor " << factor;
+  }
+}
+
+// At a huge step the numerical dissipation lands the loaded strip on its static solution.
+TEST(LargeTimeSteps, HugeStepsSettleOnTheStaticSolution) {
+  ClampedStrip s = clamped_strip(10, TestMaterial{});
+  const ShellModel& model = *s.model;
+  std::vector<double> f(model.num_dofs(), 0.0);
+  const double g[3] = {0, 0, -0.01};
+  model.add_gravity(g, f);
+  ShellSimulation reference(model, s.fixed, f);
+  reference.solve_static();
+  double norm = 0;
+  for (double x : reference.displacement()) norm = std::max(norm, std::abs(x));
+  ShellSimulation sim(model, s.fixed, f);
+  DynamicsOptions options;
+  options.time_step = 1e3;  // 2/omega_max is 7.2e-4 for this strip; the slowest period is 18.7
+  double errors[5];
+  for (int step = 0; step < 5; ++step) {
+    sim.step(options);
+    double e = 0;
+    for (int d = 0; d < model.num_dofs(); ++d) e = std::max(e, std::abs(sim.displacement()[d] - reference.displacement()[d]));
+    errors[step] = e / norm;
+    std::printf("dt 1e3, step %d: max |u - u_static| / max |u_static| = %.3e\n", step + 1, errors[step]);
+  }
+  EXPECT_LT(errors[4], 1e-6);
+}
+
+// ---------------------------------------------------------------------------------------
+// Large rotations. A strip under a load large enough to bend it through ~90 degrees: the
+// linear model moves the points straight down and stretches the strip; the corotated
+// model keeps its length (measured along the edge y = 0).
+double edge_length(const Mesh& mesh, const std::vector<double>& u) {
+  std::vector<std::pair<double, int>> row;  // nodes on y = 0, by x
+  for (int a = 0; a < mesh.num_nodes(); ++a)
+    if (std::abs(mesh.node(a)[1]) < 1e-9) row.push_back({mesh.node(a)[0], a});
+  std::sort(row.begin(), row.end());
+  double length = 0;
+  for (size_t k = 1; k < row.size(); ++k) {
+    double d2 = 0;
+    for (int c = 0; c < 3; ++c) {
+      const double d = mesh.node(row[k].second)[c] + u[3 * row[k].second + c] - mesh.node(row[k - 1].second)[c] -
+                       u[3 * row[k - 1].second + c];
+      d2 += d * d;
+    }
+    length += std::sqrt(d2);
+  }
+  return length;
+}
+
+TEST(LargeRotations, LinearModelStretchesTheBentStripCorotatedKeepsItsLength) {
+  TestMaterial m;
+  ClampedStrip s = clamped_strip(10, m);
+  const ShellModel& model = *s.model;
+  std::vector<double> f(model.num_dofs(), 0.0);
+  const double g[3] = {0, 0, -0.3};  // linear tip deflection q L^4 / 8D = 4.1 L
+  model.add_gravity(g, f);
+  const double q = m.rho * m.h * 0.3, D = kernels::bending_rigidity(m.E, m.nu, m.h);
+  DynamicsOptions options;
+  options.time_step = 0.5;  // the strip swings down within ~10 steps
+  double longest[2] = {0, 0}, shortest[2] = {1e9, 1e9}, lowest_tip[2] = {0, 0};
+  for (int corotational = 0; corotational < 2; ++corotational) {
+    options.corotational = corotational == 1;
+    ShellSimulation sim(model, s.fixed, f);
+    for (int step = 0; step < 20; ++step) {
+      sim.step(options);
+      const double length = edge_length(s.mesh, sim.displacement());
+      longest[corotational] = std::max(longest[corotational], length);
+      shortest[corotational] = std::min(shortest[corotational], length);
+      for (int a = 0; a < s.mesh.num_nodes(); ++a)
+        if (std::abs(s.mesh.node(a)[0] - 1) < 1e-9)
+          lowest_tip[corotational] = std::min(lowest_tip[corotational], sim.displacement()[3 * a + 2]);
+    }
+    std::printf("%s, 20 steps of dt %g (linear static tip deflection q L^4 / 8D = %.2f L): edge length in "
+                "[%.4f, %.4f] (rest 1), lowest tip z %.4f\n", corotational ? "corotated" : "linear", options.time_step,
+                q / (8 * D), shortest[corotational], longest[corotational], lowest_tip[corotational]);
+  }
+  // Linear: the strip stretches to 8x its length (measured 7.995). Corotated: at most 8 %
+  // during the fast first swing (each step linearises about the last state; measured
+  // 1.079, 1.0002-1.001 once it hangs), while it does swing down to hang (tip z near -1).
+  EXPECT_GT(longest[0], 2.0);
+  EXPECT_LT(longest[1], 1.1);
+  EXPECT_GT(shortest[1], 0.99);
+  EXPECT_LT(lowest_tip[1], -0.9);
+  EXPECT_GT(lowest_tip[1], -1.1);
+}
+
+// Corotated steps far above every time scale of the motion (dt = 1000, the strip's swing
+// takes ~5): each step is then a fixed-point iteration towards equilibrium without the
+// geometric stiffness; it stays bounded but does not settle and the strip stretches (a
+// limit: use dt of the order of the motion's time scale with corotation).
+TEST(LargeTimeSteps, CorotatedHugeStepsStayBoundedButDoNotSettle) {
+  ClampedStrip s = clamped_strip(10, TestMaterial{});
+  const ShellModel& model = *s.model;
+  std::vector<double> f(model.num_dofs(), 0.0);
+  const double g[3] = {0, 0, -0.3};
+  model.add_gravity(g, f);
+  DynamicsOptions options;
+  options.time_step = 1e3;
+  options.corotational = true;
+  ShellSimulation sim(model, s.fixed, f);
+  double largest = 0, longest = 0;
+  for (int step = 0; step < 8; ++step) {
+    sim.step(options);
+    for (double x : sim.displacement()) {
+      ASSERT_TRUE(std::isfinite(x)) << "step " << step;
+      largest = std::max(largest, std::abs(x));
+    }
+    longest = std::max(longest, edge_length(s.mesh, sim.displacement()));
+  }
+  std::printf("corotated, dt 1e3, 8 steps: max |u| %.3f, longest edge %.3f (rest 1)\n", largest, longest);
+  // Bounded: the first step from rest is the linear static solution (max |u| 4.4, edge 4.6);
+  // later steps wander between 1.2 and 1.7 without settling (200 steps measured).
+  EXPECT_LT(largest, 5.0);
+}
+
+// ---------------------------------------------------------------------------------------
+// Nearly incompressible materials. A shell is in plane stress: E/(1 - nu^2) stays finite
+// as nu -> 0.5, so there is no volumetric locking, and the clamped plate's centre
+// deflection 0.00126 q a^4 / D depends on nu only through D (the clamped conditions do not
+// involve nu). nu >= 0.5 is rejected by the scene validation (test_scene_errors,
+// test_cli_run).
+TEST(NearlyIncompressible, ClampedPlateFollowsDOfNu) {
+  const double a = 1.0, q = -1.0;
+  double ratios[3];
+  const double nus[3] = {0.3, 0.49, 0.499};
+  for (int i = 0; i < 3; ++i) {
+    TestMaterial m;
+    m.nu = nus[i];
+    const Mesh mesh = make_rectangle(a, a, 16, 16, ElementType::quad8);
+    auto edge = [a](const double* x) {
+      return std::abs(x[0]) < 1e-9 || std::abs(x[0] - a) < 1e-9 || std::abs(x[1]) < 1e-9 || std::abs(x[1] - a) < 1e-9;
+    };
+    auto model = make_model(mesh, m, 0.8, edge);
+    std::vector<char> fixed;
+    fix_nodes(mesh, edge, true, true, true, fixed);
+    std::vector<double> f(model->num_dofs(), 0.0);
+    const double force[3] = {0, 0, q};
+    model->add_area_force(force, f);
+    ShellSimulation sim(*model, fixed, f);
+    sim.solve_static();
+    double w = 0;
+    for (int n = 0; n < mesh.num_nodes(); ++n)
+      if (std::abs(mesh.node(n)[0] - a / 2) < 1e-9 && std::abs(mesh.node(n)[1] - a / 2) < 1e-9) w = sim.displacement()[3 * n + 2];
+    const double D = kernels::bending_rigidity(m.E, m.nu, m.h);
+    ratios[i] = w / (0.00126532 * q * a * a * a * a / D);
+    std::printf("clamped plate quad8 16x16, nu = %.3f: D = %.5e, w / (0.00126532 q a^4 / D) = %.5f\n", nus[i], D, ratios[i]);
+    EXPECT_NEAR(ratios[i], 1.0, 0.01) << "nu " << nus[i];
+  }
+  // The discretisation error does not depend on nu (no locking as nu -> 0.5).
+  EXPECT_NEAR(ratios[1], ratios[0], 2e-3);
+  EXPECT_NEAR(ratios[2], ratios[0], 2e-3);
+}
+
+// Uniaxial tension with free lateral contraction is reproduced exactly (a linear membrane
+// field) at nu = 0.499, and at a strongly auxetic nu = -0.9.
+TEST(NearlyIncompressible, UniaxialTensionIsExactForExtremeNu) {
+  for (ElementType type : {ElementType::quad8, ElementType::tri6}) {
+    for (double nu : {0.49, 0.499, -0.9}) {
+      TestMaterial m;
+      m.nu = nu;
+      const double sigma = 100;  // stress
+      const Mesh mesh = make_rectangle(1, 1, 4, 4, type);
+      auto model = make_model(mesh, m, 1.0);
+      std::vector<char> fixed;
+      fix_nodes(mesh, [](const double* x) { return std::abs(x[0]) < 1e-9; }, true, false, false, fixed);
+      fix_nodes(mesh, [](const double* x) { return std::abs(x[0]) < 1e-9 && std::abs(x[1]) < 1e-9; }, false, true, false, fixed);
+      fix_nodes(mesh, [](const double*) { return true; }, false, false, true, fixed);
+      // Consistent nodal loads of the traction sigma h on the edge x = 1 (4 quadratic edges of 1/4).
+      std::vector<double> f(model->num_dofs(), 0.0);
+      for (int n = 0; n < mesh.num_nodes(); ++n) {
+        const double* x = mesh.node(n);
+        if (std::abs(x[0] - 1) > 1e-9) continue;
+        const double k = x[1] * 8;  // multiples of 1/8: even = corner, odd = midside
+        const bool midside = std::abs(std::round(k)) == std::round(k) && static_cast<long>(std::round(k)) % 2 == 1;
+        const bool end = std::abs(x[1]) < 1e-9 || std::abs(x[1] - 1) < 1e-9;
+        f[3 * n] = sigma * m.h * 0.25 * (midside ? 4.0 / 6 : end ? 1.0 / 6 : 2.0 / 6);
+      }
+      ShellSimulation sim(*model, fixed, f);
+      sim.solve_static();
+      double worst = 0;
+      const double strain = sigma / m.E;
+      for (int n = 0; n < mesh.num_nodes(); ++n) {
+        const double* x = mesh.node(n);
+        worst = std::max({worst, std::abs(sim.displacement()[3 * n] - strain * x[0]),
+                          std::abs(sim.displacement()[3 * n + 1] + nu * strain * x[1])});
+      }
+      std::printf("uniaxial tension %s, nu = %6.3f: max nodal error / strain = %.2e\n",
+                  type == ElementType::quad8 ? "quad8" : "tri6", nu, worst / strain);
+      EXPECT_LT(worst / strain, 1e-9) << "nu " << nu;
+    }
+  }
+}
+
+// ---------------------------------------------------------------------------------------
+// A cut exactly along element edges. Inside the elements it has no texel wall (it lies on
+// the tile borders); dgtex cuts the texel couplings across the mesh edge and gives the two
+// sides +1 and -1 (test_cuts_enrichment: H exactly +-1). Here the mechanics: a strip
+// clamped at x = 0 and cut across at x = cut_x falls under gravity; the cut-off piece must
+// fall exactly like a free body while the clamped piece sags.
+struct FallResult {
+  double fall_error;      // max over steps and free-piece nodes of |u - u_free_fall| / |u_free_fall|
+  double clamped_motion;  // max displacement of the clamped piece at the end
+};
+
+FallResult fall_of_cut_off_piece(ElementType type, double cut_x, bool tell_model_the_cut_edges = true) {
+  const Mesh mesh = make_rectangle(1, 0.5, 4, 2, type);
+  const Topology topology = build_topology(mesh);
+  CutManager cuts(mesh, topology, {points_cut({{cut_x, 0, 0}, {cut_x, 0.5, 0}})}, cholmod_enrichment(16));
+  cuts.update(0.0);
+  EXPECT_EQ(cuts.functions().size(), 1u);
+  auto clamp = [](const double* x) { return x[0] < 1e-9; };
+  auto model = make_model(mesh, TestMaterial{}, 1.0, clamp);
+  if (tell_model_the_cut_edges)
+    model->set_cut_edge_texels(cuts.edge_walls().resolution(), cuts.edge_walls().flags(mesh.num_elements()));
+  model->set_enrichments(cuts.functions());
+  std::vector<char> fixed;
+  fix_nodes(mesh, clamp, true, true, true, fixed);
+  fixed.resize(model->num_dofs(), 0);
+  const double g = 9.81, gravity[3] = {0, 0, -g};
+  std::vector<double> f(model->num_dofs(), 0.0);
+  model->add_gravity(gravity, f);
+  ShellSimulation sim(*model, fixed, f);
+  DynamicsOptions options;
+  options.time_step = 1e-2;
+  // Total displacement at a node, seen from an element wholly on the node's side.
+  std::vector<int> element_of(mesh.num_nodes(), -1), local_of(mesh.num_nodes(), -1);
+  for (int e = 0; e < mesh.num_elements(); ++e) {
+    double centre = 0;
+    for (int a = 0; a < mesh.nodes_per_element(); ++a) centre += mesh.node(mesh.element_nodes(e)[a])[0] / mesh.nodes_per_element();
+    for (int a = 0; a < mesh.nodes_per_element(); ++a) {
+      const int n = mesh.element_nodes(e)[a];
+      const bool same_side = (mesh.node(n)[0] - cut_x) * (centre - cut_x) > 0 || std::abs(mesh.node(n)[0] - cut_x) < 1e-9;
+      if (same_side && (element_of[n] < 0 || std::abs(mesh.node(n)[0] - cut_x) < 1e-9 ? centre > cut_x : false))
+        element_of[n] = e, local_of[n] = a;
+      if (element_of[n] < 0 && same_side) element_of[n] = e, local_of[n] = a;
+    }
+  }
+  FallResult r{0, 0};
+  const int steps = 30;
+  for (int s = 1; s <= steps; ++s) {
+    sim.step(options);
+    const double expected = -g * options.time_step * options.time_step * s * (s + 1) / 2;  // discrete free fall
+    for (int n = 0; n < mesh.num_nodes(); ++n) {
+      double xi[2], u[3];
+      kernels::node_parametric_position(type, local_of[n], xi);
+      model->interpolate(sim.displacement(), element_of[n], xi, u);
+      if (mesh.node(n)[0] >= cut_x - 1e-9)
+        r.fall_error = std::max({r.fall_error, std::abs(u[2] - expected) / std::abs(expected), std::hypot(u[0], u[1]) / std::abs(expected)});
+      else if (s == steps)
+        r.clamped_motion = std::max(r.clamped_motion, std::sqrt(u[0] * u[0] + u[1] * u[1] + u[2] * u[2]));
+    }
+  }
+  return r;
+}
+
+TEST(CutAlongElementEdges, CutInsideElementsSeparatesExactly) {
+  for (ElementType type : {ElementType::quad8, ElementType::tri6}) {
+    const FallResult inside = fall_of_cut_off_piece(type, 0.578125);
+    std::printf("%s cut inside elements (x = 0.578): free-fall error %.3e, clamped piece moved %.3e\n",
+                type == ElementType::quad8 ? "quad8" : "tri6", inside.fall_error, inside.clamped_motion);
+    EXPECT_LT(inside.fall_error, 1e-10);       // measured 6e-15
+    EXPECT_GT(inside.clamped_motion, 0.1);     // the clamped piece sags (0.5), so a tie would show
+  }
+}
+
+// A cut exactly along element edges: the DG edge terms across it would tie the pieces'
+// rotations (the clamped piece's rotation drags the cut-off piece: 6 % (quad8) / 10 % (tri6)
+// off free fall after 30 steps). ShellModel::set_cut_edge_texels (SceneRun passes the cut
+// manager's mesh-edge walls) drops the edge terms over the cut texel segments.
+// quad8: exact separation. tri6: KNOWN GAP, 1.1e-2 remains (from 9.8e-2): the textures of
+// triangles touching the cut only at a corner node hold 0 and -1 values where the piece is
+// +1 (found with this test, not yet traced); the bound below records it so a fix shows.
+TEST(CutAlongElementEdges, EdgeTermsAcrossTheCutAreDropped) {
+  for (ElementType type : {ElementType::quad8, ElementType::tri6}) {
+    const FallResult along = fall_of_cut_off_piece(type, 0.5);
+    const FallResult tied = fall_of_cut_off_piece(type, 0.5, false);
+    std::printf("%s cut along element edges (x = 0.5): free-fall error %.3e (edge terms kept: %.3e), clamped piece moved %.3e\n",
+                type == ElementType::quad8 ? "quad8" : "tri6", along.fall_error, tied.fall_error, along.clamped_motion);
+    if (type == ElementType::quad8) {
+      EXPECT_LT(along.fall_error, 1e-10);  // measured 7e-15
+    } else {
+      EXPECT_LT(along.fall_error, 2e-2) << "tri6 known gap grew";
+      EXPECT_GT(along.fall_error, 1e-3) << "tri6 known gap fixed? then assert < 1e-10 here";
+    }
+    EXPECT_GT(along.clamped_motion, 0.1);
+    EXPECT_GT(tied.fall_error, 1e-2);  // the failure mode the remedy removes (measured 0.058 / 0.098)
+  }
+}
+
+}  // namespace
