@@ -12,6 +12,22 @@
 namespace dgtex::kernels {
 namespace {
 
+// Corotational rest strain of the standard functions, B (X0 - R^T X0) (enriched DOFs rest
+// at 0): membrane rows into strain[0..2], bending rows into strain[3..5] (added).
+void rest_corotation_strain(const double* positions, const int* nodes, int npe, const double* R, const double* Bm,
+                            const double* Bb, double strain[6]) {
+  for (int a = 0; a < npe; ++a) {
+    const double* x = positions + 3 * static_cast<std::int64_t>(nodes[a]);
+    double d[3];
+    for (int k = 0; k < 3; ++k) d[k] = x[k] - (R[0 * 3 + k] * x[0] + R[1 * 3 + k] * x[1] + R[2 * 3 + k] * x[2]);
+    for (int r = 0; r < 3; ++r)
+      for (int c = 0; c < 3; ++c) {
+        strain[r] += Bm[9 * a + r * 3 + c] * d[c];
+        strain[3 + r] += Bb[9 * a + r * 3 + c] * d[c];
+      }
+  }
+}
+
 // Everything about one quadrature point of an enriched element.
 struct EnrichedPoint {
   ShapeValues standard;
@@ -71,18 +87,7 @@ void element_stiffness(const EnrichedElementBatch& b, const EnrichedQuadrature& 
     }
     const double* R = rotations ? rotations + 9 * q : nullptr;
     double strain[6] = {0, 0, 0, 0, 0, 0};  // B (X0 - R^T X0); enriched X0 = 0
-    if (R && forces) {
-      for (int a = 0; a < npe; ++a) {
-        const double* x = b.positions + 3 * static_cast<std::int64_t>(nodes[a]);
-        double d[3];
-        for (int k = 0; k < 3; ++k) d[k] = x[k] - (R[0 * 3 + k] * x[0] + R[1 * 3 + k] * x[1] + R[2 * 3 + k] * x[2]);
-        for (int r = 0; r < 3; ++r)
-          for (int c = 0; c < 3; ++c) {
-            strain[r] += Bm[9 * a + r * 3 + c] * d[c];
-            strain[3 + r] += Bb[9 * a + r * 3 + c] * d[c];
-          }
-      }
-    }
+    if (R && forces) rest_corotation_strain(b.positions, nodes, npe, R, Bm.data(), Bb.data(), strain);
     if (R)
       for (int a = 0; a < n; ++a) rotate_rows(&Bm[9 * a], R), rotate_rows(&Bb[9 * a], R);
     const double sm = std::sqrt(p.weight * dn), sb = std::sqrt(p.weight * dm);
@@ -291,18 +296,7 @@ void chunk_stiffness(const EnrichedElementBatch& b, const EnrichedQuadrature& qu
     }
     const double* R = rotations ? rotations + 9 * q : nullptr;
     double strain[6] = {0, 0, 0, 0, 0, 0};  // B (X0 - R^T X0); enriched X0 = 0
-    if (R && want_forces) {
-      for (int a = 0; a < npe; ++a) {
-        const double* x = b.positions + 3 * static_cast<std::int64_t>(nodes[a]);
-        double d[3];
-        for (int k = 0; k < 3; ++k) d[k] = x[k] - (R[0 * 3 + k] * x[0] + R[1 * 3 + k] * x[1] + R[2 * 3 + k] * x[2]);
-        for (int rr = 0; rr < 3; ++rr)
-          for (int c = 0; c < 3; ++c) {
-            strain[rr] += Bm[9 * a + rr * 3 + c] * d[c];
-            strain[3 + rr] += Bb[9 * a + rr * 3 + c] * d[c];
-          }
-      }
-    }
+    if (R && want_forces) rest_corotation_strain(b.positions, nodes, npe, R, Bm, Bb, strain);
     if (R)
       for (int a = 0; a < m; ++a) rotate_rows(&Bm[9 * a], R), rotate_rows(&Bb[9 * a], R);
     const double sm = std::sqrt(weight * dn), sb = std::sqrt(weight * dm);

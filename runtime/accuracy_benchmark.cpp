@@ -1,5 +1,6 @@
 // Reporting of the speed-against-accuracy sweeps: machine description, JSON and Markdown.
 #include "dgtex/accuracy_benchmark.h"
+#include "dgtex/stage_timer.h"
 
 #include <omp.h>
 #include <time.h>
@@ -17,9 +18,7 @@ namespace dgtex {
 double accuracy_clock_ms(AccuracyClock clock) {
   if (clock == AccuracyClock::wall)
     return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now().time_since_epoch()).count();
-  timespec t{};
-  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
-  return t.tv_sec * 1e3 + t.tv_nsec * 1e-6;
+  return process_cpu_ms();
 }
 
 std::string accuracy_clock_name(AccuracyClock clock) { return clock == AccuracyClock::cpu ? "CPU" : "wall"; }

@@ -8,6 +8,7 @@
 #include <stdexcept>
 
 #include "dgtex/enrichment_span.h"
+#include "dgtex/stage_timer.h"
 #include "dgtex/texel_storage.h"
 
 namespace dgtex {
@@ -47,9 +48,6 @@ std::uint64_t fnv(std::uint64_t h, const void* data, std::size_t bytes) {
 }
 constexpr std::uint64_t kFnvSeed = 1469598103934665603ull;
 
-double ms_since(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
-}
 
 // Two segments that share an end point P (a cut starting where another ends, a V, the
 // next segment of one cut) can both reach P's lattice point over the same lattice edge:

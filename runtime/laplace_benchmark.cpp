@@ -17,12 +17,12 @@
 #include "dgtex/kernels/multigrid_smooth.h"
 #include "dgtex/kernels/multigrid_unknowns.h"
 #include "dgtex/laplace_domains.h"
+#include "dgtex/stage_timer.h"
 
 namespace dgtex {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-double ms_since(Clock::time_point start) { return std::chrono::duration<double, std::milli>(Clock::now() - start).count(); }
 
 double relative_residual(const TexelLaplaceSystem& system, const Eigen::VectorXd& x) {
   const double b = system.b.norm();

@@ -14,6 +14,7 @@
 #include "dgtex/kernels/multigrid_smooth.h"
 #include "dgtex/kernels/multigrid_transfer.h"
 #include "dgtex/kernels/multigrid_unknowns.h"
+#include "dgtex/stage_timer.h"
 
 // Choices, measured with T=256/1024 single-element solves to 1e-6 from zero (1 thread):
 // - V(1,1) as CG preconditioner (default): 6 iterations on open/slit/accordion (0.085 per
@@ -45,7 +46,6 @@ using kernels::GridShape;
 namespace {
 
 using Clock = std::chrono::steady_clock;
-double ms_since(Clock::time_point start) { return std::chrono::duration<double, std::milli>(Clock::now() - start).count(); }
 
 // Levels smaller than this run serially: a parallel region costs more than the work.
 // On the 2-core machine (idle), open T = 256: 9.1 ms serial against 14.3 ms with 2 threads

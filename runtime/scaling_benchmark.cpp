@@ -18,6 +18,7 @@
 #include "dgtex/scene_model.h"
 #include "dgtex/scene_run.h"
 #include "dgtex/sparse_cholesky.h"
+#include "dgtex/stage_timer.h"
 #include "dgtex/topology.h"
 
 namespace dgtex {
@@ -26,7 +27,6 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-double ms_since(Clock::time_point start) { return std::chrono::duration<double, std::milli>(Clock::now() - start).count(); }
 
 void check_threads(const std::vector<int>& threads) {
   if (threads.empty()) throw std::invalid_argument("thread list is empty; give at least one count, e.g. 1,2");

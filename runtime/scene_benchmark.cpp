@@ -11,6 +11,7 @@
 
 #include "dgtex/model_error.h"
 #include "dgtex/scene_run.h"
+#include "dgtex/stage_timer.h"
 
 namespace dgtex {
 
@@ -18,13 +19,7 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-double ms_since(Clock::time_point start) { return std::chrono::duration<double, std::milli>(Clock::now() - start).count(); }
 
-double process_cpu_ms() {
-  timespec t{};
-  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
-  return t.tv_sec * 1e3 + t.tv_nsec * 1e-6;
-}
 
 double stage_total(const StageTimings& timings, const char* stage) {
   const auto it = timings.find(stage);

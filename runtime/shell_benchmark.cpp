@@ -11,17 +11,12 @@
 #include "dgtex/scene_io.h"
 #include "dgtex/scene_model.h"
 #include "dgtex/shell_simulation.h"
+#include "dgtex/stage_timer.h"
 
 namespace dgtex {
 
 namespace {
 using Clock = std::chrono::steady_clock;
-double ms_since(Clock::time_point start) { return std::chrono::duration<double, std::milli>(Clock::now() - start).count(); }
-double process_cpu_ms() {
-  timespec t{};
-  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
-  return t.tv_sec * 1e3 + t.tv_nsec * 1e-6;
-}
 }  // namespace
 
 // The flop model (a multiply-add counts 2). Exact for the products that dominate:

@@ -12,6 +12,7 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
+#include "cli_test_support.h"
 #include "dgtex/scene_benchmark.h"
 #include "dgtex/scene_io.h"
 #include "dgtex/scene_run.h"
@@ -23,25 +24,10 @@ namespace {
 
 const std::string kScenes = std::string(DGTEX_SOURCE_DIR) + "/examples/scenes";
 
-struct Result {
-  int exit_code;
-  std::string stderr_text;
-};
+using Result = test::CliResult;
+using test::run_cli;
 
-Result run_cli(const std::string& args, const fs::path& workdir) {
-  const fs::path err = workdir / "stderr.txt";
-  const std::string command = std::string(DGTEX_CLI) + " " + args + " 2> " + err.string() + " > /dev/null";
-  const int status = std::system(command.c_str());
-  std::ifstream in(err);
-  return {WEXITSTATUS(status), std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>())};
-}
-
-fs::path fresh_dir(const std::string& name) {
-  const fs::path dir = fs::temp_directory_path() / ("dgtex_bench_scenes_" + name + "_" + std::to_string(::getpid()));
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  return dir;
-}
+fs::path fresh_dir(const std::string& name) { return test::fresh_dir("dgtex_bench_scenes", name); }
 
 nlohmann::json read_json(const fs::path& path) {
   std::ifstream in(path);

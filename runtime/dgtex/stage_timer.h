@@ -3,10 +3,24 @@
 // Value types; ScopedStage keeps a reference to its StageTimings entry (which must outlive
 // it). Not thread-safe: time stages from one thread. Times in milliseconds.
 #include <chrono>
+#include <ctime>
 #include <map>
 #include <string>
 
 namespace dgtex {
+
+// Milliseconds of wall clock since `start`.
+inline double ms_since(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+}
+
+// CPU milliseconds this process has used (all threads): robust against other processes
+// taking the cores, unlike wall-clock times.
+inline double process_cpu_ms() {
+  timespec t{};
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+  return t.tv_sec * 1e3 + t.tv_nsec * 1e-6;
+}
 
 struct StageStatistics {
   double total_ms = 0;

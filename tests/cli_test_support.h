@@ -1,0 +1,38 @@
+#pragma once
+// Running the dgtex tool from a test: exit code and stderr of one command, and a fresh
+// scratch folder per test process.
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <string>
+
+namespace dgtex::test {
+
+struct CliResult {
+  int exit_code;
+  std::string stderr_text;
+};
+
+// Runs `dgtex ARGS` (stdout discarded), keeping stderr in WORKDIR/stderr.txt.
+inline CliResult run_cli(const std::string& args, const std::filesystem::path& workdir) {
+  const std::filesystem::path err = workdir / "stderr.txt";
+  const std::string command = std::string(DGTEX_CLI) + " " + args + " 2> " + err.string() + " > /dev/null";
+  const int status = std::system(command.c_str());
+  std::ifstream in(err);
+  return {WEXITSTATUS(status), std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>())};
+}
+
+// An empty folder under the system's temporary folder, named after PREFIX, NAME and the pid.
+inline std::filesystem::path fresh_dir(const std::string& prefix, const std::string& name) {
+  const std::filesystem::path dir =
+      std::filesystem::temp_directory_path() / (prefix + "_" + name + "_" + std::to_string(::getpid()));
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  return dir;
+}
+
+}  // namespace dgtex::test
