@@ -395,9 +395,11 @@ TEST(CutAlongElementEdges, CutInsideElementsSeparatesExactly) {
 // rotations (the clamped piece's rotation drags the cut-off piece: 6 % (quad8) / 10 % (tri6)
 // off free fall after 30 steps). ShellModel::set_cut_edge_texels (SceneRun passes the cut
 // manager's mesh-edge walls) drops the edge terms over the cut texel segments.
-// quad8: exact separation. tri6: KNOWN GAP, 1.1e-2 remains (from 9.8e-2): the textures of
-// triangles touching the cut only at a corner node hold 0 and -1 values where the piece is
-// +1 (found with this test, not yet traced); the bound below records it so a fix shows.
+// quad8: exact separation. tri6: KNOWN GAP, 1.1e-2 remains (from 9.8e-2): where the mesh
+// edge under the cut is the hypotenuse of one side's reference triangle (element 2 here),
+// the cut is rasterised as a staircase through that element's half-covered diagonal
+// texels instead of as a mesh-edge wall, so some of them get the other side's -1 and the
+// element's far node is enriched; the bound below records it so that a fix shows.
 TEST(CutAlongElementEdges, EdgeTermsAcrossTheCutAreDropped) {
   for (ElementType type : {ElementType::quad8, ElementType::tri6}) {
     const FallResult along = fall_of_cut_off_piece(type, 0.5);
