@@ -72,6 +72,10 @@ void rasterize_segment(TexelPoint p, TexelPoint q, const TexelTile& tile, std::v
   const double ux = q[0] - p[0], uy = q[1] - p[1];
   // Unnormalised distance of a lattice point to the segment's line (same line either way).
   auto distance = [&](int x, int y) { return std::abs(ux * (y - p[1]) - uy * (x - p[0])); };
+  // Distances equal to 1e-9 texels are ties: a segment along a tri6 hypotenuse arrives with
+  // round-off from the surface projection, and an exact comparison then let the staircase
+  // wander to the inner side of the diagonal texels (giving them the other side's value).
+  const double tie = 1e-9 * (std::abs(ux) + std::abs(uy));
   const int sx = b.x > a.x ? 1 : -1, sy = b.y > a.y ? 1 : -1;
   const std::size_t first = out.size();
   int x = a.x, y = a.y;
@@ -81,7 +85,7 @@ void rasterize_segment(TexelPoint p, TexelPoint q, const TexelTile& tile, std::v
     else if (y == b.y) step_x = true;
     else {
       const double dist_x = distance(x + sx, y), dist_y = distance(x, y + sy);
-      if (dist_x != dist_y) step_x = dist_x < dist_y;
+      if (std::abs(dist_x - dist_y) > tie) step_x = dist_x < dist_y;
       else if (sx != sy) step_x = sx > 0;  // larger x + y first (only differs when sx != sy)
       else step_x = true;
     }

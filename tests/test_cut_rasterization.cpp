@@ -252,6 +252,22 @@ TEST(CutRasterization, Tri6HypotenuseFollowsTheActiveBoundary) {
   }
 }
 
+// The same hypotenuse with the round-off a surface projection leaves (ends and an
+// intermediate point off the line by 1e-13 texels, both ways): still the outer staircase.
+// With an exact tie test the path wandered to the inner side of some diagonal texels.
+TEST(CutRasterization, Tri6HypotenuseWithRoundOffFollowsTheActiveBoundary) {
+  const int t = 16;
+  const TexelTile tile = make_element_tile(ElementType::tri6, t);
+  for (double eps : {1e-13, -1e-13}) {
+    const std::vector<TexelPoint> line{{16 - eps, eps}, {8 + eps, 8 + eps}, {eps, 16 - 2 * eps}};
+    TexelTile cut = tile;
+    const CutRaster raster = rasterize_cut(line, cut);
+    ASSERT_EQ(raster.edges.size(), 2u * t);
+    EXPECT_EQ(raster.interior_edge_count(), 0) << "eps " << eps;
+    for (const auto& e : raster.edges) EXPECT_TRUE((e.left_texel >= 0) != (e.right_texel >= 0)) << "eps " << eps;
+  }
+}
+
 TEST(CutRasterization, ParametricMapsRoundTrip) {
   for (ElementType type : {ElementType::quad8, ElementType::tri6}) {
     const TexelPoint p = texel_point_from_parametric(type, 64, 0.25, 0.5);

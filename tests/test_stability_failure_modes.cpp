@@ -395,23 +395,15 @@ TEST(CutAlongElementEdges, CutInsideElementsSeparatesExactly) {
 // rotations (the clamped piece's rotation drags the cut-off piece: 6 % (quad8) / 10 % (tri6)
 // off free fall after 30 steps). ShellModel::set_cut_edge_texels (SceneRun passes the cut
 // manager's mesh-edge walls) drops the edge terms over the cut texel segments.
-// quad8: exact separation. tri6: KNOWN GAP, 1.1e-2 remains (from 9.8e-2): where the mesh
-// edge under the cut is the hypotenuse of one side's reference triangle (element 2 here),
-// the cut is rasterised as a staircase through that element's half-covered diagonal
-// texels instead of as a mesh-edge wall, so some of them get the other side's -1 and the
-// element's far node is enriched; the bound below records it so that a fix shows.
+// Both element types then separate exactly. (tri6 also needed the rasteriser to treat
+// round-off ties as ties: the strip's cut runs along element 2's hypotenuse.)
 TEST(CutAlongElementEdges, EdgeTermsAcrossTheCutAreDropped) {
   for (ElementType type : {ElementType::quad8, ElementType::tri6}) {
     const FallResult along = fall_of_cut_off_piece(type, 0.5);
     const FallResult tied = fall_of_cut_off_piece(type, 0.5, false);
     std::printf("%s cut along element edges (x = 0.5): free-fall error %.3e (edge terms kept: %.3e), clamped piece moved %.3e\n",
                 type == ElementType::quad8 ? "quad8" : "tri6", along.fall_error, tied.fall_error, along.clamped_motion);
-    if (type == ElementType::quad8) {
-      EXPECT_LT(along.fall_error, 1e-10);  // measured 7e-15
-    } else {
-      EXPECT_LT(along.fall_error, 2e-2) << "tri6 known gap grew";
-      EXPECT_GT(along.fall_error, 1e-3) << "tri6 known gap fixed? then assert < 1e-10 here";
-    }
+    EXPECT_LT(along.fall_error, 1e-10);  // measured 7e-15 (quad8 and tri6)
     EXPECT_GT(along.clamped_motion, 0.1);
     EXPECT_GT(tied.fall_error, 1e-2);  // the failure mode the remedy removes (measured 0.058 / 0.098)
   }
