@@ -11,6 +11,7 @@
 #include <cstdio>
 #include <memory>
 
+#include "dense_matrix_support.h"
 #include "dgtex/mesh_generators.h"
 #include "dgtex/model_error.h"
 #include "dgtex/shell_model.h"
@@ -75,24 +76,8 @@ double tip_ratio(int n, double penalty, bool penalty_only) {
 
 // Dense free-DOF stiffness and mass of a strip (small meshes only).
 void dense_free_matrices(const Strip& s, Eigen::MatrixXd& K, Eigen::MatrixXd& M) {
-  std::vector<double> blocks;
-  s.model->assemble_stiffness(nullptr, blocks, nullptr);
-  const BlockAssembly& p = s.model->pattern();
-  std::vector<int> unknown(s.model->num_dofs(), -1);
-  int count = 0;
-  for (int d = 0; d < s.model->num_dofs(); ++d)
-    if (!s.fixed[d]) unknown[d] = count++;
-  K = Eigen::MatrixXd::Zero(count, count);
-  M = Eigen::MatrixXd::Zero(count, count);
-  for (int r = 0; r < p.num_nodes(); ++r)
-    for (std::int64_t k = p.row_start()[r]; k < p.row_start()[r + 1]; ++k)
-      for (int i = 0; i < 3; ++i)
-        for (int j = 0; j < 3; ++j) {
-          const int a = unknown[3 * r + i], b = unknown[3 * p.column()[k] + j];
-          if (a < 0 || b < 0) continue;
-          K(a, b) = blocks[k * 9 + i * 3 + j];
-          M(a, b) = s.model->mass_blocks()[k * 9 + i * 3 + j];
-        }
+  std::vector<int> unknown;
+  testing_support::dense_free_matrices(*s.model, s.fixed, K, M, unknown);
 }
 
 struct Spectrum {
