@@ -52,13 +52,19 @@ inline void half_constitutive(double nu, double scale, const double v[3], double
   out[2] = scale * std::sqrt(0.5 * (1 - nu)) * v[2];
 }
 
-// B' = B R^T for a 3x3 row block (rows: Voigt components, columns: x, y, z).
-inline void rotate_rows(double B[9], const double R[9]) {
-  double out[9];
-  for (int r = 0; r < 3; ++r)
-    for (int c = 0; c < 3; ++c)
-      out[r * 3 + c] = B[r * 3 + 0] * R[c * 3 + 0] + B[r * 3 + 1] * R[c * 3 + 1] + B[r * 3 + 2] * R[c * 3 + 2];
-  for (int i = 0; i < 9; ++i) B[i] = out[i];
+// The strain rows of n basis functions scaled by the square root of the constitutive
+// matrix (sm, sb: membrane and bending weights): row[0..2] membrane, row[3..5] bending,
+// 3 columns (x, y, z) per function, so that sum over rows of row^T row is B^T D B w.
+void scaled_strain_rows(int n, const double* Bm, const double* Bb, double nu, double sm, double sb, double* const row[6]) {
+  for (int a = 0; a < n; ++a)
+    for (int c = 0; c < 3; ++c) {
+      const double vm[3] = {Bm[9 * a + c], Bm[9 * a + 3 + c], Bm[9 * a + 6 + c]};
+      const double vb[3] = {Bb[9 * a + c], Bb[9 * a + 3 + c], Bb[9 * a + 6 + c]};
+      double om[3], ob[3];
+      half_constitutive(nu, sm, vm, om);
+      half_constitutive(nu, sb, vb, ob);
+      for (int k = 0; k < 3; ++k) row[k][3 * a + c] = om[k], row[3 + k][3 * a + c] = ob[k];
+    }
 }
 
 void element_stiffness(const EnrichedElementBatch& b, const EnrichedQuadrature& quad, std::int64_t e,
@@ -92,15 +98,8 @@ void element_stiffness(const EnrichedElementBatch& b, const EnrichedQuadrature& 
       for (int a = 0; a < n; ++a) rotate_rows(&Bm[9 * a], R), rotate_rows(&Bb[9 * a], R);
     const double sm = std::sqrt(p.weight * dn), sb = std::sqrt(p.weight * dm);
     double rows[6][3 * max_enriched_basis];
-    for (int a = 0; a < n; ++a)
-      for (int c = 0; c < 3; ++c) {
-        const double vm[3] = {Bm[9 * a + c], Bm[9 * a + 3 + c], Bm[9 * a + 6 + c]};
-        const double vb[3] = {Bb[9 * a + c], Bb[9 * a + 3 + c], Bb[9 * a + 6 + c]};
-        double om[3], ob[3];
-        half_constitutive(nu, sm, vm, om);
-        half_constitutive(nu, sb, vb, ob);
-        for (int r = 0; r < 3; ++r) rows[r][3 * a + c] = om[r], rows[3 + r][3 * a + c] = ob[r];
-      }
+    double* const row_starts[6] = {rows[0], rows[1], rows[2], rows[3], rows[4], rows[5]};
+    scaled_strain_rows(n, Bm.data(), Bb.data(), nu, sm, sb, row_starts);
     for (int r = 0; r < 6; ++r) {
       double* row = K.next();
       for (int i = 0; i < 3 * n; ++i) row[i] = rows[r][i];
@@ -302,15 +301,7 @@ void chunk_stiffness(const EnrichedElementBatch& b, const EnrichedQuadrature& qu
     const double sm = std::sqrt(weight * dn), sb = std::sqrt(weight * dm);
     double* row[6];
     for (int k = 0; k < 6; ++k) row[k] = rows.data() + static_cast<std::size_t>(k) * M;
-    for (int a = 0; a < m; ++a)
-      for (int c = 0; c < 3; ++c) {
-        const double vm[3] = {Bm[9 * a + c], Bm[9 * a + 3 + c], Bm[9 * a + 6 + c]};
-        const double vb[3] = {Bb[9 * a + c], Bb[9 * a + 3 + c], Bb[9 * a + 6 + c]};
-        double om[3], ob[3];
-        half_constitutive(nu, sm, vm, om);
-        half_constitutive(nu, sb, vb, ob);
-        for (int k = 0; k < 3; ++k) row[k][3 * a + c] = om[k], row[3 + k][3 * a + c] = ob[k];
-      }
+    scaled_strain_rows(m, Bm, Bb, nu, sm, sb, row);
     // G += S^T S (upper triangle), one rank-6 update.
     double* G = group.G.data();
     for (int i = 0; i < M; ++i) {

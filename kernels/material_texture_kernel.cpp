@@ -1,9 +1,9 @@
-#include "dgtex/kernels/vec3.h"
 #include "dgtex/kernels/material_texture_kernel.h"
 
 #include <stdexcept>
 
 #include "dgtex/kernels/shell_point.h"
+#include "dgtex/kernels/vec3.h"
 #include "shell_point_rows.h"
 
 namespace dgtex::kernels {
@@ -42,15 +42,6 @@ inline void apply_plane_stress(double nu, double scale, const double in[3], doub
   out[0] = scale * (in[0] + nu * in[1]);
   out[1] = scale * (nu * in[0] + in[1]);
   out[2] = scale * 0.5 * (1 - nu) * in[2];
-}
-
-// B R^T for a 3x3 row block.
-inline void rotate_rows(double B[9], const double R[9]) {
-  double out[9];
-  for (int r = 0; r < 3; ++r)
-    for (int c = 0; c < 3; ++c)
-      out[r * 3 + c] = B[r * 3 + 0] * R[c * 3 + 0] + B[r * 3 + 1] * R[c * 3 + 1] + B[r * 3 + 2] * R[c * 3 + 2];
-  for (int i = 0; i < 9; ++i) B[i] = out[i];
 }
 
 void element_stiffness(const PointSectionBatch& b, std::int64_t e, const double* rotations, double* blocks,

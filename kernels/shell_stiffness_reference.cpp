@@ -19,13 +19,6 @@ inline void apply_plane_stress(double nu, double scale, const double in[3], doub
   out[2] = scale * 0.5 * (1 - nu) * in[2];
 }
 
-// B' = B R^T for a 3x3 row block (rows: Voigt components, columns: x, y, z).
-inline void rotate_rows(const double B[9], const double R[9], double out[9]) {
-  for (int r = 0; r < 3; ++r)
-    for (int c = 0; c < 3; ++c)
-      out[r * 3 + c] = B[r * 3 + 0] * R[c * 3 + 0] + B[r * 3 + 1] * R[c * 3 + 1] + B[r * 3 + 2] * R[c * 3 + 2];
-}
-
 void element_stiffness_reference(const ElementBatch& b, std::int64_t e, const double* rotations, double* blocks,
                        double* forces) {
   const int npe = nodes_per_element(b.type);

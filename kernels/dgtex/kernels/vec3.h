@@ -16,6 +16,19 @@ inline void normalize3(double* v) {
   v[0] /= l, v[1] /= l, v[2] /= l;
 }
 
+// B' = B R^T for a 3x3 row block (rows: Voigt strain components, columns: x, y, z): the
+// strain rows of a corotated point.
+inline void rotate_rows(const double B[9], const double R[9], double out[9]) {
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c)
+      out[r * 3 + c] = B[r * 3 + 0] * R[c * 3 + 0] + B[r * 3 + 1] * R[c * 3 + 1] + B[r * 3 + 2] * R[c * 3 + 2];
+}
+inline void rotate_rows(double B[9], const double R[9]) {
+  double out[9];
+  rotate_rows(B, R, out);
+  for (int i = 0; i < 9; ++i) B[i] = out[i];
+}
+
 // Inverse of a row-major 3x3 matrix by cofactors (the caller ensures it is regular).
 inline void invert3(const double m[9], double inv[9]) {
   const double c00 = m[4] * m[8] - m[5] * m[7], c01 = m[5] * m[6] - m[3] * m[8], c02 = m[3] * m[7] - m[4] * m[6];
