@@ -342,21 +342,20 @@ struct LaplaceMultigrid::Hierarchy {
   }
 
   // Deterministic dot product over the level-0 layout (rows summed in order).
-  // Deterministic dot product on level l (rows summed in order).
-  double dot_on(std::size_t l, const std::vector<double>& a, const std::vector<double>& b) {
+  // Deterministic dot product on level l: per-row sums into `rows`, then summed in order.
+  double dot_on(std::size_t l, const std::vector<double>& a, const std::vector<double>& b, std::vector<double>& rows) {
     const GridShape g = levels[l].shape;
+    rows.resize(g.ny);
     kernels::forall(
         g.ny,
         [&](std::int64_t j) {
           const std::int64_t row = g.at(0, static_cast<int>(j));
           double sum = 0;
           for (int i = 0; i < g.nx; ++i) sum += a[row + i] * b[row + i];
-          coarse_rows[j] = sum;
+          rows[j] = sum;
         },
         levels[l].execution);
-    double sum = 0;
-    for (int j = 0; j < g.ny; ++j) sum += coarse_rows[j];
-    return sum;
+    return sum_in_order(rows);
   }
 
   // Level 1 solved to options.coarse_solve_tolerance by CG preconditioned with the level-1
@@ -368,14 +367,14 @@ struct LaplaceMultigrid::Hierarchy {
     k_b.swap(level.b);  // the right-hand side; level.b is the preconditioner's input from here
     std::copy(k_b.begin(), k_b.end(), k_r.begin());
     std::fill(k_x.begin(), k_x.end(), 0.0);
-    const double b2 = dot_on(1, k_r, k_r), target = options.coarse_solve_tolerance * options.coarse_solve_tolerance * b2;
+    const double b2 = dot_on(1, k_r, k_r, coarse_rows), target = options.coarse_solve_tolerance * options.coarse_solve_tolerance * b2;
     double rz = 0, r2 = b2;
     for (int it = 0; it < coarse_solve_max_iterations && r2 > target; ++it) {
       level.b.swap(k_r);
       cycle(1, MultigridCycle::v, true);
       level.b.swap(k_r);
       k_z.swap(level.x);
-      const double rz_new = dot_on(1, k_r, k_z);
+      const double rz_new = dot_on(1, k_r, k_z, coarse_rows);
       const double beta = it == 0 ? 0.0 : rz_new / rz;
       rz = rz_new;
       kernels::forall(
@@ -387,7 +386,7 @@ struct LaplaceMultigrid::Hierarchy {
           ex);
       // k_q = 0 - A p (the residual kernel with b = 0).
       kernels::residual_stencil9(g, level.stencil(), k_zero.data(), k_p.data(), k_q.data(), nullptr, ex);
-      const double pq = -dot_on(1, k_p, k_q);
+      const double pq = -dot_on(1, k_p, k_q, coarse_rows);
       if (!(pq > 0)) break;
       const double alpha = rz / pq;
       kernels::forall(
@@ -410,20 +409,7 @@ struct LaplaceMultigrid::Hierarchy {
     k_b.swap(level.b);
   }
 
-  double dot(const std::vector<double>& a, const std::vector<double>& b) {
-    const GridShape g = levels[0].shape;
-    row_partial.resize(g.ny);
-    kernels::forall(
-        g.ny,
-        [&](std::int64_t j) {
-          const std::int64_t row = g.at(0, static_cast<int>(j));
-          double sum = 0;
-          for (int i = 0; i < g.nx; ++i) sum += a[row + i] * b[row + i];
-          row_partial[j] = sum;
-        },
-        levels[0].execution);
-    return sum_in_order(row_partial);
-  }
+  double dot(const std::vector<double>& a, const std::vector<double>& b) { return dot_on(0, a, b, row_partial); }
 };
 
 LaplaceMultigrid::LaplaceMultigrid(const kernels::TexelTile& tile, LaplaceMultigridOptions options)
