@@ -19,6 +19,19 @@ inline double stencil9_operator(const Stencil9View& a, const double* x, std::int
          a.ne[t] * x[t + s + 1];
 }
 
+// The plain form of b - A x at texel (i, j) (0 off the unknowns), for the references.
+double reference_texel_residual(GridShape shape, const std::uint8_t* bits, const double* b, const double* x, int i,
+                                int j) {
+  const std::int64_t t = shape.at(i, j);
+  if (!(bits[t] & is_unknown)) return 0;
+  double ax = laplace_degree(bits[t]) * x[t];
+  ax -= (bits[t] & couples_west_unknown) ? x[shape.at(i - 1, j)] : 0.0;
+  ax -= (bits[t] & couples_east_unknown) ? x[shape.at(i + 1, j)] : 0.0;
+  ax -= (bits[t] & couples_south_unknown) ? x[shape.at(i, j - 1)] : 0.0;
+  ax -= (bits[t] & couples_north_unknown) ? x[shape.at(i, j + 1)] : 0.0;
+  return b[t] - ax;
+}
+
 }  // namespace
 
 void residual_texels(GridShape shape, const std::uint8_t* bits, const double* b, const double* x, double* r,
@@ -47,15 +60,7 @@ void residual_texels_reference(GridShape shape, const std::uint8_t* bits, const 
     double norm2 = 0;
     for (int i = 0; i < shape.nx; ++i) {
       const std::int64_t t = shape.at(i, j);
-      double value = 0;
-      if (bits[t] & is_unknown) {
-        double ax = laplace_degree(bits[t]) * x[t];
-        ax -= (bits[t] & couples_west_unknown) ? x[shape.at(i - 1, j)] : 0.0;
-        ax -= (bits[t] & couples_east_unknown) ? x[shape.at(i + 1, j)] : 0.0;
-        ax -= (bits[t] & couples_south_unknown) ? x[shape.at(i, j - 1)] : 0.0;
-        ax -= (bits[t] & couples_north_unknown) ? x[shape.at(i, j + 1)] : 0.0;
-        value = b[t] - ax;
-      }
+      const double value = reference_texel_residual(shape, bits, b, x, i, j);
       r[t] = value;
       norm2 += value * value;
     }
@@ -85,15 +90,7 @@ void residual_texels_color_reference(GridShape shape, const std::uint8_t* bits, 
     for (int i = 0; i < shape.nx; ++i) {
       if ((i + j) % 2 != color) continue;
       const std::int64_t t = shape.at(i, j);
-      double value = 0;
-      if (bits[t] & is_unknown) {
-        double ax = laplace_degree(bits[t]) * x[t];
-        ax -= (bits[t] & couples_west_unknown) ? x[shape.at(i - 1, j)] : 0.0;
-        ax -= (bits[t] & couples_east_unknown) ? x[shape.at(i + 1, j)] : 0.0;
-        ax -= (bits[t] & couples_south_unknown) ? x[shape.at(i, j - 1)] : 0.0;
-        ax -= (bits[t] & couples_north_unknown) ? x[shape.at(i, j + 1)] : 0.0;
-        value = b[t] - ax;
-      }
+      const double value = reference_texel_residual(shape, bits, b, x, i, j);
       r[t] = value;
     }
 }

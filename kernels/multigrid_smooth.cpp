@@ -139,22 +139,8 @@ void smooth_stencil9_sweep(GridShape shape, Stencil9View a, const double* b, dou
 
 void smooth_texels_color(GridShape shape, const std::uint8_t* bits, const double* b, double* x, int color,
                          Execution execution) {
-  const std::int64_t s = shape.stride();
   forall(
-      shape.ny,
-      [&](std::int64_t j) {
-        const std::int64_t row = shape.at(0, static_cast<int>(j));
-        for (int i = static_cast<int>((color + j) & 1); i < shape.nx; i += 2) {
-          const std::int64_t t = row + i;
-          const std::uint8_t m = bits[t];
-          const double sum = b[t] + ((m & couples_west_unknown) ? x[t - 1] : 0.0) +
-                             ((m & couples_east_unknown) ? x[t + 1] : 0.0) +
-                             ((m & couples_south_unknown) ? x[t - s] : 0.0) +
-                             ((m & couples_north_unknown) ? x[t + s] : 0.0);
-          if (m & is_unknown) x[t] = sum * inverse_degree[laplace_degree(m)];
-        }
-      },
-      execution);
+      shape.ny, [&](std::int64_t j) { texel_row(shape, bits, b, x, static_cast<int>(j), color); }, execution);
 }
 
 void smooth_texels_color_reference(GridShape shape, const std::uint8_t* bits, const double* b, double* x, int color) {
