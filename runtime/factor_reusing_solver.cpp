@@ -58,14 +58,56 @@ FactorReusingSolver::FactorReusingSolver(const BlockAssembly& pattern, const Fre
   system.expand_vector(ones, mask);
   free_.resize(mask.size());
   for (size_t d = 0; d < mask.size(); ++d) free_[d] = mask[d] != 0;
+  // Two nodes of one element have a non-zero consistent-mass block; the DG edge terms'
+  // couplings across an edge have none.
+  element_local_blocks_.assign(blocks, 0);
+  for (std::int64_t k = 0; k < blocks && static_cast<std::int64_t>(mass.size()) == blocks * 9; ++k)
+    for (int i = 0; i < 9; ++i) element_local_blocks_[k] |= mass[9 * k + i] != 0;
+  for (char kept : element_local_blocks_) element_local_differs_ |= !kept;
+  set_options(options);
+}
+
+void FactorReusingSolver::set_options(const FactorReuseOptions& options) {
+  const bool element_local = options.preconditioner_pattern == PreconditionerPattern::element_local &&
+                             element_local_differs_ && stats_.element_local_fallbacks == 0;
+  if (element_local != use_element_local_) factor_current_ = false;
+  use_element_local_ = element_local;
+  options_ = options;
+}
+
+void FactorReusingSolver::fall_back_to_full_pattern() {
+  use_element_local_ = false;
+  factor_current_ = false;
+  ++stats_.element_local_fallbacks;
+  element_local_factor_.reset();
 }
 
 void FactorReusingSolver::factorize(const ScaledBlockSum& A, SparseCholesky& cholesky) {
-  system_.gather(mass_.data(), A.mass_scale, A.stiffness->data(), A.stiffness_scale, values_);
-  if (!cholesky.analyzed()) cholesky.analyze(system_.size(), system_.column_start(), system_.row_index());
   const auto start = std::chrono::steady_clock::now();
-  cholesky.factorize(values_);
-  if (options_.single_precision_preconditioner) cholesky.copy_factor_to_single_precision();
+  if (use_element_local_) {
+    if (!element_local_system_) {
+      std::vector<char> fixed(free_.size());
+      for (size_t d = 0; d < free_.size(); ++d) fixed[d] = !free_[d];
+      element_local_system_ = std::make_unique<FreeDofSystem>(pattern_, fixed, &element_local_blocks_);
+    }
+    if (!element_local_factor_) element_local_factor_ = std::make_unique<SparseCholesky>();
+    element_local_system_->gather(mass_.data(), A.mass_scale, A.stiffness->data(), A.stiffness_scale, values_);
+    if (!element_local_factor_->analyzed())
+      element_local_factor_->analyze(element_local_system_->size(), element_local_system_->column_start(),
+                                     element_local_system_->row_index());
+    try {
+      element_local_factor_->factorize(values_);
+    } catch (const NotPositiveDefinite&) {
+      fall_back_to_full_pattern();  // the dropped couplings were needed: A itself is checked below
+    }
+  }
+  SparseCholesky& factor = use_element_local_ ? *element_local_factor_ : cholesky;
+  if (!use_element_local_) {
+    system_.gather(mass_.data(), A.mass_scale, A.stiffness->data(), A.stiffness_scale, values_);
+    if (!cholesky.analyzed()) cholesky.analyze(system_.size(), system_.column_start(), system_.row_index());
+    cholesky.factorize(values_);
+  }
+  if (options_.single_precision_preconditioner) factor.copy_factor_to_single_precision();
   stats_.factorize_ms += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   factor_current_ = true;
   ++stats_.factorizations;
@@ -74,11 +116,13 @@ void FactorReusingSolver::factorize(const ScaledBlockSum& A, SparseCholesky& cho
 void FactorReusingSolver::precondition(const SparseCholesky& cholesky, const std::vector<double>& r,
                                        std::vector<double>& z) {
   const auto start = std::chrono::steady_clock::now();
+  // Both systems have the same free DOFs, so either restricts and expands alike.
+  const SparseCholesky& factor = use_element_local_ ? *element_local_factor_ : cholesky;
   system_.restrict_vector(r, reduced_in_);
   if (options_.single_precision_preconditioner)
-    cholesky.solve_single_precision(reduced_in_, reduced_out_);
+    factor.solve_single_precision(reduced_in_, reduced_out_);
   else
-    cholesky.solve(reduced_in_, reduced_out_);
+    factor.solve(reduced_in_, reduced_out_);
   system_.expand_vector(reduced_out_, z);
   stats_.precondition_ms += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
 }
@@ -191,22 +235,31 @@ void FactorReusingSolver::solve(const ScaledBlockSum& A, const std::vector<doubl
     stats_.last_relative_residual = 0;
     return;
   }
-  if (!factor_current_) factorize(A, cholesky);
+  const bool fresh = !factor_current_;
+  if (fresh) factorize(A, cholesky);
   guess_ = x;
   double residual = 0;
   int iterations = pcg(A, b, x, cholesky, residual, stiffness_times_x);
   int wasted = 0;
-  if (iterations < 0) {
+  if (iterations < 0 && !fresh) {
     // The old factor no longer preconditions well enough: factorise this matrix.
-    wasted = options_.max_iterations;
+    wasted += options_.max_iterations;
     factorize(A, cholesky);
     x = guess_;
     iterations = pcg(A, b, x, cholesky, residual, stiffness_times_x);  // x is the guess again
-    if (iterations < 0)
-      throw std::runtime_error("FactorReusingSolver: no convergence to relative residual " +
-                               std::to_string(options_.relative_tolerance) + " even with a fresh factor (residual " +
-                               std::to_string(residual) + "); the system is ill-conditioned");
   }
+  if (iterations < 0 && use_element_local_) {
+    // Even a fresh element-local factor is too far from A: use the whole pattern.
+    wasted += options_.max_iterations;
+    fall_back_to_full_pattern();
+    factorize(A, cholesky);
+    x = guess_;
+    iterations = pcg(A, b, x, cholesky, residual, stiffness_times_x);
+  }
+  if (iterations < 0)
+    throw std::runtime_error("FactorReusingSolver: no convergence to relative residual " +
+                             std::to_string(options_.relative_tolerance) + " even with a fresh factor (residual " +
+                             std::to_string(residual) + "); the system is ill-conditioned");
   // Judged by the factor now held (a fresh one after a failed attempt).
   if (iterations > options_.refactor_after_iterations) factor_current_ = false;
   iterations += wasted;

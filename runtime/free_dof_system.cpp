@@ -1,12 +1,18 @@
 #include "dgtex/free_dof_system.h"
 
 #include <algorithm>
+#include <stdexcept>
+#include <string>
 
 #include "dgtex/kernels/forall.h"
 
 namespace dgtex {
 
-FreeDofSystem::FreeDofSystem(const BlockAssembly& pattern, const std::vector<char>& fixed) {
+FreeDofSystem::FreeDofSystem(const BlockAssembly& pattern, const std::vector<char>& fixed,
+                             const std::vector<char>* kept_blocks) {
+  if (kept_blocks && static_cast<std::int64_t>(kept_blocks->size()) != pattern.num_blocks())
+    throw std::invalid_argument("FreeDofSystem: kept_blocks has " + std::to_string(kept_blocks->size()) +
+                                " flags, the pattern " + std::to_string(pattern.num_blocks()) + " blocks");
   const int ndofs = 3 * pattern.num_nodes();
   unknown_of_dof_.assign(ndofs, -1);
   for (int d = 0; d < ndofs; ++d)
@@ -20,7 +26,8 @@ FreeDofSystem::FreeDofSystem(const BlockAssembly& pattern, const std::vector<cha
   const auto& start = pattern.row_start();
   const auto& col = pattern.column();
   for (int rn = 0; rn < pattern.num_nodes(); ++rn)
-    for (std::int64_t k = start[rn]; k < start[rn + 1]; ++k)
+    for (std::int64_t k = start[rn]; k < start[rn + 1]; ++k) {
+      if (kept_blocks && !(*kept_blocks)[k]) continue;
       for (int r = 0; r < 3; ++r)
         for (int c = 0; c < 3; ++c) {
           const int ur = unknown_of_dof_[3 * rn + r];
@@ -28,6 +35,7 @@ FreeDofSystem::FreeDofSystem(const BlockAssembly& pattern, const std::vector<cha
           if (ur < 0 || uc < 0 || ur < uc) continue;
           per_column[uc].emplace_back(ur, k * 9 + r * 3 + c);
         }
+    }
   column_start_.assign(dof_of_unknown_.size() + 1, 0);
   for (size_t j = 0; j < per_column.size(); ++j) {
     auto& entries = per_column[j];

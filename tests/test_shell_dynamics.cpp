@@ -22,6 +22,11 @@ TEST(Dynamics, UnconstrainedShellFallsWithGravity) {
     const double g[3] = {0, 0, -9.81};
     model->add_gravity(g, f);
     ShellSimulation sim(*model, std::vector<char>(model->num_dofs(), 0), f);
+    // The corotated steps are solved by PCG to a relative residual: set it far below the
+    // 1e-9 asserted here, so that the assertion tests the dynamics, not the solver's bound.
+    FactorReuseOptions solver;
+    solver.relative_tolerance = 1e-13;
+    sim.set_solver_options(solver);
     DynamicsOptions options;
     options.time_step = 1e-3;
     for (bool corotational : {false, true}) {

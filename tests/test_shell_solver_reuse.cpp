@@ -152,6 +152,62 @@ TEST(FactorReuse, StalePreconditionerIsReplacedAndTheBoundStillHolds) {
   EXPECT_EQ(solver.statistics().factorizations, 2);
 }
 
+TEST(FactorReuse, ElementLocalPreconditionerIsSparserAndGivesTheSameSteps) {
+  // The default preconditioner factorises only the element-local couplings; it must meet
+  // the same bound, agree with the whole-pattern preconditioner to the solver tolerance,
+  // and have a much sparser factor (the DG edge couplings are what fill L).
+  CompressedCylinder c;
+  ShellSimulation element_local(*c.model, c.fixed, c.load), full(*c.model, c.fixed, c.load);
+  FactorReuseOptions full_options;
+  full_options.preconditioner_pattern = PreconditionerPattern::full;
+  full.set_solver_options(full_options);
+  for (int s = 0; s < 16; ++s) {
+    element_local.step(c.options);
+    full.step(c.options);
+    EXPECT_LE(element_local.solver_statistics().last_relative_residual, FactorReuseOptions{}.relative_tolerance);
+  }
+  double diff = 0, scale = 0;
+  for (size_t d = 0; d < full.displacement().size(); ++d) {
+    diff = std::max(diff, std::abs(element_local.displacement()[d] - full.displacement()[d]));
+    scale = std::max(scale, std::abs(full.displacement()[d]));
+  }
+  const FactorReuseStatistics& e = element_local.solver_statistics();
+  std::printf("element-local: nnz(L) %ld, %ld factorisations, %ld iterations; full: nnz(L) %ld, %ld, %ld; "
+              "max |du| / max |u| = %.2e\n",
+              static_cast<long>(element_local.factor_nonzeros()), e.factorizations, e.iterations,
+              static_cast<long>(full.factor_nonzeros()), full.solver_statistics().factorizations,
+              full.solver_statistics().iterations, diff / scale);
+  EXPECT_EQ(e.element_local_fallbacks, 0);
+  EXPECT_GT(scale, 1e-3);
+  EXPECT_LE(diff, 1e-6 * scale);  // as the factorise-every-step comparison above
+  EXPECT_LT(2 * element_local.factor_nonzeros(), full.factor_nonzeros());
+}
+
+TEST(FactorReuse, FallsBackToTheWholePatternWhenElementLocalIsTooWeak) {
+  // With one iteration allowed and an exact (double) preconditioner only a factor of A
+  // itself converges: the element-local factor fails twice (stale, then fresh) and the
+  // solver must switch to the whole pattern for good, still meeting the bound.
+  CompressedCylinder c;
+  std::vector<double> K;
+  c.model->assemble_stiffness(nullptr, K, nullptr);
+  FreeDofSystem system(c.model->pattern(), c.fixed);
+  SparseCholesky cholesky;
+  FactorReuseOptions options;
+  options.max_iterations = 1;
+  options.single_precision_preconditioner = false;
+  FactorReusingSolver solver(c.model->pattern(), system, c.model->mass_blocks(), options);
+  ASSERT_TRUE(solver.element_local());
+  const ScaledBlockSum A{1.0, &K, 4e-6};
+  for (int s = 0; s < 2; ++s) {
+    std::vector<double> x(c.model->num_dofs(), 0.0);
+    solver.solve(A, c.load, x, cholesky);
+    EXPECT_LE(solver.statistics().last_relative_residual, options.relative_tolerance);
+  }
+  EXPECT_FALSE(solver.element_local());
+  EXPECT_EQ(solver.statistics().element_local_fallbacks, 1);
+  EXPECT_EQ(solver.statistics().factorizations, 2);  // element-local once, then A once (reused by solve 2)
+}
+
 TEST(DeterministicDot, IsIndependentOfThreadCount) {
   std::vector<double> x(100003), y(x.size());
   for (size_t i = 0; i < x.size(); ++i) x[i] = std::sin(0.1 * i), y[i] = std::cos(0.37 * i) * 1e3;

@@ -78,6 +78,11 @@ int bench_shell_command(int argc, char** argv) {
   app.add_option("--tolerance", solver.relative_tolerance, "PCG relative residual bound per step")->capture_default_str();
   app.add_option("--refactor-after", solver.refactor_after_iterations,
                  "refactorise when a step needed more PCG iterations than this")->capture_default_str();
+  std::string preconditioner = "element_local";
+  app.add_option("--preconditioner", preconditioner,
+                 "pattern of the PCG preconditioner's factor: element_local (the default) or full")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"element_local", "full"}));
   app.add_flag("--refactor-every-step", refactor_every_step,
                "reference solver path: factorise the corotated matrix every step (no PCG)");
   std::string wait_policy = "passive";
@@ -91,6 +96,8 @@ int bench_shell_command(int argc, char** argv) {
   } catch (const CLI::ParseError& e) {
     return app.exit(e) == 0 ? 0 : 2;
   }
+  solver.preconditioner_pattern =
+      preconditioner == "full" ? PreconditionerPattern::full : PreconditionerPattern::element_local;
   // libgomp reads OMP_WAIT_POLICY once, when it loads: to change it, run again under it.
   const char* current_policy = std::getenv("OMP_WAIT_POLICY");
   if (wait_policy != "inherit" && (!current_policy || wait_policy != current_policy)) {
@@ -174,6 +181,7 @@ int bench_shell_command(int argc, char** argv) {
                             {"pcg_relative_tolerance", solver.relative_tolerance},
                             {"omp_wait_policy", std::getenv("OMP_WAIT_POLICY") ? std::getenv("OMP_WAIT_POLICY") : "default"},
                             {"refactor_after_iterations", solver.refactor_after_iterations},
+                            {"preconditioner", preconditioner},
                             {"counts", {{"elements", first.elements}, {"nodes", first.nodes}, {"free_dofs", first.free_dofs},
                                         {"quadrature_points", first.quadrature_points},
                                         {"factor_nonzeros", first.factor_nonzeros}}},

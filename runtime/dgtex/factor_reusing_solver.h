@@ -3,14 +3,24 @@
 // matrix M + dt D + dt^2 R K R^T) by conjugate gradients preconditioned with the Cholesky
 // factor of an earlier A_j, refactorising only when that preconditioner has gone stale.
 //
-// Why: for the cylinder buckling scene (8525 free DOFs) nnz(L) is ~3.4M whatever the
+// Why: for the cylinder buckling scene (8525 free DOFs) nnz(L) is ~4.4M whatever the
 // ordering (METIS, AMD, NESDIS are within 10%: the DG edge terms couple every node to ~80
-// others), so one factorisation costs ~2 GFLOP (~150 ms) while one forward/backward solve
-// costs ~1.5-3 ms. Under corotation A_k changes slowly, so A_j^-1 A_k stays close to I:
+// others), so one factorisation costs ~2 GFLOP (~250 ms) while one forward/backward solve
+// costs ~2-3 ms. Under corotation A_k changes slowly, so A_j^-1 A_k stays close to I:
 // PCG needs 2-3 solves per step right after a factorisation, ~8 some 20 steps later
 // (the membrane term dt^2 K is ~30x the mass at the highest modes, so small rotation
 // changes matter; rotating the old factor along per-node rotations did not help).
 //
+// Element-local preconditioner (the default): the factor is taken of A with only the
+// blocks that couple two nodes of one element (where the consistent mass is non-zero),
+// i.e. without the DG edge terms' couplings across an edge. Those terms act on the
+// rotation jump (bending, ~t^3), small next to mass and membrane stiffness, so PCG needs
+// only a few more iterations, but nnz(L) drops ~4x (cylinder: 1.15M instead of 4.36M):
+// a factorisation costs ~75 ms instead of ~300, an application ~0.7 ms instead of ~2.5.
+// It is a heuristic, so it falls back to the whole pattern for the rest of the run when
+// its matrix is not positive definite or a fresh element-local factor does not reach the
+// tolerance within max_iterations (statistics().element_local_fallbacks counts it).
+
 // Contract: the returned x satisfies ||b - A x||_2 <= relative_tolerance * ||b||_2 over the
 // free DOFs (the PCG recurrence residual; round-off may let the true one differ slightly),
 // or the solver throws. If max_iterations do not suffice, A_k itself is factorised and PCG
@@ -22,11 +32,12 @@
 // and the dot products (fixed chunking, summed in a fixed order) do not depend on the
 // number of threads, and neither does the refactorisation decision, so x is bitwise
 // identical for any thread count.
-// FactorReusingSolver owns its work vectors and statistics and keeps references to the
-// pattern, the free-DOF system and the mass blocks (all must outlive it); the Cholesky
-// factor is the caller's, passed to each solve. Not thread-safe; a solve uses all OpenMP
+// FactorReusingSolver owns its work vectors, statistics and the element-local factor and
+// keeps references to the pattern, the free-DOF system and the mass blocks (all must
+// outlive it); the factor of the whole pattern is the caller's, passed to each solve. Not thread-safe; a solve uses all OpenMP
 // threads. Units: those of the system (SI: kg, N/m, N).
 #include <cstdint>
+#include <memory>
 #include <stdexcept>
 #include <vector>
 
@@ -36,23 +47,26 @@
 
 namespace dgtex {
 
+// Which couplings of A the preconditioner factorises (see above).
+enum class PreconditionerPattern { full, element_local };
+
 struct FactorReuseOptions {
   // On ||b - A x|| / ||b|| over the free DOFs (the PCG recurrence residual). 1e-8 keeps the
   // cylinder scene's probe within 5e-10 (relative) of refactorising every step.
   double relative_tolerance = 1e-8;
   // A solve slower than this factorises the next system. Measured on the cylinder scene
-  // (50 steps, 1 thread; `dgtex bench shell --refactor-after N`): N = 6: 8 factorisations +
-  // 208 iterations, solve 45 ms/step; 8: 5 + 249, 37 ms; 12: 3 + 310, 35 ms; 16: 2 + 365,
-  // 38 ms. One factorisation costs ~60 preconditioner applications, so 8-12 is the optimum.
-  // Over 100 steps (the buckling develops) N = 8: 18 factorisations + 546 iterations; 12:
-  // 11 + 730; 16: 7 + 910; 24: 5 + 1180. At ~150 ms per factorisation and ~3.3 ms per
-  // iteration (1 thread) 12 and 16 cost ~10% less than 8, 24 more: 12.
+  // (100 steps, 1 thread, CPU time per step; `dgtex bench shell --refactor-after N`), with
+  // the element-local preconditioner: N = 6: 27 factorisations + 595 iterations, 44-46 ms;
+  // 8: 19 + 664, 39-47 ms; 10: 14 + 741, 40-42 ms; 12: 11 + 821, 41-42 ms; 16: 8 + 967,
+  // 40-43 ms; 24: 5 + 1257, 42-44 ms (a shared machine: the spread is noise). Flat from 8
+  // to 20; 12 also was the optimum of the whole-pattern factor (11 + 730, 61-64 ms).
   int refactor_after_iterations = 12;
   int max_iterations = 40;            // beyond this, factorise the current system now
   // Apply the preconditioner with a float copy of L (SparseCholesky::solve_single_precision):
   // half the memory traffic per iteration; the residual bound is unchanged (the PCG
   // arithmetic stays in double, only the preconditioner is approximated further).
   bool single_precision_preconditioner = true;
+  PreconditionerPattern preconditioner_pattern = PreconditionerPattern::element_local;
 };
 
 struct FactorReuseStatistics {
@@ -63,6 +77,9 @@ struct FactorReuseStatistics {
   double factorize_ms = 0;       // wall time in numeric factorisations
   double precondition_ms = 0;    // wall time in preconditioner applications (L^-T L^-1 r)
   double last_relative_residual = 0;
+  // Element-local preconditioning given up for the whole pattern (0 or 1): its matrix was
+  // not positive definite, or a fresh factor of it did not converge in max_iterations.
+  int element_local_fallbacks = 0;
 };
 
 // The step matrix A = mass_scale M + stiffness_scale K (blocks in the solver's pattern). A is
@@ -82,8 +99,9 @@ class FactorReusingSolver {
                       FactorReuseOptions options = {});
 
   // b: #dofs (fixed entries ignored). x: #dofs, in: initial guess, out: solution with
-  // fixed entries zero. `cholesky` is the factorisation it reuses and refreshes (analysed
-  // on first use). Throws NotPositiveDefinite from a factorisation.
+  // fixed entries zero. `cholesky` is the factorisation of the whole pattern it reuses and
+  // refreshes (analysed on first use) when the preconditioner pattern is full or after a
+  // fallback; the element-local factor is the solver's own. Throws NotPositiveDefinite from a factorisation.
   // stiffness_times_x (optional): K times the initial guess x, when the caller has it (e.g.
   // from block_multiply_pair): saves one pass over K; the result is bitwise the same.
   void solve(const ScaledBlockSum& A, const std::vector<double>& b, std::vector<double>& x, SparseCholesky& cholesky,
@@ -94,9 +112,16 @@ class FactorReusingSolver {
 
   // Forces a factorisation at the next solve (e.g. the matrix changed abruptly).
   void invalidate() { factor_current_ = false; }
+  // True while the preconditioner is the element-local factor (no fallback happened).
+  bool element_local() const { return use_element_local_; }
+  // Non-zeros of the element-local factor L (0 before its first factorisation).
+  std::int64_t element_local_factor_nonzeros() const {
+    return element_local_factor_ ? element_local_factor_->factor_nonzeros() : 0;
+  }
   const FactorReuseStatistics& statistics() const { return stats_; }
   const FactorReuseOptions& options() const { return options_; }
-  void set_options(const FactorReuseOptions& options) { options_ = options; }
+  // A change of the preconditioner pattern takes effect with a factorisation at the next solve.
+  void set_options(const FactorReuseOptions& options);
 
  private:
   const BlockAssembly& pattern_;
@@ -108,8 +133,18 @@ class FactorReusingSolver {
   bool factor_current_ = false;  // cholesky holds a factor of some earlier A
   std::vector<double> values_, r_, z_, p_, q_, reduced_in_, reduced_out_, b_free_, guess_;
   std::vector<char> free_;
+  // Element-local preconditioner: the blocks it keeps, its system and factor (built on
+  // first use), and whether it is in use.
+  std::vector<char> element_local_blocks_;
+  std::unique_ptr<FreeDofSystem> element_local_system_;
+  std::unique_ptr<SparseCholesky> element_local_factor_;
+  bool element_local_differs_ = false;  // some coupling block is not element-local
+  bool use_element_local_ = false;
 
+  // Factorises A (element-local, or the whole pattern into `cholesky`); an element-local
+  // matrix that is not positive definite switches to the whole pattern.
   void factorize(const ScaledBlockSum& A, SparseCholesky& cholesky);
+  void fall_back_to_full_pattern();
   void precondition(const SparseCholesky& cholesky, const std::vector<double>& r, std::vector<double>& z);
   // y = A x over free DOFs (fixed entries of y set to zero).
   void multiply(const ScaledBlockSum& A, const std::vector<double>& x, std::vector<double>& y) const;

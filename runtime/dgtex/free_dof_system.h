@@ -15,8 +15,11 @@ namespace dgtex {
 class FreeDofSystem {
  public:
   FreeDofSystem() = default;
-  // fixed: #dofs flags (3 per node).
-  FreeDofSystem(const BlockAssembly& pattern, const std::vector<char>& fixed);
+  // fixed: #dofs flags (3 per node). kept_blocks (optional, #blocks of pattern): only the
+  // blocks flagged non-zero enter the system (a sparser approximation, e.g. for a
+  // preconditioner); gather still reads values in the layout of the whole pattern.
+  FreeDofSystem(const BlockAssembly& pattern, const std::vector<char>& fixed,
+                const std::vector<char>* kept_blocks = nullptr);
 
   int size() const { return static_cast<int>(dof_of_unknown_.size()); }
   std::int64_t nonzeros() const { return static_cast<std::int64_t>(row_index_.size()); }

@@ -50,7 +50,11 @@ class ShellSimulation {
   double time() const { return time_; }
   const StageTimings& timings() const { return timings_; }
   const FreeDofSystem& system() const { return system_; }
-  std::int64_t factor_nonzeros() const { return cholesky_.factor_nonzeros(); }
+  // Non-zeros of the factor in use: the PCG preconditioner's when it is element-local.
+  std::int64_t factor_nonzeros() const {
+    return solver_.element_local() && solver_.element_local_factor_nonzeros() > 0 ? solver_.element_local_factor_nonzeros()
+                                                                                   : cholesky_.factor_nonzeros();
+  }
   // Solver of the corotated steps: its tolerance and refactorisation policy, and counts.
   void set_solver_options(const FactorReuseOptions& options);
   const FactorReuseStatistics& solver_statistics() const { return solver_.statistics(); }
