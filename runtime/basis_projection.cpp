@@ -5,17 +5,6 @@
 
 namespace dgtex {
 
-namespace {
-
-std::vector<double> moments_of(const ShellModel& old_model, const std::vector<double>& values,
-                               const ShellModel& new_model) {
-  return new_model.mass_weighted_moments([&](int element, const double xi[2], double out[3]) {
-    old_model.interpolate(values, element, xi, out);
-  });
-}
-
-}  // namespace
-
 ProjectedState project_onto_basis(const ShellModel& old_model, const std::vector<double>& old_displacement,
                                   const std::vector<double>& old_velocity, const ShellModel& new_model,
                                   const std::vector<char>& fixed) {
@@ -26,16 +15,20 @@ ProjectedState project_onto_basis(const ShellModel& old_model, const std::vector
   mass.analyze(system.size(), system.column_start(), system.row_index());
   mass.factorize(values);
 
-  auto project = [&](const std::vector<double>& old_values) {
+  // Moments of displacement and velocity in one pass over the quadrature points.
+  std::vector<const std::vector<double>*> fields = {&old_displacement};
+  if (!old_velocity.empty()) fields.push_back(&old_velocity);
+  const std::vector<std::vector<double>> moments = new_model.moments_of_fields(old_model, fields);
+  auto project = [&](const std::vector<double>& moment) {
     std::vector<double> rhs, reduced, solution;
-    system.restrict_vector(moments_of(old_model, old_values, new_model), rhs);
+    system.restrict_vector(moment, rhs);
     mass.solve(rhs, reduced);
     system.expand_vector(reduced, solution);
     return solution;
   };
   ProjectedState state;
-  state.displacement = project(old_displacement);
-  state.velocity = old_velocity.empty() ? std::vector<double>(new_model.num_dofs(), 0.0) : project(old_velocity);
+  state.displacement = project(moments[0]);
+  state.velocity = old_velocity.empty() ? std::vector<double>(new_model.num_dofs(), 0.0) : project(moments[1]);
   return state;
 }
 

@@ -1,9 +1,11 @@
 #include "dgtex/laplace_multigrid.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <stdexcept>
 #include <string>
+#include <cstdint>
 
 #include <Eigen/CholmodSupport>
 #include <Eigen/Dense>
@@ -15,6 +17,7 @@
 #include "dgtex/kernels/multigrid_transfer.h"
 #include "dgtex/kernels/multigrid_unknowns.h"
 #include "dgtex/stage_timer.h"
+#include "multigrid_buffer.h"
 
 // Choices, measured with T=256/1024 single-element solves to 1e-6 from zero (1 thread):
 // - V(1,1) as CG preconditioner (default): 6 iterations on open/slit/accordion (0.085 per
@@ -39,6 +42,16 @@
 //   (T=1024: ~100 -> ~23 ms), Galerkin products unrolled at compile time (T=1024 level 0:
 //   60-100 -> ~10 ms), dense Cholesky for coarsest levels up to 400 unknowns (CHOLMOD's
 //   analysis alone costs more for the usual 8x8 level).
+// - Memory and passes (setup + solve, CPU time, 1 thread, best of 10-40, old/new side by side):
+//   the level and CG arrays come zeroed from a size-keyed block cache / huge pages instead of
+//   fresh 4 KiB pages filled by vector::assign (multigrid_buffer.h), 9 -> 6 level-0 arrays
+//   (z stays in levels[0].x, q shares levels[0].r, no saved rhs), the rhs pass also forms
+//   ||b|| and r = b for a zero initial guess, and the setup's union-find skips repeated
+//   unions: open T = 256 8.4 -> 7.0 ms (setup 2.9 -> 1.7), T = 1024 224 -> 176 ms (setup 64
+//   -> 36). Tried and rejected: vectorised (omp simd, both colours + blend) red-black rows:
+//   2x slower than the stride-2 scalar loop (SSE2/AVX2, gathers of 1/degree); W-cycles
+//   below level 0 or 1: spiral T = 512 17 -> 15-17 iterations (W from level 0: 11, but
+//   slower); see also the spiral note in multigrid_galerkin.h.
 namespace dgtex {
 using kernels::Execution;
 using kernels::GridShape;
@@ -52,8 +65,15 @@ using Clock = std::chrono::steady_clock;
 // at the old bound 16384; with this bound T = 256 is serial (8.0 ms), T = 512 drops from
 // 47 to 36-39 ms (its 66k-node level 1 runs serially), T = 1024 182 -> 151 ms.
 constexpr long parallel_min_nodes = 131072;
+// Level 0 forms and restricts its red residual in one pass (restrict_red_residual_texels)
+// from this many nodes on; below, where the level fits the cache, the two-pass form is
+// cheaper (the one-pass form evaluates cell-centre residuals twice). Setup + solve, CPU,
+// 1 thread, open: T = 256 6.9 -> 7.4 ms one-pass, T = 512 33 ms both, T = 1024 188 -> 180 ms.
+constexpr long fused_restriction_min_nodes = 1l << 19;
 // Coarsest levels up to this many unknowns are factored densely.
 constexpr int dense_coarsest_max = 400;
+
+using detail::MultigridBuffer;
 
 double sum_in_order(const std::vector<double>& rows) {
   double sum = 0;
@@ -67,10 +87,10 @@ struct LaplaceMultigrid::Hierarchy {
   struct Level {
     GridShape shape;
     Execution execution = Execution::serial;
-    std::vector<double> x, b, r;
+    MultigridBuffer x, b, r;
     std::vector<std::uint8_t> active;       // node has an unknown (prolongation mask)
-    std::vector<double> c, e, n, ne, nw;    // 9-point operator (levels >= 1)
-    std::vector<double> p[8];               // interpolation to the next finer level (levels >= 1)
+    MultigridBuffer c, e, n, ne, nw;        // 9-point operator (levels >= 1)
+    MultigridBuffer p[8];                   // interpolation to the next finer level (levels >= 1)
     kernels::Stencil9View stencil() const { return {c.data(), e.data(), n.data(), ne.data(), nw.data()}; }
     kernels::InterpolationView interpolation() const {
       return {p[0].data(), p[1].data(), p[2].data(), p[3].data(), p[4].data(), p[5].data(), p[6].data(), p[7].data()};
@@ -83,13 +103,21 @@ struct LaplaceMultigrid::Hierarchy {
   std::vector<std::uint8_t> bits;        // level-0 operator, padded layout
   std::vector<Level> levels;
   std::vector<double> row_partial;       // per-row partial sums (deterministic reductions)
-  std::vector<double> cg_z, cg_p, cg_q;  // preconditioned CG vectors (level-0 layout)
+  // Preconditioned CG vectors (level-0 layout). q = A p lives from its product to the next
+  // update of x and r, never across a cycle, so it shares levels[0].r (the cycle's residual)
+  // unless the robust cycle's flexible CG needs q after the cycle: 2 of 9 level-0 arrays
+  // fewer (with the rhs kept in the preconditioner's slot, see solve()). T = 1024: 17 MB less
+  // memory to fault in and clear per setup (25 MB with cg_z, below).
+  // The preconditioned residual z stays where the cycle leaves it, in levels[0].x: it is
+  // dead once the direction p is updated, before the next cycle starts (one array fewer).
+  MultigridBuffer cg_p, cg_q;
   std::vector<std::int64_t> coarsest_nodes;
   Eigen::CholmodSupernodalLLT<Eigen::SparseMatrix<double>, Eigen::Lower> coarsest_factor;
   Eigen::LLT<Eigen::MatrixXd> coarsest_dense;  // used up to dense_coarsest_max unknowns
   bool coarsest_is_dense = false;
-  std::vector<double> cg_x, cg_r, cg_b;      // preconditioned CG iterate, residual, saved rhs
-  std::vector<double> k_x, k_r, k_z, k_p, k_q, k_b, k_zero, coarse_rows;  // level-1 CG of the robust cycle
+  MultigridBuffer cg_x, cg_r;                // preconditioned CG iterate and residual
+  MultigridBuffer k_x, k_r, k_z, k_p, k_q, k_b, k_zero;  // level-1 CG of the robust cycle
+  std::vector<double> coarse_rows;
   static constexpr int coarse_solve_max_iterations = 50;
   bool robust_coarse_solve() const { return options.coarse_solve_tolerance > 0 && levels.size() > 2; }
   int orphans_at_stop = 0;
@@ -111,8 +139,7 @@ struct LaplaceMultigrid::Hierarchy {
     kernels::classify_laplace_texels_padded(tile, bits.data(), fine.execution);
     fine.active.resize(fine.shape.padded_size());
     for (std::size_t t = 0; t < bits.size(); ++t) fine.active[t] = (bits[t] & kernels::is_unknown) ? 1 : 0;
-    fine.x.assign(fine.shape.padded_size(), 0.0);
-    fine.b = fine.r = fine.x;
+    for (auto* v : {&fine.x, &fine.b, &fine.r}) *v = MultigridBuffer(fine.shape.padded_size());
     levels.clear();
     levels.push_back(std::move(fine));
 
@@ -124,8 +151,8 @@ struct LaplaceMultigrid::Hierarchy {
       coarse.execution = execution_for(coarse.shape);
       const std::size_t size = coarse.shape.padded_size();
       for (auto* v : {&coarse.x, &coarse.b, &coarse.r, &coarse.c, &coarse.e, &coarse.n, &coarse.ne, &coarse.nw})
-        v->assign(size, 0.0);
-      for (auto& v : coarse.p) v.assign(size, 0.0);
+        *v = MultigridBuffer(size);
+      for (auto& v : coarse.p) v = MultigridBuffer(size);
       kernels::InterpolationArrays p{coarse.p[0].data(), coarse.p[1].data(), coarse.p[2].data(), coarse.p[3].data(),
                                      coarse.p[4].data(), coarse.p[5].data(), coarse.p[6].data(), coarse.p[7].data()};
       kernels::Stencil9Arrays a{coarse.c.data(), coarse.e.data(), coarse.n.data(), coarse.ne.data(), coarse.nw.data()};
@@ -152,12 +179,12 @@ struct LaplaceMultigrid::Hierarchy {
     row_partial.assign(rows, 0.0);
     if (robust_coarse_solve()) {
       const std::size_t n1 = levels[1].shape.padded_size();
-      for (auto* v : {&k_x, &k_r, &k_z, &k_p, &k_q, &k_b, &k_zero}) v->assign(n1, 0.0);
+      for (auto* v : {&k_x, &k_r, &k_z, &k_p, &k_q, &k_b, &k_zero}) *v = MultigridBuffer(n1);
       coarse_rows.assign(levels[1].shape.ny, 0.0);
     }
     if (options.use_as_cg_preconditioner) {
-      cg_z.assign(levels[0].shape.padded_size(), 0.0);
-      cg_p = cg_q = cg_x = cg_r = cg_b = cg_z;
+      for (auto* v : {&cg_p, &cg_x, &cg_r}) *v = MultigridBuffer(levels[0].shape.padded_size());
+      if (robust_coarse_solve()) cg_q = MultigridBuffer(levels[0].shape.padded_size());
     }
   }
 
@@ -304,10 +331,15 @@ struct LaplaceMultigrid::Hierarchy {
       }
       smooth(0, true, sweeps);
       if (pre > 0) {
-        kernels::residual_texels_color(level.shape, bits.data(), level.b.data(), level.x.data(), level.r.data(), 0,
-                                       level.execution);
-        kernels::restrict_red_residual(level.shape, coarse.shape, coarse.interpolation(), level.r.data(),
-                                       coarse.b.data(), coarse.execution);
+        if (static_cast<long>(level.shape.nx) * level.shape.ny >= fused_restriction_min_nodes) {
+          kernels::restrict_red_residual_texels(level.shape, coarse.shape, coarse.interpolation(), bits.data(),
+                                                level.b.data(), level.x.data(), coarse.b.data(), level.execution);
+        } else {
+          kernels::residual_texels_color(level.shape, bits.data(), level.b.data(), level.x.data(), level.r.data(), 0,
+                                         level.execution);
+          kernels::restrict_red_residual(level.shape, coarse.shape, coarse.interpolation(), level.r.data(),
+                                         coarse.b.data(), coarse.execution);
+        }
       } else {
         residual(0, nullptr);
         kernels::restrict_residual(level.shape, coarse.shape, coarse.interpolation(), level.r.data(),
@@ -343,7 +375,7 @@ struct LaplaceMultigrid::Hierarchy {
 
   // Deterministic dot product over the level-0 layout (rows summed in order).
   // Deterministic dot product on level l: per-row sums into `rows`, then summed in order.
-  double dot_on(std::size_t l, const std::vector<double>& a, const std::vector<double>& b, std::vector<double>& rows) {
+  double dot_on(std::size_t l, const MultigridBuffer& a, const MultigridBuffer& b, std::vector<double>& rows) {
     const GridShape g = levels[l].shape;
     rows.resize(g.ny);
     kernels::forall(
@@ -409,7 +441,7 @@ struct LaplaceMultigrid::Hierarchy {
     k_b.swap(level.b);
   }
 
-  double dot(const std::vector<double>& a, const std::vector<double>& b) { return dot_on(0, a, b, row_partial); }
+  double dot(const MultigridBuffer& a, const MultigridBuffer& b) { return dot_on(0, a, b, row_partial); }
 };
 
 LaplaceMultigrid::LaplaceMultigrid(const kernels::TexelTile& tile, LaplaceMultigridOptions options)
@@ -452,13 +484,20 @@ LaplaceSolveStats LaplaceMultigrid::solve(kernels::TexelTile& tile, std::vector<
   const LaplaceMultigridOptions& o = h.options;
 
   // Right-hand side (coupled Dirichlet neighbours) and initial guess, one row per index.
+  // The same pass forms the row sums of b^2 (the order of dot()) and sets r = b, which is
+  // the initial residual when the initial guess is zero (bench, first solves): two passes
+  // over level 0 fewer (of ~50 per solve at 6 iterations), bitwise the same results.
+  h.row_partial.resize(g.ny);
+  std::vector<std::uint8_t> row_has_guess(g.ny, 0);
   kernels::forall(
       g.ny,
       [&](std::int64_t j64) {
         const int j = static_cast<int>(j64);
+        double b2 = 0;
         for (int i = 0; i < g.nx; ++i) {
           const std::int64_t t = g.at(i, j);
           fine.b[t] = 0.0;
+          fine.r[t] = 0.0;
           fine.x[t] = 0.0;
           if (!(h.bits[t] & kernels::is_unknown)) continue;
           const int k = tile.index(i, j);
@@ -475,18 +514,25 @@ LaplaceSolveStats LaplaceMultigrid::solve(kernels::TexelTile& tile, std::vector<
           if (j + 1 < g.ny && !(f[k] & kernels::wall_north) && (f[k + g.nx] & (inactive | dirichlet)) == dirichlet)
             b += tile.values[k + g.nx];
           fine.b[t] = b;
-          if (o.warm_start && std::isfinite(tile.values[k])) fine.x[t] = tile.values[k];
+          fine.r[t] = b;
+          b2 += b * b;
+          if (o.warm_start && std::isfinite(tile.values[k]) && tile.values[k] != 0.0) {
+            fine.x[t] = tile.values[k];
+            row_has_guess[j] = 1;
+          }
         }
+        h.row_partial[j] = b2;
       },
       fine.execution);
 
   LaplaceSolveStats stats;
-  const double b_norm = std::sqrt(h.dot(fine.b, fine.b));
+  const double b_norm = std::sqrt(sum_in_order(h.row_partial));
+  const bool zero_guess = std::find(row_has_guess.begin(), row_has_guess.end(), 1) == row_has_guess.end();
   auto record = [&](double relative) {
     if (history) history->push_back({ms_since(start), relative});
   };
   if (b_norm > 0) {
-    double relative = h.level0_residual_norm() / b_norm;
+    double relative = zero_guess ? 1.0 : h.level0_residual_norm() / b_norm;  // r = b for x = 0
     record(relative);
     if (!o.use_as_cg_preconditioner) {
       while (relative > o.tolerance && stats.iterations < o.max_cycles) {
@@ -497,10 +543,10 @@ LaplaceSolveStats LaplaceMultigrid::solve(kernels::TexelTile& tile, std::vector<
       }
     } else if (relative > o.tolerance) {
       // Preconditioned CG: z = V-cycle(r) from a zero initial guess. Vectors are swapped in
-      // and out of level 0 (no copies): fine.b holds r while the cycle runs.
+      // and out of level 0 (no copies): fine.b holds r while the cycle runs (and cg_r the rhs).
       h.cg_x.swap(fine.x);
       h.cg_r.swap(fine.r);
-      h.cg_b.swap(fine.b);
+      MultigridBuffer& cg_q = h.robust_coarse_solve() ? h.cg_q : fine.r;  // see Hierarchy::cg_q
       // z = M r and r . z; the dot product comes out of the last smoothing sweep when there is one.
       // The first forward sweep from zero can be fused into the CG update of x and r.
       const bool fused_first_sweep = o.pre_smoothing > 0 && h.levels.size() > 1;
@@ -509,14 +555,13 @@ LaplaceSolveStats LaplaceMultigrid::solve(kernels::TexelTile& tile, std::vector<
         const bool fused_dot = o.post_smoothing > 0 && h.levels.size() > 1;
         h.cycle(0, MultigridCycle::v, true, fused_dot ? h.row_partial.data() : nullptr, first_sweep_done);
         fine.b.swap(h.cg_r);
-        h.cg_z.swap(fine.x);
-        if (!fused_dot) return h.dot(h.cg_r, h.cg_z);
+        if (!fused_dot) return h.dot(h.cg_r, fine.x);  // z = fine.x
         h.row_partial.resize(g.ny);
         return sum_in_order(h.row_partial);
       };
       double rz = precondition(false);
-      std::copy(h.cg_z.begin(), h.cg_z.end(), h.cg_p.begin());
-      kernels::apply_texels(g, h.bits.data(), h.cg_p.data(), h.cg_q.data(), h.row_partial.data(), fine.execution);
+      std::copy(fine.x.begin(), fine.x.end(), h.cg_p.begin());
+      kernels::apply_texels(g, h.bits.data(), h.cg_p.data(), cg_q.data(), h.row_partial.data(), fine.execution);
       while (relative > o.tolerance && stats.iterations < o.max_cycles) {
         h.row_partial.resize(g.ny);
         const double pq = sum_in_order(h.row_partial);  // p . A p
@@ -525,7 +570,7 @@ LaplaceSolveStats LaplaceMultigrid::solve(kernels::TexelTile& tile, std::vector<
         double* x = h.cg_x.data();
         double* r = h.cg_r.data();
         const double* pp = h.cg_p.data();
-        const double* q = h.cg_q.data();
+        const double* q = cg_q.data();
         if (fused_first_sweep) {
           kernels::cg_update_and_smooth_texels_from_zero(g, h.bits.data(), alpha, pp, q, x, r, fine.x.data(),
                                                          h.row_partial.data(), fine.execution);
@@ -552,13 +597,12 @@ LaplaceSolveStats LaplaceMultigrid::solve(kernels::TexelTile& tile, std::vector<
         double beta = rz_new / rz;
         // The robust cycle's inner CG makes the preconditioner depend on r: flexible CG
         // (Polak-Ribiere: beta = z_new . (r_new - r_old) / (z_old . r_old), r_new - r_old = -alpha q).
-        if (h.robust_coarse_solve()) beta = -alpha * h.dot(h.cg_z, h.cg_q) / rz;
+        if (h.robust_coarse_solve()) beta = -alpha * h.dot(fine.x, cg_q) / rz;
         rz = rz_new;
-        kernels::update_direction_and_apply_texels(g, h.bits.data(), h.cg_z.data(), beta, h.cg_p.data(),
-                                                   h.cg_q.data(), h.row_partial.data(), fine.execution);
+        kernels::update_direction_and_apply_texels(g, h.bits.data(), fine.x.data(), beta, h.cg_p.data(),
+                                                   cg_q.data(), h.row_partial.data(), fine.execution);
       }
       h.cg_x.swap(fine.x);
-      h.cg_b.swap(fine.b);
       relative = h.level0_residual_norm() / b_norm;  // the true residual, not the recursive one
     }
     stats.relative_residual = relative;

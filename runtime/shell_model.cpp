@@ -2,9 +2,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <stdexcept>
 #include <string>
 
+#include "dgtex/kernels/enriched_element_rest_integrals.h"
 #include "dgtex/kernels/polar_decomposition.h"
 #include "dgtex/kernels/shell_point.h"
 #include "dgtex/mesh_validation.h"
@@ -110,8 +112,9 @@ void ShellModel::rebuild() {
 
   const kernels::EnrichedElementBatch eb = enriched_element_batch();
   const kernels::EnrichedEdgeBatch gb = enriched_edge_batch(eb);
+  std::vector<double> enriched_element_mass;  // #enriched elements x width^2
   if (enriched) {
-    kernels::enriched_element_quadrature(eb, options_.enrichment_quadrature, element_qp_start_, element_qp_);
+    integrate_enriched_elements(eb, enriched_element_mass);
     kernels::enriched_edge_quadrature(gb, options_.enrichment_quadrature, edge_qp_start_, edge_qp_);
     drop_cut_edge_points();
     families.push_back({num_enriched_elements(), width_, enriched_global_nodes_});
@@ -138,8 +141,7 @@ void ShellModel::rebuild() {
   std::vector<const double*> locals = {mass_local.data(), nullptr};
   std::vector<double> enriched_mass_local;
   if (enriched) {
-    std::vector<double> mass(static_cast<size_t>(num_enriched_elements()) * width_ * width_);
-    kernels::enriched_element_mass(eb, {element_qp_start_.data(), element_qp_.data()}, mass.data());
+    const std::vector<double>& mass = enriched_element_mass;
     enriched_mass_local.assign(mass.size() * 9, 0.0);
     for (size_t i = 0; i < mass.size(); ++i)
       for (int d = 0; d < 3; ++d) enriched_mass_local[i * 9 + d * 4] = mass[i];
@@ -159,11 +161,11 @@ void ShellModel::rebuild() {
   area_weights_.resize(static_cast<size_t>(num_plain) * npe);
   mass_weights_.resize(static_cast<size_t>(num_plain) * npe);
   kernels::shell_element_load_weights(element_batch(), area_weights_.data(), mass_weights_.data());
-  enriched_area_weights_.assign(static_cast<size_t>(num_enriched_elements()) * width_, 0.0);
-  enriched_mass_weights_.assign(enriched_area_weights_.size(), 0.0);
-  if (enriched)
-    kernels::enriched_element_load_weights(eb, {element_qp_start_.data(), element_qp_.data()},
-                                           enriched_area_weights_.data(), enriched_mass_weights_.data());
+  if (!enriched) {
+    enriched_area_weights_.clear();
+    enriched_mass_weights_.clear();
+    element_integrals_.clear();
+  }
   textured_area_weights_.assign(static_cast<size_t>(num_textured_elements()) * npe, 0.0);
   textured_mass_weights_.assign(textured_area_weights_.size(), 0.0);
   if (textured)
@@ -350,6 +352,139 @@ void ShellModel::install_enrichments(std::vector<EnrichmentFunction> functions) 
   for (int e = 0; e < num_enriched_elements(); ++e)
     kernels::enriched_global_nodes(eb, e, enriched_global_nodes_.data() + static_cast<size_t>(e) * width_);
   rebuild();
+}
+
+void ShellModel::integrate_enriched_elements(const kernels::EnrichedElementBatch& eb, std::vector<double>& mass) {
+  const int npe = mesh_.nodes_per_element();
+  const int T = resolution_;
+  const std::int64_t count = eb.count;
+  const int W = width_;
+  // The inputs of each enriched element, compared bitwise with what its integrals were
+  // computed from: the textures decide the quadrature; textures, enriched local nodes and
+  // shifts the mass and load weights (geometry, section and options are the model's own).
+  std::vector<std::shared_ptr<const ElementIntegrals>> reused(count);
+  std::vector<char> same_textures(count, 0);
+  const size_t texels = static_cast<size_t>(T) * T;
+  for (std::int64_t x = 0; x < count; ++x) {
+    const int e = enriched_elements_[x];
+    const ElementIntegrals* old =
+        e < static_cast<int>(element_integrals_.size()) ? element_integrals_[e].get() : nullptr;
+    const int first = enrichment_start_[x], k_count = enrichment_start_[x + 1] - first;
+    if (!old || static_cast<int>(old->values.size()) != k_count) continue;
+    bool same = true;
+    for (int k = 0; k < k_count && same; ++k)
+      same = old->values[k].size() == texels &&
+             std::equal(old->values[k].begin(), old->values[k].end(), textures_[first + k].values,
+                        [](double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }) &&
+             std::equal(old->flags[k].begin(), old->flags[k].end(), textures_[first + k].flags);
+    if (!same) continue;
+    same_textures[x] = 1;
+    for (int i = 0; i < k_count * npe && same; ++i) {
+      const double shift = enriched_node_[first * npe + i] >= 0 ? enriched_shift_[first * npe + i] : std::nan("");
+      same = std::memcmp(&shift, &old->shifts[i], sizeof shift) == 0;
+    }
+    if (same) reused[x] = element_integrals_[e];
+  }
+  // Batches of the elements to compute: a sub-batch of eb (kernels work per element, so
+  // each element's result does not depend on which others are in the batch).
+  std::vector<int> todo_index, todo_element, todo_start(1, 0), todo_node;
+  std::vector<kernels::TextureView> todo_textures;
+  std::vector<double> todo_shift;
+  for (std::int64_t x = 0; x < count; ++x) {
+    if (reused[x]) continue;
+    todo_index.push_back(static_cast<int>(x));
+    todo_element.push_back(enriched_elements_[x]);
+    for (int k = enrichment_start_[x]; k < enrichment_start_[x + 1]; ++k) {
+      todo_textures.push_back(textures_[k]);
+      todo_node.insert(todo_node.end(), enriched_node_.begin() + k * npe, enriched_node_.begin() + (k + 1) * npe);
+      todo_shift.insert(todo_shift.end(), enriched_shift_.begin() + k * npe, enriched_shift_.begin() + (k + 1) * npe);
+    }
+    todo_start.push_back(static_cast<int>(todo_textures.size()));
+  }
+  const std::int64_t todo = static_cast<std::int64_t>(todo_index.size());
+  kernels::EnrichedElementBatch sub = eb;
+  sub.count = todo;
+  sub.element = todo_element.data();
+  sub.enrichment_start = todo_start.data();
+  sub.textures = todo_textures.data();
+  sub.enriched_node = todo_node.data();
+  sub.node_shift = todo_shift.data();
+  // Quadrature: reused where only the shifts changed.
+  std::vector<std::int64_t> sub_start(1, 0);
+  std::vector<double> sub_points;
+  {
+    std::vector<int> quad_index;
+    for (std::int64_t t = 0; t < todo; ++t)
+      if (!same_textures[todo_index[t]]) quad_index.push_back(static_cast<int>(t));
+    kernels::EnrichedElementBatch qb = sub;
+    std::vector<int> q_element, q_start(1, 0);
+    std::vector<kernels::TextureView> q_textures;
+    for (int t : quad_index) {
+      q_element.push_back(todo_element[t]);
+      q_textures.insert(q_textures.end(), todo_textures.begin() + todo_start[t], todo_textures.begin() + todo_start[t + 1]);
+      q_start.push_back(static_cast<int>(q_textures.size()));
+    }
+    qb.count = static_cast<std::int64_t>(quad_index.size());
+    qb.element = q_element.data();
+    qb.enrichment_start = q_start.data();
+    qb.textures = q_textures.data();
+    std::vector<std::int64_t> q_point_start;
+    std::vector<double> q_points;
+    kernels::enriched_element_quadrature(qb, options_.enrichment_quadrature, q_point_start, q_points);
+    for (std::int64_t t = 0, next = 0; t < todo; ++t) {
+      if (next < qb.count && quad_index[next] == t) {
+        sub_points.insert(sub_points.end(), q_points.begin() + 3 * q_point_start[next],
+                          q_points.begin() + 3 * q_point_start[next + 1]);
+        ++next;
+      } else {
+        const std::vector<double>& old = element_integrals_[todo_element[t]]->points;
+        sub_points.insert(sub_points.end(), old.begin(), old.end());
+      }
+      sub_start.push_back(static_cast<std::int64_t>(sub_points.size() / 3));
+    }
+  }
+  std::vector<double> sub_mass(static_cast<size_t>(todo) * W * W), sub_area(static_cast<size_t>(todo) * W),
+      sub_mass_weights(sub_area.size());
+  kernels::enriched_element_mass_and_load_weights(sub, {sub_start.data(), sub_points.data()}, sub_mass.data(),
+                                                  sub_area.data(), sub_mass_weights.data());
+  for (std::int64_t t = 0; t < todo; ++t) {
+    auto entry = std::make_shared<ElementIntegrals>();
+    const int x = todo_index[t];
+    for (int k = enrichment_start_[x]; k < enrichment_start_[x + 1]; ++k) {
+      entry->values.emplace_back(textures_[k].values, textures_[k].values + texels);
+      entry->flags.emplace_back(textures_[k].flags, textures_[k].flags + texels);
+      for (int a = 0; a < npe; ++a)
+        entry->shifts.push_back(enriched_node_[k * npe + a] >= 0 ? enriched_shift_[k * npe + a] : std::nan(""));
+    }
+    const int n = kernels::enriched_basis_count(sub, t);
+    entry->count = n;
+    entry->points.assign(sub_points.begin() + 3 * sub_start[t], sub_points.begin() + 3 * sub_start[t + 1]);
+    entry->mass.resize(static_cast<size_t>(n) * n);
+    for (int a = 0; a < n; ++a)
+      for (int c = 0; c < n; ++c) entry->mass[a * n + c] = sub_mass[(t * W + a) * W + c];
+    entry->area_weights.assign(sub_area.begin() + t * W, sub_area.begin() + t * W + n);
+    entry->mass_weights.assign(sub_mass_weights.begin() + t * W, sub_mass_weights.begin() + t * W + n);
+    reused[x] = std::move(entry);
+  }
+  // Gather everything in enriched-element order (the layout the kernels would have written).
+  element_integrals_.assign(mesh_.num_elements(), nullptr);
+  element_qp_start_.assign(1, 0);
+  element_qp_.clear();
+  mass.assign(static_cast<size_t>(count) * W * W, 0.0);
+  enriched_area_weights_.assign(static_cast<size_t>(count) * W, 0.0);
+  enriched_mass_weights_.assign(enriched_area_weights_.size(), 0.0);
+  for (std::int64_t x = 0; x < count; ++x) {
+    const ElementIntegrals& in = *reused[x];
+    element_qp_.insert(element_qp_.end(), in.points.begin(), in.points.end());
+    element_qp_start_.push_back(static_cast<std::int64_t>(element_qp_.size() / 3));
+    const int n = in.count;
+    for (int a = 0; a < n; ++a) {
+      for (int c = 0; c < n; ++c) mass[(x * W + a) * W + c] = in.mass[a * n + c];
+      enriched_area_weights_[x * W + a] = in.area_weights[a];
+      enriched_mass_weights_[x * W + a] = in.mass_weights[a];
+    }
+    element_integrals_[enriched_elements_[x]] = std::move(reused[x]);
+  }
 }
 
 void ShellModel::drop_cut_edge_points() {
@@ -551,6 +686,7 @@ void ShellModel::add_area_force(const double q[3], std::vector<double>& f) const
 
 void ShellModel::set_enrichments(std::vector<EnrichmentFunction> functions) {
   install_enrichments(std::move(functions));
+
   pruned_enriched_nodes_ = 0;
   if (options_.min_enrichment_mass_ratio <= 0 || num_enriched_nodes() == 0) return;
   // A cut that leaves a fragment a few texels wide makes enriched functions that are almost
@@ -669,6 +805,102 @@ std::vector<double> ShellModel::mass_weighted_moments(
       for (std::int64_t q = element_qp_start_[index]; q < element_qp_start_[index + 1]; ++q) {
         const double xi[2] = {element_qp_[3 * q], element_qp_[3 * q + 1]};
         accumulate(e, xi, element_qp_[3 * q + 2], sections_[e]);
+      }
+    }
+  }
+  return out;
+}
+
+int ShellModel::basis_values_at(int element, const double xi[2], const kernels::ShapeValues& s, TexelCache& cache,
+                                int* global, double* values) const {
+  const int index = enriched_index_.empty() ? -1 : enriched_index_[element];
+  if (index < 0) {
+    for (int a = 0; a < s.count; ++a) global[a] = mesh_.element_nodes(element)[a], values[a] = s.N[a];
+    return s.count;
+  }
+  const kernels::EnrichedElementBatch eb = enriched_element_batch();
+  kernels::enriched_global_nodes(eb, index, global);
+  return kernels::enriched_shape_values(eb, index, xi[0], xi[1], s, cache, values);
+}
+
+std::vector<std::vector<double>> ShellModel::moments_of_fields(const ShellModel& source,
+                                                               const std::vector<const std::vector<double>*>& fields) const {
+  if (source.mesh_.num_nodes() != mesh_.num_nodes() || source.mesh_.num_elements() != mesh_.num_elements())
+    throw std::invalid_argument("moments_of_fields: the source model has another mesh (" +
+                                std::to_string(source.mesh_.num_elements()) + " elements, this one " +
+                                std::to_string(mesh_.num_elements()) + ")");
+  const int nf = static_cast<int>(fields.size());
+  for (int f = 0; f < nf; ++f)
+    if (static_cast<int>(fields[f]->size()) != source.num_dofs())
+      throw std::invalid_argument("moments_of_fields: field " + std::to_string(f) + " has " +
+                                  std::to_string(fields[f]->size()) + " values, the source model " +
+                                  std::to_string(source.num_dofs()) + " DOFs");
+  std::vector<std::vector<double>> out(nf, std::vector<double>(num_dofs(), 0.0));
+  const kernels::QuadratureRule standard = kernels::element_quadrature(mesh_.type);
+  const int stride = std::max(mesh_.nodes_per_element(), width_);  // this model's local basis
+  constexpr std::int64_t block = kernels::rest_integral_block_points;
+  constexpr std::int64_t span = 16 * block;
+  // Per point of a span: w, this basis (global nodes, values) and every field's value there,
+  // evaluated in parallel (fixed blocks); then w N_A g_c added serially in point order:
+  // exactly the sums of mass_weighted_moments with g = source.interpolate.
+  const int per_point = 1 + stride + 3 * nf;
+  std::vector<int> counts(span), globals(static_cast<size_t>(span) * stride);
+  std::vector<double> data(static_cast<size_t>(span) * per_point);
+  for (int e = 0; e < mesh_.num_elements(); ++e) {
+    const int index = enriched_index_.empty() ? -1 : enriched_index_[e];
+    const int textured = textured_index_.empty() ? -1 : textured_index_[e];
+    std::int64_t first = 0, total = standard.count;
+    if (textured >= 0) first = textured_qp_start_[textured], total = textured_qp_start_[textured + 1] - first;
+    else if (index >= 0) first = element_qp_start_[index], total = element_qp_start_[index + 1] - first;
+    auto point = [&](std::int64_t q, double xi[2], double& weight) -> const kernels::ShellSection& {
+      if (textured >= 0) {
+        xi[0] = textured_qp_[3 * q], xi[1] = textured_qp_[3 * q + 1], weight = textured_qp_[3 * q + 2];
+        return textured_qp_sections_[q];
+      }
+      if (index < 0) xi[0] = standard.xi1[q], xi[1] = standard.xi2[q], weight = standard.weight[q];
+      else xi[0] = element_qp_[3 * q], xi[1] = element_qp_[3 * q + 1], weight = element_qp_[3 * q + 2];
+      return sections_[e];
+    };
+    for (std::int64_t begin = 0; begin < total; begin += span) {
+      const std::int64_t count = std::min(span, total - begin);
+      auto evaluate = [&](std::int64_t item) {
+        TexelCache cache, source_cache;
+        int source_global[kernels::max_enriched_basis];
+        double source_values[kernels::max_enriched_basis];
+        for (std::int64_t p = item * block; p < std::min(count, (item + 1) * block); ++p) {
+          double xi[2], weight;
+          const kernels::ShellSection& section = point(first + begin + p, xi, weight);
+          kernels::ShapeValues shape;
+          kernels::evaluate_shape(mesh_.type, xi[0], xi[1], shape);
+          kernels::RestPoint rest;
+          kernels::evaluate_rest_point(shape, mesh_.element_nodes(e), mesh_.positions.data(), rest);
+          double* d = data.data() + p * per_point;
+          d[0] = weight * rest.j0 * section.density * section.thickness;
+          const int m = source.basis_values_at(e, xi, shape, source_cache, source_global, source_values);
+          counts[p] = basis_values_at(e, xi, shape, cache, globals.data() + p * stride, d + 1);
+          for (int f = 0; f < nf; ++f) {
+            const double* u = fields[f]->data();
+            double* value = d + 1 + stride + 3 * f;
+            value[0] = value[1] = value[2] = 0;
+            for (int a = 0; a < m; ++a)
+              for (int c = 0; c < 3; ++c) value[c] += source_values[a] * u[3 * source_global[a] + c];
+          }
+        }
+      };
+      // Plain elements have a handful of points: no parallel region for them.
+      kernels::forall((count + block - 1) / block, evaluate,
+                      count > block ? kernels::Execution::parallel : kernels::Execution::serial);
+      for (std::int64_t p = 0; p < count; ++p) {
+        const int* global = globals.data() + p * stride;
+        const double* d = data.data() + p * per_point;
+        const double w = d[0];
+        const double* values = d + 1;
+        for (int f = 0; f < nf; ++f) {
+          const double* value = d + 1 + stride + 3 * f;
+          double* o = out[f].data();
+          for (int a = 0; a < counts[p]; ++a)
+            for (int c = 0; c < 3; ++c) o[3 * global[a] + c] += w * values[a] * value[c];
+        }
       }
     }
   }

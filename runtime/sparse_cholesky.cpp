@@ -2,25 +2,83 @@
 
 #include <cholmod.h>
 
+#include <algorithm>
 #include <cstring>
 #include <vector>
 
-// Single-precision BLAS (Fortran interface of the system BLAS, OpenBLAS on Debian).
-extern "C" {
-void sgemv_(const char* trans, const int* m, const int* n, const float* alpha, const float* a, const int* lda,
-            const float* x, const int* incx, const float* beta, float* y, const int* incy);
-void strsv_(const char* uplo, const char* trans, const char* diag, const int* n, const float* a, const int* lda,
-            float* x, const int* incx);
+namespace dgtex {
+
+namespace {
+// Below this many unknowns the subtrees are solved one after another (same arithmetic):
+// waking the OpenMP team costs more than the solve.
+constexpr int parallel_solve_size = 2000;
+
+
+// Dense kernels of the single-precision solve on one supernode: X is its column-major
+// nrow x ncol block (leading dimension nrow), the first ncol rows the diagonal triangle.
+// Plain loops rather than BLAS: Debian's serial OpenBLAS is not safe for concurrent calls,
+// and the subtrees below are solved concurrently. Sums run over 8 fixed lanes so that the
+// compiler vectorises them without reassociating (the order is the code's, not the
+// compiler's), so results do not depend on the build's vector width.
+float lane_dot(const float* a, const float* b, int n) {
+  float lane[8] = {0, 0, 0, 0, 0, 0, 0, 0};
+  int i = 0;
+  for (; i + 8 <= n; i += 8)
+    for (int l = 0; l < 8; ++l) lane[l] += a[i + l] * b[i + l];
+  for (int l = 0; i < n; ++i, ++l) lane[l] += a[i] * b[i];
+  return ((lane[0] + lane[4]) + (lane[1] + lane[5])) + ((lane[2] + lane[6]) + (lane[3] + lane[7]));
 }
 
-namespace dgtex {
+// y = X_tri^-1 y, then below[i] = sum_j X[ncol + i, j] y[j].
+void forward_supernode(const float* X, int nrow, int ncol, float* y, float* below) {
+  for (int j = 0; j < ncol; ++j) {
+    const float* column = X + static_cast<std::size_t>(j) * nrow;
+    const float yj = y[j] / column[j];
+    y[j] = yj;
+    for (int i = j + 1; i < ncol; ++i) y[i] -= column[i] * yj;
+  }
+  const int rows_below = nrow - ncol;
+  std::fill(below, below + rows_below, 0.0f);
+  for (int j = 0; j < ncol; ++j) {
+    const float* column = X + static_cast<std::size_t>(j) * nrow + ncol;
+    const float yj = y[j];
+    for (int i = 0; i < rows_below; ++i) below[i] += column[i] * yj;
+  }
+}
+
+// y = X_tri^-T (y - X_below^T t), t the solution at the rows below.
+void backward_supernode(const float* X, int nrow, int ncol, float* y, const float* t) {
+  const int rows_below = nrow - ncol;
+  for (int j = 0; j < ncol; ++j) y[j] -= lane_dot(X + static_cast<std::size_t>(j) * nrow + ncol, t, rows_below);
+  for (int j = ncol - 1; j >= 0; --j) {
+    const float* column = X + static_cast<std::size_t>(j) * nrow;
+    y[j] = (y[j] - lane_dot(column + j + 1, y + j + 1, ncol - j - 1)) / column[j];
+  }
+}
+
+}  // namespace
+
+// Parallel schedule of the single-precision solve over the supernodal elimination tree:
+// disjoint subtrees ("tasks", each a contiguous range of postordered supernodes) are
+// solved concurrently; the supernodes above them ("top": the separators) serially. In
+// the forward solve a task's updates of top rows go to its own accumulator, added to y in
+// task order, so the arithmetic is fixed by the factor's structure, not by the threads.
+struct SolveSchedule {
+  std::vector<int> task_first, task_last;  // supernode ranges, in postorder
+  std::vector<int> top;                    // top supernodes, ascending (postorder)
+  std::vector<int> top_slot;               // per row of L: its index among top rows, or -1
+  int top_rows = 0;
+};
 
 struct SparseCholesky::Impl {
   cholmod_common common;
   cholmod_sparse* matrix = nullptr;
   cholmod_factor* factor = nullptr;
   std::vector<float> single_values;  // supernodal L in float (same layout as factor->x)
-  mutable std::vector<float> work, gathered;
+  SolveSchedule schedule;            // built with the first single-precision copy
+  mutable std::vector<float> work, top_updates;  // y; per task x top rows accumulators
+  mutable std::vector<std::vector<float>> gathered;  // per task (forward, backward) scratch
+  mutable std::vector<float> top_scratch;            // the same for the top supernodes
 
   Impl() {
     cholmod_start(&common);
@@ -52,6 +110,7 @@ void SparseCholesky::analyze(int n, const std::vector<int>& column_start, const 
   std::memcpy(m.matrix->p, column_start.data(), sizeof(int) * (n + 1));
   std::memcpy(m.matrix->i, row_index.data(), sizeof(int) * nnz);
   std::memset(m.matrix->x, 0, sizeof(double) * nnz);
+  m.schedule = SolveSchedule{};
   m.factor = cholmod_analyze(m.matrix, &m.common);
   if (!m.factor || m.common.status < CHOLMOD_OK)
     throw std::runtime_error("CHOLMOD: symbolic analysis failed (status " + std::to_string(m.common.status) + ")");
@@ -94,6 +153,63 @@ void SparseCholesky::copy_factor_to_single_precision() {
   const double* x = static_cast<const double*>(f->x);
   m.single_values.resize(f->xsize);
   for (size_t i = 0; i < f->xsize; ++i) m.single_values[i] = static_cast<float>(x[i]);
+  if (m.schedule.top_slot.empty()) build_solve_schedule();
+}
+
+void SparseCholesky::build_solve_schedule() {
+  Impl& m = *impl_;
+  const cholmod_factor* f = m.factor;
+  const int* super = static_cast<const int*>(f->super);
+  const int* pi = static_cast<const int*>(f->pi);
+  const int* px = static_cast<const int*>(f->px);
+  const int* rows = static_cast<const int*>(f->s);
+  const int nsuper = static_cast<int>(f->nsuper);
+  // Parent of a supernode: the one holding its first row below the diagonal block.
+  std::vector<int> supernode_of_column(n_), parent(nsuper, -1), subtree_size(nsuper, 1);
+  std::vector<double> work(nsuper);
+  std::vector<std::vector<int>> children(nsuper);
+  for (int s = 0; s < nsuper; ++s)
+    for (int k = super[s]; k < super[s + 1]; ++k) supernode_of_column[k] = s;
+  std::vector<int> roots;
+  for (int s = 0; s < nsuper; ++s) {
+    const int ncol = super[s + 1] - super[s], nrow = pi[s + 1] - pi[s];
+    work[s] += static_cast<double>(px[s + 1] - px[s]);
+    if (nrow > ncol) {
+      parent[s] = supernode_of_column[rows[pi[s] + ncol]];
+      children[parent[s]].push_back(s);
+      work[parent[s]] += work[s];  // postorder: children come first
+      subtree_size[parent[s]] += subtree_size[s];
+    } else {
+      roots.push_back(s);
+    }
+  }
+  // Split the heaviest subtree into its children until none holds more than 1/4 of the
+  // work: enough tasks to balance 2-4 threads, a fixed rule (the same for any count).
+  double total = 0;  // work[s] is its subtree's by now
+  for (int root : roots) total += work[root];
+  std::vector<int> tasks = roots;
+  std::vector<char> is_top(nsuper, 0);
+  for (;;) {
+    auto heaviest = std::max_element(tasks.begin(), tasks.end(), [&](int a, int b) { return work[a] < work[b]; });
+    if (heaviest == tasks.end() || work[*heaviest] <= total / 4 || children[*heaviest].empty()) break;
+    const int s = *heaviest;
+    tasks.erase(heaviest);
+    is_top[s] = 1;
+    tasks.insert(tasks.end(), children[s].begin(), children[s].end());
+  }
+  std::sort(tasks.begin(), tasks.end());
+  SolveSchedule schedule;
+  for (int root : tasks) {
+    schedule.task_first.push_back(root - subtree_size[root] + 1);
+    schedule.task_last.push_back(root);
+  }
+  schedule.top_slot.assign(n_, -1);
+  for (int s = 0; s < nsuper; ++s)
+    if (is_top[s]) {
+      schedule.top.push_back(s);
+      for (int k = super[s]; k < super[s + 1]; ++k) schedule.top_slot[k] = schedule.top_rows++;
+    }
+  m.schedule = std::move(schedule);
 }
 
 void SparseCholesky::solve_single_precision(const std::vector<double>& b, std::vector<double>& x) const {
@@ -107,36 +223,50 @@ void SparseCholesky::solve_single_precision(const std::vector<double>& b, std::v
   const int* rows = static_cast<const int*>(f->s);
   const int* perm = static_cast<const int*>(f->Perm);
   const float* L = m.single_values.data();
-  const int nsuper = static_cast<int>(f->nsuper);
+  const SolveSchedule& schedule = m.schedule;
+  const int tasks = static_cast<int>(schedule.task_first.size());
   std::vector<float>& y = m.work;
-  std::vector<float>& t = m.gathered;
   y.resize(n_);
   for (int k = 0; k < n_; ++k) y[k] = static_cast<float>(b[perm[k]]);  // L L^T = P A P^T
-  const int one = 1;
-  const float plus = 1, minus = -1, zero = 0;
+  m.top_updates.assign(static_cast<std::size_t>(tasks) * schedule.top_rows, 0.0f);
+  m.gathered.resize(tasks);
   // Per supernode: columns k1..k2-1, a dense nrow x ncol column-major block whose first
   // ncol rows are the diagonal triangle and whose other rows are listed in `rows`.
-  for (int s = 0; s < nsuper; ++s) {  // forward, L y = P b
+  auto forward = [&](int s, std::vector<float>& t, float* top_updates) {
     const int k1 = super[s], ncol = super[s + 1] - k1, nrow = pi[s + 1] - pi[s], below = nrow - ncol;
-    const float* X = L + px[s];
-    strsv_("L", "N", "N", &ncol, X, &nrow, y.data() + k1, &one);
-    if (below <= 0) continue;
-    t.resize(below);
-    sgemv_("N", &below, &ncol, &plus, X + ncol, &nrow, y.data() + k1, &one, &zero, t.data(), &one);
+    t.resize(std::max(below, 0));
+    forward_supernode(L + px[s], nrow, ncol, y.data() + k1, t.data());
     const int* r = rows + pi[s] + ncol;
-    for (int i = 0; i < below; ++i) y[r[i]] -= t[i];
-  }
-  for (int s = nsuper - 1; s >= 0; --s) {  // backward, L^T z = y
-    const int k1 = super[s], ncol = super[s + 1] - k1, nrow = pi[s + 1] - pi[s], below = nrow - ncol;
-    const float* X = L + px[s];
-    if (below > 0) {
-      t.resize(below);
-      const int* r = rows + pi[s] + ncol;
-      for (int i = 0; i < below; ++i) t[i] = y[r[i]];
-      sgemv_("T", &below, &ncol, &minus, X + ncol, &nrow, t.data(), &one, &plus, y.data() + k1, &one);
+    for (int i = 0; i < below; ++i) {
+      const int slot = top_updates ? schedule.top_slot[r[i]] : -1;
+      if (slot >= 0)
+        top_updates[slot] += t[i];
+      else
+        y[r[i]] -= t[i];
     }
-    strsv_("L", "T", "N", &ncol, X, &nrow, y.data() + k1, &one);
-  }
+  };
+  auto backward = [&](int s, std::vector<float>& t) {
+    const int k1 = super[s], ncol = super[s + 1] - k1, nrow = pi[s + 1] - pi[s], below = nrow - ncol;
+    t.resize(std::max(below, 0));
+    const int* r = rows + pi[s] + ncol;
+    for (int i = 0; i < below; ++i) t[i] = y[r[i]];
+    backward_supernode(L + px[s], nrow, ncol, y.data() + k1, t.data());
+  };
+  // Forward, L y = P b: the subtrees, then their updates of the top rows in task order,
+  // then the top supernodes. Backward, L^T z = y, in the reverse order.
+#pragma omp parallel for schedule(dynamic, 1) if (n_ >= parallel_solve_size)
+  for (int task = 0; task < tasks; ++task)
+    for (int s = schedule.task_first[task]; s <= schedule.task_last[task]; ++s)
+      forward(s, m.gathered[task], m.top_updates.data() + static_cast<std::size_t>(task) * schedule.top_rows);
+  for (int s : schedule.top)
+    for (int k = super[s]; k < super[s + 1]; ++k)
+      for (int task = 0; task < tasks; ++task)
+        y[k] -= m.top_updates[static_cast<std::size_t>(task) * schedule.top_rows + schedule.top_slot[k]];
+  for (int s : schedule.top) forward(s, m.top_scratch, nullptr);
+  for (auto s = schedule.top.rbegin(); s != schedule.top.rend(); ++s) backward(*s, m.top_scratch);
+#pragma omp parallel for schedule(dynamic, 1) if (n_ >= parallel_solve_size)
+  for (int task = 0; task < tasks; ++task)
+    for (int s = schedule.task_last[task]; s >= schedule.task_first[task]; --s) backward(s, m.gathered[task]);
   x.resize(n_);
   for (int k = 0; k < n_; ++k) x[perm[k]] = y[k];
 }

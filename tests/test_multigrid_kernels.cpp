@@ -279,6 +279,20 @@ TEST_P(MultigridKernels, RedBlackTransfersMatchReferencesAndFullForms) {
   restrict_residual_reference(L.fine, L.coarse, L.P().view(), red.data(), b3.data());
   EXPECT_EQ(b1, b2);
   for (std::size_t t = 0; t < b1.size(); ++t) EXPECT_NEAR(b1[t], b3[t], 1e-13);
+  // Red residual and its restriction in one pass: bitwise the two kernels in turn, for odd
+  // grid sizes too (cell centres in the ghost row / column).
+  for (int size : {96, 75}) {
+    TwoLevels M(make_laplace_domain(GetParam(), size));
+    std::vector<double> r(M.x.size(), 0.0), two_steps(M.xc.size(), 0.0), ref = two_steps, fused = two_steps;
+    residual_texels_color(M.fine, M.bits.data(), M.b.data(), M.x.data(), r.data(), 0);
+    restrict_red_residual(M.fine, M.coarse, M.P().view(), r.data(), two_steps.data());
+    restrict_red_residual_texels_reference(M.fine, M.coarse, M.P().view(), M.bits.data(), M.b.data(), M.x.data(),
+                                           ref.data());
+    restrict_red_residual_texels(M.fine, M.coarse, M.P().view(), M.bits.data(), M.b.data(), M.x.data(),
+                                 fused.data());
+    EXPECT_EQ(ref, two_steps);
+    EXPECT_EQ(fused, two_steps);
+  }
   // Prolongation to red nodes: the full prolongation's values there, black untouched.
   std::vector<std::uint8_t> active(L.bits.size());
   for (std::size_t t = 0; t < active.size(); ++t) active[t] = (L.bits[t] & is_unknown) ? 1 : 0;

@@ -14,12 +14,14 @@
 // Units: those of the scene.
 // Keeps no reference to the topology or sections it was built from.
 #include <functional>
+#include <memory>
 #include <vector>
 
 #include "dgtex/block_assembly.h"
 #include "dgtex/enrichment_function.h"
 #include "dgtex/kernels/enriched_edge_kernel.h"
 #include "dgtex/kernels/enriched_element_kernel.h"
+#include "dgtex/kernels/enriched_element_rest_integrals.h"
 #include "dgtex/kernels/enriched_quadrature.h"
 #include "dgtex/kernels/shell_edge_kernel.h"
 #include "dgtex/kernels/shell_element_kernel.h"
@@ -84,6 +86,9 @@ class ShellModel {
   // function, or more than kernels::max_enrichments_per_element functions on one element.
   // Enriched nodes below options().min_enrichment_mass_ratio are dropped (and functions
   // left without nodes), so enrichments() may hold less than was given.
+  // Cost: an enriched element whose textures (and enriched nodes and shifts) are bitwise
+  // those of the previous call on this model or the model it was copied from keeps its
+  // quadrature (and mass and load weights); the results equal a fresh model's bitwise.
   void set_enrichments(std::vector<EnrichmentFunction> functions);
   // Texel segments of mesh edges that a cut runs along (MeshEdgeWalls::flags: index
   // (element * 4 + local edge) * resolution + s, s along the element's local edge, either
@@ -136,6 +141,15 @@ class ShellModel {
   // element order. The right-hand side of the L2 projection onto this basis.
   std::vector<double> mass_weighted_moments(
       const std::function<void(int element, const double xi[2], double value[3])>& g) const;
+
+  // The same moments for fields given in `source`'s basis (same mesh), all in one pass:
+  // out[f] = mass_weighted_moments(g_f) with g_f = source.interpolate(*fields[f], ...),
+  // bitwise equal to those calls (same arithmetic and order), but every basis is evaluated
+  // once per quadrature point for all fields, and texel derivatives are reused while
+  // consecutive points lie in one texel. The right-hand sides of the projection of a state
+  // onto this basis (basis_projection.h).
+  std::vector<std::vector<double>> moments_of_fields(const ShellModel& source,
+                                                     const std::vector<const std::vector<double>*>& fields) const;
 
   // Displacement at a parametric point of an element (enriched functions included).
   void interpolate(const std::vector<double>& u, int element, const double xi[2], double out[3]) const;
@@ -211,6 +225,24 @@ class ShellModel {
   };
   mutable AssemblyWorkspace workspace_;
 
+  // What one enriched element's quadrature, mass and load weights were computed from and
+  // what they came to; a later rebuild reuses them where the inputs are bitwise equal (a
+  // cut advancing changes the textures of the few elements near its tip only). Shared and
+  // immutable, so copies of the model share them.
+  struct ElementIntegrals {
+    std::vector<std::vector<double>> values;         // per enrichment: texture values
+    std::vector<std::vector<std::uint8_t>> flags;    // per enrichment: texture flags
+    std::vector<double> shifts;                      // per enrichment x npe; NaN: node not enriched
+    int count = 0;                                   // local basis functions
+    std::vector<double> points;                      // quadrature: (xi1, xi2, weight) per point
+    std::vector<double> mass;                        // count x count
+    std::vector<double> area_weights, mass_weights;  // count
+  };
+  std::vector<std::shared_ptr<const ElementIntegrals>> element_integrals_;  // per mesh element, may be null
+  // Fills element_qp_start_/element_qp_, the enriched load weights and `mass` (#enriched
+  // elements x width^2), computing only the elements whose inputs changed.
+  void integrate_enriched_elements(const kernels::EnrichedElementBatch& eb, std::vector<double>& mass);
+
   int pruned_enriched_nodes_ = 0;
   void install_enrichments(std::vector<EnrichmentFunction> functions);
   void rebuild();
@@ -220,6 +252,10 @@ class ShellModel {
   kernels::EnrichedEdgeBatch enriched_edge_batch(const kernels::EnrichedElementBatch& elements) const;
   // Basis of an element at xi: global nodes and values (npe, or the enriched basis).
   int basis_at(int element, const double xi[2], int* global, double* values) const;
+  using TexelCache = kernels::EnrichedTexelCache;  // texel derivatives of the last texel sampled
+  // basis_at's values from the standard shape s at xi (bitwise equal), reusing `cache`.
+  int basis_values_at(int element, const double xi[2], const kernels::ShapeValues& s, TexelCache& cache, int* global,
+                      double* values) const;
 };
 
 // y = A x for block matrices in the pattern (deterministic, parallel over rows).

@@ -39,10 +39,12 @@ class SparseCholesky {
   // x = A^-1 b.
   void solve(const std::vector<double>& b, std::vector<double>& x) const;
   // A single-precision copy of the current factor (supernodal L in float, the same
-  // structure) and x ~= A^-1 b with it, computed in float through BLAS (strsv, sgemv):
+  // structure) and x ~= A^-1 b with it, computed in float (own loops, not BLAS):
   // half the memory traffic of solve() (L is ~35 MB in double for the cylinder scene),
-  // accurate to ~1e-6 relative times the conditioning, meant as a preconditioner. Serial
-  // (serial BLAS) and in a fixed order, so bitwise independent of the OpenMP thread count. copy_factor_to_single_precision() must follow
+  // accurate to ~1e-6 relative times the conditioning, meant as a preconditioner. Disjoint
+  // subtrees of the elimination tree run on the OpenMP threads, in a split fixed by the
+  // factor's structure, so x is bitwise independent of the thread count. Not safe for
+  // concurrent calls on one instance. copy_factor_to_single_precision() must follow
   // each factorize() whose factor solve_single_precision() is to use.
   void copy_factor_to_single_precision();
   void solve_single_precision(const std::vector<double>& b, std::vector<double>& x) const;
@@ -53,6 +55,7 @@ class SparseCholesky {
  private:
   struct Impl;
   std::unique_ptr<Impl> impl_;
+  void build_solve_schedule();  // parallel schedule of solve_single_precision (per analysis)
   int n_ = 0;
 };
 

@@ -30,6 +30,13 @@
 // spiral 0.32, but open/slit degrade from 0.085 to 0.11-0.18 through the boundary rows),
 // more coarse smoothing (16 sweeps on level 1: 3-level rate 0.92 -> 0.88). What works: the
 // robust cycle of LaplaceMultigridOptions::coarse_solve_tolerance (level 1 solved by inner CG).
+// On the spiral the loss grows with the number of channel turns, not with sub-grid width
+// (channels are 16 texels wide at T=256): V(1,1)-CG iterations at T=256 with the spiral cut
+// after k arms (full hierarchy): k <= 4: 6, k = 8: 7, k = 12: 9, k = 16: 11, k = 21: 15, all
+// arms: 16; with level 1 solved exactly always 6, with three levels (level 2 exact) 11. A
+// 4x larger Dirichlet centre: 16, walls shifted by one texel: 16, channels 19 wide: 12; the
+// accordion (a serpentine of 19 straight channels) stays at 6. So the level 1 -> 2
+// interpolation loses energy at each corner of the spiral's channel, and the losses add up.
 //
 // Both setup kernels write the coarse arrays (padded layout, ghosts must be zero on entry
 // and stay zero) for every coarse node and are gathers, so serial and parallel agree bitwise.

@@ -27,6 +27,21 @@ void residual_texels_color(GridShape shape, const std::uint8_t* bits, const doub
 void residual_texels_color_reference(GridShape shape, const std::uint8_t* bits, const double* b, const double* x,
                                      double* r, int color);
 
+// The two steps above that follow a forward red-black sweep on level 0, in one pass:
+// b_coarse = P^T r for r = the red residual (residual_texels_color, colour 0; 0 at black
+// nodes), as restrict_red_residual (multigrid_transfer.h) computes it, without storing r.
+// Each coarse node forms the residual at its own node and at the two cell centres to its
+// east; those to its west come from the previous node of the row, so every cell-centre
+// residual is formed twice (once per coarse row) and r never makes a round trip through
+// memory. Bitwise equal to residual_texels_color + restrict_red_residual (the reference).
+// Measured (open T = 1024, CPU, 1 thread): the two kernels took 9.4% of a solve.
+void restrict_red_residual_texels(GridShape fine, GridShape coarse, InterpolationView p, const std::uint8_t* bits,
+                                  const double* b, const double* x, double* b_coarse,
+                                  Execution execution = Execution::parallel);
+void restrict_red_residual_texels_reference(GridShape fine, GridShape coarse, InterpolationView p,
+                                            const std::uint8_t* bits, const double* b, const double* x,
+                                            double* b_coarse);
+
 // Coarse levels (9-point). row_norm2 may be null.
 void residual_stencil9(GridShape shape, Stencil9View a, const double* b, const double* x, double* r,
                        double* row_norm2, Execution execution = Execution::parallel);

@@ -1,0 +1,119 @@
+#include "multigrid_buffer.h"
+
+#include <cstdint>
+#include <cstdlib>
+#include <cstring>
+#include <mutex>
+
+#if defined(__linux__)
+#include <sys/mman.h>
+#endif
+
+namespace dgtex::detail {
+namespace {
+
+constexpr std::size_t huge_page = std::size_t{2} << 20;
+constexpr std::size_t min_mapped_bytes = std::size_t{1} << 20;
+constexpr std::size_t min_cached_bytes = std::size_t{64} << 10;
+constexpr std::size_t max_cached_total = std::size_t{128} << 20;
+constexpr int max_cached_blocks = 64;
+
+bool mapped(std::size_t bytes) {
+#if defined(__linux__) && defined(MADV_HUGEPAGE)
+  return bytes >= min_mapped_bytes;
+#else
+  (void)bytes;
+  return false;
+#endif
+}
+
+std::size_t mapped_bytes(std::size_t bytes) { return (bytes + huge_page - 1) / huge_page * huge_page; }
+
+void* fresh_block(std::size_t bytes) {
+#if defined(__linux__) && defined(MADV_HUGEPAGE)
+  if (mapped(bytes)) {
+    const std::size_t size = mapped_bytes(bytes);
+    // Over-map by one huge page, then unmap the unaligned head and the tail.
+    void* raw = mmap(nullptr, size + huge_page, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
+    if (raw == MAP_FAILED) throw std::bad_alloc();
+    char* base = static_cast<char*>(raw);
+    char* aligned = base + (huge_page - reinterpret_cast<std::uintptr_t>(base) % huge_page) % huge_page;
+    if (aligned > base) munmap(base, aligned - base);
+    char* end = aligned + size;
+    if (base + size + huge_page > end) munmap(end, base + size + huge_page - end);
+    madvise(aligned, size, MADV_HUGEPAGE);
+    return aligned;
+  }
+#endif
+  void* block = std::calloc(bytes == 0 ? 1 : bytes, 1);
+  if (!block) throw std::bad_alloc();
+  return block;
+}
+
+void free_block(void* block, std::size_t bytes) noexcept {
+#if defined(__linux__) && defined(MADV_HUGEPAGE)
+  if (mapped(bytes)) {
+    munmap(block, mapped_bytes(bytes));
+    return;
+  }
+#endif
+  std::free(block);
+}
+
+struct BlockCache {
+  std::mutex mutex;
+  struct Entry {
+    void* block;
+    std::size_t bytes;
+  };
+  Entry entries[max_cached_blocks];
+  int count = 0;
+  std::size_t total = 0;
+};
+
+// Never destroyed: arrays released during static destruction still find it (the process
+// returns the cached blocks to the system at exit).
+BlockCache& cache() {
+  static BlockCache* instance = new BlockCache;
+  return *instance;
+}
+
+}  // namespace
+
+void* acquire_zeroed_block(std::size_t bytes) {
+  if (bytes >= min_cached_bytes) {
+    BlockCache& c = cache();
+    void* block = nullptr;
+    {
+      const std::lock_guard<std::mutex> lock(c.mutex);
+      for (int k = c.count - 1; k >= 0; --k)
+        if (c.entries[k].bytes == bytes) {
+          block = c.entries[k].block;
+          c.total -= bytes;
+          c.entries[k] = c.entries[--c.count];
+          break;
+        }
+    }
+    if (block) {
+      std::memset(block, 0, bytes);
+      return block;
+    }
+  }
+  return fresh_block(bytes);
+}
+
+void release_block(void* block, std::size_t bytes) noexcept {
+  if (!block) return;
+  if (bytes >= min_cached_bytes) {
+    BlockCache& c = cache();
+    const std::lock_guard<std::mutex> lock(c.mutex);
+    if (c.count < max_cached_blocks && c.total + bytes <= max_cached_total) {
+      c.entries[c.count++] = {block, bytes};
+      c.total += bytes;
+      return;
+    }
+  }
+  free_block(block, bytes);
+}
+
+}  // namespace dgtex::detail

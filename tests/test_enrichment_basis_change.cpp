@@ -1,0 +1,223 @@
+// The fast basis change of a progressive cut (SceneRun::change_basis) against the plain
+// path it replaces, bitwise (‖·‖∞ = 0, compared with memcmp):
+//  - a model that takes new enrichments after earlier ones (reusing the quadrature, mass and
+//    load weights of elements whose textures, enriched nodes and shifts are unchanged)
+//    equals a model built from scratch with the same functions;
+//  - ShellModel::moments_of_fields equals mass_weighted_moments of source.interpolate per
+//    field;
+//  - project_onto_basis equals the projection written out with those reference moments;
+//  - kernels::enriched_element_mass_and_load_weights (serial and parallel) equals
+//    enriched_element_mass and enriched_element_load_weights, and enriched_shape_values
+//    equals evaluate_enriched_shape's N.
+// The cut advances across a 3x3 quad8 plate (and a 2x2 tri6 one) over several steps, so
+// elements far from the tip keep their textures while the others change.
+#include <gtest/gtest.h>
+
+#include <cstring>
+#include <memory>
+#include <random>
+
+#include "cut_test_support.h"
+#include "dgtex/basis_projection.h"
+#include "dgtex/cut_manager.h"
+#include "dgtex/free_dof_system.h"
+#include "dgtex/harmonic_enrichment.h"
+#include "dgtex/kernels/cut_rasterization.h"
+#include "dgtex/kernels/enriched_element_rest_integrals.h"
+#include "dgtex/kernels/enriched_quadrature.h"
+#include "dgtex/mesh_generators.h"
+#include "dgtex/sparse_cholesky.h"
+#include "dgtex/topology.h"
+
+using namespace dgtex;
+using namespace dgtex::testing_support;
+
+namespace {
+
+bool bitwise_equal(const std::vector<double>& a, const std::vector<double>& b) {
+  return a.size() == b.size() && (a.empty() || std::memcmp(a.data(), b.data(), a.size() * sizeof(double)) == 0);
+}
+
+std::vector<double> random_state(int dofs, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> uniform(-1e-3, 1e-3);
+  std::vector<double> x(dofs);
+  for (double& v : x) v = uniform(rng);
+  return x;
+}
+
+std::unique_ptr<ShellModel> plain_model(const Mesh& mesh, const Topology& topology) {
+  std::vector<kernels::ShellSection> sections(mesh.num_elements(), {1e6, 0.3, 0.01, 1000});
+  ShellModelOptions options;
+  options.penalty = 1.0;
+  return std::make_unique<ShellModel>(mesh, topology, sections, std::vector<int>{}, options);
+}
+
+// The projection as basis_projection.cpp wrote it before the fast moments.
+ProjectedState reference_projection(const ShellModel& old_model, const std::vector<double>& u,
+                                    const std::vector<double>& v, const ShellModel& new_model,
+                                    const std::vector<char>& fixed) {
+  const FreeDofSystem system(new_model.pattern(), fixed);
+  std::vector<double> values;
+  system.gather(new_model.mass_blocks().data(), 1.0, nullptr, 0.0, values);
+  SparseCholesky mass;
+  mass.analyze(system.size(), system.column_start(), system.row_index());
+  mass.factorize(values);
+  auto project = [&](const std::vector<double>& x) {
+    std::vector<double> rhs, reduced, solution;
+    system.restrict_vector(
+        new_model.mass_weighted_moments([&](int e, const double xi[2], double out[3]) { old_model.interpolate(x, e, xi, out); }),
+        rhs);
+    mass.solve(rhs, reduced);
+    system.expand_vector(reduced, solution);
+    return solution;
+  };
+  return {project(u), project(v)};
+}
+
+void check_progressive_cut(const Mesh& mesh, const Cut& cut, int steps, double dt) {
+  const Topology topology = build_topology(mesh);
+  CutManager cuts(mesh, topology, {cut}, cholmod_enrichment(32));
+  std::unique_ptr<ShellModel> model = plain_model(mesh, topology);
+  std::vector<double> u = random_state(model->num_dofs(), 1), v = random_state(model->num_dofs(), 2);
+  int changes = 0, reused_some = 0;
+  for (int step = 0; step < steps; ++step) {
+    if (!cuts.update(step * dt)) continue;
+    ++changes;
+    SCOPED_TRACE("step " + std::to_string(step));
+    // The chained model (as SceneRun does: a copy takes the new functions)...
+    auto next = std::make_unique<ShellModel>(*model);
+    next->set_cut_edge_texels(cuts.edge_walls().resolution(), cuts.edge_walls().flags(mesh.num_elements()));
+    next->set_enrichments(cuts.functions());
+    // ...equals one built from scratch.
+    auto fresh = plain_model(mesh, topology);
+    fresh->set_cut_edge_texels(cuts.edge_walls().resolution(), cuts.edge_walls().flags(mesh.num_elements()));
+    fresh->set_enrichments(cuts.functions());
+    ASSERT_EQ(next->num_dofs(), fresh->num_dofs());
+    EXPECT_EQ(next->pattern().column(), fresh->pattern().column());
+    EXPECT_EQ(next->pattern().row_start(), fresh->pattern().row_start());
+    EXPECT_EQ(next->num_enriched_element_quadrature_points(), fresh->num_enriched_element_quadrature_points());
+    EXPECT_TRUE(bitwise_equal(next->mass_blocks(), fresh->mass_blocks()));
+    const double g[3] = {0.1, -0.2, -9.81}, q[3] = {1, 2, 3};
+    std::vector<double> f_next(next->num_dofs(), 0.0), f_fresh(fresh->num_dofs(), 0.0);
+    next->add_gravity(g, f_next);
+    next->add_area_force(q, f_next);
+    fresh->add_gravity(g, f_fresh);
+    fresh->add_area_force(q, f_fresh);
+    EXPECT_TRUE(bitwise_equal(f_next, f_fresh));
+    std::vector<double> k_next, k_fresh;
+    next->assemble_stiffness(nullptr, k_next, nullptr);
+    fresh->assemble_stiffness(nullptr, k_fresh, nullptr);
+    EXPECT_TRUE(bitwise_equal(k_next, k_fresh));
+    if (model->num_enriched_elements() > 0 && next->num_enriched_elements() > 1) ++reused_some;
+
+    // Moments of both fields in one pass equal the per-field reference.
+    const std::vector<std::vector<double>> moments = next->moments_of_fields(*model, {&u, &v});
+    for (int f = 0; f < 2; ++f) {
+      const std::vector<double>& x = f == 0 ? u : v;
+      const std::vector<double> expected =
+          next->mass_weighted_moments([&](int e, const double xi[2], double out[3]) { model->interpolate(x, e, xi, out); });
+      EXPECT_TRUE(bitwise_equal(moments[f], expected)) << "field " << f;
+    }
+    // The projection equals the reference one; fix a few DOFs so the free system is reduced.
+    std::vector<char> fixed(next->num_dofs(), 0);
+    for (int d = 0; d < 9; ++d) fixed[d] = 1;
+    const ProjectedState fast = project_onto_basis(*model, u, v, *next, fixed);
+    const ProjectedState reference = reference_projection(*model, u, v, *next, fixed);
+    EXPECT_TRUE(bitwise_equal(fast.displacement, reference.displacement));
+    EXPECT_TRUE(bitwise_equal(fast.velocity, reference.velocity));
+    u = fast.displacement;
+    v = fast.velocity;
+    model = std::move(next);
+  }
+  EXPECT_GE(changes, 3);
+  EXPECT_GE(reused_some, 2);
+}
+
+Cut progressive(std::vector<Vec3> points, double speed) {
+  Cut cut = points_cut(std::move(points));
+  cut.has_schedule = true;
+  cut.start_time = 0;
+  cut.speed = speed;
+  return cut;
+}
+
+TEST(BasisChange, ChainedQuad8ModelAndProjectionEqualTheReferenceBitwise) {
+  const Mesh mesh = make_rectangle(3, 3, 3, 3, ElementType::quad8);
+  // 0.35 per step: every step moves the tip by about a third of an element.
+  check_progressive_cut(mesh, progressive({{0, 1.37, 0}, {1.7, 1.61, 0}, {3, 1.45, 0}}, 0.35), 9, 1.0);
+}
+
+TEST(BasisChange, ChainedTri6ModelAndProjectionEqualTheReferenceBitwise) {
+  const Mesh mesh = make_rectangle(2, 2, 2, 2, ElementType::tri6);
+  check_progressive_cut(mesh, progressive({{0, 0.83, 0}, {2, 1.21, 0}}, 0.3), 7, 1.0);
+}
+
+// Two quad8 elements of one mesh, each with harmonic partial cuts (the second with two
+// enrichments), some nodes not enriched: the fused kernel against the two kernels.
+TEST(BasisChange, FusedMassAndLoadWeightsEqualTheTwoKernelsBitwise) {
+  const Mesh mesh = make_rectangle(2, 1, 2, 1, ElementType::quad8);
+  const int t = 32;
+  auto harmonic = [&](std::vector<kernels::TexelPoint> path) {
+    kernels::TexelTile walls = kernels::make_element_tile(ElementType::quad8, t);
+    const kernels::CutRaster raster = kernels::rasterize_cut(path, walls);
+    return harmonic_enrichment(walls, raster).tile;
+  };
+  const std::vector<kernels::TexelTile> tiles = {harmonic({{0, 15.5}, {20.3, 17.2}}), harmonic({{32, 9.2}, {12.1, 8.4}}),
+                                                 harmonic({{7.3, 32}, {9.8, 21.6}})};
+  std::vector<kernels::TextureView> views;
+  for (const auto& tile : tiles) views.push_back({tile.values.data(), tile.flags.data()});
+  std::vector<kernels::ShellSection> sections(mesh.num_elements(), {1e6, 0.3, 0.01, 1000});
+  const int npe = 8;
+  const std::vector<int> element = {0, 1}, start = {0, 1, 3};
+  std::vector<int> node(3 * npe);
+  std::vector<double> shift(3 * npe);
+  for (int k = 0; k < 3; ++k)
+    for (int a = 0; a < npe; ++a) {
+      node[k * npe + a] = (k + a) % 3 == 0 ? -1 : 100 + k * npe + a;  // some nodes not enriched
+      shift[k * npe + a] = 0.1 * (a - 3) + 0.05 * k;
+    }
+  int width = 0;
+  kernels::EnrichedElementBatch batch{ElementType::quad8, 2, element.data(), mesh.elements.data(), mesh.positions.data(),
+                                      sections.data(), t, 0, start.data(), views.data(), node.data(), shift.data()};
+  for (int e = 0; e < 2; ++e) width = std::max(width, kernels::enriched_basis_count(batch, e));
+  batch.width = width;
+  for (bool adaptive : {true, false}) {
+    SCOPED_TRACE(adaptive ? "adaptive quadrature" : "per-texel quadrature");
+    kernels::EnrichedQuadratureOptions options;
+    options.adaptive = adaptive;
+    std::vector<std::int64_t> qs;
+    std::vector<double> qp;
+    kernels::enriched_element_quadrature(batch, options, qs, qp);
+    ASSERT_GT(qs.back(), 2 * kernels::rest_integral_block_points);  // several work items
+    const kernels::EnrichedQuadrature quad{qs.data(), qp.data()};
+    std::vector<double> mass(2 * width * width), area(2 * width), weights(2 * width);
+    kernels::enriched_element_mass(batch, quad, mass.data());
+    kernels::enriched_element_load_weights(batch, quad, area.data(), weights.data());
+    for (auto execution : {kernels::Execution::serial, kernels::Execution::parallel}) {
+      std::vector<double> fused_mass(mass.size(), -1.0), fused_area(area.size(), -1.0), fused_weights(area.size(), -1.0);
+      kernels::enriched_element_mass_and_load_weights(batch, quad, fused_mass.data(), fused_area.data(),
+                                                      fused_weights.data(), execution);
+      EXPECT_TRUE(bitwise_equal(fused_mass, mass));
+      EXPECT_TRUE(bitwise_equal(fused_area, area));
+      EXPECT_TRUE(bitwise_equal(fused_weights, weights));
+    }
+  }
+  // Shape values at points in shuffled order (the texel cache refills and hits).
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> uniform(-1, 1);
+  kernels::EnrichedTexelCache cache;
+  for (int trial = 0; trial < 2000; ++trial) {
+    const int e = trial % 3 == 0 ? 0 : 1;
+    const double xi1 = uniform(rng), xi2 = trial % 5 == 0 ? -1.0 : uniform(rng);
+    kernels::ShapeValues s;
+    kernels::evaluate_shape(ElementType::quad8, xi1, xi2, s);
+    kernels::EnrichedShapeValues full;
+    kernels::evaluate_enriched_shape(batch, e, xi1, xi2, s, full);
+    double values[kernels::max_enriched_basis];
+    ASSERT_EQ(kernels::enriched_shape_values(batch, e, xi1, xi2, s, cache, values), full.count);
+    ASSERT_EQ(std::memcmp(values, full.N, sizeof(double) * full.count), 0) << "point " << trial;
+  }
+}
+
+}  // namespace

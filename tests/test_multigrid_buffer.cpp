@@ -1,0 +1,50 @@
+// The multigrid's array allocator (runtime/multigrid_buffer.h): every MultigridBuffer(n)
+// holds n zeros, also when its block comes back from the cache with old values in it, for
+// heap-sized, cached and huge-page-mapped sizes; blocks are reused for the same size.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+
+#include "multigrid_buffer.h"
+
+namespace {
+
+using dgtex::detail::MultigridBuffer;
+
+bool all_zero(const MultigridBuffer& v) {
+  return std::all_of(v.begin(), v.end(), [](double x) { return x == 0.0 && !std::signbit(x); });
+}
+
+TEST(MultigridBuffer, FreshBuffersAreZeroForEverySizeClass) {
+  // Below the cache bound, cached, and mapped for huge pages (>= 1 MiB), odd sizes included.
+  for (std::size_t n : {std::size_t{0}, std::size_t{1}, std::size_t{1000}, std::size_t{8192}, std::size_t{70001},
+                        std::size_t{131072}, std::size_t{300007}}) {
+    for (int round = 0; round < 3; ++round) {
+      MultigridBuffer v(n);
+      ASSERT_EQ(v.size(), n);
+      EXPECT_TRUE(all_zero(v)) << "size " << n << " round " << round;
+      std::fill(v.begin(), v.end(), -7.5);  // leave garbage for the next round's block
+    }
+  }
+}
+
+TEST(MultigridBuffer, ReleasedBlocksAreReusedForTheSameSize) {
+  const std::size_t n = 200000;  // 1.6 MB: mapped and cached
+  const double* first = nullptr;
+  {
+    MultigridBuffer v(n);
+    first = v.data();
+    v[n / 2] = 3.0;
+  }
+  MultigridBuffer again(n);
+  EXPECT_EQ(again.data(), first);  // the cached block, not a new mapping
+  EXPECT_TRUE(all_zero(again));
+#if defined(__linux__)
+  // A huge-page mapped block is 2 MiB aligned.
+  EXPECT_EQ(reinterpret_cast<std::uintptr_t>(again.data()) % (std::uintptr_t{2} << 20), 0u);
+#endif
+}
+
+}  // namespace
