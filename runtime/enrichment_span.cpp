@@ -5,6 +5,7 @@
 #include <map>
 #include <stdexcept>
 #include <string>
+#include <utility>
 
 namespace dgtex {
 namespace {
@@ -21,6 +22,35 @@ double dot(const std::vector<double>& a, const std::vector<double>& b) {
   return s;
 }
 
+// Count, mean and sum of squared deviations of one tile's active texel values (two
+// passes: stable for the nearly constant tiles of complete cuts).
+struct TexelMoments {
+  double count = 0, mean = 0, m2 = 0;
+};
+
+TexelMoments active_moments(const kernels::TexelTile& tile) {
+  TexelMoments m;
+  double sum = 0;
+  for (std::size_t p = 0; p < tile.flags.size(); ++p)
+    if (!(tile.flags[p] & kernels::inactive)) sum += tile.values[p], m.count += 1;
+  if (m.count == 0) return m;
+  m.mean = sum / m.count;
+  for (std::size_t p = 0; p < tile.flags.size(); ++p)
+    if (!(tile.flags[p] & kernels::inactive)) m.m2 += (tile.values[p] - m.mean) * (tile.values[p] - m.mean);
+  return m;
+}
+
+// Pooled moments of several tiles (Chan et al.'s combination, stable like the two passes).
+TexelMoments pool(const std::vector<const TexelMoments*>& parts) {
+  TexelMoments all;
+  for (const TexelMoments* p : parts) all.count += p->count;
+  if (all.count == 0) return all;
+  for (const TexelMoments* p : parts) all.mean += p->count * p->mean;
+  all.mean /= all.count;
+  for (const TexelMoments* p : parts) all.m2 += p->m2 + p->count * (p->mean - all.mean) * (p->mean - all.mean);
+  return all;
+}
+
 }  // namespace
 
 std::vector<std::vector<int>> independent_enriched_nodes(const std::vector<std::vector<int>>& node_elements,
@@ -34,10 +64,44 @@ std::vector<std::vector<int>> independent_enriched_nodes(const std::vector<std::
   std::vector<std::vector<int>> kept(functions.size());
   std::vector<std::vector<double>> basis;  // orthonormal over the node's support texels
   std::vector<double> column;
+  // Per (function, element) moments, for nodes that only one function enriches: there the
+  // Gram-Schmidt residual of H against 1 is H minus its mean, whose norm is sqrt(m2) of the
+  // pooled moments, so each tile is read once instead of once per incident node.
+  std::map<std::pair<int, int>, TexelMoments> moments;
+  std::vector<const TexelMoments*> parts;
+  std::map<std::pair<std::vector<int>, std::vector<int>>, std::vector<char>> memo;  // (support, functions) -> kept
   for (const auto& [a, list] : by_node) {
+    if (list.size() == 1 && a >= 0 && a < static_cast<int>(node_elements.size())) {
+      parts.clear();
+      for (int e : node_elements[a]) {
+        const kernels::TexelTile* tile = texture_of(functions[list[0]], e);
+        if (!tile)
+          throw std::invalid_argument("enrichment function " + std::to_string(list[0]) + ": element " +
+                                      std::to_string(e) + " is incident to enriched node " + std::to_string(a) +
+                                      " but has no texture");
+        auto it = moments.find({list[0], e});
+        if (it == moments.end()) it = moments.emplace(std::make_pair(list[0], e), active_moments(*tile)).first;
+        parts.push_back(&it->second);
+      }
+      const TexelMoments all = pool(parts);
+      if (all.count == 0) continue;
+      if (std::sqrt(all.m2) > tolerance * std::sqrt(all.count)) kept[list[0]].push_back(a);
+      continue;
+    }
     if (a < 0 || a >= static_cast<int>(node_elements.size()))
       throw std::invalid_argument("enrichment function " + std::to_string(list[0]) + ": enriched node " +
                                   std::to_string(a) + " out of range [0, " + std::to_string(node_elements.size()) + ")");
+    // Nodes with the same support (same elements, same order) and the same functions get
+    // the same answer: computed once (all nodes of an element with many cuts, midside nodes).
+    auto memo_key = std::make_pair(node_elements[a], list);
+    const auto known = memo.find(memo_key);
+    if (known != memo.end()) {
+      for (std::size_t k = 0; k < list.size(); ++k)
+        if (known->second[k]) kept[list[k]].push_back(a);
+      continue;
+    }
+    std::vector<char>& keeps = memo[memo_key];
+    keeps.assign(list.size(), 0);
     // The tiles of every function on every element incident to a.
     std::vector<std::vector<const kernels::TexelTile*>> tiles(list.size());
     for (std::size_t k = 0; k < list.size(); ++k)
@@ -76,6 +140,7 @@ std::vector<std::vector<int>> independent_enriched_nodes(const std::vector<std::
       for (double& v : column) v /= norm;
       basis.push_back(column);
       kept[list[k]].push_back(a);
+      keeps[k] = 1;
     }
   }
   return kept;  // by_node is ordered by node, so each list is sorted

@@ -9,6 +9,7 @@
 #include <Eigen/CholmodSupport>
 #include <Eigen/SparseCore>
 
+#include "dgtex/kernels/forall.h"
 #include "dgtex/kernels/multigrid_unknowns.h"
 
 namespace dgtex {
@@ -111,6 +112,8 @@ class TexelGraph {
     return nb[0] >= 0 && !walls_.blocked(tiles_[l].element, edge, s) &&
            !walls_.blocked(tiles_[nb[0]].element, nb[1], t_ - 1 - s);
   }
+  // The region tile across local edge `edge` of tile l and its local edge there ({-1, -1}: none).
+  std::array<int, 2> across(int l, int edge) const { return across_[4 * l + edge]; }
   bool active(int node) const { return !(flags(node) & kernels::inactive); }
   bool data(int node) const {
     return active(node) && (tiles_[node / tt_].frozen || (flags(node) & kernels::dirichlet));
@@ -127,6 +130,8 @@ class TexelGraph {
     if (i > 0 && kernels::texels_coupled_east(tile, i - 1, j)) f(node - 1);
     if (kernels::texels_coupled_north(tile, i, j)) f(node + t_);
     if (j > 0 && kernels::texels_coupled_north(tile, i, j - 1)) f(node - t_);
+    // Only texels on the element border couple across mesh edges (tri6: also the hypotenuse).
+    if (i > 0 && j > 0 && i < t_ - 1 && j < t_ - 1 && (type_ == ElementType::quad8 || i + j < t_ - 1)) return;
     int edges[2], positions[2];
     const int n = texel_edges(type_, t_, i, j, edges, positions);
     for (int e = 0; e < n; ++e) {
@@ -147,8 +152,12 @@ class TexelGraph {
   std::vector<std::array<int, 2>> across_;
 };
 
-// Where each region tile sits in one planar texel tile (quad8 only): tile l covers texels
-// [T * x[l], T * (x[l] + 1)) x [T * y[l], T * (y[l] + 1)) of the patch. Exact when every
+// Where each solved region tile sits in one planar texel tile (quad8 only): tile l covers
+// texels [T * x[l], T * (x[l] + 1)) x [T * y[l], T * (y[l] + 1)) of the patch (inside a
+// one-texel margin). Frozen tiles are not placed: their texels coupled to placed tiles
+// become Dirichlet "ghost" texels in the margin or gaps beside the edge they couple
+// across (see solve_mesh_texel_laplace), so a ring closed only through frozen tiles (a
+// cylinder with a settled element) still fits. Exact when every
 // coupling of the texel graph is a 5-point coupling of the patch and vice versa: every mesh
 // edge shared by two region tiles pairs edge k with edge (k + 2) % 4 (the neighbour keeps the
 // orientation) and joins tiles that sit side by side across that edge; side-by-side tiles
@@ -164,12 +173,16 @@ bool place_region_in_plane(const std::vector<RegionTile>& tiles, ElementType typ
   if (type != ElementType::quad8) return false;
   const int count = static_cast<int>(tiles.size());
   std::unordered_map<int, int> local;
-  for (int l = 0; l < count; ++l) local.emplace(tiles[l].element, l);
+  for (int l = 0; l < count; ++l)
+    if (!tiles[l].frozen) local.emplace(tiles[l].element, l);
+  if (local.empty()) return false;
   constexpr int dx[4] = {0, 1, 0, -1}, dy[4] = {-1, 0, 1, 0};  // quad8 local edges: south, east, north, west
   std::vector<int> x(count, 0), y(count, 0);
   std::vector<char> placed(count, 0);
-  std::vector<int> queue = {0};
-  placed[0] = 1;
+  int first = 0;
+  while (tiles[first].frozen) ++first;
+  std::vector<int> queue = {first};
+  placed[first] = 1;
   for (std::size_t q = 0; q < queue.size(); ++q) {
     const int l = queue[q];
     for (int k = 0; k < 4; ++k) {
@@ -187,15 +200,16 @@ bool place_region_in_plane(const std::vector<RegionTile>& tiles, ElementType typ
       queue.push_back(m);
     }
   }
-  if (static_cast<int>(queue.size()) != count) return false;  // not edge-connected
-  const int x0 = *std::min_element(x.begin(), x.end()), y0 = *std::min_element(y.begin(), y.end());
+  if (queue.size() != local.size()) return false;  // not edge-connected
+  int x0 = x[first], y0 = y[first];
+  for (int l : queue) x0 = std::min(x0, x[l]), y0 = std::min(y0, y[l]);
   std::unordered_map<long long, int> at;
-  for (int l = 0; l < count; ++l) {
+  for (int l : queue) {
     x[l] -= x0, y[l] -= y0;
     if (!at.emplace(static_cast<long long>(x[l]) << 32 | static_cast<unsigned>(y[l]), l).second) return false;
   }
-  placement.columns = *std::max_element(x.begin(), x.end()) + 1;
-  placement.rows = *std::max_element(y.begin(), y.end()) + 1;
+  placement.columns = 0, placement.rows = 0;
+  for (int l : queue) placement.columns = std::max(placement.columns, x[l] + 1), placement.rows = std::max(placement.rows, y[l] + 1);
   placement.x = std::move(x);
   placement.y = std::move(y);
   return true;
@@ -218,26 +232,47 @@ MeshLaplaceStats solve_mesh_texel_laplace(std::vector<RegionTile>& tiles, Elemen
   for (const RegionTile& r : tiles) (r.frozen ? stats.frozen_tiles : stats.solved_tiles) += 1;
   const int n = graph.nodes();
 
-  // Components of free texels; each collects the data values it touches.
+  // Components of free texels; each collects the data values it touches. Union-find
+  // links the larger root under the smaller, so parent[v] <= v and one forward pass
+  // flattens every texel to its root.
+  std::vector<char> is_free(n), is_data(n);
+  for (int v = 0; v < n; ++v) is_free[v] = graph.free(v), is_data[v] = graph.data(v);
   std::vector<int> parent(n);
   for (int v = 0; v < n; ++v) parent[v] = v;
-  for (int v = 0; v < n; ++v) {
-    if (!graph.free(v)) continue;
-    graph.for_each_coupling(v, [&](int w) {
-      if (w > v && graph.free(w)) {
-        const int a = find_root(parent, v), b = find_root(parent, w);
-        if (a != b) parent[std::max(a, b)] = std::min(a, b);
+  const int t = tiles.front().tile.width, tt = t * t;
+  auto unite = [&](int v, int w) {
+    const int a = find_root(parent, v), b = find_root(parent, w);
+    if (a != b) parent[std::max(a, b)] = std::min(a, b);
+  };
+  for (int l = 0; l < static_cast<int>(tiles.size()); ++l) {
+    const std::uint8_t* flags = tiles[l].tile.flags.data();
+    for (int j = 0; j < t; ++j)
+      for (int i = 0; i < t; ++i) {
+        const int v = l * tt + j * t + i;
+        if (!is_free[v]) continue;
+        const bool border = i == 0 || j == 0 || i == t - 1 || j == t - 1 || (type == ElementType::tri6 && i + j >= t - 1);
+        if (border) {
+          graph.for_each_coupling(v, [&](int w) {
+            if (w > v && is_free[w]) unite(v, w);
+          });
+          continue;
+        }
+        // Interior texel: its east and north neighbours are in the tile.
+        const std::uint8_t f = flags[j * t + i];
+        if (!(f & kernels::wall_east) && is_free[v + 1]) unite(v, v + 1);
+        if (!(f & kernels::wall_north) && is_free[v + t]) unite(v, v + t);
       }
-    });
   }
+  for (int v = 0; v < n; ++v) parent[v] = parent[parent[v]];
   enum : std::uint8_t { no_data = 0, constant = 1, varying = 2 };
   std::vector<std::uint8_t> state(n, no_data);
   std::vector<double> constant_value(n, 0.0);
   for (int v = 0; v < n; ++v) {
-    if (!graph.free(v)) continue;
-    const int root = find_root(parent, v);
+    if (!is_free[v]) continue;
+    const int root = parent[v];
+    if (state[root] == varying) continue;  // nothing more to learn
     graph.for_each_coupling(v, [&](int w) {
-      if (!graph.data(w)) return;
+      if (!is_data[w]) return;
       const double x = graph.value(w);
       if (state[root] == no_data) state[root] = constant, constant_value[root] = x;
       else if (state[root] == constant && x != constant_value[root]) state[root] = varying;
@@ -246,8 +281,8 @@ MeshLaplaceStats solve_mesh_texel_laplace(std::vector<RegionTile>& tiles, Elemen
   std::vector<int> unknown_of(n, -1);
   std::vector<int> node_of;
   for (int v = 0; v < n; ++v) {
-    if (!graph.free(v)) continue;
-    const int root = find_root(parent, v);
+    if (!is_free[v]) continue;
+    const int root = parent[v];
     if (root == v) {
       stats.constant_components += state[v] == constant;
       stats.solved_components += state[v] == varying;
@@ -268,32 +303,102 @@ MeshLaplaceStats solve_mesh_texel_laplace(std::vector<RegionTile>& tiles, Elemen
     if (solver == LaplaceSolver::multigrid && tiles.size() > 1 &&
         place_region_in_plane(tiles, type, adjacency, placement)) {
       try {
-        // The region is a planar block of tiles: one patch tile, the tile multigrid, the
-        // same discrete problem (every texel-graph coupling is a 5-point coupling there).
-        const int t = tiles.front().tile.width, tt = t * t, w = t * placement.columns;
-        TexelTile patch(w, t * placement.rows);
+        // The solved tiles form a planar block: one patch tile, the tile multigrid, the same
+        // discrete problem (every texel-graph coupling is a 5-point coupling there).
+        // A one-texel margin for the ghosts, only where frozen tiles are (else the patch is
+        // exactly the block of tiles, the multigrid's coarse grids aligned with them).
+        const int margin = stats.frozen_tiles > 0 ? 1 : 0;
+        const int w = t * placement.columns + 2 * margin, h = t * placement.rows + 2 * margin;
+        TexelTile patch(w, h);
         std::fill(patch.flags.begin(), patch.flags.end(), static_cast<std::uint8_t>(kernels::inactive));
-        auto patch_index = [&](int l, int i, int j) { return (t * placement.y[l] + j) * w + t * placement.x[l] + i; };
-        for (int l = 0; l < static_cast<int>(tiles.size()); ++l) {
+        auto patch_index = [&](int l, int i, int j) {
+          return (margin + t * placement.y[l] + j) * w + margin + t * placement.x[l] + i;
+        };
+        std::vector<char> in_tile(patch.flags.size(), 0);
+        // Rows in parallel: each writes its own patch texels.
+        kernels::forall(static_cast<std::int64_t>(tiles.size()) * t, [&](std::int64_t row) {
+          const int l = static_cast<int>(row / t), j = static_cast<int>(row % t);
+          if (tiles[l].frozen) return;
           const std::vector<std::uint8_t>& flags = tiles[l].tile.flags;
-          for (int j = 0; j < t; ++j)
-            for (int i = 0; i < t; ++i) {
-              const int v = l * tt + j * t + i;
-              if (!graph.active(v)) continue;
-              std::uint8_t f = flags[j * t + i] & (kernels::wall_east | kernels::wall_north);
-              if (i == t - 1) f = (f & ~kernels::wall_east) | (graph.couples_across(l, 1, j) ? 0 : kernels::wall_east);
-              if (j == t - 1)
-                f = (f & ~kernels::wall_north) | (graph.couples_across(l, 2, t - 1 - i) ? 0 : kernels::wall_north);
-              if (unknown_of[v] < 0) f |= kernels::dirichlet;
-              const int g = patch_index(l, i, j);
-              patch.flags[g] = f;
-              patch.values[g] = graph.value(v);  // data, or the initial guess (the previous H)
+          for (int i = 0; i < t; ++i) {
+            const int v = l * tt + j * t + i;
+            const int g = patch_index(l, i, j);
+            in_tile[g] = 1;
+            if (!graph.active(v)) continue;
+            std::uint8_t f = flags[j * t + i] & (kernels::wall_east | kernels::wall_north);
+            if (i == t - 1) f = (f & ~kernels::wall_east) | (graph.couples_across(l, 1, j) ? 0 : kernels::wall_east);
+            if (j == t - 1)
+              f = (f & ~kernels::wall_north) | (graph.couples_across(l, 2, t - 1 - i) ? 0 : kernels::wall_north);
+            if (unknown_of[v] < 0) f |= kernels::dirichlet;
+            patch.flags[g] = f;
+            patch.values[g] = graph.value(v);  // data, or the initial guess (the previous H)
+          }
+        });
+        // Ghost texels: the frozen texel coupled across a placed tile's edge, as Dirichlet
+        // data right beside that edge. Each ghost couples only to its partner(s): walls
+        // toward every other neighbour. A ghost that would land in a placed tile, or two
+        // different frozen values on one ghost, leave the region to CHOLMOD.
+        constexpr int gx[4] = {0, 1, 0, -1}, gy[4] = {-1, 0, 1, 0};  // outward, per quad8 edge
+        std::unordered_map<int, std::uint8_t> ghost_partners;  // ghost -> bit d: couples toward direction d
+        bool ghosts_fit = true;
+        for (int l = 0; l < static_cast<int>(tiles.size()) && ghosts_fit; ++l) {
+          if (tiles[l].frozen) continue;
+          for (int k = 0; k < 4 && ghosts_fit; ++k) {
+            const auto nb = graph.across(l, k);
+            if (nb[0] < 0 || !tiles[nb[0]].frozen) continue;
+            for (int q = 0; q < t; ++q) {
+              if (!graph.couples_across(l, k, q)) continue;
+              const int v = l * tt + edge_texel_index(type, t, k, q);
+              const int other = nb[0] * tt + edge_texel_index(type, t, nb[1], t - 1 - q);
+              if (!graph.active(v) || !graph.active(other)) continue;
+              const int i = v % tt % t, j = v % tt / t;
+              const int gi = margin + t * placement.x[l] + i + gx[k], gj = margin + t * placement.y[l] + j + gy[k];
+              if (gi < 0 || gj < 0 || gi >= w || gj >= h) {
+                ghosts_fit = false;
+                break;
+              }
+              const int g = gj * w + gi;
+              if (in_tile[g]) {
+                ghosts_fit = false;
+                break;
+              }
+              const double value = graph.value(other);
+              const auto it = ghost_partners.find(g);
+              if (it != ghost_partners.end() && patch.values[g] != value) {
+                ghosts_fit = false;
+                break;
+              }
+              patch.flags[g] = kernels::dirichlet;
+              patch.values[g] = value;
+              ghost_partners[g] |= static_cast<std::uint8_t>(1u << ((k + 2) % 4));  // toward the tile
             }
+          }
+        }
+        if (!ghosts_fit) throw std::runtime_error("ghost texels do not fit the patch");
+        for (const auto& [g, partners] : ghost_partners) {
+          const int gi = g % w, gj = g / w;
+          const int neighbour[4] = {g - w, g + 1, g + w, g - 1};  // south, east, north, west
+          const bool inside[4] = {gj > 0, gi + 1 < w, gj + 1 < h, gi > 0};
+          for (int d = 0; d < 4; ++d) {
+            if ((partners & (1u << d)) || !inside[d]) continue;
+            const int q = neighbour[d];
+            // the wall bit sits on the west / south texel of the pair
+            if (d == 0) patch.flags[q] |= kernels::wall_north;
+            if (d == 1) patch.flags[g] |= kernels::wall_east;
+            if (d == 2) patch.flags[g] |= kernels::wall_north;
+            if (d == 3) patch.flags[q] |= kernels::wall_east;
+          }
         }
         const LaplaceSolveStats s = solve_laplace(patch, LaplaceSolver::multigrid, options);
         stats.relative_residual = s.relative_residual;
         stats.multigrid = true;
-        for (int v : node_of) graph.value(v) = patch.values[patch_index(v / tt, v % tt % t, v % tt / t)];
+        kernels::forall(static_cast<std::int64_t>(tiles.size()) * t, [&](std::int64_t row) {
+          const int l = static_cast<int>(row / t), j = static_cast<int>(row % t);
+          if (tiles[l].frozen) return;
+          const int first = l * tt + j * t, g = patch_index(l, 0, j);
+          for (int i = 0; i < t; ++i)
+            if (unknown_of[first + i] >= 0) tiles[l].tile.values[j * t + i] = patch.values[g + i];
+        });
       } catch (const std::runtime_error&) {
         stats.multigrid = false;
       }

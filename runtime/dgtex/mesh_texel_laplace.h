@@ -16,10 +16,14 @@
 // (connected through free-free couplings) with no data get 0; a component whose data are
 // all one value v gets exactly v without a solve; the rest are the unknowns of one SPD
 // system. With LaplaceSolver::multigrid (the enrichment's default) a single tile, or a quad8
-// region whose tiles lie side by side in the plane without turning or closing up (e.g.
-// blocks of a rectangle mesh: chad's 2x2), is solved by the tile multigrid on one patch tile
-// holding the same couplings (options: tolerance, warm start from the tiles' values); other
-// regions (tri6, cylinder rings, turned neighbours) and LaplaceSolver::cholmod use CHOLMOD.
+// region whose solved (non-frozen) tiles lie side by side in the plane without turning or
+// closing up (e.g. blocks of a rectangle mesh: chad's 2x2; a cylinder ring closed only
+// through frozen tiles: slinky after its first cut settles), is solved by the tile multigrid
+// on one patch tile holding the same couplings (options: tolerance, warm start from the
+// tiles' values); frozen texels coupled to solved ones enter that patch as Dirichlet ghost
+// texels beside the edge they couple across, walled off from everything else. Other regions
+// (tri6, rings closed through solved tiles, turned neighbours) and LaplaceSolver::cholmod
+// use CHOLMOD.
 // Value types that own their data (MeshEdgeWalls its key set, RegionTile its tile) and
 // functions that keep nothing; a solve may use all OpenMP threads. Values dimensionless.
 #include <cstdint>
