@@ -2,8 +2,23 @@
 
 #include <algorithm>
 #include <cmath>
+#include <memory>
 
+#include "dgtex/kernels/texel_derivative_rows.h"
 #include "dgtex/kernels/texel_grid.h"
+
+// The fast form of the rule (the reference twin, enriched_quadrature_reference.cpp, is the
+// rule written plainly; both give bitwise the same arrays). Where the time went and what
+// replaces it:
+//  - texel derivatives of every texel: texel_derivative_rows (reachability bits, no
+//    per-neighbour look-ups), in row blocks across threads even for one element;
+//  - the merge test re-scanned every texel of a candidate cell for domain and walls at every
+//    level: per-row prefix sums of "outside", east and north walls answer that in O(rows)
+//    before any texel polynomial is compared (the test is a conjunction: order is free), and
+//    the polynomials are then compared row by row in a vectorizable loop;
+//  - one element ran on one thread: the quadtree is expanded serially down to a few levels,
+//    the cells there become independent subtrees (tasks) and their point lists are spliced
+//    back in the serial order.
 
 namespace dgtex::kernels {
 namespace {
@@ -21,97 +36,186 @@ inline bool agrees(const TexelDerivatives& ref, const TexelDerivatives& t, doubl
   return size * size * ds <= tol;
 }
 
-struct CellBuilder {
-  ElementType type;
-  int t;
-  const TextureView* textures;
-  int texture_count;
-  const EnrichedQuadratureOptions& options;
-  std::vector<TexelDerivatives> fields;  // texture_count x T x T (texels in the domain only)
-  std::vector<double>& out;
-  // Wall counts along texel rows and columns (walls of any texture), as prefix sums:
-  // north_prefix[j * (T + 1) + i] = walls north of texels (0..i-1, j); east_prefix[i * (T + 1) + j]
-  // = walls east of texels (i, 0..j-1).
-  std::vector<int> north_prefix, east_prefix;
+// agrees() for texels i0 .. i0 + length - 1 of one row (d2 = j - rj), in two passes: the
+// three deviations of a chunk of texels with the same expressions (a branch-free loop that
+// vectorizes), then the comparisons (the conjunction is the same boolean).
+constexpr int deviation_chunk = 128;
+inline double larger(double a, double b) { return a < b ? b : a; }  // std::max, by value
+inline bool row_agrees(const TexelDerivatives& ref, const TexelDerivativePlanes& row, int i0, int length, int ri,
+                       double d2, double size, double tol) {
+  double dv[deviation_chunk], dg[deviation_chunk], dh[deviation_chunk];
+  const double rv = ref.value, rg0 = ref.g[0], rg1 = ref.g[1], rs0 = ref.s[0], rs1 = ref.s[1], rs2 = ref.s[2];
+  for (int c0 = i0; c0 < i0 + length; c0 += deviation_chunk) {
+    const int n = std::min(deviation_chunk, i0 + length - c0);
+    const double *v = row.value + c0, *ga = row.g[0] + c0, *gb = row.g[1] + c0;
+    const double *sa = row.s[0] + c0, *sb = row.s[1] + c0, *sc = row.s[2] + c0;
+    for (int m = 0; m < n; ++m) {
+      const double d1 = c0 + m - ri;
+      const double p = rv + rg0 * d1 + rg1 * d2 + 0.5 * (rs0 * d1 * d1 + rs1 * d2 * d2) + rs2 * d1 * d2;
+      const double g1 = rg0 + rs0 * d1 + rs2 * d2;
+      const double g2 = rg1 + rs2 * d1 + rs1 * d2;
+      dv[m] = std::abs(v[m] - p);
+      dg[m] = larger(std::abs(ga[m] - g1), std::abs(gb[m] - g2));
+      dh[m] = larger(larger(std::abs(sa[m] - rs0), std::abs(sb[m] - rs1)), std::abs(sc[m] - rs2));
+    }
+    for (int m = 0; m < n; ++m)
+      if (!(dv[m] <= tol) || !(size * dg[m] <= tol) || !(size * size * dh[m] <= tol)) return false;
+  }
+  return true;
+}
 
-  void count_walls() {
-    north_prefix.assign(static_cast<std::size_t>(t) * (t + 1), 0);
-    east_prefix.assign(static_cast<std::size_t>(t) * (t + 1), 0);
-    for (int j = 0; j < t; ++j)
+constexpr int row_block = 16;  // texel rows per work item of the per-texel set-up
+constexpr int task_depth = 3;  // quadtree levels expanded serially before subtrees become tasks
+
+// Everything the merge test reads, per element, built once (in row blocks, each allocated
+// and filled by its own work item: no serial zero-filling of megabytes).
+struct ElementInputs {
+  ElementType type;
+  int t = 0;
+  const TextureView* textures = nullptr;
+  int texture_count = 0;
+  // Planar texel derivatives (texel_derivative_rows.h) of row block b and texture k at
+  // [b * texture_count + k]: six planes of row_block x T each.
+  std::vector<std::unique_ptr<double[]>> field_blocks;
+  // Row prefix sums (row j at j * (T + 1), texel i at + i) of texels outside the domain of
+  // some texture, east walls and north walls (any texture) among texels (0..i-1, j);
+  // interleaved, as the merge test reads all three at the same places.
+  struct RowCounts {
+    int outside, east, north;
+  };
+  std::unique_ptr<RowCounts[]> row_prefix;
+  // Walls on the line between rows j and j + 1 over columns [i0, i0 + w).
+  int north_walls(int j, int i0, int w) const {
+    const RowCounts* p = row_prefix.get() + static_cast<std::size_t>(j) * (t + 1);
+    return p[i0 + w].north - p[i0].north;
+  }
+  // Column prefix sums (column i at i * (T + 1)): east walls of texels (i, 0..j-1).
+  std::unique_ptr<int[]> east_column_prefix;
+
+  void allocate(bool adaptive) {
+    if (!adaptive) return;
+    const std::size_t prefix = static_cast<std::size_t>(t) * (t + 1);
+    row_prefix.reset(new RowCounts[prefix]);
+    east_column_prefix.reset(new int[prefix]);
+    field_blocks.resize(static_cast<std::size_t>((t + row_block - 1) / row_block) * texture_count);
+  }
+  // The planes of row j of texture k.
+  TexelDerivativePlanes field_row(int k, int j) const {
+    double* block = field_blocks[static_cast<std::size_t>(j / row_block) * texture_count + k].get();
+    const std::size_t plane = static_cast<std::size_t>(row_block) * t, row = static_cast<std::size_t>(j % row_block) * t;
+    return {block + row, {block + plane + row, block + 2 * plane + row},
+            {block + 3 * plane + row, block + 4 * plane + row, block + 5 * plane + row}};
+  }
+
+  void build_block(int block) {
+    const int row_begin = block * row_block, row_end = std::min(row_begin + row_block, t);
+    for (int k = 0; k < texture_count; ++k) {
+      std::unique_ptr<double[]>& planes = field_blocks[static_cast<std::size_t>(block) * texture_count + k];
+      planes.reset(new double[6 * static_cast<std::size_t>(row_block) * t]);  // filled just below
+      texel_derivative_rows(type, t, textures[k], row_begin, row_end, field_row(k, row_begin));
+    }
+    const bool tri = type == ElementType::tri6;
+    for (int j = row_begin; j < row_end; ++j) {
+      RowCounts* counts = row_prefix.get() + static_cast<std::size_t>(j) * (t + 1);
+      counts[0] = {0, 0, 0};
       for (int i = 0; i < t; ++i) {
         std::uint8_t f = 0;
         for (int k = 0; k < texture_count; ++k) f |= textures[k].flags[j * t + i];
-        north_prefix[j * (t + 1) + i + 1] = north_prefix[j * (t + 1) + i] + ((f & wall_north) ? 1 : 0);
-        east_prefix[i * (t + 1) + j + 1] = east_prefix[i * (t + 1) + j] + ((f & wall_east) ? 1 : 0);
+        const bool out = (f & inactive) || (tri && i + j > t - 1);
+        counts[i + 1] = {counts[i].outside + (out ? 1 : 0), counts[i].east + ((f & wall_east) ? 1 : 0),
+                         counts[i].north + ((f & wall_north) ? 1 : 0)};
       }
+    }
   }
-  // Walls on the line between rows j and j + 1 over columns [i0, i0 + w), and between
-  // columns i and i + 1 over rows [j0, j0 + h).
-  int walls_north_of_row(int j, int i0, int w) const {
-    return north_prefix[j * (t + 1) + i0 + w] - north_prefix[j * (t + 1) + i0];
+  void build_column(int i) {
+    int* east = east_column_prefix.get() + static_cast<std::size_t>(i) * (t + 1);
+    east[0] = 0;
+    for (int j = 0; j < t; ++j) {
+      std::uint8_t f = 0;
+      for (int k = 0; k < texture_count; ++k) f |= textures[k].flags[j * t + i];
+      east[j + 1] = east[j] + ((f & wall_east) ? 1 : 0);
+    }
   }
-  int walls_east_of_column(int i, int j0, int h) const {
-    return east_prefix[i * (t + 1) + j0 + h] - east_prefix[i * (t + 1) + j0];
+  static int count(const std::unique_ptr<int[]>& prefix, int t, int line, int begin, int length) {
+    const int* p = prefix.get() + static_cast<std::size_t>(line) * (t + 1);
+    return p[begin + length] - p[begin];
   }
+};
 
-  // The interior line of a rectangular cell that carries walls along at least 3/4 of its
-  // length and lies closest to the cell's middle (ties: horizontal, then lower). Splitting
-  // there leaves a long straight wall on the border of both children instead of inside
-  // them. Returns false when no line qualifies (no walls, or only short/staircase walls).
+// A subtree of the quadtree whose points are produced independently (see splice).
+struct Task {
+  std::int64_t element;
+  int i0, j0, w, h;
+  std::size_t position;  // where its points go in the element's planned list (doubles)
+  std::vector<double> points;
+};
+
+struct CellBuilder {
+  const ElementInputs& in;
+  const EnrichedQuadratureOptions& options;
+  std::vector<double>& out;
+  // Planning: cells at task_depth become tasks instead of being visited (nullptr: visit all).
+  std::vector<Task>* tasks = nullptr;
+  std::int64_t element = 0;
+  double texel = texel_size(in.type, in.t);
+  double origin = in.type == ElementType::quad8 ? -1.0 : 0.0;
+  QuadratureRule triangle_rule = element_quadrature(ElementType::tri6);
+
+  // The wall line of the header's split rule (same scan and tie order as the reference).
   bool wall_line(int i0, int j0, int w, int h, bool& horizontal, int& offset) const {
-    long best = -1;  // distance to the middle, relative to the cell size (cross-multiplied)
+    long best = -1;
     auto dominant = [](int walls, int length) { return 4 * walls >= 3 * length; };
     for (int m = 1; m < h; ++m)
-      if (dominant(walls_north_of_row(j0 + m - 1, i0, w), w)) {
+      if (dominant(in.north_walls(j0 + m - 1, i0, w), w)) {
         const long d = static_cast<long>(std::abs(2 * m - h)) * w;
         if (best < 0 || d < best) best = d, horizontal = true, offset = m;
       }
     for (int m = 1; m < w; ++m)
-      if (dominant(walls_east_of_column(i0 + m - 1, j0, h), h)) {
+      if (dominant(ElementInputs::count(in.east_column_prefix, in.t, i0 + m - 1, j0, h), h)) {
         const long d = static_cast<long>(std::abs(2 * m - w)) * h;
         if (best < 0 || d < best) best = d, horizontal = false, offset = m;
       }
     return best >= 0;
   }
 
-  const TexelDerivatives& field(int k, int i, int j) const {
-    return fields[(static_cast<std::size_t>(k) * t + j) * t + i];
-  }
-
-  bool in_cell(int i, int j, int i0, int j0, int w, int h, bool triangle) const {
-    if (i < i0 || j < j0 || i >= i0 + w || j >= j0 + h) return false;
-    return !triangle || (i - i0) + (j - j0) <= w - 1;
-  }
-
+  // The merge test: no texel outside the domain, no wall between two texels of the cell
+  // (both by prefix sums, row by row), then every texel's polynomial against the reference.
   bool uniform(int i0, int j0, int w, int h, bool triangle) const {
+    const int t = in.t;
+    for (int r = 0; r < h; ++r) {
+      const int j = j0 + r, length = triangle ? w - r : w;  // texels i0 .. i0 + length - 1
+      const ElementInputs::RowCounts* counts = in.row_prefix.get() + static_cast<std::size_t>(j) * (t + 1);
+      const ElementInputs::RowCounts &first = counts[i0], &last = counts[i0 + length];
+      if (last.outside != first.outside) return false;
+      if (counts[i0 + length - 1].east != first.east) return false;
+      // North walls count where the texel above is in the cell too.
+      const int north_length = triangle ? length - 1 : (r + 1 < h ? length : 0);
+      if (north_length > 0 && counts[i0 + north_length].north != first.north) return false;
+    }
     int ri = i0 + w / 2, rj = j0 + h / 2;
     if (triangle) ri = i0 + w / 4, rj = j0 + h / 4;
     const double size = std::max(w, h);
-    for (int j = j0; j < j0 + h; ++j)
-      for (int i = i0; i < i0 + w; ++i) {
-        if (!in_cell(i, j, i0, j0, w, h, triangle)) continue;
-        for (int k = 0; k < texture_count; ++k) {
-          const std::uint8_t* flags = textures[k].flags;
-          if (!texel_in_domain(type, t, flags, i, j)) return false;
-          const std::uint8_t f = flags[j * t + i];
-          if ((f & wall_east) && in_cell(i + 1, j, i0, j0, w, h, triangle)) return false;
-          if ((f & wall_north) && in_cell(i, j + 1, i0, j0, w, h, triangle)) return false;
-          if (!agrees(field(k, ri, rj), field(k, i, j), i - ri, j - rj, size, options.merge_tolerance)) return false;
-        }
+    const double tol = options.merge_tolerance;
+    for (int k = 0; k < in.texture_count; ++k) {
+      const TexelDerivativePlanes at_ref = in.field_row(k, rj);
+      TexelDerivatives ref;
+      ref.value = at_ref.value[ri];
+      for (int c = 0; c < 2; ++c) ref.g[c] = at_ref.g[c][ri];
+      for (int c = 0; c < 3; ++c) ref.s[c] = at_ref.s[c][ri];
+      for (int r = 0; r < h; ++r) {
+        const int j = j0 + r, length = triangle ? w - r : w;
+        if (!row_agrees(ref, in.field_row(k, j), i0, length, ri, j - rj, size, tol)) return false;
       }
+    }
     return true;
   }
 
-  // Texel-space point (x, y) and texel-space weight -> parametric point and weight.
   void emit(double x, double y, double w) {
-    const double h = texel_size(type, t);
-    const double origin = type == ElementType::quad8 ? -1.0 : 0.0;
-    out.push_back(origin + x * h);
-    out.push_back(origin + y * h);
-    out.push_back(w * h * h);
+    out.push_back(origin + x * texel);
+    out.push_back(origin + y * texel);
+    out.push_back(w * texel * texel);
   }
 
-  // n1 x n2 Gauss points on the texel rectangle [i0, i0 + w] x [j0, j0 + h].
   void emit_rectangle(int i0, int j0, int w, int h, int n1, int n2) {
     const LineRule g1 = gauss_legendre(n1), g2 = gauss_legendre(n2);
     for (int b = 0; b < g2.count; ++b)
@@ -120,14 +224,19 @@ struct CellBuilder {
   }
 
   void emit_triangle(int i0, int j0, int size) {
-    const QuadratureRule r = element_quadrature(ElementType::tri6);
+    const QuadratureRule& r = triangle_rule;
     for (int q = 0; q < r.count; ++q)
       emit(i0 + size * r.xi1[q], j0 + size * r.xi2[q], size * size * r.weight[q]);
   }
 
-  void visit(int i0, int j0, int w, int h) {
-    const bool tri = type == ElementType::tri6;
+  void visit(int i0, int j0, int w, int h, int depth) {
+    const int t = in.t;
+    const bool tri = in.type == ElementType::tri6;
     if (tri && i0 + j0 >= t) return;  // outside the triangle
+    if (tasks && depth == task_depth) {
+      tasks->push_back({element, i0, j0, w, h, out.size(), {}});
+      return;
+    }
     const bool inside = !tri || i0 + w + j0 + h <= t;
     const bool diagonal = tri && w == h && i0 + j0 + w == t;
     if (inside || diagonal) {
@@ -138,61 +247,46 @@ struct CellBuilder {
       }
       if (options.adaptive && uniform(i0, j0, w, h, diagonal)) {
         if (diagonal) emit_triangle(i0, j0, w);
-        // Sides of at most 2 texels: 2 Gauss points, near the texel centres (3 would put the
-        // middle ones on the texel edge between two texel polynomials).
         else emit_rectangle(i0, j0, w, h, w <= 2 ? 2 : 3, h <= 2 ? 2 : 3);
         return;
       }
     }
-    // Wall-aware splits of rectangular cells (not the tri6 diagonal): at a long straight
-    // wall, else in halves of the long side only for an elongated cell.
     int w1 = (w + 1) / 2, h1 = (h + 1) / 2;
     if (options.adaptive && inside) {
       bool horizontal = false;
       int offset = 0;
       if (wall_line(i0, j0, w, h, horizontal, offset)) {
         if (horizontal) {
-          visit(i0, j0, w, offset);
-          visit(i0, j0 + offset, w, h - offset);
+          visit(i0, j0, w, offset, depth + 1);
+          visit(i0, j0 + offset, w, h - offset, depth + 1);
         } else {
-          visit(i0, j0, offset, h);
-          visit(i0 + offset, j0, w - offset, h);
+          visit(i0, j0, offset, h, depth + 1);
+          visit(i0 + offset, j0, w - offset, h, depth + 1);
         }
         return;
       }
       if (w >= 2 * h) h1 = h;
       else if (h >= 2 * w) w1 = w;
     }
-    visit(i0, j0, w1, h1);
-    if (w > w1) visit(i0 + w1, j0, w - w1, h1);
-    if (h > h1) visit(i0, j0 + h1, w1, h - h1);
-    if (w > w1 && h > h1) visit(i0 + w1, j0 + h1, w - w1, h - h1);
+    visit(i0, j0, w1, h1, depth + 1);
+    if (w > w1) visit(i0 + w1, j0, w - w1, h1, depth + 1);
+    if (h > h1) visit(i0, j0 + h1, w1, h - h1, depth + 1);
+    if (w > w1 && h > h1) visit(i0 + w1, j0 + h1, w - w1, h - h1, depth + 1);
   }
 };
 
-void element_points(const EnrichedElementBatch& b, std::int64_t e, const EnrichedQuadratureOptions& options,
-                    std::vector<double>& out) {
+// The element's points above task_depth (the whole list when nothing is left to a task).
+void plan_element(const ElementInputs& in, std::int64_t e, const EnrichedQuadratureOptions& options,
+                  std::vector<double>& out, std::vector<Task>& tasks) {
   out.clear();
-  const int first = b.enrichment_start[e], count = b.enrichment_start[e + 1] - first;
-  const int t = b.resolution;
-  CellBuilder builder{b.type, t, b.textures + first, count, options, {}, out, {}, {}};
-  if (options.adaptive) {
-    builder.fields.resize(static_cast<std::size_t>(count) * t * t);
-    for (int k = 0; k < count; ++k)
-      for (int j = 0; j < t; ++j)
-        for (int i = 0; i < t; ++i)
-          if (texel_in_domain(b.type, t, b.textures[first + k].flags, i, j))
-            texel_derivatives(b.type, t, b.textures[first + k], i, j, builder.fields[(static_cast<std::size_t>(k) * t + j) * t + i]);
-    builder.count_walls();
+  CellBuilder builder{in, options, out, &tasks, e};
+  if (options.adaptive && builder.uniform(0, 0, in.t, in.t, in.type == ElementType::tri6)) {
     // The whole element merged: exactly the standard element rule.
-    const bool triangle = b.type == ElementType::tri6;
-    if (builder.uniform(0, 0, t, t, triangle)) {
-      const QuadratureRule r = element_quadrature(b.type);
-      for (int q = 0; q < r.count; ++q) out.insert(out.end(), {r.xi1[q], r.xi2[q], r.weight[q]});
-      return;
-    }
+    const QuadratureRule r = element_quadrature(in.type);
+    for (int q = 0; q < r.count; ++q) out.insert(out.end(), {r.xi1[q], r.xi2[q], r.weight[q]});
+    return;
   }
-  builder.visit(0, 0, t, t);
+  builder.visit(0, 0, in.t, in.t, 0);
 }
 
 }  // namespace
@@ -215,14 +309,63 @@ bool texels_share_one_quadratic(ElementType type, int t, const TextureView* text
 
 void enriched_element_quadrature(const EnrichedElementBatch& batch, const EnrichedQuadratureOptions& options,
                                  std::vector<std::int64_t>& start, std::vector<double>& points, Execution execution) {
-  std::vector<std::vector<double>> per_element(static_cast<std::size_t>(batch.count));
-  forall(batch.count, [&](std::int64_t e) { element_points(batch, e, options, per_element[e]); }, execution);
-  start.assign(static_cast<std::size_t>(batch.count) + 1, 0);
-  for (std::int64_t e = 0; e < batch.count; ++e)
-    start[e + 1] = start[e] + static_cast<std::int64_t>(per_element[e].size() / 3);
-  points.resize(static_cast<std::size_t>(start[batch.count]) * 3);
-  forall(batch.count, [&](std::int64_t e) { std::copy(per_element[e].begin(), per_element[e].end(), points.begin() + start[e] * 3); },
-         execution);
+  const std::int64_t n = batch.count;
+  const int t = batch.resolution;
+  // 1. Per-texel inputs of every element, in row blocks (parallel even for one element).
+  std::vector<ElementInputs> inputs(static_cast<std::size_t>(n));
+  for (std::int64_t e = 0; e < n; ++e) {
+    ElementInputs& in = inputs[e];
+    const int first = batch.enrichment_start[e];
+    in.type = batch.type;
+    in.t = t;
+    in.textures = batch.textures + first;
+    in.texture_count = batch.enrichment_start[e + 1] - first;
+    in.allocate(options.adaptive);
+  }
+  if (options.adaptive) {
+    // Row blocks, then columns (of the wall-line prefix sums), in one loop: every parallel
+    // region costs a barrier.
+    const std::int64_t blocks = (t + row_block - 1) / row_block;
+    forall(n * (blocks + t), [&](std::int64_t m) {
+      if (m < n * blocks) inputs[m / blocks].build_block(static_cast<int>(m % blocks));
+      else inputs[(m - n * blocks) / t].build_column(static_cast<int>((m - n * blocks) % t));
+    }, execution);
+  }
+  // 2. The top levels of every element's quadtree; deeper cells become tasks.
+  std::vector<std::vector<double>> planned(static_cast<std::size_t>(n));
+  std::vector<std::vector<Task>> element_tasks(static_cast<std::size_t>(n));
+  forall(n, [&](std::int64_t e) { plan_element(inputs[e], e, options, planned[e], element_tasks[e]); },
+         n > 1 ? execution : Execution::serial);
+  std::vector<Task*> tasks;
+  for (auto& list : element_tasks)
+    for (Task& task : list) tasks.push_back(&task);
+  // 3. The subtrees, each into its own list. Neighbouring subtrees are alike in cost, so the
+  // loop takes every other one first (static scheduling then hands each thread a mix).
+  const std::int64_t task_count = static_cast<std::int64_t>(tasks.size()), half = (task_count + 1) / 2;
+  forall(task_count, [&](std::int64_t m) {
+    Task& task = *tasks[m < half ? 2 * m : 2 * (m - half) + 1];
+    CellBuilder builder{inputs[task.element], options, task.points};
+    builder.visit(task.i0, task.j0, task.w, task.h, task_depth);
+  }, execution);
+  // 4. Splice each element's task lists into its planned list at their positions.
+  start.assign(static_cast<std::size_t>(n) + 1, 0);
+  for (std::int64_t e = 0; e < n; ++e) {
+    std::size_t size = planned[e].size();
+    for (const Task& task : element_tasks[e]) size += task.points.size();
+    start[e + 1] = start[e] + static_cast<std::int64_t>(size / 3);
+  }
+  points.resize(static_cast<std::size_t>(start[n]) * 3);
+  for (std::int64_t e = 0; e < n; ++e) {  // copies only: not worth a parallel region
+    const std::vector<double>& plan = planned[e];
+    double* dst = points.data() + start[e] * 3;
+    std::size_t from = 0;
+    for (const Task& task : element_tasks[e]) {
+      dst = std::copy(plan.begin() + from, plan.begin() + task.position, dst);
+      dst = std::copy(task.points.begin(), task.points.end(), dst);
+      from = task.position;
+    }
+    std::copy(plan.begin() + from, plan.end(), dst);
+  }
 }
 
 }  // namespace dgtex::kernels

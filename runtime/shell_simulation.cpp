@@ -30,6 +30,7 @@ void ShellSimulation::set_state(std::vector<double> u, std::vector<double> v) {
   u_ = std::move(u);
   v_ = std::move(v);
   previous_v_.clear();
+  previous_previous_v_.clear();
 }
 
 std::string ShellSimulation::enrichment_hint() const {
@@ -142,11 +143,15 @@ void ShellSimulation::step(const DynamicsOptions& o) {
   solver_.multiply_mass(v_, mv_);  // M's scalar diagonal: 1/9 of the traffic
   const bool reuse = o.corotational && o.reuse_factorization;
   if (reuse) {
-    // Initial guess: the velocity extrapolated linearly from the last two steps (it
-    // starts PCG ~10x closer than v itself; v alone right after set_state). K u and K
-    // times the guess share one pass over K.
+    // Initial guess: the velocity extrapolated quadratically from the last three steps
+    // (linearly from two, v alone right after set_state). Linear starts PCG ~10x closer
+    // than v itself; quadratic saves another 4-9 % of the iterations on the cylinder scene
+    // (100 steps: 786 instead of 821; 30 steps: 173 instead of 190). K u and K times the
+    // guess share one pass over K.
     guess_ = v_;
-    if (previous_v_.size() == v_.size())
+    if (previous_previous_v_.size() == v_.size())
+      for (int d = 0; d < ndofs; ++d) guess_[d] = 3 * v_[d] - 3 * previous_v_[d] + previous_previous_v_[d];
+    else if (previous_v_.size() == v_.size())
       for (int d = 0; d < ndofs; ++d) guess_[d] = 2 * v_[d] - previous_v_[d];
     for (int d = 0; d < ndofs; ++d)
       if (fixed_[d]) guess_[d] = 0;  // as the solver would set them
@@ -163,6 +168,7 @@ void ShellSimulation::step(const DynamicsOptions& o) {
     if (reuse) {
       // A = (1 + dt a) M + (dt b + dt^2) K, never formed (ScaledBlockSum).
       const ScaledBlockSum A{mass_scale, K, stiffness_scale};
+      previous_previous_v_.swap(previous_v_);
       previous_v_ = v_;
       solver_.solve(A, rhs_full_, guess_, cholesky_, &k_guess_);
       v_.swap(guess_);

@@ -76,7 +76,7 @@ class ShellSimulation {
   FactorReusingSolver solver_;
   // Buffers reused by every step (no allocation per step).
   std::vector<double> current_, corotated_k_, corrective_, mv_, ku_, rhs_full_, rhs_, v_new_, values_;
-  std::vector<double> previous_v_, guess_;  // velocity of the step before, PCG start
+  std::vector<double> previous_v_, previous_previous_v_, guess_;  // velocities of the steps before, PCG start
   std::vector<double> k_guess_;             // K guess_
 
   const std::vector<double>& linear_stiffness();

@@ -51,9 +51,15 @@ struct EnrichedQuadratureOptions {
   double merge_tolerance = 1e-2;
 };
 
+// Parallel inside an element too (row blocks of the per-texel set-up, quadtree subtrees);
+// the arrays are bitwise those of the reference for any thread count.
 void enriched_element_quadrature(const EnrichedElementBatch& batch, const EnrichedQuadratureOptions& options,
                                  std::vector<std::int64_t>& start, std::vector<double>& points,
                                  Execution execution = Execution::parallel);
+// The serial reference twin: the rule written plainly (each candidate cell re-tests all its
+// texels for domain, walls and polynomial agreement). For tests.
+void enriched_element_quadrature_reference(const EnrichedElementBatch& batch, const EnrichedQuadratureOptions& options,
+                                           std::vector<std::int64_t>& start, std::vector<double>& points);
 
 // Deviation test of the rule above over an explicit list of texels (texel units; used by
 // the element cells and by the edge segments): true if every texture's polynomials at

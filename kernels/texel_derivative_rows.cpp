@@ -1,0 +1,143 @@
+#include "dgtex/kernels/texel_derivative_rows.h"
+
+#include <algorithm>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "dgtex/kernels/texel_grid.h"
+
+namespace dgtex::kernels {
+namespace {
+
+// Per-texel connectivity bits: the texel is in the domain, and each unit neighbour is
+// reachable (in the domain and no wall between), as enriched_basis.cpp's reachable() says.
+enum : std::uint8_t { in_domain = 1, reach_east = 2, reach_west = 4, reach_north = 8, reach_south = 16 };
+
+struct Tile {
+  ElementType type;
+  int t;
+  const double* values;
+  const std::uint8_t* flags;
+  int row0;                         // first row held in bits
+  std::vector<std::uint8_t> bits;   // rows row0 .. row0 + bits.size() / t - 1
+
+  // Connectivity bits of rows [row0, row_last); domain of rows row0 - 1 .. row_last first.
+  void classify(int row_last) {
+    const int d0 = std::max(row0 - 1, 0), d1 = std::min(row_last + 1, t);
+    std::vector<std::uint8_t> domain(static_cast<std::size_t>(d1 - d0) * t);
+    for (int j = d0; j < d1; ++j)
+      for (int i = 0; i < t; ++i)
+        domain[static_cast<std::size_t>(j - d0) * t + i] =
+            !(type == ElementType::tri6 && i + j > t - 1) && !(flags[j * t + i] & inactive);
+    bits.assign(static_cast<std::size_t>(row_last - row0) * t, 0);
+    for (int j = row0; j < row_last; ++j) {
+      const std::uint8_t* row = domain.data() + static_cast<std::size_t>(j - d0) * t;
+      const std::uint8_t* below = j > 0 ? row - t : nullptr;
+      const std::uint8_t* above = j + 1 < t ? row + t : nullptr;
+      const std::uint8_t* f = flags + static_cast<std::size_t>(j) * t;
+      std::uint8_t* b = bits.data() + static_cast<std::size_t>(j - row0) * t;
+      for (int i = 0; i < t; ++i) {
+        if (!row[i]) continue;
+        std::uint8_t c = in_domain;
+        if (i + 1 < t && row[i + 1] && !(f[i] & wall_east)) c |= reach_east;
+        if (i > 0 && row[i - 1] && !(f[i - 1] & wall_east)) c |= reach_west;
+        if (above && above[i] && !(f[i] & wall_north)) c |= reach_north;
+        if (below && below[i] && !(f[i - t] & wall_north)) c |= reach_south;
+        b[i] = c;
+      }
+    }
+  }
+  std::uint8_t at(int i, int j) const { return bits[static_cast<std::size_t>(j - row0) * t + i]; }
+  double value(int i, int j) const { return values[j * t + i]; }
+
+  // axis_differences of enriched_basis.cpp, same expressions (bitwise the same results).
+  void differences(int i, int j, int axis, double& g, double& s) const {
+    const int di = axis == 0 ? 1 : 0, dj = axis == 0 ? 0 : 1;
+    const std::uint8_t plus_bit = axis == 0 ? reach_east : reach_north;
+    const std::uint8_t minus_bit = axis == 0 ? reach_west : reach_south;
+    const double h = value(i, j);
+    const std::uint8_t b = at(i, j);
+    const bool plus = b & plus_bit, minus = b & minus_bit;
+    if (plus && minus) {
+      const double hp = value(i + di, j + dj), hm = value(i - di, j - dj);
+      g = 0.5 * (hp - hm);
+      s = hp - 2 * h + hm;
+      return;
+    }
+    if (!plus && !minus) {
+      g = s = 0;
+      return;
+    }
+    const int sign = plus ? 1 : -1;
+    const int i1 = i + sign * di, j1 = j + sign * dj;
+    const double h1 = value(i1, j1);
+    if (at(i1, j1) & (plus ? plus_bit : minus_bit)) {
+      const double h2 = value(i1 + sign * di, j1 + sign * dj);
+      g = sign * 0.5 * (-3 * h + 4 * h1 - h2);
+      s = h - 2 * h1 + h2;
+    } else {
+      g = sign * (h1 - h);
+      s = 0;
+    }
+  }
+};
+
+// mixed_part of enriched_basis.cpp from the neighbours' already computed gradients.
+inline double mixed(bool plus, bool minus, double gp, double gm, double own_gradient) {
+  if (plus && minus) return 0.5 * (gp - gm);
+  if (plus) return gp - own_gradient;
+  if (minus) return own_gradient - gm;
+  return 0;
+}
+
+}  // namespace
+
+void texel_derivative_rows(ElementType type, int t, const TextureView& texture, int row_begin, int row_end,
+                           const TexelDerivativePlanes& out) {
+  if (row_begin < 0)
+    throw std::invalid_argument("texel_derivative_rows: row_begin must be >= 0, got " + std::to_string(row_begin));
+  row_end = std::min(row_end, t);
+  if (row_begin >= row_end) return;
+  // Connectivity of rows row_begin - 2 .. row_end + 1 (one-sided differences look two rows
+  // away; the mixed term takes neighbour rows' gradients, which look one row further).
+  Tile tile{type, t, texture.values, texture.flags, std::max(row_begin - 2, 0), {}};
+  tile.classify(std::min(row_end + 2, t));
+  // g_1 (and S_11) of rows row_begin - 1 .. row_end: d/dxi2 g_1 of the mixed term needs the
+  // rows around.
+  const int g_row0 = std::max(row_begin - 1, 0), g_last = std::min(row_end + 1, t);
+  std::vector<double> g1(static_cast<std::size_t>(g_last - g_row0) * t, 0.0), s11(g1.size(), 0.0);
+  std::vector<double> row_g2(t, 0.0), row_s22(t, 0.0);
+  for (int j = g_row0; j < g_last; ++j)
+    for (int i = 0; i < t; ++i) {
+      const std::size_t n = static_cast<std::size_t>(j - g_row0) * t + i;
+      if (tile.at(i, j) & in_domain) tile.differences(i, j, 0, g1[n], s11[n]);
+    }
+  for (int j = row_begin; j < row_end; ++j) {
+    for (int i = 0; i < t; ++i)
+      if (tile.at(i, j) & in_domain) tile.differences(i, j, 1, row_g2[i], row_s22[i]);
+    const std::size_t row = static_cast<std::size_t>(j - g_row0) * t;
+    const double* g1_row = g1.data() + row;
+    const std::size_t o = static_cast<std::size_t>(j - row_begin) * t;
+    for (int i = 0; i < t; ++i) {
+      const std::uint8_t b = tile.at(i, j);
+      if (!(b & in_domain)) {
+        out.value[o + i] = out.g[0][o + i] = out.g[1][o + i] = out.s[0][o + i] = out.s[1][o + i] = out.s[2][o + i] = 0;
+        continue;
+      }
+      out.value[o + i] = tile.value(i, j);
+      out.g[0][o + i] = g1_row[i];
+      out.s[0][o + i] = s11[row + i];
+      out.g[1][o + i] = row_g2[i];
+      out.s[1][o + i] = row_s22[i];
+      const bool north = b & reach_north, south = b & reach_south;
+      const bool east = b & reach_east, west = b & reach_west;
+      const double g1_north = north ? g1_row[i + t] : 0, g1_south = south ? g1_row[i - t] : 0;
+      const double g2_east = east ? row_g2[i + 1] : 0, g2_west = west ? row_g2[i - 1] : 0;
+      out.s[2][o + i] =
+          0.5 * (mixed(north, south, g1_north, g1_south, g1_row[i]) + mixed(east, west, g2_east, g2_west, row_g2[i]));
+    }
+  }
+}
+
+}  // namespace dgtex::kernels
