@@ -7,6 +7,7 @@
 #include <Eigen/CholmodSupport>
 
 #include "dgtex/kernels/multigrid_unknowns.h"
+#include "cholmod_lock.h"
 
 namespace dgtex {
 
@@ -62,6 +63,7 @@ LaplaceSolveStats solve_laplace_direct(kernels::TexelTile& tile) {
   LaplaceSolveStats stats;
   if (system.b.size() > 0 && system.b.squaredNorm() > 0) {
     Eigen::CholmodSupernodalLLT<Eigen::SparseMatrix<double>, Eigen::Lower> cholesky;
+    const auto lock = detail::lock_cholmod();  // held through the solve below
     cholesky.compute(system.A);
     if (cholesky.info() != Eigen::Success)
       throw std::runtime_error("Laplace solve: CHOLMOD could not factor the " + std::to_string(system.b.size()) +

@@ -18,6 +18,7 @@
 #include "dgtex/kernels/multigrid_unknowns.h"
 #include "dgtex/stage_timer.h"
 #include "multigrid_buffer.h"
+#include "cholmod_lock.h"
 
 // Choices, measured with T=256/1024 single-element solves to 1e-6 from zero (1 thread):
 // - V(1,1) as CG preconditioner (default): 6 iterations on open/slit/accordion (0.085 per
@@ -257,6 +258,7 @@ struct LaplaceMultigrid::Hierarchy {
       coarsest_dense.compute(Eigen::MatrixXd(m));
       ok = coarsest_dense.info() == Eigen::Success;
     } else if (n > 0) {
+      const auto lock = detail::lock_cholmod();
       coarsest_factor.compute(m);
       ok = coarsest_factor.info() == Eigen::Success;
     }
@@ -293,8 +295,13 @@ struct LaplaceMultigrid::Hierarchy {
     if (n == 0) return;
     Eigen::VectorXd rhs(n);
     for (int k = 0; k < n; ++k) rhs[k] = level.b[coarsest_nodes[k]];
-    const Eigen::VectorXd solution = coarsest_is_dense ? Eigen::VectorXd(coarsest_dense.solve(rhs))
-                                                       : Eigen::VectorXd(coarsest_factor.solve(rhs));
+    Eigen::VectorXd solution;
+    if (coarsest_is_dense) {
+      solution = coarsest_dense.solve(rhs);
+    } else {
+      const auto lock = detail::lock_cholmod();
+      solution = coarsest_factor.solve(rhs);
+    }
     for (int k = 0; k < n; ++k) level.x[coarsest_nodes[k]] = solution[k];
   }
 

@@ -11,6 +11,7 @@
 
 #include "dgtex/kernels/forall.h"
 #include "dgtex/kernels/multigrid_unknowns.h"
+#include "cholmod_lock.h"
 
 namespace dgtex {
 
@@ -438,6 +439,7 @@ MeshLaplaceStats solve_mesh_texel_laplace(std::vector<RegionTile>& tiles, Elemen
       }
       a.makeCompressed();
       Eigen::CholmodSupernodalLLT<Eigen::SparseMatrix<double>, Eigen::Lower> cholesky;
+      const auto lock = detail::lock_cholmod();  // held through the solve below
       cholesky.compute(a);
       if (cholesky.info() != Eigen::Success)
         throw std::runtime_error("enrichment Laplace solve: CHOLMOD could not factor the " + std::to_string(m) +

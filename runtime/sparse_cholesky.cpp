@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cstring>
 #include <vector>
+#include "cholmod_lock.h"
 
 namespace dgtex {
 
@@ -111,7 +112,10 @@ void SparseCholesky::analyze(int n, const std::vector<int>& column_start, const 
   std::memcpy(m.matrix->i, row_index.data(), sizeof(int) * nnz);
   std::memset(m.matrix->x, 0, sizeof(double) * nnz);
   m.schedule = SolveSchedule{};
-  m.factor = cholmod_analyze(m.matrix, &m.common);
+  {
+    const auto lock = detail::lock_cholmod();
+    m.factor = cholmod_analyze(m.matrix, &m.common);
+  }
   if (!m.factor || m.common.status < CHOLMOD_OK)
     throw std::runtime_error("CHOLMOD: symbolic analysis failed (status " + std::to_string(m.common.status) + ")");
 }
@@ -121,7 +125,10 @@ void SparseCholesky::factorize(const std::vector<double>& values) {
   if (!m.factor) throw std::logic_error("SparseCholesky::factorize called before analyze");
   if (values.size() != m.matrix->nzmax) throw std::invalid_argument("SparseCholesky::factorize: value count does not match the pattern");
   std::memcpy(m.matrix->x, values.data(), sizeof(double) * values.size());
-  cholmod_factorize(m.matrix, m.factor, &m.common);
+  {
+    const auto lock = detail::lock_cholmod();
+    cholmod_factorize(m.matrix, m.factor, &m.common);
+  }
   if (m.common.status == CHOLMOD_NOT_POSDEF || m.factor->minor < static_cast<size_t>(n_))
     throw NotPositiveDefinite("matrix not positive definite (non-positive pivot at column " +
                                   std::to_string(m.factor->minor) + " of " + std::to_string(n_) + ")",
@@ -134,7 +141,11 @@ void SparseCholesky::solve(const std::vector<double>& b, std::vector<double>& x)
   Impl& m = *impl_;
   cholmod_dense* rhs = cholmod_allocate_dense(n_, 1, n_, CHOLMOD_REAL, &m.common);
   std::memcpy(rhs->x, b.data(), sizeof(double) * n_);
-  cholmod_dense* sol = cholmod_solve(CHOLMOD_A, m.factor, rhs, &m.common);
+  cholmod_dense* sol = nullptr;
+  {
+    const auto lock = detail::lock_cholmod();
+    sol = cholmod_solve(CHOLMOD_A, m.factor, rhs, &m.common);
+  }
   if (!sol) {
     cholmod_free_dense(&rhs, &m.common);
     throw std::runtime_error("CHOLMOD: solve failed (status " + std::to_string(m.common.status) + ")");

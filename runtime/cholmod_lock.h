@@ -1,0 +1,18 @@
+#pragma once
+// Internal: one process-wide lock held around every CHOLMOD analysis, factorisation and
+// solve in dgtex (SparseCholesky and Eigen's CholmodSupernodalLLT alike).
+// Why: independent simulations may run on several threads of one process (one SceneRun
+// per thread), but (1) Debian's libopenblas0-serial, the BLAS that CHOLMOD calls, is built
+// without locking and collided under concurrent calls (a spurious "not positive definite"
+// with two chad runs at once), and (2) METIS, CHOLMOD's ordering, draws from one global
+// random generator, so concurrent orderings interleaved its draws and the results of two
+// cylinder runs at once differed from solo runs (1e-11, and 1e-7 with the PCG steps).
+// Serialised, every run orders and factorises exactly as it would alone. The cost: CHOLMOD
+// calls of different simulations wait for each other; nothing else is serialised.
+#include <mutex>
+
+namespace dgtex::detail {
+
+std::unique_lock<std::mutex> lock_cholmod();
+
+}  // namespace dgtex::detail
