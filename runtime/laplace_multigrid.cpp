@@ -17,8 +17,8 @@
 #include "dgtex/kernels/multigrid_transfer.h"
 #include "dgtex/kernels/multigrid_unknowns.h"
 #include "dgtex/stage_timer.h"
-#include "multigrid_buffer.h"
 #include "cholmod_lock.h"
+#include "multigrid_buffer.h"
 
 // Choices, measured with T=256/1024 single-element solves to 1e-6 from zero (1 thread):
 // - V(1,1) as CG preconditioner (default): 6 iterations on open/slit/accordion (0.085 per

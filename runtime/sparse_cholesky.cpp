@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cstring>
 #include <vector>
+
 #include "cholmod_lock.h"
 
 namespace dgtex {
@@ -13,7 +14,6 @@ namespace {
 // Below this many unknowns the subtrees are solved one after another (same arithmetic):
 // waking the OpenMP team costs more than the solve.
 constexpr int parallel_solve_size = 2000;
-
 
 // Dense kernels of the single-precision solve on one supernode: X is its column-major
 // nrow x ncol block (leading dimension nrow), the first ncol rows the diagonal triangle.
