@@ -16,15 +16,16 @@
 // i.e. without the DG edge terms' couplings across an edge. Those terms act on the
 // rotation jump (bending, ~t^3), small next to mass and membrane stiffness, so PCG needs
 // only a few more iterations, but nnz(L) drops ~4x (cylinder: 1.15M instead of 4.36M):
-// a factorisation costs ~75 ms instead of ~300, an application ~0.7 ms instead of ~2.5.
+// a factorisation costs ~70 ms instead of ~220, an application ~0.65 ms instead of 2-3.
 // It is a heuristic, so it falls back to the whole pattern for the rest of the run when
 // its matrix is not positive definite or a fresh element-local factor does not reach the
 // tolerance within max_iterations (statistics().element_local_fallbacks counts it).
-
+//
 // Contract: the returned x satisfies ||b - A x||_2 <= relative_tolerance * ||b||_2 over the
 // free DOFs (the PCG recurrence residual; round-off may let the true one differ slightly),
-// or the solver throws. If max_iterations do not suffice, A_k itself is factorised and PCG
-// restarts from the same guess with that exact factor.
+// or the solver throws. If max_iterations do not suffice with an old factor, A_k itself is
+// factorised and PCG restarts from the same guess; if a fresh element-local factor does
+// not suffice either, the whole pattern of A_k is.
 // Refactorisation happens when a solve took more than `refactor_after_iterations`
 // iterations (the next system is factorised) or did not converge in `max_iterations`.
 //
@@ -34,8 +35,9 @@
 // identical for any thread count.
 // FactorReusingSolver owns its work vectors, statistics and the element-local factor and
 // keeps references to the pattern, the free-DOF system and the mass blocks (all must
-// outlive it); the factor of the whole pattern is the caller's, passed to each solve. Not thread-safe; a solve uses all OpenMP
-// threads. Units: those of the system (SI: kg, N/m, N).
+// outlive it); the factor of the whole pattern is the caller's, passed to each solve.
+// Not thread-safe; a solve uses all OpenMP threads. Units: those of the system (SI: kg,
+// N/m, N).
 #include <cstdint>
 #include <memory>
 #include <stdexcept>
@@ -56,7 +58,7 @@ struct FactorReuseOptions {
   double relative_tolerance = 1e-8;
   // A solve slower than this factorises the next system. Measured on the cylinder scene
   // (100 steps, 1 thread, CPU time per step; `dgtex bench shell --refactor-after N`), with
-  // the element-local preconditioner: N = 6: 27 factorisations + 595 iterations, 44-46 ms;
+  // the element-local preconditioner and the linear initial guess: N = 6: 27 factorisations + 595 iterations, 44-46 ms;
   // 8: 19 + 664, 39-47 ms; 10: 14 + 741, 40-42 ms; 12: 11 + 821, 41-42 ms; 16: 8 + 967,
   // 40-43 ms; 24: 5 + 1257, 42-44 ms (a shared machine: the spread is noise). Flat from 8
   // to 20; 12 also was the optimum of the whole-pattern factor (11 + 730, 61-64 ms).
