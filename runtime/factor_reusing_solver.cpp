@@ -24,6 +24,13 @@ kernels::Execution vector_execution(std::size_t n) {
 }
 }  // namespace
 
+std::vector<char> element_local_blocks(const std::vector<double>& mass) {
+  std::vector<char> kept(mass.size() / 9, 0);
+  for (std::size_t k = 0; k < kept.size(); ++k)
+    for (int i = 0; i < 9; ++i) kept[k] |= mass[9 * k + i] != 0;
+  return kept;
+}
+
 double deterministic_dot(const std::vector<double>& x, const std::vector<double>& y) {
   const std::int64_t n = static_cast<std::int64_t>(x.size());
   double partial[dot_chunks];
@@ -58,11 +65,7 @@ FactorReusingSolver::FactorReusingSolver(const BlockAssembly& pattern, const Fre
   system.expand_vector(ones, mask);
   free_.resize(mask.size());
   for (size_t d = 0; d < mask.size(); ++d) free_[d] = mask[d] != 0;
-  // Two nodes of one element have a non-zero consistent-mass block; the DG edge terms'
-  // couplings across an edge have none.
-  element_local_blocks_.assign(blocks, 0);
-  for (std::int64_t k = 0; k < blocks && static_cast<std::int64_t>(mass.size()) == blocks * 9; ++k)
-    for (int i = 0; i < 9; ++i) element_local_blocks_[k] |= mass[9 * k + i] != 0;
+  if (static_cast<std::int64_t>(mass.size()) == blocks * 9) element_local_blocks_ = element_local_blocks(mass);
   for (char kept : element_local_blocks_) element_local_differs_ |= !kept;
   set_options(options);
 }

@@ -13,6 +13,7 @@
 #include <thread>
 
 #include "dgtex/cut_manager.h"
+#include "dgtex/factor_reusing_solver.h"
 #include "dgtex/free_dof_system.h"
 #include "dgtex/kernels/polar_decomposition.h"
 #include "dgtex/scene_model.h"
@@ -165,12 +166,8 @@ KernelScaling scale_factorization(const Scene& scene, const std::vector<int>& th
   const Mesh mesh = build_scene_mesh(scene);
   SceneModel built = build_scene_model(scene, mesh);
   const ShellModel& model = *built.model;
-  // The matrix the corotated step factorises: its element-local couplings (the blocks
-  // where the consistent mass is non-zero; FactorReusingSolver's preconditioner).
-  const std::vector<double>& mass = model.mass_blocks();
-  std::vector<char> element_local(mass.size() / 9, 0);
-  for (std::size_t k = 0; k < element_local.size(); ++k)
-    for (int i = 0; i < 9; ++i) element_local[k] |= mass[9 * k + i] != 0;
+  // The matrix the corotated step factorises: FactorReusingSolver's element-local pattern.
+  const std::vector<char> element_local = element_local_blocks(model.mass_blocks());
   const FreeDofSystem system(model.pattern(), built.fixed, &element_local);
   std::vector<double> K, values;
   model.assemble_stiffness(nullptr, K, nullptr);

@@ -156,6 +156,11 @@ class FactorReusingSolver {
           const SparseCholesky& cholesky, double& relative_residual, const std::vector<double>* kx);
 };
 
+// Per block of the pattern (mass: num_blocks x 9): 1 where the two nodes belong to one
+// element, i.e. the consistent-mass block is non-zero; the DG edge terms' couplings across
+// an edge have none. The pattern of the element-local preconditioner.
+std::vector<char> element_local_blocks(const std::vector<double>& mass);
+
 // Sum of x[i] * y[i] in a fixed order, independent of the thread count.
 double deterministic_dot(const std::vector<double>& x, const std::vector<double>& y);
 
