@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "dgtex/kernels/texel_grid.h"
+#include "texel_difference_rule.h"
 
 namespace dgtex::kernels {
 namespace {
@@ -31,31 +32,9 @@ inline bool reachable(ElementType type, int t, const std::uint8_t* flags, int i,
 
 // First and second difference of the texel values along one axis (rule of the header).
 void axis_differences(ElementType type, int t, const TextureView& tex, int i, int j, int axis, double& g, double& s) {
-  const int di = axis == 0 ? 1 : 0, dj = axis == 0 ? 0 : 1;
-  const double h = tex.values[j * t + i];
-  const bool plus = reachable(type, t, tex.flags, i, j, di, dj);
-  const bool minus = reachable(type, t, tex.flags, i, j, -di, -dj);
-  if (plus && minus) {
-    const double hp = tex.values[(j + dj) * t + i + di], hm = tex.values[(j - dj) * t + i - di];
-    g = 0.5 * (hp - hm);
-    s = hp - 2 * h + hm;
-    return;
-  }
-  if (!plus && !minus) {
-    g = s = 0;
-    return;
-  }
-  const int sign = plus ? 1 : -1;
-  const int i1 = i + sign * di, j1 = j + sign * dj;
-  const double h1 = tex.values[j1 * t + i1];
-  if (reachable(type, t, tex.flags, i1, j1, sign * di, sign * dj)) {
-    const double h2 = tex.values[(j1 + sign * dj) * t + i1 + sign * di];
-    g = sign * 0.5 * (-3 * h + 4 * h1 - h2);
-    s = h - 2 * h1 + h2;
-  } else {
-    g = sign * (h1 - h);
-    s = 0;
-  }
+  detail::axis_difference_rule(
+      i, j, axis == 0 ? 1 : 0, axis == 0 ? 0 : 1, [&](int a, int b) { return tex.values[b * t + a]; },
+      [&](int a, int b, int da, int db) { return reachable(type, t, tex.flags, a, b, da, db); }, g, s);
 }
 
 // First difference along `axis` of the other axis' gradient (for the mixed term).
@@ -67,10 +46,7 @@ double mixed_part(ElementType type, int t, const TextureView& tex, int i, int j,
   double gp = 0, gm = 0, unused = 0;
   if (plus) axis_differences(type, t, tex, i + di, j + dj, other, gp, unused);
   if (minus) axis_differences(type, t, tex, i - di, j - dj, other, gm, unused);
-  if (plus && minus) return 0.5 * (gp - gm);
-  if (plus) return gp - own_gradient;
-  if (minus) return own_gradient - gm;
-  return 0;
+  return detail::mixed_difference_rule(plus, minus, gp, gm, own_gradient);
 }
 
 }  // namespace

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "dgtex/kernels/texel_grid.h"
+#include "texel_difference_rule.h"
 
 namespace dgtex::kernels {
 namespace {
@@ -51,45 +52,18 @@ struct Tile {
   std::uint8_t at(int i, int j) const { return bits[static_cast<std::size_t>(j - row0) * t + i]; }
   double value(int i, int j) const { return values[j * t + i]; }
 
-  // axis_differences of enriched_basis.cpp, same expressions (bitwise the same results).
+  // Whether texel (i, j) connects to its unit neighbour (i + di, j + dj).
+  bool reaches(int i, int j, int di, int dj) const {
+    const std::uint8_t bit = di > 0 ? reach_east : di < 0 ? reach_west : dj > 0 ? reach_north : reach_south;
+    return at(i, j) & bit;
+  }
+  // The rule of enriched_basis.cpp (texel_difference_rule.h) on the connectivity bits.
   void differences(int i, int j, int axis, double& g, double& s) const {
-    const int di = axis == 0 ? 1 : 0, dj = axis == 0 ? 0 : 1;
-    const std::uint8_t plus_bit = axis == 0 ? reach_east : reach_north;
-    const std::uint8_t minus_bit = axis == 0 ? reach_west : reach_south;
-    const double h = value(i, j);
-    const std::uint8_t b = at(i, j);
-    const bool plus = b & plus_bit, minus = b & minus_bit;
-    if (plus && minus) {
-      const double hp = value(i + di, j + dj), hm = value(i - di, j - dj);
-      g = 0.5 * (hp - hm);
-      s = hp - 2 * h + hm;
-      return;
-    }
-    if (!plus && !minus) {
-      g = s = 0;
-      return;
-    }
-    const int sign = plus ? 1 : -1;
-    const int i1 = i + sign * di, j1 = j + sign * dj;
-    const double h1 = value(i1, j1);
-    if (at(i1, j1) & (plus ? plus_bit : minus_bit)) {
-      const double h2 = value(i1 + sign * di, j1 + sign * dj);
-      g = sign * 0.5 * (-3 * h + 4 * h1 - h2);
-      s = h - 2 * h1 + h2;
-    } else {
-      g = sign * (h1 - h);
-      s = 0;
-    }
+    detail::axis_difference_rule(
+        i, j, axis == 0 ? 1 : 0, axis == 0 ? 0 : 1, [this](int a, int b) { return value(a, b); },
+        [this](int a, int b, int da, int db) { return reaches(a, b, da, db); }, g, s);
   }
 };
-
-// mixed_part of enriched_basis.cpp from the neighbours' already computed gradients.
-inline double mixed(bool plus, bool minus, double gp, double gm, double own_gradient) {
-  if (plus && minus) return 0.5 * (gp - gm);
-  if (plus) return gp - own_gradient;
-  if (minus) return own_gradient - gm;
-  return 0;
-}
 
 }  // namespace
 
@@ -135,7 +109,8 @@ void texel_derivative_rows(ElementType type, int t, const TextureView& texture, 
       const double g1_north = north ? g1_row[i + t] : 0, g1_south = south ? g1_row[i - t] : 0;
       const double g2_east = east ? row_g2[i + 1] : 0, g2_west = west ? row_g2[i - 1] : 0;
       out.s[2][o + i] =
-          0.5 * (mixed(north, south, g1_north, g1_south, g1_row[i]) + mixed(east, west, g2_east, g2_west, row_g2[i]));
+          0.5 * (detail::mixed_difference_rule(north, south, g1_north, g1_south, g1_row[i]) +
+                  detail::mixed_difference_rule(east, west, g2_east, g2_west, row_g2[i]));
     }
   }
 }
