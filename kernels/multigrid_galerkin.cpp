@@ -8,7 +8,6 @@ namespace {
 // Entry A(t, t + dx + dy * stride) of the level-0 texel operator (dx, dy in -1..1).
 struct TexelOperator {
   const std::uint8_t* bits;
-  std::int64_t s;
   double operator()(std::int64_t t, int dx, int dy) const {
     const std::uint8_t m = bits[t];
     if (dx == 0 && dy == 0) return (m & is_unknown) ? laplace_degree(m) : 0.0;
@@ -37,26 +36,40 @@ struct Stencil9Operator {
   }
 };
 
+// The 5-point operator the interpolation of a 9-point level is built from (multigrid_galerkin.h):
+// each diagonal coupling goes half to each of the two axis neighbours next to it that the
+// node couples to, all to the one if only one is coupled, and to the centre if neither is
+// (row sums are kept). A zero axis coupling (a wall) stays exactly zero.
+struct LumpedStencil9Operator {
+  Stencil9Operator a;
+  double operator()(std::int64_t t, int dx, int dy) const {
+    if (dx == 0 && dy == 0) {
+      double centre = a(t, 0, 0);
+      for (int ey = -1; ey <= 1; ey += 2)
+        for (int ex = -1; ex <= 1; ex += 2)
+          if (a(t, ex, 0) == 0.0 && a(t, 0, ey) == 0.0) centre += a(t, ex, ey);
+      return centre;
+    }
+    if (dx != 0 && dy != 0) return 0.0;
+    double coupling = a(t, dx, dy);
+    if (coupling == 0.0) return 0.0;
+    // The two diagonal neighbours next to (dx, dy) are (dx, dy) +- (dy, dx); the other axis
+    // neighbour next to each of them is +-(dy, dx).
+    for (int k = -1; k <= 1; k += 2) {
+      const double diagonal = a(t, dx + k * dy, dy + k * dx);
+      if (diagonal != 0.0) coupling += a(t, k * dy, k * dx) != 0.0 ? 0.5 * diagonal : diagonal;
+    }
+    return coupling;
+  }
+};
+
 // A weight -numerator / denominator, or 0 where the denominator vanishes (a node that is
 // no unknown, or one coupled only across the collapsed direction: no coarse representation).
 inline double weight(double numerator, double denominator, double diagonal) {
   return (diagonal > 0 && denominator > 1e-12 * diagonal) ? -numerator / denominator : 0.0;
 }
 
-// Coupling `to_g` of an edge node to a cell-centre neighbour g (which is no interpolation
-// point) is shared between the edge node's two coarse neighbours in proportion to g's own
-// (negative) couplings to them, g_first and g_second; where g couples to neither, g is assumed to
-// follow the edge node (collapse into the centre).
-inline void distribute(double to_g, double g_first, double g_second, double& first, double& second, double& centre) {
-  const double u = g_first < 0 ? g_first : 0.0, v = g_second < 0 ? g_second : 0.0;
-  if (to_g != 0.0 && u + v < 0) {
-    first += to_g * (u / (u + v));
-    second += to_g * (v / (u + v));
-  } else {
-    centre += to_g;
-  }
-}
-
+// Black-box interpolation for a 5-point operator a(t, dx, dy) (centre and axis entries).
 template <class Operator>
 void build_interpolation(GridShape fine, const Operator& a, InterpolationArrays p, Execution execution) {
   const GridShape coarse = fine.coarser();
@@ -70,29 +83,21 @@ void build_interpolation(GridShape fine, const Operator& a, InterpolationArrays 
           const std::int64_t c = coarse.at(I, J);
           p.xw[c] = p.xe[c] = p.ys[c] = p.yn[c] = 0.0;
           if (2 * I + 1 < fine.nx) {
-            const std::int64_t f = fine.at(2 * I + 1, 2 * J), fs = f - fine.stride(), fn = f + fine.stride();
-            double west = a(f, -1, -1) + a(f, -1, 0) + a(f, -1, 1);
-            double east = a(f, 1, -1) + a(f, 1, 0) + a(f, 1, 1);
-            double centre = a(f, 0, 0);
-            distribute(a(f, 0, -1), a(fs, -1, 1), a(fs, 1, 1), west, east, centre);
-            distribute(a(f, 0, 1), a(fn, -1, -1), a(fn, 1, -1), west, east, centre);
-            p.xw[c] = weight(west, centre, a(f, 0, 0));
-            p.xe[c] = weight(east, centre, a(f, 0, 0));
+            const std::int64_t f = fine.at(2 * I + 1, 2 * J);
+            const double diagonal = a(f, 0, 0), centre = diagonal + a(f, 0, -1) + a(f, 0, 1);
+            p.xw[c] = weight(a(f, -1, 0), centre, diagonal);
+            p.xe[c] = weight(a(f, 1, 0), centre, diagonal);
           }
           if (2 * J + 1 < fine.ny) {
             const std::int64_t f = fine.at(2 * I, 2 * J + 1);
-            double south = a(f, -1, -1) + a(f, 0, -1) + a(f, 1, -1);
-            double north = a(f, -1, 1) + a(f, 0, 1) + a(f, 1, 1);
-            double centre = a(f, 0, 0);
-            distribute(a(f, -1, 0), a(f - 1, 1, -1), a(f - 1, 1, 1), south, north, centre);
-            distribute(a(f, 1, 0), a(f + 1, -1, -1), a(f + 1, -1, 1), south, north, centre);
-            p.ys[c] = weight(south, centre, a(f, 0, 0));
-            p.yn[c] = weight(north, centre, a(f, 0, 0));
+            const double diagonal = a(f, 0, 0), centre = diagonal + a(f, -1, 0) + a(f, 1, 0);
+            p.ys[c] = weight(a(f, 0, -1), centre, diagonal);
+            p.yn[c] = weight(a(f, 0, 1), centre, diagonal);
           }
         }
       },
       execution);
-  // Pass 2: cell-centre fine nodes, from their full stencil and the pass-1 weights.
+  // Pass 2: cell-centre fine nodes, from their axis couplings and the pass-1 weights.
   forall(
       coarse.ny,
       [&](std::int64_t J64) {
@@ -105,10 +110,10 @@ void build_interpolation(GridShape fine, const Operator& a, InterpolationArrays 
           const double d = a(f, 0, 0);
           if (!(d > 0)) continue;
           const double as = a(f, 0, -1), an = a(f, 0, 1), aw = a(f, -1, 0), ae = a(f, 1, 0);
-          p.sw[c] = -(a(f, -1, -1) + as * p.xw[c] + aw * p.ys[c]) / d;
-          p.se[c] = -(a(f, 1, -1) + as * p.xe[c] + ae * p.ys[c + 1]) / d;
-          p.nw[c] = -(a(f, -1, 1) + an * p.xw[c + cs] + aw * p.yn[c]) / d;
-          p.ne[c] = -(a(f, 1, 1) + an * p.xe[c + cs] + ae * p.yn[c + 1]) / d;
+          p.sw[c] = -(as * p.xw[c] + aw * p.ys[c]) / d;
+          p.se[c] = -(as * p.xe[c] + ae * p.ys[c + 1]) / d;
+          p.nw[c] = -(an * p.xw[c + cs] + aw * p.yn[c]) / d;
+          p.ne[c] = -(an * p.xe[c + cs] + ae * p.yn[c + 1]) / d;
         }
       },
       execution);
@@ -246,10 +251,10 @@ void galerkin(GridShape fine, const Entries& a, InterpolationView p, Stencil9Arr
 }  // namespace
 
 void build_interpolation_texels(GridShape fine, const std::uint8_t* bits, InterpolationArrays p, Execution execution) {
-  build_interpolation(fine, TexelOperator{bits, fine.stride()}, p, execution);
+  build_interpolation(fine, TexelOperator{bits}, p, execution);
 }
 void build_interpolation_stencil9(GridShape fine, Stencil9View a, InterpolationArrays p, Execution execution) {
-  build_interpolation(fine, Stencil9Operator{a, fine.stride()}, p, execution);
+  build_interpolation(fine, LumpedStencil9Operator{Stencil9Operator{a, fine.stride()}}, p, execution);
 }
 void galerkin_texels(GridShape fine, const std::uint8_t* bits, InterpolationView p, Stencil9Arrays coarse_a,
                      Execution execution) {

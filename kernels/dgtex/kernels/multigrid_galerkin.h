@@ -12,31 +12,23 @@
 // with piecewise-constant aggregation). Dirichlet texels are no unknowns: their
 // couplings only add to the diagonal, so interpolation decays towards them.
 //
-// Edge nodes (fine nodes on a coarse grid line) do not collapse their couplings to the two
-// cell-centre neighbours blindly: each such coupling is shared between the edge node's
-// two coarse neighbours in proportion to the cell centre's own couplings to them (as in
-// Ruge-Stueben interpolation), and collapsed only where the cell centre couples to
-// neither (always the case on the 5-point level, where this is plain black-box). Why:
-// at a gap in a wall (chad's 2-texel bridge) plain collapse puts the edge node half-way
-// between inside and outside although its other neighbours are inside; measured energy
-// of the disk's indicator on level 2 of chad T=128: 5.09 plain, 2.73 with this rule
-// (level 0: 2.0), per-cycle reduction of V(1,1)-CG at T=256: chad 0.367 -> 0.327, spiral
-// 0.436 -> 0.416, open/slit/accordion unchanged (0.085-0.094).
-// Known limit (measured, T=256, CG): with level 1 solved exactly the reduction is <= 0.082
-// on chad and spiral, with three levels 0.24-0.28, with the full hierarchy 0.33-0.42: the
-// coarse spaces from level 2 on cannot represent modes that live on sub-coarse-grid
-// features (a bridge or channel narrower than the coarse spacing). Tried and rejected:
-// Jacobi iteration of the edge/cell-centre weights within the compact pattern (chad 0.25,
-// spiral 0.32, but open/slit degrade from 0.085 to 0.11-0.18 through the boundary rows),
-// more coarse smoothing (16 sweeps on level 1: 3-level rate 0.92 -> 0.88). What works: the
-// robust cycle of LaplaceMultigridOptions::coarse_solve_tolerance (level 1 solved by inner CG).
-// On the spiral the loss grows with the number of channel turns, not with sub-grid width
-// (channels are 16 texels wide at T=256): V(1,1)-CG iterations at T=256 with the spiral cut
-// after k arms (full hierarchy): k <= 4: 6, k = 8: 7, k = 12: 9, k = 16: 11, k = 21: 15, all
-// arms: 16; with level 1 solved exactly always 6, with three levels (level 2 exact) 11. A
-// 4x larger Dirichlet centre: 16, walls shifted by one texel: 16, channels 19 wide: 12; the
-// accordion (a serpentine of 19 straight channels) stays at 6. So the level 1 -> 2
-// interpolation loses energy at each corner of the spiral's channel, and the losses add up.
+// Interpolation from a 9-point level is built from its lumped 5-point form (each diagonal
+// coupling shared between the axis neighbours next to it that the node couples to; walls
+// stay exact zeros), then the 5-point black-box rules above; the Galerkin product uses the
+// full 9-point operator. Why: collapsing the full 9-point stencil gives lopsided weights at
+// wall corners (e.g. 0.82/0.18 along a straight channel side, positive coarse couplings up to
+// 1.14 x the diagonal on spiral level 2), and the energy lost at each corner adds up along
+// the spiral's channel: two-grid PCG from level 1 needed 13 iterations on the spiral and 11
+// on chad (T = 256; from level 0: 6). With the lumped form: 6 and 6. V(1,1)-CG, full
+// hierarchy, T = 256/512/1024: spiral 16/17/18 -> 6/6/6 iterations, chad 13/16/22 -> 7/7/7,
+// open/slit/accordion/one_ring unchanged (6); `dgtex bench laplace`, 1 thread, setup +
+// solve: spiral T = 256/512/1024 18-24 -> 9, 78 -> 36-39, 420 -> 178 ms, chad 13-14 -> 9,
+// 71-75 -> 36-38, 501 -> 190 ms; cost per iteration and setup unchanged within noise. Tried and rejected (same harness):
+// de Zeeuw's (MGD9V) weights (spiral 17, chad 15-20), extra Gauss-Seidel sweeps on the nodes
+// within 1-3 nodes of a wall on levels >= 1 (1-4 sweeps: spiral 17 -> 15-16), sharing the
+// edge node's couplings by the cell centre's raw diagonal couplings (Ruge-Stueben style, the
+// earlier rule) on top of the lumped form (no gain). Remaining: chad T = 256 0.111 per
+// cycle (7 iterations), the 0.1 elsewhere.
 //
 // Both setup kernels write the coarse arrays (padded layout, ghosts must be zero on entry
 // and stay zero) for every coarse node and are gathers, so serial and parallel agree bitwise.
