@@ -6,6 +6,8 @@
 #include <stdexcept>
 #include <string>
 #include <cstdint>
+#include <cstdlib>
+#include <strings.h>
 
 #include <Eigen/CholmodSupport>
 #include <Eigen/Dense>
@@ -30,15 +32,12 @@
 //   recomputed next), the CG's r.z comes out of the last sweep and p-update + A p + p.Ap are
 //   one pass. Together with the setup below: T=256 open 17.6 -> ~8 ms, T=1024 551 -> ~215 ms
 //   (CPU time on a loaded 2-core machine; `dgtex bench laplace` gives wall times).
-// - Robust cycle (options.coarse_solve_tolerance > 0, not the default): the hard domains fail
-//   the 0.1-per-cycle target because coarse spaces from level 2 on miss the slow modes of
-//   sub-grid features (multigrid_galerkin.h); level 1 with an exact solve gives <= 0.082.
-//   Solving level 1 in every cycle by CG with its own V-cycle to 2% restores that: 0.08-0.094
-//   per cycle on all test domains at T=128/256, 0.092 spiral and 0.104 chad at T=1024 (6-7
-//   iterations instead of 13-22). It costs 1.05-1.4x the plain cycle's time on the measured
-//   domains (CPU: chad T=256 13 -> 18 ms, T=1024 549 -> 767 ms; open T=256 7.9 -> 11 ms),
-//   so the fast plain cycle stays the default. Fixed inner iteration counts were worse (6
-//   inner steps: chad T=1024 0.20 per cycle); the outer CG must then be flexible.
+// - Robust cycle (options.coarse_solve_tolerance > 0, not the default): solves level 1 in
+//   every cycle by CG with its own V-cycle to 2% (the outer CG then flexible). It was the
+//   only way to 0.1 per cycle on spiral and chad while coarse interpolation lost energy at
+//   wall corners (13-22 iterations); since interpolation is built from the lumped 5-point
+//   stencil (multigrid_galerkin.h) the plain cycle needs 6-7 there, so the robust cycle only
+//   adds cost (spiral T=512, 2 threads: 36-39 ms plain). Kept as an option and tested.
 // - Setup: components by union-find over texel runs instead of a per-texel flood fill
 //   (T=1024: ~100 -> ~23 ms), Galerkin products unrolled at compile time (T=1024 level 0:
 //   60-100 -> ~10 ms), dense Cholesky for coarsest levels up to 400 unknowns (CHOLMOD's
@@ -53,6 +52,19 @@
 //   2x slower than the stride-2 scalar loop (SSE2/AVX2, gathers of 1/degree); W-cycles
 //   below level 0 or 1: spiral T = 512 17 -> 15-17 iterations (W from level 0: 11, but
 //   slower); see also the spiral note in multigrid_galerkin.h.
+// - Session 5 (setup): most level arrays come from the block cache without zero-filling
+//   (frame_zeroed_buffer: ghosts zeroed, interior written before any read; a NaN-poison
+//   test guards that): open T = 1024 setup 39 -> 32 ms, total 174 -> 164 ms, T = 256 7.4 ->
+//   7.2 ms (1 thread, best of 3 x 15, same binary). Orphan count and coarse activity are one
+//   row-parallel pass. Setup at T = 1024 before (1 thread, loaded machine, ~45 ms): level
+//   0 -> 1 interpolation + Galerkin 14-18 ms, zero-filling cached blocks ~12 ms, level 1 -> 2
+//   1-6 ms. The first setup of a size also pays huge-page clearing (~40k faults at T = 1024).
+// - Session 5 (threads): with OMP_WAIT_POLICY=active, levels from 4096 nodes run parallel
+//   (see parallel_min_nodes): open T = 256 7.0 -> 4.4 ms, T = 512 20.7 -> 19.3 ms (idle
+//   machine, 2 threads). Not with the default policy: on a loaded machine (other processes
+//   on both cores) every barrier can wait a time slice, and 2-thread T = 256 solves took
+//   0.2 -> 5 s. Measured and not done (time): float cycle as CG preconditioner, F-cycle /
+//   nested-iteration start, one parallel region per cycle.
 namespace dgtex {
 using kernels::Execution;
 using kernels::GridShape;
@@ -62,10 +74,21 @@ namespace {
 using Clock = std::chrono::steady_clock;
 
 // Levels smaller than this run serially: a parallel region costs more than the work.
-// On the 2-core machine (idle), open T = 256: 9.1 ms serial against 14.3 ms with 2 threads
-// at the old bound 16384; with this bound T = 256 is serial (8.0 ms), T = 512 drops from
-// 47 to 36-39 ms (its 66k-node level 1 runs serially), T = 1024 182 -> 151 ms.
-constexpr long parallel_min_nodes = 131072;
+// The cost depends on how idle OpenMP threads wait. Sleeping (passive) or spinning a while
+// then sleeping (libgomp's default): tens of us, and on a shared machine a barrier may wait
+// for a descheduled thread; on the 2-core machine (idle), open T = 256: 9.1 ms serial against
+// 14.3 ms with 2 threads at bound 16384, so the bound is 131072 (T = 256 serial, T = 512
+// 47 -> 36-39 ms, T = 1024 182 -> 151 ms). With OMP_WAIT_POLICY=active (the user says the
+// cores are ours) a region costs ~1 us: bound 4096, open T = 256 7.0 -> 4.4 ms (bound 1024:
+// 4.7 ms, within the noise; idle machine, 2 threads, best of 20). Read once per process.
+long parallel_min_nodes() {
+  static const long bound = [] {
+    const char* policy = std::getenv("OMP_WAIT_POLICY");
+    return (policy && strcasecmp(policy, "active") == 0) ? 4096l : 131072l;
+  }();
+  return bound;
+}
+
 // Level 0 forms and restricts its red residual in one pass (restrict_red_residual_texels)
 // from this many nodes on; below, where the level fits the cache, the two-pass form is
 // cheaper (the one-pass form evaluates cell-centre residuals twice). Setup + solve, CPU,
@@ -75,6 +98,8 @@ constexpr long fused_restriction_min_nodes = 1l << 19;
 constexpr int dense_coarsest_max = 400;
 
 using detail::MultigridBuffer;
+
+MultigridBuffer frame_buffer(GridShape g) { return detail::frame_zeroed_buffer(g.stride(), g.ny + 2); }
 
 double sum_in_order(const std::vector<double>& rows) {
   double sum = 0;
@@ -104,6 +129,7 @@ struct LaplaceMultigrid::Hierarchy {
   std::vector<std::uint8_t> bits;        // level-0 operator, padded layout
   std::vector<Level> levels;
   std::vector<double> row_partial;       // per-row partial sums (deterministic reductions)
+  std::vector<int> row_orphans;          // per coarse row, during the setup
   // Preconditioned CG vectors (level-0 layout). q = A p lives from its product to the next
   // update of x and r, never across a cycle, so it shares levels[0].r (the cycle's residual)
   // unless the robust cycle's flexible CG needs q after the cycle: 2 of 9 level-0 arrays
@@ -125,7 +151,7 @@ struct LaplaceMultigrid::Hierarchy {
   double setup_ms = 0;
 
   Execution execution_for(GridShape shape) const {
-    return (options.execution == Execution::parallel && static_cast<long>(shape.nx) * shape.ny >= parallel_min_nodes)
+    return (options.execution == Execution::parallel && static_cast<long>(shape.nx) * shape.ny >= parallel_min_nodes())
                ? Execution::parallel : Execution::serial;
   }
 
@@ -139,8 +165,16 @@ struct LaplaceMultigrid::Hierarchy {
     bits.resize(fine.shape.padded_size());
     kernels::classify_laplace_texels_padded(tile, bits.data(), fine.execution);
     fine.active.resize(fine.shape.padded_size());
-    for (std::size_t t = 0; t < bits.size(); ++t) fine.active[t] = (bits[t] & kernels::is_unknown) ? 1 : 0;
-    for (auto* v : {&fine.x, &fine.b, &fine.r}) *v = MultigridBuffer(fine.shape.padded_size());
+    kernels::forall(
+        fine.shape.ny + 2,
+        [&](std::int64_t j) {
+          const std::int64_t row = j * fine.shape.stride();
+          for (std::int64_t t = row; t < row + fine.shape.stride(); ++t)
+            fine.active[t] = (bits[t] & kernels::is_unknown) ? 1 : 0;
+        },
+        fine.execution);
+    // The solve's first pass writes every level-0 entry (frame_zeroed_buffer).
+    for (auto* v : {&fine.x, &fine.b, &fine.r}) *v = frame_buffer(fine.shape);
     levels.clear();
     levels.push_back(std::move(fine));
 
@@ -151,9 +185,10 @@ struct LaplaceMultigrid::Hierarchy {
       coarse.shape = levels[l].shape.coarser();
       coarse.execution = execution_for(coarse.shape);
       const std::size_t size = coarse.shape.padded_size();
-      for (auto* v : {&coarse.x, &coarse.b, &coarse.r, &coarse.c, &coarse.e, &coarse.n, &coarse.ne, &coarse.nw})
-        *v = MultigridBuffer(size);
-      for (auto& v : coarse.p) v = MultigridBuffer(size);
+      for (auto* v : {&coarse.x, &coarse.b, &coarse.r}) *v = MultigridBuffer(size);
+      // The setup kernels write every coarse node of the operator and interpolation arrays.
+      for (auto* v : {&coarse.c, &coarse.e, &coarse.n, &coarse.ne, &coarse.nw}) *v = frame_buffer(coarse.shape);
+      for (auto& v : coarse.p) v = frame_buffer(coarse.shape);
       kernels::InterpolationArrays p{coarse.p[0].data(), coarse.p[1].data(), coarse.p[2].data(), coarse.p[3].data(),
                                      coarse.p[4].data(), coarse.p[5].data(), coarse.p[6].data(), coarse.p[7].data()};
       kernels::Stencil9Arrays a{coarse.c.data(), coarse.e.data(), coarse.n.data(), coarse.ne.data(), coarse.nw.data()};
@@ -165,13 +200,12 @@ struct LaplaceMultigrid::Hierarchy {
         kernels::build_interpolation_stencil9(levels[l].shape, levels[l].stencil(), p, ex);
         kernels::galerkin_stencil9(levels[l].shape, levels[l].stencil(), p.view(), a, ex);
       }
-      const int orphans = count_orphans(levels[l], coarse);
+      coarse.active.assign(size, 0);
+      const int orphans = count_orphans_and_mark_active(levels[l], coarse, ex);
       if (orphans > options.max_orphans) {
         orphans_at_stop = orphans;
         break;  // this coarsening would lose part of the domain: solve level l directly
       }
-      coarse.active.assign(size, 0);
-      for (std::size_t t = 0; t < size; ++t) coarse.active[t] = coarse.c[t] > 0 ? 1 : 0;
       levels.push_back(std::move(coarse));
     }
     factor_coarsest();
@@ -184,26 +218,39 @@ struct LaplaceMultigrid::Hierarchy {
       coarse_rows.assign(levels[1].shape.ny, 0.0);
     }
     if (options.use_as_cg_preconditioner) {
-      for (auto* v : {&cg_p, &cg_x, &cg_r}) *v = MultigridBuffer(levels[0].shape.padded_size());
+      // cg_p is a copy of z, cg_x and cg_r trade places with level 0's x and r (see solve()).
+      for (auto* v : {&cg_p, &cg_x, &cg_r}) *v = frame_buffer(levels[0].shape);
       if (robust_coarse_solve()) cg_q = MultigridBuffer(levels[0].shape.padded_size());
     }
   }
 
   // Active fine nodes (not coarse points) whose interpolation row is zero: parts of the
   // domain (channels narrower than the coarse spacing) the coarse level cannot represent.
-  static int count_orphans(const Level& fine, const Level& coarse) {
+  // The same pass over the coarse rows sets coarse.active (c > 0); counts are per row.
+  int count_orphans_and_mark_active(const Level& fine, Level& coarse, Execution execution) {
     const kernels::InterpolationView p = coarse.interpolation();
+    row_orphans.assign(coarse.shape.ny, 0);
+    kernels::forall(
+        coarse.shape.ny,
+        [&](std::int64_t J64) {
+          const int J = static_cast<int>(J64);
+          int orphans = 0;
+          for (int I = 0; I < coarse.shape.nx; ++I) {
+            const std::int64_t c = coarse.shape.at(I, J);
+            coarse.active[c] = coarse.c[c] > 0 ? 1 : 0;
+            auto check = [&](int i, int j, double weight_sum) {
+              if (i < fine.shape.nx && j < fine.shape.ny && fine.active[fine.shape.at(i, j)] && weight_sum == 0.0)
+                ++orphans;
+            };
+            check(2 * I + 1, 2 * J, std::abs(p.xw[c]) + std::abs(p.xe[c]));
+            check(2 * I, 2 * J + 1, std::abs(p.ys[c]) + std::abs(p.yn[c]));
+            check(2 * I + 1, 2 * J + 1, std::abs(p.sw[c]) + std::abs(p.se[c]) + std::abs(p.nw[c]) + std::abs(p.ne[c]));
+          }
+          row_orphans[J] = orphans;
+        },
+        execution);
     int orphans = 0;
-    for (int J = 0; J < coarse.shape.ny; ++J)
-      for (int I = 0; I < coarse.shape.nx; ++I) {
-        const std::int64_t c = coarse.shape.at(I, J);
-        auto check = [&](int i, int j, double weight_sum) {
-          if (i < fine.shape.nx && j < fine.shape.ny && fine.active[fine.shape.at(i, j)] && weight_sum == 0.0) ++orphans;
-        };
-        check(2 * I + 1, 2 * J, std::abs(p.xw[c]) + std::abs(p.xe[c]));
-        check(2 * I, 2 * J + 1, std::abs(p.ys[c]) + std::abs(p.yn[c]));
-        check(2 * I + 1, 2 * J + 1, std::abs(p.sw[c]) + std::abs(p.se[c]) + std::abs(p.nw[c]) + std::abs(p.ne[c]));
-      }
+    for (int count : row_orphans) orphans += count;
     return orphans;
   }
 

@@ -1,8 +1,11 @@
 #include "multigrid_buffer.h"
 
+#include <algorithm>
+#include <atomic>
 #include <cstdint>
 #include <cstdlib>
 #include <cstring>
+#include <limits>
 #include <mutex>
 
 #if defined(__linux__)
@@ -78,7 +81,31 @@ BlockCache& cache() {
   return *instance;
 }
 
+thread_local bool skip_cached_zeroing = false;
+std::atomic<bool> poison_unzeroed{false};
+
 }  // namespace
+
+SkipCachedBlockZeroing::SkipCachedBlockZeroing() { skip_cached_zeroing = true; }
+SkipCachedBlockZeroing::~SkipCachedBlockZeroing() { skip_cached_zeroing = false; }
+void set_poison_unzeroed_blocks(bool poison) noexcept { poison_unzeroed = poison; }
+
+MultigridBuffer frame_zeroed_buffer(std::size_t nx_padded, std::size_t ny_padded) {
+  MultigridBuffer v;
+  {
+    const SkipCachedBlockZeroing skip;
+    v = MultigridBuffer(nx_padded * ny_padded);
+  }
+  if (ny_padded == 0) return v;
+  double* a = v.data();
+  std::fill(a, a + nx_padded, 0.0);
+  std::fill(a + (ny_padded - 1) * nx_padded, a + ny_padded * nx_padded, 0.0);
+  for (std::size_t j = 1; j + 1 < ny_padded; ++j) {
+    a[j * nx_padded] = 0.0;
+    a[j * nx_padded + nx_padded - 1] = 0.0;
+  }
+  return v;
+}
 
 void* acquire_zeroed_block(std::size_t bytes) {
   if (bytes >= min_cached_bytes) {
@@ -95,7 +122,10 @@ void* acquire_zeroed_block(std::size_t bytes) {
         }
     }
     if (block) {
-      std::memset(block, 0, bytes);
+      if (!skip_cached_zeroing)
+        std::memset(block, 0, bytes);
+      else if (poison_unzeroed)
+        std::fill_n(static_cast<double*>(block), bytes / sizeof(double), std::numeric_limits<double>::quiet_NaN());
       return block;
     }
   }
