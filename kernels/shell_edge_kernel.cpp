@@ -2,9 +2,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <vector>
 
 #include "dgtex/kernels/shell_point.h"
 #include "dgtex/kernels/edge_frame.h"
+#include "dgtex/kernels/low_rank_block.h"
 #include "dgtex/kernels/vec3.h"
 #include "shell_point_rows.h"
 
@@ -80,6 +82,69 @@ void edge_basis(const EdgeBatch& b, std::int64_t e, bool merged, EdgeBasis& basi
   }
 }
 
+// Per-edge constants of the edge terms: the penalty eta^e times the mean bending rigidity,
+// and the weight of each side's moment in the average (0 for penalty-only coupling).
+struct EdgeCoefficients {
+  double dm_plus, dm_minus, penalty, average;
+};
+
+EdgeCoefficients edge_coefficients(const EdgeBatch& b, std::int64_t e) {
+  const int* ed = b.edges + 4 * e;
+  const bool interior = ed[2] >= 0;
+  const ShellSection& sp = b.sections[ed[0]];
+  const ShellSection& sm = b.sections[interior ? ed[2] : ed[0]];
+  EdgeCoefficients c;
+  c.dm_plus = bending_rigidity(sp.youngs_modulus, sp.poisson_ratio, sp.thickness);
+  c.dm_minus = bending_rigidity(sm.youngs_modulus, sm.poisson_ratio, sm.thickness);
+  c.penalty = b.penalty / b.edge_size[e] * (interior ? 0.5 * (c.dm_plus + c.dm_minus) : c.dm_plus);
+  // Penalty-only coupling drops the moment rows M (consistency and symmetry terms).
+  c.average = b.penalty_only ? 0.0 : (interior ? 0.5 : 1.0);
+  return c;
+}
+
+// The rest rows of Gauss point q of edge e over its local basis: G = [[g]] (jump of the
+// hinge rotation measure) and M = {m_nunu} (average normal bending moment), 3 columns per
+// basis function (zero beyond basis.count), and the length weight ds. They depend on the
+// rest geometry only; the corotation rotates them (R G, R M).
+void edge_point_rows(const EdgeBatch& b, const EdgeRuleShapes& shapes, std::int64_t e, const EdgeBasis& basis,
+                     const EdgeCoefficients& co, int q, double& ds, double (*G)[3], double (*M)[3]) {
+  const int npe = nodes_per_element(b.type);
+  const int* ed = b.edges + 4 * e;
+  const bool interior = ed[2] >= 0;
+  const ShellSection& sp = b.sections[ed[0]];
+  const ShellSection& sm = b.sections[interior ? ed[2] : ed[0]];
+  Side plus, minus;
+  evaluate_side(b, shapes, ed[0], ed[1], 0, q, plus);
+  if (interior) evaluate_side(b, shapes, ed[2], ed[3], 1, q, minus);
+  ds = std::sqrt(dot3(plus.tangent, plus.tangent)) * shapes.rule.weight[q];
+  double tau[3] = {plus.tangent[0], plus.tangent[1], plus.tangent[2]};
+  normalize3(tau);
+  for (int i = 0; i < 2 * npe; ++i)
+    for (int c = 0; c < 3; ++c) G[i][c] = M[i][c] = 0;
+  for (int side = 0; side < (interior ? 2 : 1); ++side) {
+    const Side& s = side == 0 ? plus : minus;
+    const double nu_p = (side == 0 ? sp : sm).poisson_ratio;
+    const double dm = side == 0 ? co.dm_plus : co.dm_minus;
+    const double sign = side == 0 ? 1.0 : -1.0;
+    double nu_vec[3], e1[3], e2[3];
+    cross3(s.point.t0, tau, nu_vec);
+    frame_along(s.point, tau, e1, e2);  // e1 = tau, e2 = t0 x tau = nu
+    fast_rows::PointFrame frame;
+    fast_rows::make_point_frame(s.point, e1, e2, frame);
+    for (int a = 0; a < npe; ++a) {
+      double T[9], Bb[9];
+      fast_rows::normal_change(s.point, frame, s.shape->dN[a], T);
+      fast_rows::bending(s.point, frame, s.shape->d2N[a], T, Bb);
+      const int i = basis.slot[side][a];
+      for (int c = 0; c < 3; ++c) {
+        G[i][c] += sign * (nu_vec[0] * T[0 * 3 + c] + nu_vec[1] * T[1 * 3 + c] + nu_vec[2] * T[2 * 3 + c]);
+        // m_nunu = D (nu rho_11 + rho_22) in the frame (tau, nu).
+        M[i][c] += co.average * dm * (nu_p * Bb[0 * 3 + c] + Bb[1 * 3 + c]);
+      }
+    }
+  }
+}
+
 // K = sum over points of ds (penalty G G^T + M G^T + G M^T) with G, M the rows of the jump
 // and the average moment over the edge's local basis, evaluated as P G^T + Q M^T per point
 // (P = ds (penalty G + M), Q = ds G; rows stacked as Ls = [P; Q], Rs = [G; M]): 2 nq (3n)^2
@@ -89,8 +154,6 @@ void edge_stiffness(const EdgeBatch& b, const EdgeRuleShapes& shapes, std::int64
                     const double* rotations, double* blocks, double* forces) {
   const int npe = nodes_per_element(b.type);
   const int nb = 2 * npe;
-  const int* ed = b.edges + 4 * e;
-  const bool interior = ed[2] >= 0;
   EdgeBasis basis;
   edge_basis(b, e, merged, basis);
   const int n = basis.count;
@@ -99,51 +162,16 @@ void edge_stiffness(const EdgeBatch& b, const EdgeRuleShapes& shapes, std::int64
   if (f)
     for (int i = 0; i < nb * 3; ++i) f[i] = 0;
 
-  const ShellSection& sp = b.sections[ed[0]];
-  const ShellSection& sm = b.sections[interior ? ed[2] : ed[0]];
-  const double dm_plus = bending_rigidity(sp.youngs_modulus, sp.poisson_ratio, sp.thickness);
-  const double dm_minus = bending_rigidity(sm.youngs_modulus, sm.poisson_ratio, sm.thickness);
-  const double penalty = b.penalty / b.edge_size[e] * (interior ? 0.5 * (dm_plus + dm_minus) : dm_plus);
-  // Penalty-only coupling drops the moment rows M (consistency and symmetry terms).
-  const double average = b.penalty_only ? 0.0 : (interior ? 0.5 : 1.0);
+  const EdgeCoefficients co = edge_coefficients(b, e);
+  const double penalty = co.penalty;
   const LineRule& rule = shapes.rule;
 
   // Per point: Ls = [P; Q] and Rs = [G; M] over (basis function, component).
   alignas(64) double Ls[2 * max_edge_points][max_edge_dofs], Rs[2 * max_edge_points][max_edge_dofs];
   for (int q = 0; q < rule.count; ++q) {
-    Side plus, minus;
-    evaluate_side(b, shapes, ed[0], ed[1], 0, q, plus);
-    if (interior) evaluate_side(b, shapes, ed[2], ed[3], 1, q, minus);
-    const double ds = std::sqrt(dot3(plus.tangent, plus.tangent)) * rule.weight[q];
-    double tau[3] = {plus.tangent[0], plus.tangent[1], plus.tangent[2]};
-    normalize3(tau);
-
-    // Rows over the edge's local basis: G = [[g]] (jump of the hinge rotation measure) and
-    // Mbar = {m_nunu} (average normal bending moment), each 3 columns per basis function.
-    double G[2 * max_element_nodes][3] = {}, M[2 * max_element_nodes][3] = {};
-    for (int side = 0; side < (interior ? 2 : 1); ++side) {
-      const Side& s = side == 0 ? plus : minus;
-      const ShellSection& sec = side == 0 ? sp : sm;
-      const double nu_p = sec.poisson_ratio;
-      const double dm = side == 0 ? dm_plus : dm_minus;
-      const double sign = side == 0 ? 1.0 : -1.0;
-      double nu_vec[3], e1[3], e2[3];
-      cross3(s.point.t0, tau, nu_vec);
-      frame_along(s.point, tau, e1, e2);  // e1 = tau, e2 = t0 x tau = nu
-      fast_rows::PointFrame frame;
-      fast_rows::make_point_frame(s.point, e1, e2, frame);
-      for (int a = 0; a < npe; ++a) {
-        double T[9], Bb[9];
-        fast_rows::normal_change(s.point, frame, s.shape->dN[a], T);
-        fast_rows::bending(s.point, frame, s.shape->d2N[a], T, Bb);
-        const int i = basis.slot[side][a];
-        for (int c = 0; c < 3; ++c) {
-          G[i][c] += sign * (nu_vec[0] * T[0 * 3 + c] + nu_vec[1] * T[1 * 3 + c] + nu_vec[2] * T[2 * 3 + c]);
-          // m_nunu = D (nu rho_11 + rho_22) in the frame (tau, nu).
-          M[i][c] += average * dm * (nu_p * Bb[0 * 3 + c] + Bb[1 * 3 + c]);
-        }
-      }
-    }
+    double ds;
+    double G[2 * max_element_nodes][3], M[2 * max_element_nodes][3];
+    edge_point_rows(b, shapes, e, basis, co, q, ds, G, M);
     const double* R = rotations ? rotations + (e * rule.count + q) * 9 : nullptr;
     double gd = 0, md = 0;  // G . d and M . d for the corrective force, d = X0 - R^T X0
     if (R && f) {
@@ -205,6 +233,77 @@ void edge_stiffness(const EdgeBatch& b, const EdgeRuleShapes& shapes, std::int64
           for (int k = 0; k < 9; ++k) K[(i * nb + j) * 9 + k] = 0;
 }
 
+// Rest rows of every point of edge e (shell_edge_rest_rows layout) at `rows`.
+void edge_rest_rows(const EdgeBatch& b, const EdgeRuleShapes& shapes, std::int64_t e, double* rows) {
+  const int nb = 2 * nodes_per_element(b.type);
+  EdgeBasis basis;
+  edge_basis(b, e, true, basis);
+  const EdgeCoefficients co = edge_coefficients(b, e);
+  const std::int64_t stride = 2 + 6 * nb;
+  for (int q = 0; q < shapes.rule.count; ++q) {
+    double* row = rows + q * stride;
+    double G[2 * max_element_nodes][3], M[2 * max_element_nodes][3];
+    edge_point_rows(b, shapes, e, basis, co, q, row[0], G, M);
+    row[1] = co.penalty;
+    for (int i = 0; i < nb; ++i)
+      for (int c = 0; c < 3; ++c) {
+        row[2 + 3 * i + c] = G[i][c];
+        row[2 + 3 * nb + 3 * i + c] = M[i][c];
+      }
+  }
+}
+
+// Factors (and corrective forces) of edge e from its rest rows `rows`: the arithmetic of
+// edge_stiffness after its rows are evaluated, so products of the factors equal its blocks.
+void edge_factors(const EdgeBatch& b, std::int64_t e, const double* rows, const double* rotations, double* factors,
+                  double* forces) {
+  const int nb = 2 * nodes_per_element(b.type);
+  const int nq = b.quadrature_points, rank = 2 * nq;
+  EdgeBasis basis;
+  edge_basis(b, e, true, basis);
+  const int n = basis.count;
+  double* F = factors + e * nb * 2 * rank * 3;
+  double* f = forces ? forces + e * nb * 3 : nullptr;
+  if (f)
+    for (int i = 0; i < nb * 3; ++i) f[i] = 0;
+  const std::int64_t stride = 2 + 6 * nb;
+  for (int q = 0; q < nq; ++q) {
+    const double* row = rows + q * stride;
+    const double ds = row[0], penalty = row[1];
+    const double (*G)[3] = reinterpret_cast<const double (*)[3]>(row + 2);
+    const double (*M)[3] = reinterpret_cast<const double (*)[3]>(row + 2 + 3 * nb);
+    const double* R = rotations ? rotations + (e * nq + q) * 9 : nullptr;
+    double gd = 0, md = 0;  // G . d and M . d for the corrective force, d = X0 - R^T X0
+    if (R && f) {
+      for (int i = 0; i < n; ++i) {
+        const double* x = b.positions + 3 * static_cast<long>(basis.node[i]);
+        for (int k = 0; k < 3; ++k) {
+          const double d = x[k] - (R[0 * 3 + k] * x[0] + R[1 * 3 + k] * x[1] + R[2 * 3 + k] * x[2]);
+          gd += G[i][k] * d;
+          md += M[i][k] * d;
+        }
+      }
+    }
+    for (int i = 0; i < n; ++i) {
+      double g[3], m[3];
+      for (int c = 0; c < 3; ++c) {
+        g[c] = R ? G[i][0] * R[c * 3 + 0] + G[i][1] * R[c * 3 + 1] + G[i][2] * R[c * 3 + 2] : G[i][c];
+        m[c] = R ? M[i][0] * R[c * 3 + 0] + M[i][1] * R[c * 3 + 1] + M[i][2] * R[c * 3 + 2] : M[i][c];
+      }
+      double* L = F + i * 2 * rank * 3;
+      double* Rt = L + rank * 3;
+      for (int c = 0; c < 3; ++c) {
+        L[(2 * q) * 3 + c] = ds * (penalty * g[c] + m[c]);
+        L[(2 * q + 1) * 3 + c] = ds * g[c];
+        Rt[(2 * q) * 3 + c] = g[c];
+        Rt[(2 * q + 1) * 3 + c] = m[c];
+      }
+      if (R && f)
+        for (int r = 0; r < 3; ++r) f[i * 3 + r] += ds * (penalty * g[r] * gd + m[r] * gd + g[r] * md);
+    }
+  }
+}
+
 }  // namespace
 
 void shell_edge_stiffness(const EdgeBatch& batch, const double* rotations, double* blocks, double* forces,
@@ -221,6 +320,49 @@ void shell_edge_stiffness_merged(const EdgeBatch& batch, const double* rotations
   forall(
       batch.count, [&](std::int64_t e) { edge_stiffness(batch, shapes, e, true, rotations, blocks, forces); },
       execution);
+}
+
+std::int64_t shell_edge_rest_row_stride(const EdgeBatch& batch) { return 2 + 12 * nodes_per_element(batch.type); }
+
+std::int64_t shell_edge_factor_stride(const EdgeBatch& batch) {
+  return 2 * nodes_per_element(batch.type) * 2 * shell_edge_factor_rank(batch) * 3;
+}
+
+void shell_edge_rest_rows(const EdgeBatch& batch, double* rows, Execution execution) {
+  const EdgeRuleShapes shapes(batch.type, batch.quadrature_points);
+  const std::int64_t per_edge = batch.quadrature_points * shell_edge_rest_row_stride(batch);
+  forall(batch.count, [&](std::int64_t e) { edge_rest_rows(batch, shapes, e, rows + e * per_edge); }, execution);
+}
+
+void shell_edge_factors(const EdgeBatch& batch, const double* rest_rows, const double* rotations, double* factors,
+                        double* forces, Execution execution) {
+  const std::int64_t per_edge = batch.quadrature_points * shell_edge_rest_row_stride(batch);
+  forall(
+      batch.count,
+      [&](std::int64_t e) { edge_factors(batch, e, rest_rows + e * per_edge, rotations, factors, forces); },
+      execution);
+}
+
+void shell_edge_factors_reference(const EdgeBatch& batch, const double* rotations, double* factors, double* forces) {
+  const EdgeRuleShapes shapes(batch.type, batch.quadrature_points);
+  std::vector<double> rows(batch.quadrature_points * shell_edge_rest_row_stride(batch));
+  for (std::int64_t e = 0; e < batch.count; ++e) {
+    edge_rest_rows(batch, shapes, e, rows.data());
+    edge_factors(batch, e, rows.data(), rotations, factors, forces);
+  }
+}
+
+void shell_edge_blocks_from_factors(const EdgeBatch& batch, const double* factors, double* blocks) {
+  const int nb = 2 * nodes_per_element(batch.type);
+  const int rank = shell_edge_factor_rank(batch);
+  for (std::int64_t e = 0; e < batch.count; ++e) {
+    int nodes[2 * max_element_nodes];
+    const int n = shell_edge_merged_nodes(batch, e, nodes);
+    const double* F = factors + e * shell_edge_factor_stride(batch);
+    for (int i = 0; i < n; ++i)
+      for (int j = 0; j < n; ++j)
+        low_rank_block(rank, F + i * 2 * rank * 3, F + j * 2 * rank * 3 + rank * 3, blocks + ((e * nb + i) * nb + j) * 9);
+  }
 }
 
 int shell_edge_merged_nodes(const EdgeBatch& batch, std::int64_t edge, int* nodes) {

@@ -48,8 +48,31 @@ struct ElementRuleShapes {
   }
 };
 
-void element_stiffness(const ElementBatch& b, const ElementRuleShapes& shapes, std::int64_t e, const double* rotations,
-                       double* blocks, double* forces) {
+// Rest rows of point q of element e: the weight w = quadrature weight x j0 and the
+// membrane and bending rows Bm, Bb of every basis function (depend on the rest geometry only).
+void element_point_rows(const ElementBatch& b, const ElementRuleShapes& shapes, std::int64_t e, int q, double& w,
+                        double (*Bm)[9], double (*Bb)[9]) {
+  const int npe = nodes_per_element(b.type);
+  const ShapeValues& s = shapes.shape[q];
+  RestPoint p;
+  evaluate_rest_point(s, b.connectivity + e * npe, b.positions, p);
+  double e1[3], e2[3];
+  frame_along(p, p.a1, e1, e2);
+  w = shapes.rule.weight[q] * p.j0;
+  fast_rows::PointFrame frame;
+  fast_rows::make_point_frame(p, e1, e2, frame);
+  for (int a = 0; a < npe; ++a) {
+    double T[9];
+    fast_rows::membrane(frame, s.dN[a], Bm[a]);
+    fast_rows::normal_change(p, frame, s.dN[a], T);
+    fast_rows::bending(p, frame, s.d2N[a], T, Bb[a]);
+  }
+}
+
+// Stiffness of element e; its rest rows come from `rest_rows` (the layout of
+// shell_element_rest_rows, this element's first point) or, if null, are evaluated here.
+void element_stiffness(const ElementBatch& b, const ElementRuleShapes& shapes, std::int64_t e, const double* rest_rows,
+                       const double* rotations, double* blocks, double* forces) {
   const int npe = nodes_per_element(b.type);
   const int ndof = 3 * npe;
   const int* nodes = b.connectivity + e * npe;
@@ -70,21 +93,15 @@ void element_stiffness(const ElementBatch& b, const ElementRuleShapes& shapes, s
     for (int k = 0; k < nk; ++k)
       for (int c = ndof; c < max_element_dofs; ++c) Bs[k][c] = DBs[k][c] = 0;
   for (int q = 0; q < rule.count; ++q) {
-    const ShapeValues& s = shapes.shape[q];
-    RestPoint p;
-    evaluate_rest_point(s, nodes, b.positions, p);
-    double e1[3], e2[3];
-    frame_along(p, p.a1, e1, e2);
-    const double w = rule.weight[q] * p.j0;
-
+    double w;
     double Bm[max_element_nodes][9], Bb[max_element_nodes][9];
-    fast_rows::PointFrame frame;
-    fast_rows::make_point_frame(p, e1, e2, frame);
-    for (int a = 0; a < npe; ++a) {
-      double T[9];
-      fast_rows::membrane(frame, s.dN[a], Bm[a]);
-      fast_rows::normal_change(p, frame, s.dN[a], T);
-      fast_rows::bending(p, frame, s.d2N[a], T, Bb[a]);
+    if (rest_rows) {
+      const double* row = rest_rows + q * (1 + 18 * npe);
+      w = row[0];
+      for (int a = 0; a < npe; ++a)
+        for (int i = 0; i < 9; ++i) Bm[a][i] = row[1 + 9 * a + i], Bb[a][i] = row[1 + 9 * (npe + a) + i];
+    } else {
+      element_point_rows(b, shapes, e, q, w, Bm, Bb);
     }
     const double* R = rotations ? rotations + (e * rule.count + q) * 9 : nullptr;
     double strain_m[3] = {0, 0, 0}, strain_b[3] = {0, 0, 0};
@@ -148,7 +165,43 @@ void element_stiffness(const ElementBatch& b, const ElementRuleShapes& shapes, s
 void shell_element_stiffness(const ElementBatch& batch, const double* rotations, double* blocks, double* forces,
                              Execution execution) {
   const ElementRuleShapes shapes(batch.type);
-  forall(batch.count, [&](std::int64_t e) { element_stiffness(batch, shapes, e, rotations, blocks, forces); }, execution);
+  forall(
+      batch.count, [&](std::int64_t e) { element_stiffness(batch, shapes, e, nullptr, rotations, blocks, forces); },
+      execution);
+}
+
+std::int64_t shell_element_rest_row_stride(const ElementBatch& batch) {
+  return 1 + 18 * nodes_per_element(batch.type);
+}
+
+void shell_element_rest_rows(const ElementBatch& batch, double* rest_rows, Execution execution) {
+  const ElementRuleShapes shapes(batch.type);
+  const int npe = nodes_per_element(batch.type);
+  const std::int64_t stride = shell_element_rest_row_stride(batch);
+  forall(
+      batch.count,
+      [&](std::int64_t e) {
+        for (int q = 0; q < shapes.rule.count; ++q) {
+          double* row = rest_rows + (e * shapes.rule.count + q) * stride;
+          double Bm[max_element_nodes][9], Bb[max_element_nodes][9];
+          element_point_rows(batch, shapes, e, q, row[0], Bm, Bb);
+          for (int a = 0; a < npe; ++a)
+            for (int i = 0; i < 9; ++i) row[1 + 9 * a + i] = Bm[a][i], row[1 + 9 * (npe + a) + i] = Bb[a][i];
+        }
+      },
+      execution);
+}
+
+void shell_element_stiffness_cached(const ElementBatch& batch, const double* rest_rows, const double* rotations,
+                                    double* blocks, double* forces, Execution execution) {
+  const ElementRuleShapes shapes(batch.type);
+  const std::int64_t per_element = shapes.rule.count * shell_element_rest_row_stride(batch);
+  forall(
+      batch.count,
+      [&](std::int64_t e) {
+        element_stiffness(batch, shapes, e, rest_rows + e * per_element, rotations, blocks, forces);
+      },
+      execution);
 }
 
 void shell_element_deformation_gradients(const ElementBatch& b, const double* current, double* F,

@@ -131,6 +131,8 @@ void ShellModel::rebuild() {
   }
   if (textured) families.push_back({num_textured_elements(), npe, textured_connectivity_});
   assembly_ = BlockAssembly(mesh_.num_nodes() + num_enriched_nodes(), families);
+  workspace_.element_rest_rows.clear();  // the plain elements and edges may have changed
+  workspace_.edge_rest_rows.clear();
 
   // Mass and load weights depend on the rest geometry only.
   std::vector<double> element_mass(static_cast<size_t>(num_plain) * npe * npe);
@@ -588,13 +590,45 @@ void ShellModel::assemble_stiffness(const double* current, std::vector<double>& 
     kernels::shell_edge_rotations(gb, current, w.edge_rotations.data(), execution);
   }
   w.element_blocks.resize(static_cast<size_t>(ne) * npe * npe * 9);
-  w.edge_blocks.resize(static_cast<size_t>(nedges) * 4 * npe * npe * 9);
   if (forces) {
     w.element_forces.resize(static_cast<size_t>(ne) * npe * 3);
     w.edge_forces.resize(static_cast<size_t>(nedges) * 2 * npe * 3);
   }
+  const bool parallel = execution == Execution::parallel;
+  if (enriched_elements_.empty() && textured_index_.empty()) {
+    // Plain model: elements over cached rest rows; edges as low-rank factors over cached
+    // rest rows, gathered straight into the (symmetric) global blocks, so no 13 x 13 edge
+    // blocks are written or read back.
+    const size_t element_rest_size = static_cast<size_t>(ne) * nq * kernels::shell_element_rest_row_stride(eb);
+    if (w.element_rest_rows.size() != element_rest_size) {
+      w.element_rest_rows.resize(element_rest_size);
+      kernels::shell_element_rest_rows(eb, w.element_rest_rows.data(), execution);
+    }
+    kernels::shell_element_stiffness_cached(eb, w.element_rest_rows.data(), current ? w.element_rotations.data() : nullptr,
+                                            w.element_blocks.data(), forces ? w.element_forces.data() : nullptr,
+                                            execution);
+    const size_t rest_size = static_cast<size_t>(nedges) * gb.quadrature_points * kernels::shell_edge_rest_row_stride(gb);
+    if (w.edge_rest_rows.size() != rest_size) {
+      w.edge_rest_rows.resize(rest_size);
+      kernels::shell_edge_rest_rows(gb, w.edge_rest_rows.data(), execution);
+    }
+    w.edge_factors.resize(static_cast<size_t>(nedges) * kernels::shell_edge_factor_stride(gb));
+    kernels::shell_edge_factors(gb, w.edge_rest_rows.data(), current ? w.edge_rotations.data() : nullptr,
+                                w.edge_factors.data(), forces ? w.edge_forces.data() : nullptr, execution);
+    blocks.resize(assembly_.num_blocks() * 9);
+    assembly_.assemble_symmetric_matrix(
+        {{w.element_blocks.data(), 0}, {w.edge_factors.data(), kernels::shell_edge_factor_rank(gb)}}, blocks.data(),
+        parallel);
+    if (corrective) {
+      corrective->assign(num_dofs(), 0.0);
+      if (current)
+        assembly_.assemble_vector({w.element_forces.data(), w.edge_forces.data()}, corrective->data(), parallel);
+    }
+    return;
+  }
   kernels::shell_element_stiffness(eb, current ? w.element_rotations.data() : nullptr, w.element_blocks.data(),
                                    forces ? w.element_forces.data() : nullptr, execution);
+  w.edge_blocks.resize(static_cast<size_t>(nedges) * 4 * npe * npe * 9);
   kernels::shell_edge_stiffness_merged(gb, current ? w.edge_rotations.data() : nullptr, w.edge_blocks.data(),
                                        forces ? w.edge_forces.data() : nullptr, execution);
   std::vector<const double*> matrix_locals = {w.element_blocks.data(), w.edge_blocks.data()};
@@ -650,7 +684,6 @@ void ShellModel::assemble_stiffness(const double* current, std::vector<double>& 
     vector_locals.push_back(textured_forces.data());
   }
   blocks.resize(assembly_.num_blocks() * 9);
-  const bool parallel = execution == Execution::parallel;
   assembly_.assemble_matrix(matrix_locals, blocks.data(), parallel);
   if (corrective) {
     corrective->assign(num_dofs(), 0.0);

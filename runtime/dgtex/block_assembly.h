@@ -21,6 +21,16 @@ struct BlockSourceFamily {
   std::vector<int> global_nodes;  // count x width; -1 marks an unused local slot
 };
 
+// One family's local matrices for assemble_symmetric_matrix: stored blocks (layout of
+// BlockSourceFamily), or low-rank factors: local block (a, b) of source s is
+// kernels::low_rank_block(factor_rank, L, R) with L at (s * width + a) * 2 * factor_rank * 3
+// and R = L's position + factor_rank * 3 doubles for the source's local function b
+// (the layout of kernels::shell_edge_factors).
+struct LocalMatrices {
+  const double* values = nullptr;  // null: skip the family
+  int factor_rank = 0;             // 0: stored blocks; > 0 (even): factors of this rank
+};
+
 class BlockAssembly {
  public:
   BlockAssembly() = default;
@@ -33,6 +43,13 @@ class BlockAssembly {
 
   // values: num_blocks x 9. locals[f] points to family f's local blocks, or is null to skip it.
   void assemble_matrix(const std::vector<const double*>& locals, double* values, bool parallel = true) const;
+  // The same sum for a symmetric global matrix (every family's local matrices symmetric):
+  // only blocks with column >= row are summed (same fixed order as assemble_matrix, so
+  // bitwise its values there, up to the diagonal blocks' lower triangles); each entry
+  // below the diagonal is its mirror's value, so the result is exactly symmetric. Half the work of assemble_matrix, and
+  // factored families are never expanded into memory. Throws std::logic_error if the
+  // pattern is not structurally symmetric, std::invalid_argument for a wrong family count.
+  void assemble_symmetric_matrix(const std::vector<LocalMatrices>& locals, double* values, bool parallel = true) const;
   // Node vectors (#nodes x 3) from local vectors (source x width x 3), same order rules.
   void assemble_vector(const std::vector<const double*>& locals, double* out, bool parallel = true) const;
 
@@ -47,6 +64,17 @@ class BlockAssembly {
   std::vector<std::int64_t> contribution_start_;
   std::vector<int> contribution_family_;
   std::vector<std::int64_t> contribution_local_;
+  // assemble_symmetric_matrix's walk: per node row, its entries (family, source s, local
+  // function a with global node = row) in (family, s, a) order, each with the blocks it
+  // adds to in this row's upper part (local function b, block index); and per block the
+  // index of its mirror (col, row). Same summation order per block as assemble_matrix.
+  std::vector<int> family_width_;
+  bool structurally_symmetric_ = true;
+  std::vector<std::int64_t> row_entry_start_, mirror_;
+  std::vector<int> entry_family_, entry_function_;           // family, a
+  std::vector<std::int64_t> entry_source_, entry_target_start_;  // s * width, CSR over targets
+  std::vector<int> target_function_;                         // b
+  std::vector<std::int64_t> target_block_;
   // For each node: contributions to vectors.
   std::vector<std::int64_t> vector_start_;
   std::vector<int> vector_family_;

@@ -216,9 +216,14 @@ class ShellModel {
 
   // Buffers of assemble_stiffness's plain elements and edges, kept between calls (the
   // calls on one instance are not concurrent, see above). A copy starts empty.
+  // Without enrichments and material textures the plain elements read their rest rows from
+  // element_rest_rows and the plain edges are assembled from factors over edge_rest_rows
+  // (kernels::shell_element_stiffness_cached, shell_edge_factors); both filled on first
+  // use, cleared by rebuild.
   struct AssemblyWorkspace {
     std::vector<double> gradients, element_rotations, edge_rotations;
     std::vector<double> element_blocks, edge_blocks, element_forces, edge_forces;
+    std::vector<double> element_rest_rows, edge_rest_rows, edge_factors;
     AssemblyWorkspace() = default;
     AssemblyWorkspace(const AssemblyWorkspace&) {}
     AssemblyWorkspace& operator=(const AssemblyWorkspace&) { return *this; }

@@ -61,6 +61,32 @@ void shell_edge_stiffness_merged(const EdgeBatch& batch, const double* rotations
 // Global nodes of edge e's merged local basis (nodes: room for 2 npe); returns their count.
 int shell_edge_merged_nodes(const EdgeBatch& batch, std::int64_t edge, int* nodes);
 
+// shell_edge_stiffness_merged in factored form, with its rest-geometry part computed once.
+// Per point q the edge stiffness is P G^T + Q M^T (rank 2 over the local basis), with G, M
+// the jump and average-moment rows, which depend on the rest geometry only (the corotation
+// rotates them: R G, R M), and P = ds (penalty G + M), Q = ds G. So:
+//  - shell_edge_rest_rows evaluates, once per model, per (edge e, point q) at
+//    (e nq + q) * shell_edge_rest_row_stride: ds, penalty eta^e D, G (2 npe x 3), M (2 npe x 3)
+//    over the merged basis (slots beyond its count zero);
+//  - shell_edge_factors rotates them per step and writes, per edge (at e *
+//    shell_edge_factor_stride) and merged slot i (at i * 2 rank * 3), the left factor
+//    L_i = [P_0, Q_0, P_1, Q_1, ...] (rank = 2 nq 3-vectors) and then the right factor
+//    R_i = [G_0, M_0, G_1, M_1, ...]; local block (i, j) = low_rank_block(rank, L_i, R_j)
+//    (dgtex/kernels/low_rank_block.h), bitwise shell_edge_stiffness_merged's block. Forces
+//    as shell_edge_stiffness_merged's, bitwise. ~5x less output than the 13 x 13 blocks.
+// Slots at or beyond an edge's merged count are not written.
+inline int shell_edge_factor_rank(const EdgeBatch& batch) { return 2 * batch.quadrature_points; }
+std::int64_t shell_edge_rest_row_stride(const EdgeBatch& batch);  // doubles per edge point
+std::int64_t shell_edge_factor_stride(const EdgeBatch& batch);    // doubles per edge
+void shell_edge_rest_rows(const EdgeBatch& batch, double* rest_rows, Execution execution = Execution::parallel);
+void shell_edge_factors(const EdgeBatch& batch, const double* rest_rows, const double* rotations, double* factors,
+                        double* forces, Execution execution = Execution::parallel);
+// The serial reference form of shell_edge_factors: rest rows evaluated per edge as it goes
+// (no cache); bitwise equal to shell_edge_rest_rows + shell_edge_factors.
+void shell_edge_factors_reference(const EdgeBatch& batch, const double* rotations, double* factors, double* forces);
+// Expands factors into shell_edge_stiffness_merged's block layout (merged slots only).
+void shell_edge_blocks_from_factors(const EdgeBatch& batch, const double* factors, double* blocks);
+
 // The plain serial reference form of shell_edge_stiffness (per point, block by block);
 // equal to it to round-off (~1e-15 relative), not bitwise.
 void shell_edge_stiffness_reference(const EdgeBatch& batch, const double* rotations, double* blocks, double* forces);

@@ -39,6 +39,16 @@ struct ElementBatch {
 void shell_element_stiffness(const ElementBatch& batch, const double* rotations, double* blocks, double* forces,
                              Execution execution = Execution::parallel);
 
+// shell_element_stiffness with its rest-geometry part evaluated once: shell_element_rest_rows
+// writes per (element e, point q), at (e nq + q) * shell_element_rest_row_stride, the weight
+// w j0 and the membrane then bending rows of every basis function (npe x 9 each, the
+// unrotated B of report eqs. 32-33); shell_element_stiffness_cached reads them instead of
+// evaluating the geometry, and is bitwise shell_element_stiffness (same arithmetic).
+std::int64_t shell_element_rest_row_stride(const ElementBatch& batch);  // doubles per point
+void shell_element_rest_rows(const ElementBatch& batch, double* rest_rows, Execution execution = Execution::parallel);
+void shell_element_stiffness_cached(const ElementBatch& batch, const double* rest_rows, const double* rotations,
+                                    double* blocks, double* forces, Execution execution = Execution::parallel);
+
 // The plain serial reference form of shell_element_stiffness (per point, block by block,
 // as the report writes it); equal to it to round-off (~1e-15 relative), not bitwise.
 void shell_element_stiffness_reference(const ElementBatch& batch, const double* rotations, double* blocks,
