@@ -73,7 +73,7 @@ FactorReusingSolver::FactorReusingSolver(const BlockAssembly& pattern, const Fre
 void FactorReusingSolver::set_options(const FactorReuseOptions& options) {
   const bool element_local = options.preconditioner_pattern == PreconditionerPattern::element_local &&
                              element_local_differs_ && stats_.element_local_fallbacks == 0;
-  if (element_local != use_element_local_) factor_current_ = false;
+  if (element_local != use_element_local_) factor_current_ = false, factorization_pending_ = false;
   use_element_local_ = element_local;
   options_ = options;
 }
@@ -85,32 +85,52 @@ void FactorReusingSolver::fall_back_to_full_pattern() {
   element_local_factor_.reset();
 }
 
+void FactorReusingSolver::gather_element_local(const ScaledBlockSum& A) {
+  if (!element_local_system_) {
+    std::vector<char> fixed(free_.size());
+    for (size_t d = 0; d < free_.size(); ++d) fixed[d] = !free_[d];
+    element_local_system_ = std::make_unique<FreeDofSystem>(pattern_, fixed, &element_local_blocks_);
+  }
+  element_local_system_->gather(mass_.data(), A.mass_scale, A.stiffness->data(), A.stiffness_scale, values_);
+}
+
+void FactorReusingSolver::factorize_element_local_values() {
+  if (!element_local_factor_) element_local_factor_ = std::make_unique<SparseCholesky>();
+  if (!element_local_factor_->analyzed())
+    element_local_factor_->analyze(element_local_system_->size(), element_local_system_->column_start(),
+                                   element_local_system_->row_index());
+  try {
+    element_local_factor_->factorize(values_);
+  } catch (const NotPositiveDefinite&) {
+    fall_back_to_full_pattern();  // the dropped couplings were needed: A itself is checked next
+    return;
+  }
+  if (options_.single_precision_preconditioner) element_local_factor_->copy_factor_to_single_precision();
+}
+
+void FactorReusingSolver::factorize_pending() {
+  if (!factorization_pending_) return;
+  factorization_pending_ = false;
+  const auto start = std::chrono::steady_clock::now();
+  factorize_element_local_values();
+  stats_.factorize_ms += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  if (!use_element_local_) return;  // fell back: the next solve factorises the whole pattern
+  factor_current_ = true;
+  ++stats_.factorizations;
+}
+
 void FactorReusingSolver::factorize(const ScaledBlockSum& A, SparseCholesky& cholesky) {
   const auto start = std::chrono::steady_clock::now();
   if (use_element_local_) {
-    if (!element_local_system_) {
-      std::vector<char> fixed(free_.size());
-      for (size_t d = 0; d < free_.size(); ++d) fixed[d] = !free_[d];
-      element_local_system_ = std::make_unique<FreeDofSystem>(pattern_, fixed, &element_local_blocks_);
-    }
-    if (!element_local_factor_) element_local_factor_ = std::make_unique<SparseCholesky>();
-    element_local_system_->gather(mass_.data(), A.mass_scale, A.stiffness->data(), A.stiffness_scale, values_);
-    if (!element_local_factor_->analyzed())
-      element_local_factor_->analyze(element_local_system_->size(), element_local_system_->column_start(),
-                                     element_local_system_->row_index());
-    try {
-      element_local_factor_->factorize(values_);
-    } catch (const NotPositiveDefinite&) {
-      fall_back_to_full_pattern();  // the dropped couplings were needed: A itself is checked below
-    }
+    gather_element_local(A);
+    factorize_element_local_values();
   }
-  SparseCholesky& factor = use_element_local_ ? *element_local_factor_ : cholesky;
   if (!use_element_local_) {
     system_.gather(mass_.data(), A.mass_scale, A.stiffness->data(), A.stiffness_scale, values_);
     if (!cholesky.analyzed()) cholesky.analyze(system_.size(), system_.column_start(), system_.row_index());
     cholesky.factorize(values_);
+    if (options_.single_precision_preconditioner) cholesky.copy_factor_to_single_precision();
   }
-  if (options_.single_precision_preconditioner) factor.copy_factor_to_single_precision();
   stats_.factorize_ms += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   factor_current_ = true;
   ++stats_.factorizations;
@@ -238,6 +258,7 @@ void FactorReusingSolver::solve(const ScaledBlockSum& A, const std::vector<doubl
     stats_.last_relative_residual = 0;
     return;
   }
+  factorize_pending();  // if the caller did not run it beside its assembly
   const bool fresh = !factor_current_;
   if (fresh) factorize(A, cholesky);
   guess_ = x;
@@ -264,7 +285,14 @@ void FactorReusingSolver::solve(const ScaledBlockSum& A, const std::vector<doubl
                              std::to_string(options_.relative_tolerance) + " even with a fresh factor (residual " +
                              std::to_string(residual) + "); the system is ill-conditioned");
   // Judged by the factor now held (a fresh one after a failed attempt).
-  if (iterations > options_.refactor_after_iterations) factor_current_ = false;
+  if (iterations > options_.refactor_after_iterations) {
+    if (use_element_local_ && options_.overlap_factorization) {
+      gather_element_local(A);  // A_k now: the caller overwrites its K before the next solve
+      factorization_pending_ = true;
+    } else {
+      factor_current_ = false;
+    }
+  }
   iterations += wasted;
   stats_.iterations += iterations;
   stats_.last_iterations = iterations;

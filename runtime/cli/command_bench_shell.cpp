@@ -83,6 +83,9 @@ int bench_shell_command(int argc, char** argv) {
                  "pattern of the PCG preconditioner's factor: element_local (the default) or full")
       ->capture_default_str()
       ->check(CLI::IsMember({"element_local", "full"}));
+  bool synchronous_factorization = false;
+  app.add_flag("--synchronous-factorization", synchronous_factorization,
+               "factorise a stale preconditioner at the start of the next solve instead of beside the next assembly");
   app.add_flag("--refactor-every-step", refactor_every_step,
                "reference solver path: factorise the corotated matrix every step (no PCG)");
   std::string wait_policy = "passive";
@@ -98,6 +101,7 @@ int bench_shell_command(int argc, char** argv) {
   }
   solver.preconditioner_pattern =
       preconditioner == "full" ? PreconditionerPattern::full : PreconditionerPattern::element_local;
+  solver.overlap_factorization = !synchronous_factorization;
   // libgomp reads OMP_WAIT_POLICY once, when it loads: to change it, run again under it.
   const char* current_policy = std::getenv("OMP_WAIT_POLICY");
   if (wait_policy != "inherit" && (!current_policy || wait_policy != current_policy)) {
@@ -182,6 +186,7 @@ int bench_shell_command(int argc, char** argv) {
                             {"omp_wait_policy", std::getenv("OMP_WAIT_POLICY") ? std::getenv("OMP_WAIT_POLICY") : "default"},
                             {"refactor_after_iterations", solver.refactor_after_iterations},
                             {"preconditioner", preconditioner},
+                            {"overlap_factorization", solver.overlap_factorization},
                             {"counts", {{"elements", first.elements}, {"nodes", first.nodes}, {"free_dofs", first.free_dofs},
                                         {"quadrature_points", first.quadrature_points},
                                         {"factor_nonzeros", first.factor_nonzeros}}},

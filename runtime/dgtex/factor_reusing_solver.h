@@ -27,7 +27,10 @@
 // factorised and PCG restarts from the same guess; if a fresh element-local factor does
 // not suffice either, the whole pattern of A_k is.
 // Refactorisation happens when a solve took more than `refactor_after_iterations`
-// iterations (the next system is factorised) or did not converge in `max_iterations`.
+// iterations or did not converge in `max_iterations` (then A_k at once). In the first case
+// the element-local matrix of A_k itself is factorised while the caller assembles A_k+1
+// (FactorReuseOptions::overlap_factorization, factorize_pending()): CHOLMOD factorises on
+// one core, and the serial wait for it was ~5 ms of the cylinder scene's ~26 ms step.
 //
 // Determinism: the factor (CHOLMOD with serial BLAS), the block matrix-vector product
 // and the dot products (fixed chunking, summed in a fixed order) do not depend on the
@@ -69,6 +72,12 @@ struct FactorReuseOptions {
   // arithmetic stays in double, only the preconditioner is approximated further).
   bool single_precision_preconditioner = true;
   PreconditionerPattern preconditioner_pattern = PreconditionerPattern::element_local;
+  // Element-local only: a solve slower than refactor_after_iterations gathers its own matrix
+  // A_k and leaves its factorisation pending, to be run by factorize_pending() while the
+  // caller assembles the next matrix (on a thread of its own: CHOLMOD runs on one core),
+  // or else at the start of the next solve. That solve then starts from a factor one step
+  // old, judged like any reused factor. false: the next solve factorises its own A_k+1.
+  bool overlap_factorization = true;
 };
 
 struct FactorReuseStatistics {
@@ -113,7 +122,17 @@ class FactorReusingSolver {
   void multiply_mass(const std::vector<double>& x, std::vector<double>& y) const;
 
   // Forces a factorisation at the next solve (e.g. the matrix changed abruptly).
-  void invalidate() { factor_current_ = false; }
+  void invalidate() {
+    factor_current_ = false;
+    factorization_pending_ = false;
+  }
+  // A factorisation left for factorize_pending() (options().overlap_factorization).
+  bool factorization_pending() const { return factorization_pending_; }
+  // Factorises the matrix gathered by the last solve, if one is pending. Needs no OpenMP
+  // team (CHOLMOD with serial BLAS): safe to run beside code that touches neither this
+  // solver nor CHOLMOD. An element-local matrix that is not positive definite switches to
+  // the whole pattern (then the next solve factorises its own matrix).
+  void factorize_pending();
   // True while the preconditioner is the element-local factor (no fallback happened).
   bool element_local() const { return use_element_local_; }
   // Non-zeros of the element-local factor L (0 before its first factorisation).
@@ -133,6 +152,7 @@ class FactorReusingSolver {
   FactorReuseOptions options_;
   FactorReuseStatistics stats_;
   bool factor_current_ = false;  // cholesky holds a factor of some earlier A
+  bool factorization_pending_ = false;  // values_ holds an element-local A to factorise
   std::vector<double> values_, r_, z_, p_, q_, reduced_in_, reduced_out_, b_free_, guess_;
   std::vector<char> free_;
   // Element-local preconditioner: the blocks it keeps, its system and factor (built on
@@ -146,6 +166,10 @@ class FactorReusingSolver {
   // Factorises A (element-local, or the whole pattern into `cholesky`); an element-local
   // matrix that is not positive definite switches to the whole pattern.
   void factorize(const ScaledBlockSum& A, SparseCholesky& cholesky);
+  // The element-local matrix of A into values_ (its system built on first use).
+  void gather_element_local(const ScaledBlockSum& A);
+  // Numeric factorisation of values_ into the element-local factor (+ float copy).
+  void factorize_element_local_values();
   void fall_back_to_full_pattern();
   void precondition(const SparseCholesky& cholesky, const std::vector<double>& r, std::vector<double>& z);
   // y = A x over free DOFs (fixed entries of y set to zero).

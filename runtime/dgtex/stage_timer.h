@@ -36,13 +36,14 @@ struct StageStatistics {
 
 using StageTimings = std::map<std::string, StageStatistics>;
 
-// Adds the time from construction to destruction to one stage.
+// Adds the time from construction to destruction (plus earlier_ms, time of this stage
+// spent before, e.g. waiting in a concurrent section) to one stage.
 class ScopedStage {
  public:
-  ScopedStage(StageTimings& timings, const std::string& stage)
-      : stats_(timings[stage]), start_(std::chrono::steady_clock::now()) {}
+  ScopedStage(StageTimings& timings, const std::string& stage, double earlier_ms = 0)
+      : stats_(timings[stage]), start_(std::chrono::steady_clock::now()), earlier_ms_(earlier_ms) {}
   ~ScopedStage() {
-    stats_.add(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start_).count());
+    stats_.add(earlier_ms_ + std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start_).count());
   }
   ScopedStage(const ScopedStage&) = delete;
   ScopedStage& operator=(const ScopedStage&) = delete;
@@ -50,6 +51,7 @@ class ScopedStage {
  private:
   StageStatistics& stats_;
   std::chrono::steady_clock::time_point start_;
+  double earlier_ms_;
 };
 
 }  // namespace dgtex
