@@ -61,20 +61,8 @@ void element_stiffness(const PointSectionBatch& b, std::int64_t e, const double*
     const double dm = bending_rigidity(sec.youngs_modulus, nu, sec.thickness);
     ShapeValues s;
     evaluate_shape(b.type, pt[0], pt[1], s);
-    RestPoint p;
-    evaluate_rest_point(s, nodes, b.positions, p);
-    double e1[3], e2[3];
-    frame_along(p, p.a1, e1, e2);
-    const double w = pt[2] * p.j0;
     double Bm[max_element_nodes][9], Bb[max_element_nodes][9];
-    fast_rows::PointFrame frame;
-    fast_rows::make_point_frame(p, e1, e2, frame);
-    for (int a = 0; a < npe; ++a) {
-      double T[9];
-      fast_rows::membrane(frame, s.dN[a], Bm[a]);
-      fast_rows::normal_change(p, frame, s.dN[a], T);
-      fast_rows::bending(p, frame, s.d2N[a], T, Bb[a]);
-    }
+    const double w = pt[2] * fast_rows::rest_strain_rows(s, nodes, b.positions, npe, Bm, Bb);
     const double* R = rotations ? rotations + q * 9 : nullptr;
     if (R && f) {
       // Corrective term: B^T D B (X0 - R^T X0), B rotated afterwards (eq. 48).

@@ -145,6 +145,20 @@ void edge_point_rows(const EdgeBatch& b, const EdgeRuleShapes& shapes, std::int6
   }
 }
 
+// G . d and M . d over the edge's local basis for d = X0 - R^T X0 (the rest positions minus
+// their rotation): the corotational corrective force's projections.
+void corrective_projections(const EdgeBatch& b, const EdgeBasis& basis, const double* R, const double (*G)[3],
+                            const double (*M)[3], double& gd, double& md) {
+  for (int i = 0; i < basis.count; ++i) {
+    const double* x = b.positions + 3 * static_cast<long>(basis.node[i]);
+    for (int k = 0; k < 3; ++k) {
+      const double d = x[k] - (R[0 * 3 + k] * x[0] + R[1 * 3 + k] * x[1] + R[2 * 3 + k] * x[2]);
+      gd += G[i][k] * d;
+      md += M[i][k] * d;
+    }
+  }
+}
+
 // K = sum over points of ds (penalty G G^T + M G^T + G M^T) with G, M the rows of the jump
 // and the average moment over the edge's local basis, evaluated as P G^T + Q M^T per point
 // (P = ds (penalty G + M), Q = ds G; rows stacked as Ls = [P; Q], Rs = [G; M]): 2 nq (3n)^2
@@ -174,16 +188,7 @@ void edge_stiffness(const EdgeBatch& b, const EdgeRuleShapes& shapes, std::int64
     edge_point_rows(b, shapes, e, basis, co, q, ds, G, M);
     const double* R = rotations ? rotations + (e * rule.count + q) * 9 : nullptr;
     double gd = 0, md = 0;  // G . d and M . d for the corrective force, d = X0 - R^T X0
-    if (R && f) {
-      for (int i = 0; i < n; ++i) {
-        const double* x = b.positions + 3 * static_cast<long>(basis.node[i]);
-        for (int k = 0; k < 3; ++k) {
-          const double d = x[k] - (R[0 * 3 + k] * x[0] + R[1 * 3 + k] * x[1] + R[2 * 3 + k] * x[2]);
-          gd += G[i][k] * d;
-          md += M[i][k] * d;
-        }
-      }
-    }
+    if (R && f) corrective_projections(b, basis, R, G, M, gd, md);
     if (R) {
       for (int i = 0; i < n; ++i) {
         double g2[3], m2[3];
@@ -274,16 +279,7 @@ void edge_factors(const EdgeBatch& b, std::int64_t e, const double* rows, const 
     const double (*M)[3] = reinterpret_cast<const double (*)[3]>(row + 2 + 3 * nb);
     const double* R = rotations ? rotations + (e * nq + q) * 9 : nullptr;
     double gd = 0, md = 0;  // G . d and M . d for the corrective force, d = X0 - R^T X0
-    if (R && f) {
-      for (int i = 0; i < n; ++i) {
-        const double* x = b.positions + 3 * static_cast<long>(basis.node[i]);
-        for (int k = 0; k < 3; ++k) {
-          const double d = x[k] - (R[0 * 3 + k] * x[0] + R[1 * 3 + k] * x[1] + R[2 * 3 + k] * x[2]);
-          gd += G[i][k] * d;
-          md += M[i][k] * d;
-        }
-      }
-    }
+    if (R && f) corrective_projections(b, basis, R, G, M, gd, md);
     for (int i = 0; i < n; ++i) {
       double g[3], m[3];
       for (int c = 0; c < 3; ++c) {

@@ -53,20 +53,8 @@ struct ElementRuleShapes {
 void element_point_rows(const ElementBatch& b, const ElementRuleShapes& shapes, std::int64_t e, int q, double& w,
                         double (*Bm)[9], double (*Bb)[9]) {
   const int npe = nodes_per_element(b.type);
-  const ShapeValues& s = shapes.shape[q];
-  RestPoint p;
-  evaluate_rest_point(s, b.connectivity + e * npe, b.positions, p);
-  double e1[3], e2[3];
-  frame_along(p, p.a1, e1, e2);
-  w = shapes.rule.weight[q] * p.j0;
-  fast_rows::PointFrame frame;
-  fast_rows::make_point_frame(p, e1, e2, frame);
-  for (int a = 0; a < npe; ++a) {
-    double T[9];
-    fast_rows::membrane(frame, s.dN[a], Bm[a]);
-    fast_rows::normal_change(p, frame, s.dN[a], T);
-    fast_rows::bending(p, frame, s.d2N[a], T, Bb[a]);
-  }
+  const double j0 = fast_rows::rest_strain_rows(shapes.shape[q], b.connectivity + e * npe, b.positions, npe, Bm, Bb);
+  w = shapes.rule.weight[q] * j0;
 }
 
 // Stiffness of element e; its rest rows come from `rest_rows` (the layout of

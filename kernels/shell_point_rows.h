@@ -135,4 +135,24 @@ __attribute__((always_inline)) inline void symmetric_stacked_product(int n, int 
   }
 }
 
+// Membrane and bending rows Bm, Bb of every basis function at a rest point (shape values s
+// over the element's nodes), in the point's frame along a1; returns the area element j0.
+// Depends on the rest geometry only.
+inline double rest_strain_rows(const ShapeValues& s, const int* nodes, const double* X, int npe, double (*Bm)[9],
+                               double (*Bb)[9]) {
+  RestPoint p;
+  evaluate_rest_point(s, nodes, X, p);
+  double e1[3], e2[3];
+  frame_along(p, p.a1, e1, e2);
+  PointFrame frame;
+  make_point_frame(p, e1, e2, frame);
+  for (int a = 0; a < npe; ++a) {
+    double T[9];
+    membrane(frame, s.dN[a], Bm[a]);
+    normal_change(p, frame, s.dN[a], T);
+    bending(p, frame, s.d2N[a], T, Bb[a]);
+  }
+  return p.j0;
+}
+
 }  // namespace dgtex::kernels::fast_rows

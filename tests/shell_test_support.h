@@ -1,7 +1,11 @@
 #pragma once
 // Small builders shared by the shell mechanics tests.
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
 #include <functional>
 #include <memory>
+#include <random>
 #include <vector>
 
 #include "dgtex/mesh_generators.h"
@@ -40,6 +44,25 @@ inline void fix_nodes(const Mesh& mesh, const NodePredicate& where, bool x, bool
     if (where(mesh.node(n)))
       for (int c = 0; c < 3; ++c)
         if (comp[c]) fixed[3 * n + c] = 1;
+}
+
+// count proper rotations (3x3, row-major), uniformly random (normalised Gaussian quaternions),
+// reproducible from the seed: the kernels take any R per point.
+inline std::vector<double> random_rotations(std::int64_t count, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::normal_distribution<double> normal;
+  std::vector<double> R(static_cast<std::size_t>(count) * 9);
+  for (std::int64_t i = 0; i < count; ++i) {
+    double q[4], n2 = 0;
+    for (double& c : q) c = normal(rng), n2 += c * c;
+    for (double& c : q) c /= std::sqrt(n2);
+    const double w = q[0], x = q[1], y = q[2], z = q[3];
+    const double m[9] = {1 - 2 * (y * y + z * z), 2 * (x * y - w * z),     2 * (x * z + w * y),
+                         2 * (x * y + w * z),     1 - 2 * (x * x + z * z), 2 * (y * z - w * x),
+                         2 * (x * z - w * y),     2 * (y * z + w * x),     1 - 2 * (x * x + y * y)};
+    std::copy(m, m + 9, R.begin() + 9 * i);
+  }
+  return R;
 }
 
 }  // namespace dgtex::testing_support

@@ -26,23 +26,6 @@ using kernels::Execution;
 
 namespace {
 
-std::vector<double> random_rotations(std::int64_t count, unsigned seed) {
-  std::mt19937 rng(seed);
-  std::normal_distribution<double> normal;
-  std::vector<double> R(count * 9);
-  for (std::int64_t i = 0; i < count; ++i) {
-    double q[4], n2 = 0;
-    for (double& c : q) c = normal(rng), n2 += c * c;
-    for (double& c : q) c /= std::sqrt(n2);
-    const double w = q[0], x = q[1], y = q[2], z = q[3];
-    const double m[9] = {1 - 2 * (y * y + z * z), 2 * (x * y - w * z),     2 * (x * z + w * y),
-                         2 * (x * y + w * z),     1 - 2 * (x * x + z * z), 2 * (y * z - w * x),
-                         2 * (x * z - w * y),     2 * (y * z + w * x),     1 - 2 * (x * x + y * y)};
-    std::copy(m, m + 9, R.begin() + 9 * i);
-  }
-  return R;
-}
-
 class EdgeFactors : public ::testing::TestWithParam<ElementType> {};
 
 TEST_P(EdgeFactors, ProductsAreTheMergedKernelsBlocksAndParallelIsTheReference) {

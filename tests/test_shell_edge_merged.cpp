@@ -6,14 +6,15 @@
 
 #include <cmath>
 #include <map>
-#include <random>
 #include <vector>
 
 #include "dgtex/kernels/shell_edge_kernel.h"
 #include "dgtex/mesh_generators.h"
 #include "dgtex/topology.h"
+#include "shell_test_support.h"
 
 using namespace dgtex;
+using testing_support::random_rotations;
 using kernels::ElementType;
 using kernels::Execution;
 
@@ -40,19 +41,7 @@ TEST_P(MergedEdges, MatchReferenceSummedOverSharedNodes) {
                                  10.0, 3, mesh.elements.data(), mesh.positions.data(), sections.data(), false};
   const int npe = mesh.nodes_per_element(), nb = 2 * npe, nq = 3;
   // Rotations: random proper rotations per edge point (the kernels take any R).
-  std::mt19937 rng(3);
-  std::normal_distribution<double> normal;
-  std::vector<double> R(batch.count * nq * 9);
-  for (std::int64_t i = 0; i < batch.count * nq; ++i) {
-    double q[4], n2 = 0;
-    for (double& c : q) c = normal(rng), n2 += c * c;
-    for (double& c : q) c /= std::sqrt(n2);
-    const double w = q[0], x = q[1], y = q[2], z = q[3];
-    const double m[9] = {1 - 2 * (y * y + z * z), 2 * (x * y - w * z),     2 * (x * z + w * y),
-                         2 * (x * y + w * z),     1 - 2 * (x * x + z * z), 2 * (y * z - w * x),
-                         2 * (x * z - w * y),     2 * (y * z + w * x),     1 - 2 * (x * x + y * y)};
-    std::copy(m, m + 9, R.begin() + 9 * i);
-  }
+  const std::vector<double> R = random_rotations(batch.count * nq, 3);
   std::vector<double> Kref(batch.count * nb * nb * 9), fref(batch.count * nb * 3);
   kernels::shell_edge_stiffness_reference(batch, R.data(), Kref.data(), fref.data());
   std::vector<double> K(Kref.size(), 0.0), f(fref.size(), 0.0), Kpar(Kref.size(), 0.0), fpar(fref.size(), 0.0);

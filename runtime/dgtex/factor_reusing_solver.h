@@ -30,7 +30,7 @@
 // iterations or did not converge in `max_iterations` (then A_k at once). In the first case
 // the element-local matrix of A_k itself is factorised while the caller assembles A_k+1
 // (FactorReuseOptions::overlap_factorization, factorize_pending()): CHOLMOD factorises on
-// one core, and the serial wait for it was ~5 ms of the cylinder scene's ~26 ms step.
+// one core, and waiting for it cost ~4 ms of the cylinder scene's ~22 ms step (2 threads).
 //
 // Determinism: the factor (CHOLMOD with serial BLAS), the block matrix-vector product
 // and the dot products (fixed chunking, summed in a fixed order) do not depend on the
