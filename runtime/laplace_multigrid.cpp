@@ -37,7 +37,7 @@
 //   only way to 0.1 per cycle on spiral and chad while coarse interpolation lost energy at
 //   wall corners (13-22 iterations); since interpolation is built from the lumped 5-point
 //   stencil (multigrid_galerkin.h) the plain cycle needs 6-7 there, so the robust cycle only
-//   adds cost (spiral T=512, 2 threads: 36-39 ms plain). Kept as an option and tested.
+//   adds cost (spiral T=512: 6 plain iterations, 18.7 ms with 2 threads). Kept as an option.
 // - Setup: components by union-find over texel runs instead of a per-texel flood fill
 //   (T=1024: ~100 -> ~23 ms), Galerkin products unrolled at compile time (T=1024 level 0:
 //   60-100 -> ~10 ms), dense Cholesky for coarsest levels up to 400 unknowns (CHOLMOD's
@@ -63,8 +63,8 @@
 //   (see parallel_min_nodes): open T = 256 7.0 -> 4.4 ms, T = 512 20.7 -> 19.3 ms (idle
 //   machine, 2 threads). Not with the default policy: on a loaded machine (other processes
 //   on both cores) every barrier can wait a time slice, and 2-thread T = 256 solves took
-//   0.2 -> 5 s. Measured and not done (time): float cycle as CG preconditioner, F-cycle /
-//   nested-iteration start, one parallel region per cycle.
+//   0.2 -> 5 s. Not done: a float cycle as CG preconditioner (half the traffic at T = 1024),
+//   an F-cycle / nested-iteration start, one parallel region per cycle.
 namespace dgtex {
 using kernels::Execution;
 using kernels::GridShape;
