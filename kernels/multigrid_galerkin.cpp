@@ -17,11 +17,12 @@ struct TexelOperator {
   }
 };
 
-// Entry of a symmetric 9-point operator (multigrid_grid.h).
+// Entry of a symmetric 9-point operator (multigrid_grid.h), in double or float.
+template <class Real>
 struct Stencil9Operator {
-  Stencil9View a;
+  Stencil9ViewOf<Real> a;
   std::int64_t s;
-  double operator()(std::int64_t t, int dx, int dy) const {
+  [[gnu::always_inline]] double operator()(std::int64_t t, int dx, int dy) const {
     switch ((dx + 1) + 3 * (dy + 1)) {
       case 0: return a.ne[t - s - 1];  // south-west
       case 1: return a.n[t - s];       // south
@@ -40,9 +41,12 @@ struct Stencil9Operator {
 // each diagonal coupling goes half to each of the two axis neighbours next to it that the
 // node couples to, all to the one if only one is coupled, and to the centre if neither is
 // (row sums are kept). A zero axis coupling (a wall) stays exactly zero.
+// always_inline (also Stencil9Operator): GCC did not inline the float instantiation into
+// build_interpolation (open T = 1024 setup +3 ms, 1 thread).
+template <class Real>
 struct LumpedStencil9Operator {
-  Stencil9Operator a;
-  double operator()(std::int64_t t, int dx, int dy) const {
+  Stencil9Operator<Real> a;
+  [[gnu::always_inline]] double operator()(std::int64_t t, int dx, int dy) const {
     if (dx == 0 && dy == 0) {
       double centre = a(t, 0, 0);
       for (int ey = -1; ey <= 1; ey += 2)
@@ -70,8 +74,9 @@ inline double weight(double numerator, double denominator, double diagonal) {
 }
 
 // Black-box interpolation for a 5-point operator a(t, dx, dy) (centre and axis entries).
-template <class Operator>
-void build_interpolation(GridShape fine, const Operator& a, InterpolationArrays p, Execution execution) {
+// Weights are formed in double and stored as Real (pass 2 reads the stored pass-1 weights).
+template <class Operator, class Real>
+void build_interpolation(GridShape fine, const Operator& a, InterpolationArraysOf<Real> p, Execution execution) {
   const GridShape coarse = fine.coarser();
   const std::int64_t cs = coarse.stride();
   // Pass 1: fine nodes on coarse grid lines, from the stencil collapsed across the line.
@@ -81,18 +86,18 @@ void build_interpolation(GridShape fine, const Operator& a, InterpolationArrays 
         const int J = static_cast<int>(J64);
         for (int I = 0; I < coarse.nx; ++I) {
           const std::int64_t c = coarse.at(I, J);
-          p.xw[c] = p.xe[c] = p.ys[c] = p.yn[c] = 0.0;
+          p.xw[c] = p.xe[c] = p.ys[c] = p.yn[c] = Real(0);
           if (2 * I + 1 < fine.nx) {
             const std::int64_t f = fine.at(2 * I + 1, 2 * J);
             const double diagonal = a(f, 0, 0), centre = diagonal + a(f, 0, -1) + a(f, 0, 1);
-            p.xw[c] = weight(a(f, -1, 0), centre, diagonal);
-            p.xe[c] = weight(a(f, 1, 0), centre, diagonal);
+            p.xw[c] = static_cast<Real>(weight(a(f, -1, 0), centre, diagonal));
+            p.xe[c] = static_cast<Real>(weight(a(f, 1, 0), centre, diagonal));
           }
           if (2 * J + 1 < fine.ny) {
             const std::int64_t f = fine.at(2 * I, 2 * J + 1);
             const double diagonal = a(f, 0, 0), centre = diagonal + a(f, -1, 0) + a(f, 1, 0);
-            p.ys[c] = weight(a(f, 0, -1), centre, diagonal);
-            p.yn[c] = weight(a(f, 0, 1), centre, diagonal);
+            p.ys[c] = static_cast<Real>(weight(a(f, 0, -1), centre, diagonal));
+            p.yn[c] = static_cast<Real>(weight(a(f, 0, 1), centre, diagonal));
           }
         }
       },
@@ -104,16 +109,16 @@ void build_interpolation(GridShape fine, const Operator& a, InterpolationArrays 
         const int J = static_cast<int>(J64);
         for (int I = 0; I < coarse.nx; ++I) {
           const std::int64_t c = coarse.at(I, J);
-          p.sw[c] = p.se[c] = p.nw[c] = p.ne[c] = 0.0;
+          p.sw[c] = p.se[c] = p.nw[c] = p.ne[c] = Real(0);
           if (2 * I + 1 >= fine.nx || 2 * J + 1 >= fine.ny) continue;
           const std::int64_t f = fine.at(2 * I + 1, 2 * J + 1);
           const double d = a(f, 0, 0);
           if (!(d > 0)) continue;
           const double as = a(f, 0, -1), an = a(f, 0, 1), aw = a(f, -1, 0), ae = a(f, 1, 0);
-          p.sw[c] = -(as * p.xw[c] + aw * p.ys[c]) / d;
-          p.se[c] = -(as * p.xe[c] + ae * p.ys[c + 1]) / d;
-          p.nw[c] = -(an * p.xw[c + cs] + aw * p.yn[c]) / d;
-          p.ne[c] = -(an * p.xe[c + cs] + ae * p.yn[c + 1]) / d;
+          p.sw[c] = static_cast<Real>(-(as * p.xw[c] + aw * p.ys[c]) / d);
+          p.se[c] = static_cast<Real>(-(as * p.xe[c] + ae * p.ys[c + 1]) / d);
+          p.nw[c] = static_cast<Real>(-(an * p.xw[c + cs] + aw * p.yn[c]) / d);
+          p.ne[c] = static_cast<Real>(-(an * p.xe[c + cs] + ae * p.yn[c + 1]) / d);
         }
       },
       execution);
@@ -138,8 +143,9 @@ struct TexelEntries {
     else return (m & couples_north_unknown) ? -1.0 : 0.0;
   }
 };
+template <class Real>
 struct Stencil9Entries {
-  Stencil9View a;
+  Stencil9ViewOf<Real> a;
   std::int64_t s;
   template <int OX, int OY>
   static constexpr bool couples = true;
@@ -161,10 +167,10 @@ struct Stencil9Entries {
 // The Galerkin row of one coarse node C = (I, J): acc[dJ + 1][dI + 1] accumulates
 // (P^T A P)(C, (I + dI, J + dJ)). Every offset is a template argument, so the 9 x 9 x 4
 // loop nest of the definition unrolls into straight-line code (no parity switches).
-template <class Entries>
+template <class Entries, class Real>
 struct GalerkinRow {
   const Entries& a;
-  const InterpolationView& p;
+  const InterpolationViewOf<Real>& p;
   std::int64_t c, cs, f0, fs;  // coarse index and stride, fine index of (2I, 2J) and stride
   double acc[3][3] = {};
 
@@ -194,7 +200,7 @@ struct GalerkinRow {
   template <int DI, int DJ>
   double column() const {
     if constexpr (DJ == -1) return DI == -1 ? p.ne[c - cs - 1] : DI == 0 ? p.yn[c - cs] : p.nw[c - cs];
-    else if constexpr (DJ == 0) return DI == -1 ? p.xe[c - 1] : DI == 0 ? 1.0 : p.xw[c];
+    else if constexpr (DJ == 0) return DI == -1 ? p.xe[c - 1] : DI == 0 ? Real(1) : p.xw[c];
     else return DI == -1 ? p.se[c - 1] : DI == 0 ? p.ys[c] : p.sw[c];
   }
 
@@ -226,8 +232,10 @@ struct GalerkinRow {
 
 // Fine nodes outside the fine grid have P(f, C) = 0 (the interpolation arrays hold 0 there
 // and at ghosts), and ghost operator entries are 0, so no bounds checks are needed.
-template <class Entries>
-void galerkin(GridShape fine, const Entries& a, InterpolationView p, Stencil9Arrays out, Execution execution) {
+// Sums in double, stored as Real.
+template <class Entries, class Real>
+void galerkin(GridShape fine, const Entries& a, InterpolationViewOf<Real> p, Stencil9ArraysOf<Real> out,
+              Execution execution) {
   const GridShape coarse = fine.coarser();
   const std::int64_t cs = coarse.stride(), fs = fine.stride();
   forall(
@@ -236,13 +244,13 @@ void galerkin(GridShape fine, const Entries& a, InterpolationView p, Stencil9Arr
         const int J = static_cast<int>(J64);
         for (int I = 0; I < coarse.nx; ++I) {
           const std::int64_t c = coarse.at(I, J);
-          GalerkinRow<Entries> row{a, p, c, cs, fine.at(2 * I, 2 * J), fs};
+          GalerkinRow<Entries, Real> row{a, p, c, cs, fine.at(2 * I, 2 * J), fs};
           row.run();
-          out.c[c] = row.acc[1][1];
-          out.e[c] = row.acc[1][2];
-          out.n[c] = row.acc[2][1];
-          out.ne[c] = row.acc[2][2];
-          out.nw[c] = row.acc[2][0];
+          out.c[c] = static_cast<Real>(row.acc[1][1]);
+          out.e[c] = static_cast<Real>(row.acc[1][2]);
+          out.n[c] = static_cast<Real>(row.acc[2][1]);
+          out.ne[c] = static_cast<Real>(row.acc[2][2]);
+          out.nw[c] = static_cast<Real>(row.acc[2][0]);
         }
       },
       execution);
@@ -254,7 +262,15 @@ void build_interpolation_texels(GridShape fine, const std::uint8_t* bits, Interp
   build_interpolation(fine, TexelOperator{bits}, p, execution);
 }
 void build_interpolation_stencil9(GridShape fine, Stencil9View a, InterpolationArrays p, Execution execution) {
-  build_interpolation(fine, LumpedStencil9Operator{Stencil9Operator{a, fine.stride()}}, p, execution);
+  build_interpolation(fine, LumpedStencil9Operator<double>{{a, fine.stride()}}, p, execution);
+}
+void build_interpolation_texels(GridShape fine, const std::uint8_t* bits, InterpolationArraysFloat p,
+                                Execution execution) {
+  build_interpolation(fine, TexelOperator{bits}, p, execution);
+}
+void build_interpolation_stencil9(GridShape fine, Stencil9ViewFloat a, InterpolationArraysFloat p,
+                                  Execution execution) {
+  build_interpolation(fine, LumpedStencil9Operator<float>{{a, fine.stride()}}, p, execution);
 }
 void galerkin_texels(GridShape fine, const std::uint8_t* bits, InterpolationView p, Stencil9Arrays coarse_a,
                      Execution execution) {
@@ -262,7 +278,15 @@ void galerkin_texels(GridShape fine, const std::uint8_t* bits, InterpolationView
 }
 void galerkin_stencil9(GridShape fine, Stencil9View a, InterpolationView p, Stencil9Arrays coarse_a,
                        Execution execution) {
-  galerkin(fine, Stencil9Entries{a, fine.stride()}, p, coarse_a, execution);
+  galerkin(fine, Stencil9Entries<double>{a, fine.stride()}, p, coarse_a, execution);
+}
+void galerkin_texels(GridShape fine, const std::uint8_t* bits, InterpolationViewFloat p,
+                     Stencil9ArraysFloat coarse_a, Execution execution) {
+  galerkin(fine, TexelEntries{bits}, p, coarse_a, execution);
+}
+void galerkin_stencil9(GridShape fine, Stencil9ViewFloat a, InterpolationViewFloat p, Stencil9ArraysFloat coarse_a,
+                       Execution execution) {
+  galerkin(fine, Stencil9Entries<float>{a, fine.stride()}, p, coarse_a, execution);
 }
 
 }  // namespace dgtex::kernels

@@ -17,7 +17,8 @@ inline double texel_operator(std::uint8_t m, const double* x, std::int64_t t, st
          ((m & couples_north_unknown) ? x[t + s] : 0.0);
 }
 
-inline double stencil9_operator(const Stencil9View& a, const double* x, std::int64_t t, std::int64_t s) {
+template <class Real>
+inline Real stencil9_operator(const Stencil9ViewOf<Real>& a, const Real* x, std::int64_t t, std::int64_t s) {
   return a.c[t] * x[t] + a.e[t - 1] * x[t - 1] + a.e[t] * x[t + 1] + a.n[t - s] * x[t - s] + a.n[t] * x[t + s] +
          a.ne[t - s - 1] * x[t - s - 1] + a.nw[t - s + 1] * x[t - s + 1] + a.nw[t] * x[t + s - 1] +
          a.ne[t] * x[t + s + 1];
@@ -99,8 +100,11 @@ void residual_texels_color_reference(GridShape shape, const std::uint8_t* bits, 
     }
 }
 
-void restrict_red_residual_texels(GridShape fine, GridShape coarse, InterpolationView p, const std::uint8_t* bits,
-                                  const double* b, const double* x, double* b_coarse, Execution execution) {
+namespace {
+template <class Real>
+void red_residual_texels_restricted(GridShape fine, GridShape coarse, InterpolationViewOf<Real> p,
+                                    const std::uint8_t* bits, const double* b, const double* x, Real* b_coarse,
+                                    Execution execution) {
   const std::int64_t s = fine.stride(), cs = coarse.stride();
   // The red residual at fine node t; 0 at nodes without unknown, ghosts included (their bits
   // are 0), as residual_texels_color leaves them in r.
@@ -118,13 +122,23 @@ void restrict_red_residual_texels(GridShape fine, GridShape coarse, Interpolatio
         for (int I = 0; I < coarse.nx; ++I) {
           const std::int64_t c = row + I, f = f0 + 2 * I;
           const double east_north = red_residual(f + s + 1), east_south = red_residual(f - s + 1);
-          b_coarse[c] = red_residual(f) + p.sw[c] * east_north + p.se[c - 1] * west_north +
-                        p.nw[c - cs] * east_south + p.ne[c - cs - 1] * west_south;
+          b_coarse[c] = static_cast<Real>(red_residual(f) + p.sw[c] * east_north + p.se[c - 1] * west_north +
+                                          p.nw[c - cs] * east_south + p.ne[c - cs - 1] * west_south);
           west_north = east_north;
           west_south = east_south;
         }
       },
       execution);
+}
+}  // namespace
+
+void restrict_red_residual_texels(GridShape fine, GridShape coarse, InterpolationView p, const std::uint8_t* bits,
+                                  const double* b, const double* x, double* b_coarse, Execution execution) {
+  red_residual_texels_restricted(fine, coarse, p, bits, b, x, b_coarse, execution);
+}
+void restrict_red_residual_texels(GridShape fine, GridShape coarse, InterpolationViewFloat p, const std::uint8_t* bits,
+                                  const double* b, const double* x, float* b_coarse, Execution execution) {
+  red_residual_texels_restricted(fine, coarse, p, bits, b, x, b_coarse, execution);
 }
 
 void restrict_red_residual_texels_reference(GridShape fine, GridShape coarse, InterpolationView p,
@@ -134,9 +148,18 @@ void restrict_red_residual_texels_reference(GridShape fine, GridShape coarse, In
   residual_texels_color_reference(fine, bits, b, x, r.data(), 0);
   restrict_red_residual_reference(fine, coarse, p, r.data(), b_coarse);
 }
+void restrict_red_residual_texels_reference(GridShape fine, GridShape coarse, InterpolationViewFloat p,
+                                            const std::uint8_t* bits, const double* b, const double* x,
+                                            float* b_coarse) {
+  std::vector<double> r(fine.padded_size(), 0.0);
+  residual_texels_color_reference(fine, bits, b, x, r.data(), 0);
+  restrict_red_residual_reference(fine, coarse, p, r.data(), b_coarse);
+}
 
-void residual_stencil9(GridShape shape, Stencil9View a, const double* b, const double* x, double* r, double* row_norm2,
-                       Execution execution) {
+namespace {
+template <class Real>
+void stencil9_residual(GridShape shape, Stencil9ViewOf<Real> a, const Real* b, const Real* x, Real* r,
+                       double* row_norm2, Execution execution) {
   const std::int64_t s = shape.stride();
   forall(
       shape.ny,
@@ -145,34 +168,53 @@ void residual_stencil9(GridShape shape, Stencil9View a, const double* b, const d
         double norm2 = 0;
         for (int i = 0; i < shape.nx; ++i) {
           const std::int64_t t = row + i;
-          const double value = a.c[t] > 0 ? b[t] - stencil9_operator(a, x, t, s) : 0.0;
+          const Real value = a.c[t] > 0 ? b[t] - stencil9_operator(a, x, t, s) : Real(0);
           r[t] = value;
-          norm2 += value * value;
+          norm2 += static_cast<double>(value) * value;
         }
         if (row_norm2) row_norm2[j] = norm2;
       },
       execution);
 }
 
-void residual_stencil9_reference(GridShape shape, Stencil9View a, const double* b, const double* x, double* r,
+template <class Real>
+void stencil9_residual_reference(GridShape shape, Stencil9ViewOf<Real> a, const Real* b, const Real* x, Real* r,
                                  double* row_norm2) {
   const std::int64_t s = shape.stride();
   for (int j = 0; j < shape.ny; ++j) {
     double norm2 = 0;
     for (int i = 0; i < shape.nx; ++i) {
       const std::int64_t t = shape.at(i, j);
-      double value = 0;
+      Real value = 0;
       if (a.c[t] > 0) {
-        const double ax = a.c[t] * x[t] + a.e[t - 1] * x[t - 1] + a.e[t] * x[t + 1] + a.n[t - s] * x[t - s] +
+        const Real ax = a.c[t] * x[t] + a.e[t - 1] * x[t - 1] + a.e[t] * x[t + 1] + a.n[t - s] * x[t - s] +
                           a.n[t] * x[t + s] + a.ne[t - s - 1] * x[t - s - 1] + a.nw[t - s + 1] * x[t - s + 1] +
                           a.nw[t] * x[t + s - 1] + a.ne[t] * x[t + s + 1];
         value = b[t] - ax;
       }
       r[t] = value;
-      norm2 += value * value;
+      norm2 += static_cast<double>(value) * value;
     }
     if (row_norm2) row_norm2[j] = norm2;
   }
+}
+}  // namespace
+
+void residual_stencil9(GridShape shape, Stencil9View a, const double* b, const double* x, double* r, double* row_norm2,
+                       Execution execution) {
+  stencil9_residual(shape, a, b, x, r, row_norm2, execution);
+}
+void residual_stencil9(GridShape shape, Stencil9ViewFloat a, const float* b, const float* x, float* r,
+                       double* row_norm2, Execution execution) {
+  stencil9_residual(shape, a, b, x, r, row_norm2, execution);
+}
+void residual_stencil9_reference(GridShape shape, Stencil9View a, const double* b, const double* x, double* r,
+                                 double* row_norm2) {
+  stencil9_residual_reference(shape, a, b, x, r, row_norm2);
+}
+void residual_stencil9_reference(GridShape shape, Stencil9ViewFloat a, const float* b, const float* x, float* r,
+                                 double* row_norm2) {
+  stencil9_residual_reference(shape, a, b, x, r, row_norm2);
 }
 
 void apply_texels(GridShape shape, const std::uint8_t* bits, const double* x, double* y, double* row_dot,

@@ -13,7 +13,8 @@ namespace {
 constexpr double inverse_degree[8] = {0.0, 1.0, 1.0 / 2.0, 1.0 / 3.0, 1.0 / 4.0, 0.0, 0.0, 0.0};
 
 // Sum over the eight off-diagonal couplings of a 9-point stencil times x, in a fixed order.
-inline double stencil9_offdiagonal(const Stencil9View& a, const double* x, std::int64_t t, std::int64_t s) {
+template <class Real>
+inline Real stencil9_offdiagonal(const Stencil9ViewOf<Real>& a, const Real* x, std::int64_t t, std::int64_t s) {
   return a.e[t - 1] * x[t - 1] + a.e[t] * x[t + 1] + a.n[t - s] * x[t - s] + a.n[t] * x[t + s] +
          a.ne[t - s - 1] * x[t - s - 1] + a.nw[t - s + 1] * x[t - s + 1] + a.nw[t] * x[t + s - 1] +
          a.ne[t] * x[t + s + 1];
@@ -35,7 +36,8 @@ inline void texel_row(GridShape shape, const std::uint8_t* bits, const double* b
 }
 
 // One colour (i % 2 == ci) of a 9-point level on row j.
-inline void stencil9_row(GridShape shape, const Stencil9View& a, const double* b, double* x, int j, int ci) {
+template <class Real>
+inline void stencil9_row(GridShape shape, const Stencil9ViewOf<Real>& a, const Real* b, Real* x, int j, int ci) {
   const std::int64_t s = shape.stride();
   const std::int64_t row = shape.at(0, j);
   for (int i = ci; i < shape.nx; i += 2) {
@@ -118,8 +120,10 @@ void cg_update_and_smooth_texels_from_zero_reference(GridShape shape, const std:
   smooth_texels_color_reference(shape, bits, r, z, 1);
 }
 
-void smooth_stencil9_sweep(GridShape shape, Stencil9View a, const double* b, double* x, bool forward,
-                           Execution execution) {
+namespace {
+template <class Real>
+void stencil9_sweep(GridShape shape, Stencil9ViewOf<Real> a, const Real* b, Real* x, bool forward,
+                    Execution execution) {
   // Colour (ci, cj) = (i % 2, j % 2), numbered ci + 2 cj: colours 0, 1 live on even rows, 2, 3
   // on odd rows, and nodes of one row depend on the other parity's rows only through j +- 1.
   const int first_parity = forward ? 0 : 1;
@@ -135,6 +139,16 @@ void smooth_stencil9_sweep(GridShape shape, Stencil9View a, const double* b, dou
   };
   lagged_rows(
       shape.ny, [&](int j) { phase(j, true); }, [&](int j) { phase(j, false); }, execution);
+}
+}  // namespace
+
+void smooth_stencil9_sweep(GridShape shape, Stencil9View a, const double* b, double* x, bool forward,
+                           Execution execution) {
+  stencil9_sweep(shape, a, b, x, forward, execution);
+}
+void smooth_stencil9_sweep(GridShape shape, Stencil9ViewFloat a, const float* b, float* x, bool forward,
+                           Execution execution) {
+  stencil9_sweep(shape, a, b, x, forward, execution);
 }
 
 void smooth_texels_color(GridShape shape, const std::uint8_t* bits, const double* b, double* x, int color,
@@ -175,18 +189,28 @@ void smooth_stencil9_color(GridShape shape, Stencil9View a, const double* b, dou
       execution);
 }
 
-void smooth_stencil9_color_reference(GridShape shape, Stencil9View a, const double* b, double* x, int color) {
+namespace {
+template <class Real>
+void stencil9_color_reference(GridShape shape, Stencil9ViewOf<Real> a, const Real* b, Real* x, int color) {
   const std::int64_t s = shape.stride();
   for (int j = 0; j < shape.ny; ++j)
     for (int i = 0; i < shape.nx; ++i) {
       if ((i % 2) + 2 * (j % 2) != color) continue;
       const std::int64_t t = shape.at(i, j);
       if (!(a.c[t] > 0)) continue;
-      const double offdiagonal = a.e[t - 1] * x[t - 1] + a.e[t] * x[t + 1] + a.n[t - s] * x[t - s] +
+      const Real offdiagonal = a.e[t - 1] * x[t - 1] + a.e[t] * x[t + 1] + a.n[t - s] * x[t - s] +
                                  a.n[t] * x[t + s] + a.ne[t - s - 1] * x[t - s - 1] +
                                  a.nw[t - s + 1] * x[t - s + 1] + a.nw[t] * x[t + s - 1] + a.ne[t] * x[t + s + 1];
       x[t] = (b[t] - offdiagonal) / a.c[t];
     }
+}
+}  // namespace
+
+void smooth_stencil9_color_reference(GridShape shape, Stencil9View a, const double* b, double* x, int color) {
+  stencil9_color_reference(shape, a, b, x, color);
+}
+void smooth_stencil9_color_reference(GridShape shape, Stencil9ViewFloat a, const float* b, float* x, int color) {
+  stencil9_color_reference(shape, a, b, x, color);
 }
 
 }  // namespace dgtex::kernels

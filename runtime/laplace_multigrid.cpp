@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <cstdlib>
 #include <strings.h>
+#include <type_traits>
 
 #include <Eigen/CholmodSupport>
 #include <Eigen/Dense>
@@ -63,8 +64,17 @@
 //   (see parallel_min_nodes): open T = 256 7.0 -> 4.4 ms, T = 512 20.7 -> 19.3 ms (idle
 //   machine, 2 threads). Not with the default policy: on a loaded machine (other processes
 //   on both cores) every barrier can wait a time slice, and 2-thread T = 256 solves took
-//   0.2 -> 5 s. Not done: a float cycle as CG preconditioner (half the traffic at T = 1024),
-//   an F-cycle / nested-iteration start, one parallel region per cycle.
+//   0.2 -> 5 s.
+// - Session 6 (float cycle): from 2^17 texels (options.single_precision_min_texels) levels
+//   >= 1 are built and cycled in float (level 0, the outer CG and its test stay double; CG
+//   needs the same iterations and residuals to 1e-12). `dgtex bench laplace --repeat 5`, idle
+//   machine, 2 threads, old/new alternating, ms (setup): active policy open T = 512 17.3 ->
+//   16.3, T = 1024 79 -> 73 (18 -> 18.5), spiral 1024 79 -> 77, chad 1024 87 -> 82; passive
+//   open 1024 90 -> 83, chad 1024 101 -> 94, T = 512 -1..-2 ms. Not at T = 256 (setup +0.2
+//   ms of 4.1, float Galerkin converts every weight; cycles ~equal: L2-resident). 1 thread,
+//   open T = 1024: solve part 126 -> 110 ms (coarse sweeps/residuals ~20% faster, level 0
+//   unchanged: it is ~60% of a cycle). Not done: level-0 z in float, float arithmetic in the
+//   Galerkin product, an F-cycle / nested-iteration start, one parallel region per cycle.
 namespace dgtex {
 using kernels::Execution;
 using kernels::GridShape;
@@ -97,9 +107,17 @@ constexpr long fused_restriction_min_nodes = 1l << 19;
 // Coarsest levels up to this many unknowns are factored densely.
 constexpr int dense_coarsest_max = 400;
 
+using detail::FloatMultigridBuffer;
 using detail::MultigridBuffer;
 
 MultigridBuffer frame_buffer(GridShape g) { return detail::frame_zeroed_buffer(g.stride(), g.ny + 2); }
+template <class Buffer>
+Buffer frame_zeroed(GridShape g) {
+  if constexpr (std::is_same_v<Buffer, FloatMultigridBuffer>)
+    return detail::frame_zeroed_float_buffer(g.stride(), g.ny + 2);
+  else
+    return detail::frame_zeroed_buffer(g.stride(), g.ny + 2);
+}
 
 double sum_in_order(const std::vector<double>& rows) {
   double sum = 0;
@@ -121,7 +139,49 @@ struct LaplaceMultigrid::Hierarchy {
     kernels::InterpolationView interpolation() const {
       return {p[0].data(), p[1].data(), p[2].data(), p[3].data(), p[4].data(), p[5].data(), p[6].data(), p[7].data()};
     }
+    // Levels >= 1 of the single-precision cycle use these instead of the double arrays above.
+    FloatMultigridBuffer xf, bf, rf, cf, ef, nf, nef, nwf, pf[8];
   };
+  // A level's buffers in double or float (to allocate them).
+  template <class Buffer>
+  struct LevelBuffers {
+    Buffer* x;
+    Buffer* b;
+    Buffer* r;
+    Buffer* operator_and_interpolation[13];
+  };
+  template <class Real>
+  static auto arrays_of(Level& v) {
+    if constexpr (std::is_same_v<Real, float>)
+      return LevelBuffers<FloatMultigridBuffer>{
+          &v.xf, &v.bf, &v.rf,
+          {&v.cf, &v.ef, &v.nf, &v.nef, &v.nwf, &v.pf[0], &v.pf[1], &v.pf[2], &v.pf[3], &v.pf[4], &v.pf[5], &v.pf[6],
+           &v.pf[7]}};
+    else
+      return LevelBuffers<MultigridBuffer>{
+          &v.x, &v.b, &v.r,
+          {&v.c, &v.e, &v.n, &v.ne, &v.nw, &v.p[0], &v.p[1], &v.p[2], &v.p[3], &v.p[4], &v.p[5], &v.p[6], &v.p[7]}};
+  }
+  // The arrays a level's cycle works on, in double or float.
+  template <class Real>
+  struct CycleArrays {
+    Real* x;
+    Real* b;
+    Real* r;
+    std::size_t size;
+    kernels::Stencil9ViewOf<Real> a;
+    kernels::InterpolationViewOf<Real> p;  // to the next finer level
+  };
+  template <class Real>
+  static CycleArrays<Real> arrays(Level& v) {
+    if constexpr (std::is_same_v<Real, float>)
+      return {v.xf.data(), v.bf.data(), v.rf.data(), v.xf.size(),
+              {v.cf.data(), v.ef.data(), v.nf.data(), v.nef.data(), v.nwf.data()},
+              {v.pf[0].data(), v.pf[1].data(), v.pf[2].data(), v.pf[3].data(), v.pf[4].data(), v.pf[5].data(),
+               v.pf[6].data(), v.pf[7].data()}};
+    else
+      return {v.x.data(), v.b.data(), v.r.data(), v.x.size(), v.stencil(), v.interpolation()};
+  }
 
   LaplaceMultigridOptions options;
   int width = 0, height = 0;
@@ -149,6 +209,7 @@ struct LaplaceMultigrid::Hierarchy {
   bool robust_coarse_solve() const { return options.coarse_solve_tolerance > 0 && levels.size() > 2; }
   int orphans_at_stop = 0;
   double setup_ms = 0;
+  bool float_cycle = false;  // levels >= 1 of the preconditioner in float (single_precision_min_texels)
 
   Execution execution_for(GridShape shape) const {
     return (options.execution == Execution::parallel && static_cast<long>(shape.nx) * shape.ny >= parallel_min_nodes())
@@ -177,6 +238,10 @@ struct LaplaceMultigrid::Hierarchy {
     for (auto* v : {&fine.x, &fine.b, &fine.r}) *v = frame_buffer(fine.shape);
     levels.clear();
     levels.push_back(std::move(fine));
+    float_cycle = static_cast<long>(width) * height >= options.single_precision_min_texels &&
+                  options.use_as_cg_preconditioner &&
+                  options.coarse_solve_tolerance == 0 &&
+                  options.pre_smoothing > 0 && options.post_smoothing > 0;
 
     while (static_cast<long>(levels.back().shape.nx) * levels.back().shape.ny > options.coarsest_nodes &&
            (levels.back().shape.nx > 1 || levels.back().shape.ny > 1)) {
@@ -184,31 +249,18 @@ struct LaplaceMultigrid::Hierarchy {
       Level coarse;
       coarse.shape = levels[l].shape.coarser();
       coarse.execution = execution_for(coarse.shape);
-      const std::size_t size = coarse.shape.padded_size();
-      for (auto* v : {&coarse.x, &coarse.b, &coarse.r}) *v = MultigridBuffer(size);
-      // The setup kernels write every coarse node of the operator and interpolation arrays.
-      for (auto* v : {&coarse.c, &coarse.e, &coarse.n, &coarse.ne, &coarse.nw}) *v = frame_buffer(coarse.shape);
-      for (auto& v : coarse.p) v = frame_buffer(coarse.shape);
-      kernels::InterpolationArrays p{coarse.p[0].data(), coarse.p[1].data(), coarse.p[2].data(), coarse.p[3].data(),
-                                     coarse.p[4].data(), coarse.p[5].data(), coarse.p[6].data(), coarse.p[7].data()};
-      kernels::Stencil9Arrays a{coarse.c.data(), coarse.e.data(), coarse.n.data(), coarse.ne.data(), coarse.nw.data()};
-      const Execution ex = levels[l].execution;
-      if (l == 0) {
-        kernels::build_interpolation_texels(levels[0].shape, bits.data(), p, ex);
-        kernels::galerkin_texels(levels[0].shape, bits.data(), p.view(), a, ex);
-      } else {
-        kernels::build_interpolation_stencil9(levels[l].shape, levels[l].stencil(), p, ex);
-        kernels::galerkin_stencil9(levels[l].shape, levels[l].stencil(), p.view(), a, ex);
-      }
-      coarse.active.assign(size, 0);
-      const int orphans = count_orphans_and_mark_active(levels[l], coarse, ex);
+      const int orphans = float_cycle ? build_coarse_level<float>(levels[l], coarse, l == 0)
+                                      : build_coarse_level<double>(levels[l], coarse, l == 0);
       if (orphans > options.max_orphans) {
         orphans_at_stop = orphans;
         break;  // this coarsening would lose part of the domain: solve level l directly
       }
       levels.push_back(std::move(coarse));
     }
-    factor_coarsest();
+    if (float_cycle)
+      factor_coarsest<float>();
+    else
+      factor_coarsest<double>();
     std::size_t rows = 0;
     for (const Level& level : levels) rows = std::max<std::size_t>(rows, level.shape.ny);
     row_partial.assign(rows, 0.0);
@@ -224,11 +276,40 @@ struct LaplaceMultigrid::Hierarchy {
     }
   }
 
+  // Allocates `coarse` (= fine.shape.coarser()) in Real, builds its interpolation and Galerkin
+  // operator from `fine` (the texel level if texels) and returns the orphan count.
+  template <class Real>
+  int build_coarse_level(Level& fine, Level& coarse, bool texels) {
+    using Buffer = std::conditional_t<std::is_same_v<Real, float>, FloatMultigridBuffer, MultigridBuffer>;
+    const auto v = arrays_of<Real>(coarse);
+    const std::size_t size = coarse.shape.padded_size();
+    for (Buffer* a : {v.x, v.b, v.r}) *a = Buffer(size);
+    // The setup kernels write every coarse node of the operator and interpolation arrays.
+    for (Buffer* a : v.operator_and_interpolation) *a = frame_zeroed<Buffer>(coarse.shape);
+    Buffer* const* w = v.operator_and_interpolation;
+    const kernels::Stencil9ArraysOf<Real> a{w[0]->data(), w[1]->data(), w[2]->data(), w[3]->data(), w[4]->data()};
+    const kernels::InterpolationArraysOf<Real> p{w[5]->data(),  w[6]->data(),  w[7]->data(),  w[8]->data(),
+                                                 w[9]->data(), w[10]->data(), w[11]->data(), w[12]->data()};
+    const Execution ex = fine.execution;
+    if (texels) {
+      kernels::build_interpolation_texels(fine.shape, bits.data(), p, ex);
+      kernels::galerkin_texels(fine.shape, bits.data(), p.view(), a, ex);
+    } else {
+      kernels::build_interpolation_stencil9(fine.shape, arrays<Real>(fine).a, p, ex);
+      kernels::galerkin_stencil9(fine.shape, arrays<Real>(fine).a, p.view(), a, ex);
+    }
+    coarse.active.assign(size, 0);
+    return count_orphans_and_mark_active<Real>(fine, coarse, ex);
+  }
+
   // Active fine nodes (not coarse points) whose interpolation row is zero: parts of the
   // domain (channels narrower than the coarse spacing) the coarse level cannot represent.
   // The same pass over the coarse rows sets coarse.active (c > 0); counts are per row.
+  template <class Real>
   int count_orphans_and_mark_active(const Level& fine, Level& coarse, Execution execution) {
-    const kernels::InterpolationView p = coarse.interpolation();
+    const CycleArrays<Real> arrays_c = arrays<Real>(coarse);
+    const kernels::InterpolationViewOf<Real> p = arrays_c.p;
+    const Real* coarse_c = arrays_c.a.c;
     row_orphans.assign(coarse.shape.ny, 0);
     kernels::forall(
         coarse.shape.ny,
@@ -237,9 +318,9 @@ struct LaplaceMultigrid::Hierarchy {
           int orphans = 0;
           for (int I = 0; I < coarse.shape.nx; ++I) {
             const std::int64_t c = coarse.shape.at(I, J);
-            coarse.active[c] = coarse.c[c] > 0 ? 1 : 0;
-            auto check = [&](int i, int j, double weight_sum) {
-              if (i < fine.shape.nx && j < fine.shape.ny && fine.active[fine.shape.at(i, j)] && weight_sum == 0.0)
+            coarse.active[c] = coarse_c[c] > 0 ? 1 : 0;
+            auto check = [&](int i, int j, Real weight_sum) {
+              if (i < fine.shape.nx && j < fine.shape.ny && fine.active[fine.shape.at(i, j)] && weight_sum == 0)
                 ++orphans;
             };
             check(2 * I + 1, 2 * J, std::abs(p.xw[c]) + std::abs(p.xe[c]));
@@ -256,8 +337,10 @@ struct LaplaceMultigrid::Hierarchy {
 
   // Sparse Cholesky (CHOLMOD) of the coarsest operator restricted to its nodes with
   // unknowns (SPD: every column of P holds a unit entry at its own fine node).
+  template <class Real>
   void factor_coarsest() {
-    const Level& level = levels.back();
+    Level& level = levels.back();
+    const kernels::Stencil9ViewOf<Real> a = arrays<Real>(level).a;
     const bool texels = levels.size() == 1;
     coarsest_nodes.clear();
     const GridShape g = level.shape;
@@ -285,15 +368,15 @@ struct LaplaceMultigrid::Hierarchy {
         if (m & kernels::couples_north_unknown) couple(t + s, -1.0);
         continue;
       }
-      couple(t, level.c[t]);
-      couple(t + 1, level.e[t]);
-      couple(t - 1, level.e[t - 1]);
-      couple(t + s, level.n[t]);
-      couple(t - s, level.n[t - s]);
-      couple(t + s + 1, level.ne[t]);
-      couple(t - s - 1, level.ne[t - s - 1]);
-      couple(t + s - 1, level.nw[t]);
-      couple(t - s + 1, level.nw[t - s + 1]);
+      couple(t, a.c[t]);
+      couple(t + 1, a.e[t]);
+      couple(t - 1, a.e[t - 1]);
+      couple(t + s, a.n[t]);
+      couple(t - s, a.n[t - s]);
+      couple(t + s + 1, a.ne[t]);
+      couple(t - s - 1, a.ne[t - s - 1]);
+      couple(t + s - 1, a.nw[t]);
+      couple(t - s + 1, a.nw[t - s + 1]);
     }
     Eigen::SparseMatrix<double> m(n, n);
     m.setFromTriplets(entries.begin(), entries.end());
@@ -314,30 +397,23 @@ struct LaplaceMultigrid::Hierarchy {
                                " nodes) is not positive definite; this is a bug, please report the tile");
   }
 
-  void smooth(std::size_t l, bool forward, int sweeps, double* last_row_dot = nullptr) {
-    Level& level = levels[l];
-    for (int sweep = 0; sweep < sweeps; ++sweep) {
-      if (l == 0)
-        kernels::smooth_texels_sweep(level.shape, bits.data(), level.b.data(), level.x.data(), forward, level.execution,
-                                     sweep + 1 == sweeps ? last_row_dot : nullptr);
-      else
-        kernels::smooth_stencil9_sweep(level.shape, level.stencil(), level.b.data(), level.x.data(), forward,
-                                       level.execution);
-    }
+  // Level-0 sweeps and residual (coarse levels: coarse_cycle).
+  void smooth0(bool forward, int sweeps, double* last_row_dot = nullptr) {
+    Level& level = levels[0];
+    for (int sweep = 0; sweep < sweeps; ++sweep)
+      kernels::smooth_texels_sweep(level.shape, bits.data(), level.b.data(), level.x.data(), forward, level.execution,
+                                   sweep + 1 == sweeps ? last_row_dot : nullptr);
   }
 
-  void residual(std::size_t l, double* row_norm2) {
-    Level& level = levels[l];
-    if (l == 0)
-      kernels::residual_texels(level.shape, bits.data(), level.b.data(), level.x.data(), level.r.data(), row_norm2,
-                               level.execution);
-    else
-      kernels::residual_stencil9(level.shape, level.stencil(), level.b.data(), level.x.data(), level.r.data(),
-                                 row_norm2, level.execution);
+  void residual0(double* row_norm2) {
+    Level& level = levels[0];
+    kernels::residual_texels(level.shape, bits.data(), level.b.data(), level.x.data(), level.r.data(), row_norm2,
+                             level.execution);
   }
 
+  template <class Real>
   void solve_coarsest() {
-    Level& level = levels.back();
+    const CycleArrays<Real> level = arrays<Real>(levels.back());
     const int n = static_cast<int>(coarsest_nodes.size());
     if (n == 0) return;
     Eigen::VectorXd rhs(n);
@@ -349,7 +425,7 @@ struct LaplaceMultigrid::Hierarchy {
       const auto lock = detail::lock_cholmod();
       solution = coarsest_factor.solve(rhs);
     }
-    for (int k = 0; k < n; ++k) level.x[coarsest_nodes[k]] = solution[k];
+    for (int k = 0; k < n; ++k) level.x[coarsest_nodes[k]] = static_cast<Real>(solution[k]);
   }
 
   // One cycle on level l for A_l x_l = b_l, improving x_l in place (x_l = 0 on entry if
@@ -366,14 +442,13 @@ struct LaplaceMultigrid::Hierarchy {
   void cycle(std::size_t l, MultigridCycle type, bool zero_guess, double* row_dot = nullptr,
              bool first_sweep_done = false) {
     Level& level = levels[l];
-    if (l + 1 == levels.size()) {
-      if (zero_guess) std::fill(level.x.begin(), level.x.end(), 0.0);
-      solve_coarsest();  // exact: overwrites every unknown
+    if (l > 0 || l + 1 == levels.size()) {
+      coarse_cycle<double>(l, type, zero_guess);
       return;
     }
     Level& coarse = levels[l + 1];
     const int pre = options.pre_smoothing, post = options.post_smoothing;
-    if (l == 0) {
+    {
       int sweeps = pre;
       if (zero_guess && sweeps > 0) {
         if (!first_sweep_done)
@@ -383,45 +458,76 @@ struct LaplaceMultigrid::Hierarchy {
       } else if (zero_guess) {
         std::fill(level.x.begin(), level.x.end(), 0.0);
       }
-      smooth(0, true, sweeps);
-      if (pre > 0) {
-        if (static_cast<long>(level.shape.nx) * level.shape.ny >= fused_restriction_min_nodes) {
+      smooth0(true, sweeps);
+      // float_cycle: the same steps with level 1 and below in float (pre, post > 0 there).
+      const bool fused = static_cast<long>(level.shape.nx) * level.shape.ny >= fused_restriction_min_nodes;
+      if (pre > 0 && fused) {
+        if (float_cycle)
+          kernels::restrict_red_residual_texels(level.shape, coarse.shape, arrays<float>(coarse).p, bits.data(),
+                                                level.b.data(), level.x.data(), coarse.bf.data(), level.execution);
+        else
           kernels::restrict_red_residual_texels(level.shape, coarse.shape, coarse.interpolation(), bits.data(),
                                                 level.b.data(), level.x.data(), coarse.b.data(), level.execution);
-        } else {
-          kernels::residual_texels_color(level.shape, bits.data(), level.b.data(), level.x.data(), level.r.data(), 0,
-                                         level.execution);
+      } else if (pre > 0) {
+        kernels::residual_texels_color(level.shape, bits.data(), level.b.data(), level.x.data(), level.r.data(), 0,
+                                       level.execution);
+        if (float_cycle)
+          kernels::restrict_red_residual(level.shape, coarse.shape, arrays<float>(coarse).p, level.r.data(),
+                                         coarse.bf.data(), coarse.execution);
+        else
           kernels::restrict_red_residual(level.shape, coarse.shape, coarse.interpolation(), level.r.data(),
                                          coarse.b.data(), coarse.execution);
-        }
       } else {
-        residual(0, nullptr);
+        residual0(nullptr);
         kernels::restrict_residual(level.shape, coarse.shape, coarse.interpolation(), level.r.data(),
                                    coarse.b.data(), coarse.execution);
       }
-    } else {
-      if (zero_guess) std::fill(level.x.begin(), level.x.end(), 0.0);
-      smooth(l, true, pre);
-      residual(l, nullptr);
-      kernels::restrict_residual(level.shape, coarse.shape, coarse.interpolation(), level.r.data(), coarse.b.data(),
-                                 coarse.execution);
     }
-    if (l == 0 && robust_coarse_solve())
+    if (robust_coarse_solve())
       solve_level1_by_cg();
+    else if (float_cycle)
+      coarse_cycle<float>(1, MultigridCycle::v, true);
     else
-      cycle(l + 1, type, true);
-    if (type == MultigridCycle::f) cycle(l + 1, MultigridCycle::v, false);
-    if (l == 0 && post > 0)
+      cycle(1, type, true);
+    if (type == MultigridCycle::f) cycle(1, MultigridCycle::v, false);
+    if (post > 0 && float_cycle)
+      kernels::prolong_correction_red(level.shape, coarse.shape, arrays<float>(coarse).p, coarse.xf.data(),
+                                      level.active.data(), level.x.data(), level.execution);
+    else if (post > 0)
       kernels::prolong_correction_red(level.shape, coarse.shape, coarse.interpolation(), coarse.x.data(),
                                       level.active.data(), level.x.data(), level.execution);
     else
       kernels::prolong_correction(level.shape, coarse.shape, coarse.interpolation(), coarse.x.data(),
                                   level.active.data(), level.x.data(), level.execution);
-    smooth(l, false, post, row_dot);
+    smooth0(false, post, row_dot);
+  }
+
+  // The cycle on a coarse level l >= 1 (or on level 0 when it is the coarsest), in double or
+  // in float (float_cycle: V-cycles from zero only).
+  template <class Real>
+  void coarse_cycle(std::size_t l, MultigridCycle type, bool zero_guess) {
+    Level& level = levels[l];
+    const CycleArrays<Real> v = arrays<Real>(level);
+    if (zero_guess) std::fill(v.x, v.x + v.size, Real(0));
+    if (l + 1 == levels.size()) {
+      solve_coarsest<Real>();  // exact: overwrites every unknown
+      return;
+    }
+    Level& coarse = levels[l + 1];
+    const CycleArrays<Real> vc = arrays<Real>(coarse);
+    for (int sweep = 0; sweep < options.pre_smoothing; ++sweep)
+      kernels::smooth_stencil9_sweep(level.shape, v.a, v.b, v.x, true, level.execution);
+    kernels::residual_stencil9(level.shape, v.a, v.b, v.x, v.r, nullptr, level.execution);
+    kernels::restrict_residual(level.shape, coarse.shape, vc.p, v.r, vc.b, coarse.execution);
+    coarse_cycle<Real>(l + 1, type, true);
+    if (type == MultigridCycle::f) coarse_cycle<Real>(l + 1, MultigridCycle::v, false);
+    kernels::prolong_correction(level.shape, coarse.shape, vc.p, vc.x, level.active.data(), v.x, level.execution);
+    for (int sweep = 0; sweep < options.post_smoothing; ++sweep)
+      kernels::smooth_stencil9_sweep(level.shape, v.a, v.b, v.x, false, level.execution);
   }
 
   double level0_residual_norm() {
-    residual(0, row_partial.data());
+    residual0(row_partial.data());
     row_partial.resize(levels[0].shape.ny);
     const double norm = std::sqrt(sum_in_order(row_partial));
     return norm;

@@ -90,21 +90,32 @@ SkipCachedBlockZeroing::SkipCachedBlockZeroing() { skip_cached_zeroing = true; }
 SkipCachedBlockZeroing::~SkipCachedBlockZeroing() { skip_cached_zeroing = false; }
 void set_poison_unzeroed_blocks(bool poison) noexcept { poison_unzeroed = poison; }
 
-MultigridBuffer frame_zeroed_buffer(std::size_t nx_padded, std::size_t ny_padded) {
-  MultigridBuffer v;
+namespace {
+template <class Buffer>
+Buffer frame_zeroed(std::size_t nx_padded, std::size_t ny_padded) {
+  using Real = typename Buffer::value_type;
+  Buffer v;
   {
     const SkipCachedBlockZeroing skip;
-    v = MultigridBuffer(nx_padded * ny_padded);
+    v = Buffer(nx_padded * ny_padded);
   }
   if (ny_padded == 0) return v;
-  double* a = v.data();
-  std::fill(a, a + nx_padded, 0.0);
-  std::fill(a + (ny_padded - 1) * nx_padded, a + ny_padded * nx_padded, 0.0);
+  Real* a = v.data();
+  std::fill(a, a + nx_padded, Real(0));
+  std::fill(a + (ny_padded - 1) * nx_padded, a + ny_padded * nx_padded, Real(0));
   for (std::size_t j = 1; j + 1 < ny_padded; ++j) {
-    a[j * nx_padded] = 0.0;
-    a[j * nx_padded + nx_padded - 1] = 0.0;
+    a[j * nx_padded] = Real(0);
+    a[j * nx_padded + nx_padded - 1] = Real(0);
   }
   return v;
+}
+}  // namespace
+
+MultigridBuffer frame_zeroed_buffer(std::size_t nx_padded, std::size_t ny_padded) {
+  return frame_zeroed<MultigridBuffer>(nx_padded, ny_padded);
+}
+FloatMultigridBuffer frame_zeroed_float_buffer(std::size_t nx_padded, std::size_t ny_padded) {
+  return frame_zeroed<FloatMultigridBuffer>(nx_padded, ny_padded);
 }
 
 void* acquire_zeroed_block(std::size_t bytes) {
@@ -125,7 +136,7 @@ void* acquire_zeroed_block(std::size_t bytes) {
       if (!skip_cached_zeroing)
         std::memset(block, 0, bytes);
       else if (poison_unzeroed)
-        std::fill_n(static_cast<double*>(block), bytes / sizeof(double), std::numeric_limits<double>::quiet_NaN());
+        std::memset(block, 0xff, bytes);  // all-ones bytes: a NaN as double and as float
       return block;
     }
   }

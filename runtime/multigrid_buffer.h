@@ -71,11 +71,14 @@ struct ZeroedBlockAllocator {
 
 // A multigrid array (level vectors, operator and interpolation coefficients, CG vectors).
 using MultigridBuffer = std::vector<double, ZeroedBlockAllocator<double>>;
+// The float preconditioner cycle's level arrays (LaplaceMultigridOptions::single_precision_min_texels).
+using FloatMultigridBuffer = std::vector<float, ZeroedBlockAllocator<float>>;
 
 // A padded nx_padded x ny_padded grid array (multigrid_grid.h layout) whose ghost frame is
 // zero and whose interior is unspecified (left from the block's last use; NaN when
 // poisoned): for level arrays the setup or the solve overwrites completely before any read.
 // Why: zero-filling cached blocks was 13% of a T = 1024 setup (memset of ~80 MB).
 MultigridBuffer frame_zeroed_buffer(std::size_t nx_padded, std::size_t ny_padded);
+FloatMultigridBuffer frame_zeroed_float_buffer(std::size_t nx_padded, std::size_t ny_padded);
 
 }  // namespace dgtex::detail

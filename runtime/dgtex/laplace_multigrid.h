@@ -26,6 +26,12 @@ struct LaplaceMultigridOptions {
   int pre_smoothing = 1;          // red-black (coarse: 4-colour) Gauss-Seidel sweeps before ...
   int post_smoothing = 1;         // ... and after the coarse correction (equal for CG)
   bool use_as_cg_preconditioner = true;  // one symmetric V-cycle per CG iteration
+  // Tiles with at least this many texels keep the preconditioner's levels >= 1 (operators,
+  // interpolation, x, b, r) in float: half their memory traffic; level 0, the outer CG and
+  // its residual test stay double (CG reaches 1e-12 in the same iterations). Only with
+  // use_as_cg_preconditioner and the plain cycle (coarse_solve_tolerance = 0). 0: always;
+  // below the default (T = 256) the float setup costs more than the cycles save.
+  long single_precision_min_texels = 1l << 17;
   bool warm_start = true;         // initial guess = tile.values of the unknowns (else 0)
   kernels::Execution execution = kernels::Execution::parallel;
   // Robust cycle for domains with features narrower than the coarse grids (a 2-texel

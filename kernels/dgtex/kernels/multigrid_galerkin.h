@@ -42,14 +42,20 @@
 
 namespace dgtex::kernels {
 
-struct InterpolationArrays {
-  double* xw; double* xe; double* ys; double* yn; double* sw; double* se; double* nw; double* ne;
-  InterpolationView view() const { return {xw, xe, ys, yn, sw, se, nw, ne}; }
+template <class Real>
+struct InterpolationArraysOf {
+  Real* xw; Real* xe; Real* ys; Real* yn; Real* sw; Real* se; Real* nw; Real* ne;
+  InterpolationViewOf<Real> view() const { return {xw, xe, ys, yn, sw, se, nw, ne}; }
 };
-struct Stencil9Arrays {
-  double* c; double* e; double* n; double* ne; double* nw;
-  Stencil9View view() const { return {c, e, n, ne, nw}; }
+template <class Real>
+struct Stencil9ArraysOf {
+  Real* c; Real* e; Real* n; Real* ne; Real* nw;
+  Stencil9ViewOf<Real> view() const { return {c, e, n, ne, nw}; }
 };
+using InterpolationArrays = InterpolationArraysOf<double>;
+using Stencil9Arrays = Stencil9ArraysOf<double>;
+using InterpolationArraysFloat = InterpolationArraysOf<float>;
+using Stencil9ArraysFloat = Stencil9ArraysOf<float>;
 
 // Interpolation from `coarse` (= fine.coarser()) to level 0 (the texel operator `bits`).
 void build_interpolation_texels(GridShape fine, const std::uint8_t* bits, InterpolationArrays p,
@@ -62,6 +68,19 @@ void build_interpolation_stencil9(GridShape fine, Stencil9View a, InterpolationA
 void galerkin_texels(GridShape fine, const std::uint8_t* bits, InterpolationView p, Stencil9Arrays coarse_a,
                      Execution execution = Execution::parallel);
 void galerkin_stencil9(GridShape fine, Stencil9View a, InterpolationView p, Stencil9Arrays coarse_a,
+                       Execution execution = Execution::parallel);
+
+// Single-precision hierarchy (the float preconditioner cycle): the same kernels reading and
+// writing float arrays, every value formed in double and rounded when stored. So the float
+// Galerkin operator is the double product of the float interpolation, rounded; the edge
+// weights are the double ones rounded, the cell-centre weights are formed from those.
+void build_interpolation_texels(GridShape fine, const std::uint8_t* bits, InterpolationArraysFloat p,
+                                Execution execution = Execution::parallel);
+void build_interpolation_stencil9(GridShape fine, Stencil9ViewFloat a, InterpolationArraysFloat p,
+                                  Execution execution = Execution::parallel);
+void galerkin_texels(GridShape fine, const std::uint8_t* bits, InterpolationViewFloat p, Stencil9ArraysFloat coarse_a,
+                     Execution execution = Execution::parallel);
+void galerkin_stencil9(GridShape fine, Stencil9ViewFloat a, InterpolationViewFloat p, Stencil9ArraysFloat coarse_a,
                        Execution execution = Execution::parallel);
 
 }  // namespace dgtex::kernels

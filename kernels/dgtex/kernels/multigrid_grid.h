@@ -28,13 +28,18 @@ struct GridShape {
 // from the neighbours (west = e(i-1, j), south = n(i, j-1), south-west = ne(i-1, j-1),
 // south-east = nw(i+1, j-1)), so the operator is exactly symmetric. c = 0 marks a node
 // without unknown (its row and column are zero).
-struct Stencil9View {
-  const double* c;
-  const double* e;
-  const double* n;
-  const double* ne;
-  const double* nw;
+// Real: double, or float for the single-precision preconditioner cycle
+// (LaplaceMultigridOptions::single_precision_min_texels).
+template <class Real>
+struct Stencil9ViewOf {
+  const Real* c;
+  const Real* e;
+  const Real* n;
+  const Real* ne;
+  const Real* nw;
 };
+using Stencil9View = Stencil9ViewOf<double>;
+using Stencil9ViewFloat = Stencil9ViewOf<float>;
 
 // Operator-dependent interpolation P from a coarse grid to the next finer one, stored on
 // the coarse grid: for coarse node (I, J) the weights of fine nodes
@@ -43,15 +48,18 @@ struct Stencil9View {
 //   (2I+1, 2J+1): sw to (I, J), se to (I+1, J), nw to (I, J+1), ne to (I+1, J+1)
 // Fine node (2I, 2J) is the coarse node itself (weight 1). Weights of fine nodes outside
 // the fine grid are 0. Restriction is P^T.
-struct InterpolationView {
-  const double* xw;
-  const double* xe;
-  const double* ys;
-  const double* yn;
-  const double* sw;
-  const double* se;
-  const double* nw;
-  const double* ne;
+template <class Real>
+struct InterpolationViewOf {
+  const Real* xw;
+  const Real* xe;
+  const Real* ys;
+  const Real* yn;
+  const Real* sw;
+  const Real* se;
+  const Real* nw;
+  const Real* ne;
 };
+using InterpolationView = InterpolationViewOf<double>;
+using InterpolationViewFloat = InterpolationViewOf<float>;
 
 }  // namespace dgtex::kernels

@@ -41,11 +41,24 @@ void restrict_red_residual_texels(GridShape fine, GridShape coarse, Interpolatio
 void restrict_red_residual_texels_reference(GridShape fine, GridShape coarse, InterpolationView p,
                                             const std::uint8_t* bits, const double* b, const double* x,
                                             double* b_coarse);
+// Single-precision coarse level (float interpolation and b_coarse; the sum is formed in
+// double and rounded once).
+void restrict_red_residual_texels(GridShape fine, GridShape coarse, InterpolationViewFloat p, const std::uint8_t* bits,
+                                  const double* b, const double* x, float* b_coarse,
+                                  Execution execution = Execution::parallel);
+void restrict_red_residual_texels_reference(GridShape fine, GridShape coarse, InterpolationViewFloat p,
+                                            const std::uint8_t* bits, const double* b, const double* x,
+                                            float* b_coarse);
 
 // Coarse levels (9-point). row_norm2 may be null.
 void residual_stencil9(GridShape shape, Stencil9View a, const double* b, const double* x, double* r,
                        double* row_norm2, Execution execution = Execution::parallel);
 void residual_stencil9_reference(GridShape shape, Stencil9View a, const double* b, const double* x, double* r,
+                                 double* row_norm2);
+// Single precision (arithmetic in float; row_norm2 accumulated in double).
+void residual_stencil9(GridShape shape, Stencil9ViewFloat a, const float* b, const float* x, float* r,
+                       double* row_norm2, Execution execution = Execution::parallel);
+void residual_stencil9_reference(GridShape shape, Stencil9ViewFloat a, const float* b, const float* x, float* r,
                                  double* row_norm2);
 
 // y = A x on level 0 (for conjugate gradients); row_dot[j] = sum over row j of x * y.

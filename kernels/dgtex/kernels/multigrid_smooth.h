@@ -28,6 +28,8 @@ void smooth_texels_color_reference(GridShape shape, const std::uint8_t* bits, co
 void smooth_stencil9_color(GridShape shape, Stencil9View a, const double* b, double* x, int color,
                            Execution execution = Execution::parallel);
 void smooth_stencil9_color_reference(GridShape shape, Stencil9View a, const double* b, double* x, int color);
+// Single precision (the float preconditioner cycle); arithmetic in float.
+void smooth_stencil9_color_reference(GridShape shape, Stencil9ViewFloat a, const float* b, float* x, int color);
 
 // Whole sweeps in one streaming pass over the rows (what the multigrid runs). The second
 // colour(s) of row j - 1 are updated right after the first colour(s) of row j, so x, b and
@@ -45,6 +47,8 @@ void smooth_texels_sweep(GridShape shape, const std::uint8_t* bits, const double
 void smooth_texels_sweep_from_zero(GridShape shape, const std::uint8_t* bits, const double* b, double* x,
                                    Execution execution = Execution::parallel);
 void smooth_stencil9_sweep(GridShape shape, Stencil9View a, const double* b, double* x, bool forward,
+                           Execution execution = Execution::parallel);
+void smooth_stencil9_sweep(GridShape shape, Stencil9ViewFloat a, const float* b, float* x, bool forward,
                            Execution execution = Execution::parallel);
 
 // Conjugate-gradient step fused with the first sweep of the next preconditioner application:

@@ -38,4 +38,25 @@ void prolong_correction_red(GridShape fine, GridShape coarse, InterpolationView 
 void prolong_correction_red_reference(GridShape fine, GridShape coarse, InterpolationView p, const double* x_coarse,
                                       const std::uint8_t* fine_active, double* x_fine);
 
+// Single-precision forms for the float preconditioner cycle (LaplaceMultigridOptions::
+// single_precision_min_texels): between float levels the arithmetic is float; between level 0
+// (double) and a float level 1, restriction sums in double and rounds once, prolongation
+// forms the correction in float and adds it in double.
+void restrict_residual(GridShape fine, GridShape coarse, InterpolationViewFloat p, const float* r_fine,
+                       float* b_coarse, Execution execution = Execution::parallel);
+void restrict_residual_reference(GridShape fine, GridShape coarse, InterpolationViewFloat p, const float* r_fine,
+                                 float* b_coarse);
+void prolong_correction(GridShape fine, GridShape coarse, InterpolationViewFloat p, const float* x_coarse,
+                        const std::uint8_t* fine_active, float* x_fine, Execution execution = Execution::parallel);
+void prolong_correction_reference(GridShape fine, GridShape coarse, InterpolationViewFloat p, const float* x_coarse,
+                                  const std::uint8_t* fine_active, float* x_fine);
+void restrict_red_residual(GridShape fine, GridShape coarse, InterpolationViewFloat p, const double* r_fine,
+                           float* b_coarse, Execution execution = Execution::parallel);
+void restrict_red_residual_reference(GridShape fine, GridShape coarse, InterpolationViewFloat p, const double* r_fine,
+                                     float* b_coarse);
+void prolong_correction_red(GridShape fine, GridShape coarse, InterpolationViewFloat p, const float* x_coarse,
+                            const std::uint8_t* fine_active, double* x_fine, Execution execution = Execution::parallel);
+void prolong_correction_red_reference(GridShape fine, GridShape coarse, InterpolationViewFloat p, const float* x_coarse,
+                                      const std::uint8_t* fine_active, double* x_fine);
+
 }  // namespace dgtex::kernels
