@@ -6,6 +6,7 @@
 
 #include "dgtex/kernels/texel_derivative_rows.h"
 #include "dgtex/kernels/texel_grid.h"
+#include "texel_cell_rules.h"
 
 // The fast form of the rule (the reference twin, enriched_quadrature_reference.cpp, is the
 // rule written plainly; both give bitwise the same arrays). Where the time went and what
@@ -157,9 +158,7 @@ struct CellBuilder {
   // Planning: cells at task_depth become tasks instead of being visited (nullptr: visit all).
   std::vector<Task>* tasks = nullptr;
   std::int64_t element = 0;
-  double texel = texel_size(in.type, in.t);
-  double origin = in.type == ElementType::quad8 ? -1.0 : 0.0;
-  QuadratureRule triangle_rule = element_quadrature(ElementType::tri6);
+  TexelCellRules rules{in.type, in.t};
 
   // The wall line of the header's split rule (same scan and tie order as the reference).
   bool wall_line(int i0, int j0, int w, int h, bool& horizontal, int& offset) const {
@@ -210,25 +209,6 @@ struct CellBuilder {
     return true;
   }
 
-  void emit(double x, double y, double w) {
-    out.push_back(origin + x * texel);
-    out.push_back(origin + y * texel);
-    out.push_back(w * texel * texel);
-  }
-
-  void emit_rectangle(int i0, int j0, int w, int h, int n1, int n2) {
-    const LineRule g1 = gauss_legendre(n1), g2 = gauss_legendre(n2);
-    for (int b = 0; b < g2.count; ++b)
-      for (int a = 0; a < g1.count; ++a)
-        emit(i0 + 0.5 * w * (1 + g1.t[a]), j0 + 0.5 * h * (1 + g2.t[b]), 0.25 * w * h * g1.weight[a] * g2.weight[b]);
-  }
-
-  void emit_triangle(int i0, int j0, int size) {
-    const QuadratureRule& r = triangle_rule;
-    for (int q = 0; q < r.count; ++q)
-      emit(i0 + size * r.xi1[q], j0 + size * r.xi2[q], size * size * r.weight[q]);
-  }
-
   void visit(int i0, int j0, int w, int h, int depth) {
     const int t = in.t;
     const bool tri = in.type == ElementType::tri6;
@@ -241,13 +221,13 @@ struct CellBuilder {
     const bool diagonal = tri && w == h && i0 + j0 + w == t;
     if (inside || diagonal) {
       if (w == 1 && h == 1) {
-        if (diagonal) emit_triangle(i0, j0, 1);
-        else emit_rectangle(i0, j0, 1, 1, 2, 2);
+        if (diagonal) rules.triangle(out, i0, j0, 1);
+        else rules.rectangle(out, i0, j0, 1, 1, 2, 2);
         return;
       }
       if (options.adaptive && uniform(i0, j0, w, h, diagonal)) {
-        if (diagonal) emit_triangle(i0, j0, w);
-        else emit_rectangle(i0, j0, w, h, w <= 2 ? 2 : 3, h <= 2 ? 2 : 3);
+        if (diagonal) rules.triangle(out, i0, j0, w);
+        else rules.rectangle(out, i0, j0, w, h, w <= 2 ? 2 : 3, h <= 2 ? 2 : 3);
         return;
       }
     }

@@ -8,6 +8,7 @@
 #include <cmath>
 
 #include "dgtex/kernels/texel_grid.h"
+#include "texel_cell_rules.h"
 
 namespace dgtex::kernels {
 namespace {
@@ -37,6 +38,7 @@ struct CellBuilder {
   // north_prefix[j * (T + 1) + i] = walls north of texels (0..i-1, j); east_prefix[i * (T + 1) + j]
   // = walls east of texels (i, 0..j-1).
   std::vector<int> north_prefix, east_prefix;
+  TexelCellRules rules{type, t};
 
   void count_walls() {
     north_prefix.assign(static_cast<std::size_t>(t) * (t + 1), 0);
@@ -106,29 +108,6 @@ struct CellBuilder {
     return true;
   }
 
-  // Texel-space point (x, y) and texel-space weight -> parametric point and weight.
-  void emit(double x, double y, double w) {
-    const double h = texel_size(type, t);
-    const double origin = type == ElementType::quad8 ? -1.0 : 0.0;
-    out.push_back(origin + x * h);
-    out.push_back(origin + y * h);
-    out.push_back(w * h * h);
-  }
-
-  // n1 x n2 Gauss points on the texel rectangle [i0, i0 + w] x [j0, j0 + h].
-  void emit_rectangle(int i0, int j0, int w, int h, int n1, int n2) {
-    const LineRule g1 = gauss_legendre(n1), g2 = gauss_legendre(n2);
-    for (int b = 0; b < g2.count; ++b)
-      for (int a = 0; a < g1.count; ++a)
-        emit(i0 + 0.5 * w * (1 + g1.t[a]), j0 + 0.5 * h * (1 + g2.t[b]), 0.25 * w * h * g1.weight[a] * g2.weight[b]);
-  }
-
-  void emit_triangle(int i0, int j0, int size) {
-    const QuadratureRule r = element_quadrature(ElementType::tri6);
-    for (int q = 0; q < r.count; ++q)
-      emit(i0 + size * r.xi1[q], j0 + size * r.xi2[q], size * size * r.weight[q]);
-  }
-
   void visit(int i0, int j0, int w, int h) {
     const bool tri = type == ElementType::tri6;
     if (tri && i0 + j0 >= t) return;  // outside the triangle
@@ -136,15 +115,15 @@ struct CellBuilder {
     const bool diagonal = tri && w == h && i0 + j0 + w == t;
     if (inside || diagonal) {
       if (w == 1 && h == 1) {
-        if (diagonal) emit_triangle(i0, j0, 1);
-        else emit_rectangle(i0, j0, 1, 1, 2, 2);
+        if (diagonal) rules.triangle(out, i0, j0, 1);
+        else rules.rectangle(out, i0, j0, 1, 1, 2, 2);
         return;
       }
       if (options.adaptive && uniform(i0, j0, w, h, diagonal)) {
-        if (diagonal) emit_triangle(i0, j0, w);
+        if (diagonal) rules.triangle(out, i0, j0, w);
         // Sides of at most 2 texels: 2 Gauss points, near the texel centres (3 would put the
         // middle ones on the texel edge between two texel polynomials).
-        else emit_rectangle(i0, j0, w, h, w <= 2 ? 2 : 3, h <= 2 ? 2 : 3);
+        else rules.rectangle(out, i0, j0, w, h, w <= 2 ? 2 : 3, h <= 2 ? 2 : 3);
         return;
       }
     }

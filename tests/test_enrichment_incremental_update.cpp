@@ -20,6 +20,7 @@
 #include "dgtex/mesh_generators.h"
 #include "dgtex/mesh_texel_laplace.h"
 #include "dgtex/topology.h"
+#include "region_test_support.h"
 
 using namespace dgtex;
 using namespace dgtex::testing_support;
@@ -28,39 +29,10 @@ namespace {
 
 constexpr int T = 32;
 
-// +1 on a run of texels in the first solved tile, -1 in the last, a wall in every tile;
-// frozen tiles get smooth non-constant values (data), free texels 0.5 (a warm start).
-std::vector<RegionTile> make_region(const Mesh& mesh, const std::vector<int>& elements, const std::vector<int>& frozen) {
-  std::vector<RegionTile> region;
-  for (std::size_t n = 0; n < elements.size(); ++n) {
-    RegionTile r;
-    r.element = elements[n];
-    r.tile = kernels::make_element_tile(mesh.type, T);
-    for (double& v : r.tile.values) v = 0.5;
-    const int x = 5 + 7 * static_cast<int>(n) % 20;
-    for (int j = 2; j < T / 2; ++j) r.tile.flags[j * T + x] |= kernels::wall_east;
-    region.push_back(std::move(r));
-  }
-  for (int l : frozen) {
-    region[l].frozen = true;
-    for (std::size_t k = 0; k < region[l].tile.values.size(); ++k) region[l].tile.values[k] = 0.25 * std::sin(0.1 * k);
-  }
-  int first = 0, last = static_cast<int>(region.size()) - 1;
-  while (region[first].frozen) ++first;
-  while (region[last].frozen) --last;
-  for (int i = 3; i < 9; ++i) {
-    region[first].tile.flags[4 * T + i] |= kernels::dirichlet;
-    region[first].tile.values[4 * T + i] = 1.0;
-    region[last].tile.flags[6 * T + i] |= kernels::dirichlet;
-    region[last].tile.values[6 * T + i] = -1.0;
-  }
-  return region;
-}
-
 void expect_multigrid_equals_cholmod(const Mesh& mesh, const std::vector<int>& elements, const std::vector<int>& frozen,
                                      const MeshEdgeWalls& walls, bool on_patch) {
   const ElementAdjacency adjacency(mesh, build_topology(mesh));
-  std::vector<RegionTile> direct = make_region(mesh, elements, frozen);
+  std::vector<RegionTile> direct = make_test_region(mesh, elements, T, frozen);
   std::vector<RegionTile> multigrid = direct;
   const MeshLaplaceStats d = solve_mesh_texel_laplace(direct, mesh.type, adjacency, walls, LaplaceSolver::cholmod);
   LaplaceMultigridOptions options;

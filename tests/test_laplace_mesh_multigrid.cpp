@@ -11,35 +11,14 @@
 #include "dgtex/mesh_generators.h"
 #include "dgtex/mesh_texel_laplace.h"
 #include "dgtex/topology.h"
+#include "region_test_support.h"
 
 using namespace dgtex;
+using testing_support::make_test_region;
 
 namespace {
 
 constexpr int T = 32;
-
-// Region of the given elements: Dirichlet +1 on a short run of texels in the first tile and
-// -1 in the last, a wall in every tile (at varying positions), values of free texels 0.5
-// (a warm start that is not the solution).
-std::vector<RegionTile> make_region(const Mesh& mesh, const std::vector<int>& elements) {
-  std::vector<RegionTile> region;
-  for (std::size_t n = 0; n < elements.size(); ++n) {
-    RegionTile r;
-    r.element = elements[n];
-    r.tile = kernels::make_element_tile(mesh.type, T);
-    for (double& v : r.tile.values) v = 0.5;
-    const int x = 5 + 7 * static_cast<int>(n) % 20;
-    for (int j = 2; j < T / 2; ++j) r.tile.flags[j * T + x] |= kernels::wall_east;
-    region.push_back(std::move(r));
-  }
-  for (int i = 3; i < 9; ++i) {
-    region.front().tile.flags[4 * T + i] |= kernels::dirichlet;
-    region.front().tile.values[4 * T + i] = 1.0;
-    region.back().tile.flags[6 * T + i] |= kernels::dirichlet;
-    region.back().tile.values[6 * T + i] = -1.0;
-  }
-  return region;
-}
 
 double max_difference(const std::vector<RegionTile>& a, const std::vector<RegionTile>& b) {
   double worst = 0;
@@ -58,7 +37,7 @@ void expect_multigrid_equals_cholmod(const Case& c, const MeshEdgeWalls& walls, 
                                      const std::vector<int>& frozen = {}) {
   const Topology topology = build_topology(c.mesh);
   const ElementAdjacency adjacency(c.mesh, topology);
-  std::vector<RegionTile> direct = make_region(c.mesh, c.elements);
+  std::vector<RegionTile> direct = make_test_region(c.mesh, c.elements, T);
   for (int l : frozen) {
     direct[l].frozen = true;
     for (std::size_t k = 0; k < direct[l].tile.values.size(); ++k) direct[l].tile.values[k] = 0.25 * std::sin(0.1 * k);
