@@ -22,6 +22,12 @@ constexpr std::int64_t parallel_vector_length = 1 << 15;
 kernels::Execution vector_execution(std::size_t n) {
   return static_cast<std::int64_t>(n) >= parallel_vector_length ? kernels::Execution::parallel : kernels::Execution::serial;
 }
+// Block products over fewer 3x3 blocks than this run serially for the same reason (a cut
+// single element has ~64 blocks: each product is ~1 us, and PCG calls it every iteration).
+constexpr std::int64_t parallel_block_count = 4096;
+kernels::Execution block_execution(const BlockAssembly& pattern) {
+  return pattern.num_blocks() >= parallel_block_count ? kernels::Execution::parallel : kernels::Execution::serial;
+}
 }  // namespace
 
 std::vector<char> element_local_blocks(const std::vector<double>& mass) {
@@ -158,15 +164,18 @@ void FactorReusingSolver::multiply_mass(const std::vector<double>& x, std::vecto
   }
   const auto& start = pattern_.row_start();
   const auto& col = pattern_.column();
-  kernels::forall(pattern_.num_nodes(), [&](std::int64_t r) {
-    double sum[3] = {0, 0, 0};
-    for (std::int64_t k = start[r]; k < start[r + 1]; ++k) {
-      const double m = mass_scalar_[k];
-      const double* xv = x.data() + 3 * static_cast<std::int64_t>(col[k]);
-      for (int i = 0; i < 3; ++i) sum[i] += m * xv[i];
-    }
-    for (int i = 0; i < 3; ++i) y[3 * r + i] = sum[i];
-  });
+  kernels::forall(
+      pattern_.num_nodes(),
+      [&](std::int64_t r) {
+        double sum[3] = {0, 0, 0};
+        for (std::int64_t k = start[r]; k < start[r + 1]; ++k) {
+          const double m = mass_scalar_[k];
+          const double* xv = x.data() + 3 * static_cast<std::int64_t>(col[k]);
+          for (int i = 0; i < 3; ++i) sum[i] += m * xv[i];
+        }
+        for (int i = 0; i < 3; ++i) y[3 * r + i] = sum[i];
+      },
+      block_execution(pattern_));
 }
 
 void FactorReusingSolver::multiply(const ScaledBlockSum& A, const std::vector<double>& x, std::vector<double>& y) const {
@@ -176,7 +185,7 @@ void FactorReusingSolver::multiply(const ScaledBlockSum& A, const std::vector<do
   const double* K = A.stiffness->data();
   const double ms = A.mass_scale, ks = A.stiffness_scale;
   const bool scalar_mass = !mass_scalar_.empty();
-  kernels::forall(pattern_.num_nodes(), [&](std::int64_t r) {
+  const auto row = [&](std::int64_t r) {
     double k_sum[3] = {0, 0, 0}, m_sum[3] = {0, 0, 0};
     for (std::int64_t k = start[r]; k < start[r + 1]; ++k) {
       const double* b = K + 9 * k;
@@ -191,7 +200,8 @@ void FactorReusingSolver::multiply(const ScaledBlockSum& A, const std::vector<do
       }
     }
     for (int i = 0; i < 3; ++i) y[3 * r + i] = free_[3 * r + i] ? ms * m_sum[i] + ks * k_sum[i] : 0.0;
-  });
+  };
+  kernels::forall(pattern_.num_nodes(), row, block_execution(pattern_));
 }
 
 int FactorReusingSolver::pcg(const ScaledBlockSum& A, const std::vector<double>& b, std::vector<double>& x,

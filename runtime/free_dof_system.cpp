@@ -50,10 +50,15 @@ FreeDofSystem::FreeDofSystem(const BlockAssembly& pattern, const std::vector<cha
 
 void FreeDofSystem::gather(const double* a, double sa, const double* b, double sb, std::vector<double>& values) const {
   values.resize(slot_source_.size());
-  kernels::forall(static_cast<std::int64_t>(slot_source_.size()), [&](std::int64_t s) {
-    const std::int64_t src = slot_source_[s];
-    values[s] = b ? sa * a[src] + sb * b[src] : sa * a[src];
-  });
+  // Short gathers (small cut models) run serially: waking the OpenMP team costs more.
+  const std::int64_t n = static_cast<std::int64_t>(slot_source_.size());
+  kernels::forall(
+      n,
+      [&](std::int64_t s) {
+        const std::int64_t src = slot_source_[s];
+        values[s] = b ? sa * a[src] + sb * b[src] : sa * a[src];
+      },
+      n >= (1 << 15) ? kernels::Execution::parallel : kernels::Execution::serial);
 }
 
 void FreeDofSystem::restrict_vector(const std::vector<double>& full, std::vector<double>& reduced) const {

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "cholmod_lock.h"
+#include "dense_cholesky.h"
 
 namespace dgtex {
 
@@ -77,6 +78,7 @@ struct SparseCholesky::Impl {
   cholmod_factor* factor = nullptr;
   std::vector<float> single_values;  // supernodal L in float (same layout as factor->x)
   SolveSchedule schedule;            // built with the first single-precision copy
+  std::unique_ptr<detail::DenseCholesky> dense;  // instead of CHOLMOD for small systems
   mutable std::vector<float> work, top_updates;  // y; per task x top rows accumulators
   mutable std::vector<std::vector<float>> gathered;  // per task (forward, backward) scratch
   mutable std::vector<float> top_scratch;            // the same for the top supernodes
@@ -94,17 +96,26 @@ struct SparseCholesky::Impl {
   }
 };
 
-SparseCholesky::SparseCholesky() : impl_(std::make_unique<Impl>()) {}
+SparseCholesky::SparseCholesky(int dense_max_unknowns)
+    : impl_(std::make_unique<Impl>()), dense_max_unknowns_(dense_max_unknowns) {}
 SparseCholesky::~SparseCholesky() = default;
 
-bool SparseCholesky::analyzed() const { return impl_->factor != nullptr; }
+bool SparseCholesky::analyzed() const { return impl_->factor != nullptr || impl_->dense != nullptr; }
+bool SparseCholesky::dense() const { return impl_->dense != nullptr; }
 
 void SparseCholesky::analyze(int n, const std::vector<int>& column_start, const std::vector<int>& row_index) {
   Impl& m = *impl_;
   if (m.factor) cholmod_free_factor(&m.factor, &m.common);
   if (m.matrix) cholmod_free_sparse(&m.matrix, &m.common);
+  m.dense.reset();
   n_ = n;
   const size_t nnz = row_index.size();
+  const double lower_entries = 0.5 * n * (n + 1.0);
+  if (n <= dense_max_unknowns_ && (n <= 128 || nnz >= 0.25 * lower_entries)) {
+    m.dense = std::make_unique<detail::DenseCholesky>();
+    m.dense->set_pattern(n, column_start, row_index);
+    return;
+  }
   // stype -1: only the lower triangle is stored and used.
   m.matrix = cholmod_allocate_sparse(n, n, nnz, /*sorted=*/1, /*packed=*/1, /*stype=*/-1, CHOLMOD_REAL, &m.common);
   if (!m.matrix) throw std::runtime_error("CHOLMOD: out of memory allocating a " + std::to_string(n) + "x" + std::to_string(n) + " matrix");
@@ -122,6 +133,10 @@ void SparseCholesky::analyze(int n, const std::vector<int>& column_start, const 
 
 void SparseCholesky::factorize(const std::vector<double>& values) {
   Impl& m = *impl_;
+  if (m.dense) {
+    m.dense->factorize(values);
+    return;
+  }
   if (!m.factor) throw std::logic_error("SparseCholesky::factorize called before analyze");
   if (values.size() != m.matrix->nzmax) throw std::invalid_argument("SparseCholesky::factorize: value count does not match the pattern");
   std::memcpy(m.matrix->x, values.data(), sizeof(double) * values.size());
@@ -139,6 +154,10 @@ void SparseCholesky::factorize(const std::vector<double>& values) {
 
 void SparseCholesky::solve(const std::vector<double>& b, std::vector<double>& x) const {
   Impl& m = *impl_;
+  if (m.dense) {
+    m.dense->solve(b, x);
+    return;
+  }
   cholmod_dense* rhs = cholmod_allocate_dense(n_, 1, n_, CHOLMOD_REAL, &m.common);
   std::memcpy(rhs->x, b.data(), sizeof(double) * n_);
   cholmod_dense* sol = nullptr;
@@ -158,6 +177,7 @@ void SparseCholesky::solve(const std::vector<double>& b, std::vector<double>& x)
 
 void SparseCholesky::copy_factor_to_single_precision() {
   Impl& m = *impl_;
+  if (m.dense) return;
   const cholmod_factor* f = m.factor;
   if (!f || !f->is_super || f->xtype != CHOLMOD_REAL || f->itype != CHOLMOD_INT)
     throw std::logic_error("SparseCholesky::copy_factor_to_single_precision needs a real supernodal factor (call factorize first)");
@@ -225,6 +245,10 @@ void SparseCholesky::build_solve_schedule() {
 
 void SparseCholesky::solve_single_precision(const std::vector<double>& b, std::vector<double>& x) const {
   const Impl& m = *impl_;
+  if (m.dense) {
+    m.dense->solve(b, x);
+    return;
+  }
   const cholmod_factor* f = m.factor;
   if (!f || m.single_values.size() != f->xsize)
     throw std::logic_error("SparseCholesky::solve_single_precision called without copy_factor_to_single_precision");
@@ -283,6 +307,7 @@ void SparseCholesky::solve_single_precision(const std::vector<double>& b, std::v
 }
 
 std::int64_t SparseCholesky::factor_nonzeros() const {
+  if (impl_->dense) return impl_->dense->factor_nonzeros();
   const cholmod_factor* f = impl_->factor;
   if (!f) return 0;
   if (f->is_super) return static_cast<std::int64_t>(f->xsize);

@@ -1,7 +1,9 @@
 #pragma once
 // Sparse Cholesky factorisation through CHOLMOD (supernodal). The symbolic analysis (fill
 // reducing ordering, supernodes) is done once per pattern and reused by every numeric
-// factorisation with the same pattern, as in a time loop.
+// factorisation with the same pattern, as in a time loop. Small, mostly dense systems (a
+// cut single element) are factored densely instead (Eigen's LLT, see dense_cholesky.h):
+// up to 128 unknowns, or up to 512 with at least a quarter of the lower triangle stored.
 //
 // Matrices are given as the LOWER triangle in compressed-column form (n x n, 0-based).
 // SparseCholesky owns the CHOLMOD workspace, analysis and factor (not copyable). Not
@@ -26,7 +28,8 @@ class NotPositiveDefinite : public std::runtime_error {
 
 class SparseCholesky {
  public:
-  SparseCholesky();
+  // dense_max_unknowns: systems up to this size may be factored densely (0: always CHOLMOD).
+  explicit SparseCholesky(int dense_max_unknowns = 512);
   ~SparseCholesky();
   SparseCholesky(const SparseCholesky&) = delete;
   SparseCholesky& operator=(const SparseCholesky&) = delete;
@@ -45,18 +48,22 @@ class SparseCholesky {
   // subtrees of the elimination tree run on the OpenMP threads, in a split fixed by the
   // factor's structure, so x is bitwise independent of the thread count. Not safe for
   // concurrent calls on one instance. copy_factor_to_single_precision() must follow
-  // each factorize() whose factor solve_single_precision() is to use.
+  // each factorize() whose factor solve_single_precision() is to use. A dense factor
+  // (small systems) keeps no float copy: solve_single_precision() is solve() there.
   void copy_factor_to_single_precision();
   void solve_single_precision(const std::vector<double>& b, std::vector<double>& x) const;
   int size() const { return n_; }
   // Non-zeros of the factor L (after factorize).
   std::int64_t factor_nonzeros() const;
+  // Whether the analysed pattern is factored densely rather than by CHOLMOD.
+  bool dense() const;
 
  private:
   struct Impl;
   std::unique_ptr<Impl> impl_;
   void build_solve_schedule();  // parallel schedule of solve_single_precision (per analysis)
   int n_ = 0;
+  int dense_max_unknowns_ = 0;
 };
 
 }  // namespace dgtex

@@ -1,0 +1,130 @@
+// SparseCholesky's dense path for small systems (runtime/dense_cholesky.h) against its
+// CHOLMOD path on the same matrices: solutions, errors for indefinite and non-finite
+// matrices, and which systems take which path.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+#include <random>
+#include <vector>
+
+#include <Eigen/Dense>
+
+#include "dgtex/sparse_cholesky.h"
+
+namespace {
+
+struct LowerCsc {
+  int n = 0;
+  std::vector<int> column_start, row_index;
+  std::vector<double> values;
+};
+
+// The lower triangle of `a`, entries with |a_ij| > 0 (and the diagonal) kept.
+LowerCsc lower_csc(const Eigen::MatrixXd& a) {
+  LowerCsc m;
+  m.n = static_cast<int>(a.rows());
+  for (int j = 0; j < m.n; ++j) {
+    m.column_start.push_back(static_cast<int>(m.row_index.size()));
+    for (int i = j; i < m.n; ++i)
+      if (i == j || a(i, j) != 0) m.row_index.push_back(i), m.values.push_back(a(i, j));
+  }
+  m.column_start.push_back(static_cast<int>(m.row_index.size()));
+  return m;
+}
+
+Eigen::MatrixXd random_spd(int n, int bandwidth, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> u(-1, 1);
+  Eigen::MatrixXd a = Eigen::MatrixXd::Zero(n, n);
+  for (int j = 0; j < n; ++j)
+    for (int i = j + 1; i < std::min(n, j + 1 + bandwidth); ++i) a(i, j) = a(j, i) = u(rng);
+  for (int i = 0; i < n; ++i) a(i, i) = a.row(i).cwiseAbs().sum() + 1.0;  // diagonally dominant
+  return a;
+}
+
+std::vector<double> solve_with(int dense_max, const LowerCsc& m, const std::vector<double>& b, bool* dense) {
+  dgtex::SparseCholesky c(dense_max);
+  c.analyze(m.n, m.column_start, m.row_index);
+  c.factorize(m.values);
+  if (dense) *dense = c.dense();
+  std::vector<double> x;
+  c.solve(b, x);
+  return x;
+}
+
+double relative_difference(const std::vector<double>& x, const std::vector<double>& y) {
+  double d = 0, s = 0;
+  for (std::size_t i = 0; i < x.size(); ++i) d += (x[i] - y[i]) * (x[i] - y[i]), s += y[i] * y[i];
+  return std::sqrt(d / s);
+}
+
+}  // namespace
+
+TEST(DenseCholesky, SolvesLikeCholmodOnSmallSystems) {
+  // A cut single element (39 unknowns, dense), a small banded system, an accordion-sized one.
+  for (auto [n, band] : {std::pair{39, 39}, std::pair{120, 6}, std::pair{441, 441}}) {
+    const LowerCsc m = lower_csc(random_spd(n, band, 7u + n));
+    std::vector<double> b(n);
+    for (int i = 0; i < n; ++i) b[i] = std::sin(0.3 * i) + 0.1;
+    bool dense = false, cholmod_dense = true;
+    const std::vector<double> x = solve_with(512, m, b, &dense);
+    const std::vector<double> reference = solve_with(0, m, b, &cholmod_dense);
+    EXPECT_TRUE(dense) << n;
+    EXPECT_FALSE(cholmod_dense) << n;
+    EXPECT_LT(relative_difference(x, reference), 1e-12) << n;
+  }
+}
+
+TEST(DenseCholesky, LargeOrSparseSystemsStayWithCholmod) {
+  bool dense = true;
+  const LowerCsc sparse = lower_csc(random_spd(400, 3, 3u));  // 400 unknowns, < 1/4 of the triangle
+  solve_with(512, sparse, std::vector<double>(400, 1.0), &dense);
+  EXPECT_FALSE(dense);
+  const LowerCsc large = lower_csc(random_spd(600, 600, 5u));
+  solve_with(512, large, std::vector<double>(600, 1.0), &dense);
+  EXPECT_FALSE(dense);
+}
+
+TEST(DenseCholesky, SinglePrecisionSolveIsTheDoubleSolve) {
+  const LowerCsc m = lower_csc(random_spd(60, 60, 11u));
+  dgtex::SparseCholesky c;
+  c.analyze(m.n, m.column_start, m.row_index);
+  c.factorize(m.values);
+  c.copy_factor_to_single_precision();
+  std::vector<double> b(60, 1.0), x, y;
+  c.solve(b, x);
+  c.solve_single_precision(b, y);
+  EXPECT_EQ(x, y);
+  EXPECT_EQ(c.factor_nonzeros(), 60 * 61 / 2);
+}
+
+TEST(DenseCholesky, ReportsTheFirstNonPositivePivot) {
+  Eigen::MatrixXd a = random_spd(50, 50, 13u);
+  // Row and column 17 copy row and column 3 in the leading 18 x 18 block, with the diagonal
+  // one lower: the pivot at column 17 is -1 (the leading 17 x 17 block stays definite).
+  a.row(17).head(17) = a.row(3).head(17);
+  a.col(17).head(17) = a.col(3).head(17);
+  a(17, 17) = a(3, 3) - 1;
+  const LowerCsc m = lower_csc(a);
+  dgtex::SparseCholesky c;
+  c.analyze(m.n, m.column_start, m.row_index);
+  ASSERT_TRUE(c.dense());
+  try {
+    c.factorize(m.values);
+    FAIL() << "an indefinite matrix was factored";
+  } catch (const dgtex::NotPositiveDefinite& e) {
+    EXPECT_EQ(e.column(), 17);
+    EXPECT_NE(std::string(e.what()).find("column 17 of 50"), std::string::npos) << e.what();
+  }
+}
+
+TEST(DenseCholesky, RejectsNonFiniteValuesAndWrongCounts) {
+  LowerCsc m = lower_csc(random_spd(20, 20, 17u));
+  dgtex::SparseCholesky c;
+  c.analyze(m.n, m.column_start, m.row_index);
+  m.values[m.column_start[5]] = std::numeric_limits<double>::quiet_NaN();  // diagonal of column 5
+  EXPECT_THROW(c.factorize(m.values), dgtex::NotPositiveDefinite);
+  m.values.pop_back();
+  EXPECT_THROW(c.factorize(m.values), std::invalid_argument);
+}
