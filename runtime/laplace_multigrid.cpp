@@ -791,6 +791,52 @@ LaplaceSolveStats LaplaceMultigrid::solve(kernels::TexelTile& tile, std::vector<
   return stats;
 }
 
+bool LaplaceMultigrid::is_unknown(int t) const {
+  const Hierarchy& h = *hierarchy_;
+  if (t < 0 || t >= h.width * h.height)
+    throw std::out_of_range("LaplaceMultigrid::is_unknown: texel " + std::to_string(t) + " outside the " +
+                            std::to_string(h.width) + "x" + std::to_string(h.height) + " tile");
+  return h.bits[h.levels[0].shape.at(t % h.width, t / h.width)] & kernels::is_unknown;
+}
+
+void LaplaceMultigrid::precondition(const std::vector<double>& r, std::vector<double>& z) {
+  Hierarchy& h = *hierarchy_;
+  const std::size_t texels = static_cast<std::size_t>(h.width) * h.height;
+  if (r.size() != texels)
+    throw std::invalid_argument("LaplaceMultigrid::precondition: " + std::to_string(r.size()) + " values for a " +
+                                std::to_string(h.width) + "x" + std::to_string(h.height) + " tile");
+  if (!h.options.use_as_cg_preconditioner || h.robust_coarse_solve())
+    throw std::logic_error("LaplaceMultigrid::precondition needs use_as_cg_preconditioner and the plain cycle "
+                           "(coarse_solve_tolerance = 0): only then is M a fixed symmetric operator");
+  auto& fine = h.levels[0];
+  const GridShape g = fine.shape;
+  // Same layout as solve(): b at the unknowns, 0 elsewhere (ghosts included, written by the
+  // frame-zeroed buffer); the cycle leaves z in fine.x.
+  kernels::forall(
+      g.ny,
+      [&](std::int64_t j64) {
+        const int j = static_cast<int>(j64);
+        for (int i = 0; i < g.nx; ++i) {
+          const std::int64_t t = g.at(i, j);
+          fine.b[t] = (h.bits[t] & kernels::is_unknown) ? r[static_cast<std::size_t>(j) * h.width + i] : 0.0;
+          fine.x[t] = 0.0;
+        }
+      },
+      fine.execution);
+  h.cycle(0, MultigridCycle::v, true);
+  z.resize(texels);
+  kernels::forall(
+      g.ny,
+      [&](std::int64_t j64) {
+        const int j = static_cast<int>(j64);
+        for (int i = 0; i < g.nx; ++i) {
+          const std::int64_t t = g.at(i, j);
+          z[static_cast<std::size_t>(j) * h.width + i] = (h.bits[t] & kernels::is_unknown) ? fine.x[t] : 0.0;
+        }
+      },
+      fine.execution);
+}
+
 LaplaceSolveStats solve_laplace_multigrid(kernels::TexelTile& tile, const LaplaceMultigridOptions& options,
                                           std::vector<LaplaceConvergencePoint>* history) {
   const auto start = Clock::now();

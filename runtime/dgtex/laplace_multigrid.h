@@ -65,6 +65,17 @@ class LaplaceMultigrid {
   // reached within max_cycles. history, if given, receives one point per cycle (and the start).
   LaplaceSolveStats solve(kernels::TexelTile& tile, std::vector<LaplaceConvergencePoint>* history = nullptr);
 
+  // z = M r with M the CG preconditioner (one symmetric V-cycle from zero): r and z are
+  // per tile texel (tile.index(i, j)); r is read only at the unknowns (free texels of a
+  // component with Dirichlet data), z is 0 elsewhere. For callers that precondition a
+  // related operator with this hierarchy (e.g. the texel graph of a ring of elements, of
+  // which this tile is the ring cut open). M is symmetric positive definite on the unknowns
+  // and, like solve(), independent of the thread count. Needs use_as_cg_preconditioner and
+  // the plain cycle (coarse_solve_tolerance = 0).
+  void precondition(const std::vector<double>& r, std::vector<double>& z);
+  // Whether texel t (tile.index(i, j)) is an unknown of the hierarchy.
+  bool is_unknown(int t) const;
+
   int level_count() const;
   double setup_ms() const;
   const LaplaceMultigridOptions& options() const;
