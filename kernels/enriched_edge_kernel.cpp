@@ -1,12 +1,14 @@
 #include "dgtex/kernels/enriched_edge_kernel.h"
 
 #include <algorithm>
+#include <memory>
 #include <cmath>
 #include <vector>
 
 #include "dgtex/kernels/shell_point.h"
 #include "dgtex/kernels/edge_frame.h"
 #include "dgtex/kernels/vec3.h"
+#include "dgtex/kernels/gram_accumulation.h"
 
 namespace dgtex::kernels {
 namespace {
@@ -153,7 +155,9 @@ void edge_stiffness(const EnrichedEdgeBatch& b, const EdgeQuadrature& quad, std:
   // Compact numbering of the used local slots: side 0's functions, then side 1's.
   Side side_data[2];
   int counts[2] = {0, 0};
-  std::vector<double> K, G, f;
+  // K = sum_q ds penalty G_q G_q^T: rows sqrt(ds penalty) G_q, summed by blocked products.
+  std::unique_ptr<GramAccumulator> K;
+  std::vector<double> G, f;
   int m = 0;
   for (std::int64_t q = quad.start[e]; q < quad.start[e + 1]; ++q) {
     const double t = quad.points[2 * q], wt = quad.points[2 * q + 1];
@@ -162,7 +166,7 @@ void edge_stiffness(const EnrichedEdgeBatch& b, const EdgeQuadrature& quad, std:
     if (q == quad.start[e]) {
       for (int s = 0; s < sides; ++s) counts[s] = side_data[s].shape.count;
       m = counts[0] + counts[1];
-      K.assign(static_cast<std::size_t>(3 * m) * 3 * m, 0.0);
+      K = std::make_unique<GramAccumulator>(3 * m, quad.start[e + 1] - quad.start[e]);
       f.assign(3 * m, 0.0);
       G.resize(3 * m);
     }
@@ -204,28 +208,28 @@ void edge_stiffness(const EnrichedEdgeBatch& b, const EdgeQuadrature& quad, std:
         for (int c = 0; c < 3; ++c) G[3 * i + c] = g2[c];
       }
     }
-    // K += ds penalty G^T G, upper triangle.
     const int n3 = 3 * m;
-    for (int i = 0; i < n3; ++i) {
-      const double gi = ds * penalty * G[i];
-      double* row = K.data() + static_cast<std::size_t>(i) * n3;
-      for (int j = i; j < n3; ++j) row[j] += gi * G[j];
+    const double root = std::sqrt(ds * penalty);
+    double* row = K->next();
+    for (int i = 0; i < n3; ++i) row[i] = root * G[i];
+    if (R && forces) {
+      const double s = root * gd;
+      for (int i = 0; i < n3; ++i) f[i] += row[i] * s;
     }
-    if (R && forces)
-      for (int i = 0; i < n3; ++i) f[i] += ds * penalty * G[i] * gd;
+    K->push();
   }
-  // Scatter the compact matrix into the padded local layout (side s at offset s W).
+  if (K) K->flush();
+  // Scatter the compact matrix into the padded local layout (side s at offset s W); blocks
+  // of unused slots are not written (0 .. 2W^2 x 9 doubles per edge would dominate).
   double* out = blocks + e * nb * nb * 9;
-  for (int i = 0; i < nb * nb * 9; ++i) out[i] = 0;
   auto slot = [&](int i) { return i < counts[0] ? i : W + (i - counts[0]); };
-  const int n3 = 3 * m;
   for (int i = 0; i < m; ++i)
     for (int j = 0; j < m; ++j) {
       double* blk = out + (slot(i) * nb + slot(j)) * 9;
       for (int r = 0; r < 3; ++r)
         for (int c = 0; c < 3; ++c) {
           const int I = 3 * i + r, J = 3 * j + c;
-          blk[r * 3 + c] = I <= J ? K[static_cast<std::size_t>(I) * n3 + J] : K[static_cast<std::size_t>(J) * n3 + I];
+          blk[r * 3 + c] = (*K)(I, J);
         }
     }
   if (forces) {

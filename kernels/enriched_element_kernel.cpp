@@ -5,9 +5,11 @@
 #include <cstdint>
 #include <vector>
 
+#include "dgtex/kernels/polar_decomposition.h"
 #include "dgtex/kernels/shell_point.h"
 #include "dgtex/kernels/symmetric_accumulator.h"
 #include "dgtex/kernels/vec3.h"
+#include "dgtex/kernels/gram_accumulation.h"
 
 namespace dgtex::kernels {
 namespace {
@@ -200,14 +202,82 @@ inline void product_rule(const TextureSample& h, double shift, const ShapeValues
   d2N[2] = h.d2[2] * s.N[a] + h.d[0] * dn[1] + h.d[1] * dn[0] + psi * d2n[2];
 }
 
+// Per-point factors of the strain rows. Membrane rows of a function lie in the tangent
+// plane (e1, e2) and bending rows along t0 (the rest bending strain of report eq. 4 is
+// rho_ab = -(N,ab - Gamma^c_ab N,c) t0: the normal change dt is tangential and phi0,ab
+// . dt picks the Christoffel symbols Gamma^c_ab = phi0,ab . phi0^c), so a function's six
+// rows are five numbers times the point's frame: the same rows as membrane_rows and
+// bending_rows (shell_point.h), to round-off.
+struct PointRows {
+  double e[3][3];       // e1, e2, t0 (rest)
+  double q[3][3];       // R e1, R e2, R t0: the frame the rows are written in
+  double c[2][2];       // c[i][a] = phi0^a . e_i
+  double gamma[3][2];   // Gamma^c_ab for ab = 11, 22, 12
+  double bend[3][3];    // frame components [11, 22, 2 x 12] of the covariant rho_ab
+  double sm, sb, nu, k1, k2;  // sqrt(w D_m), sqrt(w D_b), nu, sqrt(1 - nu^2), sqrt((1 - nu) / 2)
+
+  void set(const RestPoint& p, const double* R, double weight, double dn, double dm, double poisson) {
+    frame_along(p, p.a1, e[0], e[1]);
+    for (int k = 0; k < 3; ++k) e[2][k] = p.t0[k];
+    for (int f = 0; f < 3; ++f)
+      for (int k = 0; k < 3; ++k)
+        q[f][k] = R ? R[k * 3 + 0] * e[f][0] + R[k * 3 + 1] * e[f][1] + R[k * 3 + 2] * e[f][2] : e[f][k];
+    c[0][0] = dot3(p.dual1, e[0]), c[0][1] = dot3(p.dual2, e[0]);
+    c[1][0] = dot3(p.dual1, e[1]), c[1][1] = dot3(p.dual2, e[1]);
+    const double* phi_ab[3] = {p.a11, p.a22, p.a12};
+    for (int r = 0; r < 3; ++r) gamma[r][0] = dot3(phi_ab[r], p.dual1), gamma[r][1] = dot3(phi_ab[r], p.dual2);
+    for (int i = 0; i < 2; ++i)  // rows 11 and 22: c_ia c_ib rho_ab
+      bend[i][0] = c[i][0] * c[i][0], bend[i][1] = c[i][1] * c[i][1], bend[i][2] = c[i][0] * c[i][1] + c[i][1] * c[i][0];
+    bend[2][0] = 2 * c[0][0] * c[1][0], bend[2][1] = 2 * c[0][1] * c[1][1];
+    bend[2][2] = 2 * (c[0][0] * c[1][1] + c[0][1] * c[1][0]);
+    sm = std::sqrt(weight * dn), sb = std::sqrt(weight * dm);
+    nu = poisson, k1 = std::sqrt(1 - nu * nu), k2 = std::sqrt(0.5 * (1 - nu));
+  }
+
+  // Unscaled strains of one function: membrane g (eps11, eps22 parts) and bending beta.
+  void strains(const double dN[2], const double d2N[3], double g[2], double beta[3]) const {
+    g[0] = c[0][0] * dN[0] + c[0][1] * dN[1];
+    g[1] = c[1][0] * dN[0] + c[1][1] * dN[1];
+    double rho[3];
+    for (int r = 0; r < 3; ++r) rho[r] = -(d2N[r] - gamma[r][0] * dN[0] - gamma[r][1] * dN[1]);
+    for (int r = 0; r < 3; ++r) beta[r] = bend[r][0] * rho[0] + bend[r][1] * rho[1] + bend[r][2] * rho[2];
+  }
+
+  // The six scaled, rotated rows of one function (3 columns each) at column `col` of the
+  // rows row[0..5]: L^T [Bm sqrt(w D_m); Bb sqrt(w D_b)] as scaled_strain_rows.
+  void write(const double dN[2], const double d2N[3], double* const row[6], int col) const {
+    double g[2], beta[3];
+    strains(dN, d2N, g, beta);
+    const double u0 = sm * g[0], u1 = sm * g[1];
+    const double m0a = u0, m0b = nu * u1, m1 = k1 * u1, m2a = k2 * u1, m2b = k2 * u0;
+    const double b0 = sb * (beta[0] + nu * beta[1]), b1 = sb * k1 * beta[1], b2 = sb * k2 * beta[2];
+    for (int k = 0; k < 3; ++k) {
+      row[0][col + k] = m0a * q[0][k] + m0b * q[1][k];
+      row[1][col + k] = m1 * q[1][k];
+      row[2][col + k] = m2a * q[0][k] + m2b * q[1][k];
+      row[3][col + k] = b0 * q[2][k];
+      row[4][col + k] = b1 * q[2][k];
+      row[5][col + k] = b2 * q[2][k];
+    }
+  }
+};
+
 // Points with the same varying textures (mask) and the same constant values: G = sum of
 // S^T S over the group's reduced basis (standard functions, then the varying textures'
-// enriched ones), upper triangle; g = sum of S^T s (corrective forces).
+// enriched ones), upper triangle; g = sum of S^T s (corrective forces). The rows of up to
+// group_block_points points are stacked and added to G in one blocked product (fixed
+// blocks: the points of the group in order, so the sums do not depend on threads).
+constexpr int group_block_points = 16;
+constexpr int group_block_rows = 6 * group_block_points;
+
 struct Group {
   std::uint32_t varying = 0;
   double value[max_enrichments_per_element];
-  int m = 0;  // reduced basis functions
-  std::vector<double> G, g;
+  int m = 0, stride = 0;       // reduced basis functions; padded row length (>= 3 m)
+  std::size_t G = 0, rows = 0;  // offsets into the chunk's arena
+  int pending = 0;              // points stacked in rows, not yet in G
+  bool written = false;         // G holds a first block
+  std::vector<double> g, s;     // g: stride; s: the stacked points' scaled rest strains
 
   bool matches(std::uint32_t mask, const double* values, int count) const {
     if (mask != varying) return false;
@@ -217,12 +287,55 @@ struct Group {
   }
 };
 
+// Adds the group's stacked points to G (and g), in point order.
+void flush(Group& group, std::vector<double>& arena, bool want_forces) {
+  if (group.pending == 0) return;
+  const int rows = 6 * group.pending, S = group.stride;
+  const double* A = arena.data() + group.rows;
+  accumulate_gram_upper(rows, S, A, arena.data() + group.G, !group.written);
+  group.written = true;
+  if (want_forces)
+    for (int k = 0; k < rows; ++k) add_scaled(S, group.s[k], A + static_cast<std::size_t>(k) * S, group.g.data());
+  group.pending = 0;
+}
+
 // Sums the chunk's points into per-group matrices, then maps the groups onto the element's
-// basis: Kc (n x n blocks, a <= c filled) and fc (3n).
+// basis: Kc (3n x 3n, row-major over DOFs, block rows a <= c filled) and fc (3n).
+// F at one point from the whole basis (the rest tangents have no enriched share), the
+// textures sampled at the point: the arithmetic of enriched_element_deformation_gradients.
+void point_deformation_gradient(const ElementLayout& L, const ShapeValues& s, const RestPoint& rest,
+                                const TextureSample* samples, const int* global, const double* current, double F[9]) {
+  const int npe = L.npe;
+  double a1[3] = {0, 0, 0}, a2[3] = {0, 0, 0};
+  for (int a = 0; a < npe; ++a) {
+    const double* x = current + 3 * static_cast<std::int64_t>(global[a]);
+    for (int k = 0; k < 3; ++k) a1[k] += s.dN[a][0] * x[k], a2[k] += s.dN[a][1] * x[k];
+  }
+  for (int k = 0; k < L.count; ++k) {
+    const TextureSample& h = samples[k];
+    for (int a = 0; a < npe; ++a) {
+      if (L.slot[k][a] < 0) continue;
+      const double psi = h.value - L.shift[k][a];
+      const double d0 = h.d[0] * s.N[a] + psi * s.dN[a][0], d1 = h.d[1] * s.N[a] + psi * s.dN[a][1];
+      const double* x = current + 3 * static_cast<std::int64_t>(global[L.slot[k][a]]);
+      for (int i = 0; i < 3; ++i) a1[i] += d0 * x[i], a2[i] += d1 * x[i];
+    }
+  }
+  double t[3];
+  cross3(a1, a2, t);
+  normalize3(t);
+  surface_deformation_gradient(rest.a1, rest.a2, rest.t0, a1, a2, t, F);
+}
+
+// Rotations: given per point (`rotations`), or computed here from `current` exactly as
+// enriched_element_deformation_gradients and polar_rotation would (the fused form), or none.
 void chunk_stiffness(const EnrichedElementBatch& b, const EnrichedQuadrature& quad, const Chunk& chunk,
-                     const double* rotations, bool want_forces, std::vector<double>& Kc, std::vector<double>& fc) {
+                     const double* rotations, const double* current, bool want_forces, std::vector<double>& Kc,
+                     std::vector<double>& fc) {
   const std::int64_t e = chunk.element;
   const ElementLayout L(b, e);
+  int global[max_enriched_basis];
+  if (current) enriched_global_nodes(b, e, global);
   const int npe = L.npe, n = L.n;
   const int* nodes = b.connectivity + static_cast<std::int64_t>(b.element[e]) * npe;
   const ShellSection& sec = b.sections[b.element[e]];
@@ -230,16 +343,18 @@ void chunk_stiffness(const EnrichedElementBatch& b, const EnrichedQuadrature& qu
   const double dn = membrane_rigidity(sec.youngs_modulus, nu, sec.thickness);
   const double dm = bending_rigidity(sec.youngs_modulus, nu, sec.thickness);
 
+  // Per thread: G and stacked rows of every group (G is never zero-filled: the first block
+  // stores, later ones add).
+  static thread_local std::vector<double> arena;
+  std::size_t used = 0;
   std::vector<Group> groups;
   int last = -1;
   TexelCache cache;
   ShapeValues s;
   RestPoint rest;
-  double Bm[max_enriched_basis * 9], Bb[max_enriched_basis * 9];
+  PointRows pr;
   double values[max_enrichments_per_element];
   TextureSample samples[max_enrichments_per_element];  // constructed once: it zero-fills
-  static thread_local std::vector<double> rows;
-  rows.resize(6 * 3 * static_cast<std::size_t>(max_enriched_basis));
   for (std::int64_t q = chunk.begin; q < chunk.end; ++q) {
     const double* pt = quad.points + 3 * q;
     evaluate_shape(b.type, pt[0], pt[1], s);
@@ -265,22 +380,37 @@ void chunk_stiffness(const EnrichedElementBatch& b, const EnrichedQuadrature& qu
       for (int k = 0; k < L.count; ++k)
         if (mask >> k & 1u)
           for (int a = 0; a < npe; ++a) fresh.m += L.slot[k][a] >= 0;
-      fresh.G.assign(static_cast<std::size_t>(9) * fresh.m * fresh.m, 0.0);
-      if (want_forces) fresh.g.assign(3 * static_cast<std::size_t>(fresh.m), 0.0);
+      const int S = (3 * fresh.m + gram_column_multiple - 1) / gram_column_multiple * gram_column_multiple;
+      fresh.stride = S;
+      fresh.G = used;
+      fresh.rows = used + static_cast<std::size_t>(S) * S;
+      used = fresh.rows + static_cast<std::size_t>(group_block_rows) * S;
+      if (arena.size() < used) arena.resize(used);
+      // Padding columns of the stacked rows stay 0.
+      for (int k = 0; k < group_block_rows; ++k)
+        for (int i = 3 * fresh.m; i < S; ++i) arena[fresh.rows + static_cast<std::size_t>(k) * S + i] = 0;
+      if (want_forces) fresh.g.assign(S, 0.0), fresh.s.assign(group_block_rows, 0.0);
       groups.push_back(std::move(fresh));
       g = static_cast<int>(groups.size()) - 1;
     }
     last = g;
     Group& group = groups[g];
-    const int m = group.m, M = 3 * m;
+    const int S = group.stride;
 
-    // Strain rows of the reduced basis.
-    double e1[3], e2[3];
-    frame_along(rest, rest.a1, e1, e2);
-    for (int a = 0; a < npe; ++a) {
-      membrane_rows(rest, e1, e2, s.dN[a], &Bm[9 * a]);
-      bending_rows(rest, e1, e2, s.dN[a], s.d2N[a], &Bb[9 * a]);
+    // This point's rows of the reduced basis, stacked under the group's pending ones.
+    double fused_rotation[9];
+    const double* R = rotations ? rotations + 9 * q : nullptr;
+    if (current) {
+      point_deformation_gradient(L, s, rest, samples, global, current, fused_rotation);
+      double F[9];
+      std::copy(fused_rotation, fused_rotation + 9, F);
+      polar_rotation(F, fused_rotation);
+      R = fused_rotation;
     }
+    pr.set(rest, R, weight, dn, dm, nu);
+    double* block = arena.data() + group.rows + static_cast<std::size_t>(6 * group.pending) * S;
+    double* const row[6] = {block, block + S, block + 2 * S, block + 3 * S, block + 4 * S, block + 5 * S};
+    for (int a = 0; a < npe; ++a) pr.write(s.dN[a], s.d2N[a], row, 3 * a);
     int r = npe;
     for (int k = 0; k < L.count; ++k) {
       if (!(mask >> k & 1u)) continue;
@@ -288,44 +418,48 @@ void chunk_stiffness(const EnrichedElementBatch& b, const EnrichedQuadrature& qu
         if (L.slot[k][a] < 0) continue;
         double dN[2], d2N[3];
         product_rule(samples[k], L.shift[k][a], s, a, dN, d2N);
-        membrane_rows(rest, e1, e2, dN, &Bm[9 * r]);
-        bending_rows(rest, e1, e2, dN, d2N, &Bb[9 * r]);
+        pr.write(dN, d2N, row, 3 * r);
         ++r;
       }
     }
-    const double* R = rotations ? rotations + 9 * q : nullptr;
-    double strain[6] = {0, 0, 0, 0, 0, 0};  // B (X0 - R^T X0); enriched X0 = 0
-    if (R && want_forces) rest_corotation_strain(b.positions, nodes, npe, R, Bm, Bb, strain);
-    if (R)
-      for (int a = 0; a < m; ++a) rotate_rows(&Bm[9 * a], R), rotate_rows(&Bb[9 * a], R);
-    const double sm = std::sqrt(weight * dn), sb = std::sqrt(weight * dm);
-    double* row[6];
-    for (int k = 0; k < 6; ++k) row[k] = rows.data() + static_cast<std::size_t>(k) * M;
-    scaled_strain_rows(m, Bm, Bb, nu, sm, sb, row);
-    // G += S^T S (upper triangle), one rank-6 update.
-    double* G = group.G.data();
-    for (int i = 0; i < M; ++i) {
-      const double r0 = row[0][i], r1 = row[1][i], r2 = row[2][i], r3 = row[3][i], r4 = row[4][i], r5 = row[5][i];
-      double* out = G + static_cast<std::size_t>(i) * M;
-      for (int j = i; j < M; ++j)
-        out[j] += r0 * row[0][j] + r1 * row[1][j] + r2 * row[2][j] + r3 * row[3][j] + r4 * row[4][j] + r5 * row[5][j];
-    }
     if (R && want_forces) {
-      double sv[6];
-      half_constitutive(nu, sm, strain, sv);
-      half_constitutive(nu, sb, strain + 3, sv + 3);
-      for (int i = 0; i < M; ++i)
-        for (int k = 0; k < 6; ++k) group.g[i] += row[k][i] * sv[k];
+      // Rest corotation strain B (X0 - R^T X0) over the standard functions (enriched X0 = 0).
+      double strain[6] = {0, 0, 0, 0, 0, 0};
+      for (int a = 0; a < npe; ++a) {
+        const double* x = b.positions + 3 * static_cast<std::int64_t>(nodes[a]);
+        double d[3], xf[3];
+        for (int k = 0; k < 3; ++k) d[k] = x[k] - (R[0 * 3 + k] * x[0] + R[1 * 3 + k] * x[1] + R[2 * 3 + k] * x[2]);
+        for (int f = 0; f < 3; ++f) xf[f] = dot3(pr.e[f], d);
+        double gm[2], beta[3];
+        pr.strains(s.dN[a], s.d2N[a], gm, beta);
+        strain[0] += gm[0] * xf[0];
+        strain[1] += gm[1] * xf[1];
+        strain[2] += gm[1] * xf[0] + gm[0] * xf[1];
+        for (int k = 0; k < 3; ++k) strain[3 + k] += beta[k] * xf[2];
+      }
+      double* sv = group.s.data() + 6 * group.pending;
+      half_constitutive(nu, pr.sm, strain, sv);
+      half_constitutive(nu, pr.sb, strain + 3, sv + 3);
     }
+    if (++group.pending == group_block_points) flush(group, arena, want_forces);
   }
+  for (Group& group : groups) flush(group, arena, want_forces);
 
   // K += T^T G T per group: basis function i of the element is reduced function red[i]
   // times scale[i] (1, or H_k - H_k(xi^a) for a constant texture k: a multiple of N^a).
-  Kc.assign(static_cast<std::size_t>(9) * n * n, 0.0);
-  fc.assign(want_forces ? 3 * static_cast<std::size_t>(n) : 0, 0.0);
+  // Kc is row-major over the element's 3n DOFs (upper part, from each diagonal block's
+  // first column). Element functions with consecutive reduced functions form runs, so each
+  // K row takes contiguous stretches of a G row. Entries of G below the diagonal are read
+  // only in the standard functions' columns (red < npe) and in diagonal 3x3 blocks: those
+  // are mirrored first.
+  const std::size_t N3 = 3 * static_cast<std::size_t>(n);
+  Kc.assign(N3 * N3, 0.0);
+  fc.assign(want_forces ? N3 : 0, 0.0);
   int red[max_enriched_basis];
   double scale[max_enriched_basis];
-  for (const Group& group : groups) {
+  std::vector<double> column_scale(N3);
+  std::vector<int> run_start, run_of(n);  // runs: first element function; run of each function
+  for (Group& group : groups) {
     for (int a = 0; a < npe; ++a) red[a] = a, scale[a] = 1;
     int r = npe;
     for (int k = 0; k < L.count; ++k)
@@ -335,19 +469,32 @@ void chunk_stiffness(const EnrichedElementBatch& b, const EnrichedQuadrature& qu
         if (group.varying >> k & 1u) red[i] = r++, scale[i] = 1;
         else red[i] = a, scale[i] = group.value[k] - L.shift[k][a];
       }
-    const int M = 3 * group.m;
-    const double* G = group.G.data();
+    run_start.clear();
+    for (int j = 0; j < n; ++j) {
+      if (j == 0 || red[j] != red[j - 1] + 1) run_start.push_back(j);
+      run_of[j] = static_cast<int>(run_start.size()) - 1;
+      for (int d = 0; d < 3; ++d) column_scale[3 * j + d] = scale[j];
+    }
+    run_start.push_back(n);
+    const std::size_t S = group.stride, M = 3 * static_cast<std::size_t>(group.m);
+    double* G = arena.data() + group.G;
+    const std::size_t standard_columns = 3 * static_cast<std::size_t>(npe);
+    for (std::size_t x = 1; x < M; ++x) {
+      for (std::size_t y = 0; y < std::min(x, standard_columns); ++y) G[x * S + y] = G[y * S + x];
+      for (std::size_t y = std::max(x / 3 * 3, standard_columns); y < x; ++y) G[x * S + y] = G[y * S + x];
+    }
     for (int i = 0; i < n; ++i) {
       if (scale[i] == 0) continue;
-      for (int j = i; j < n; ++j) {
-        if (scale[j] == 0) continue;
-        const double f = scale[i] * scale[j];
-        double* blk = Kc.data() + (static_cast<std::size_t>(i) * n + j) * 9;
-        for (int c = 0; c < 3; ++c)
-          for (int d = 0; d < 3; ++d) {
-            const int x = 3 * red[i] + c, y = 3 * red[j] + d;
-            blk[c * 3 + d] += f * (x <= y ? G[static_cast<std::size_t>(x) * M + y] : G[static_cast<std::size_t>(y) * M + x]);
-          }
+      const double si = scale[i];
+      for (int c = 0; c < 3; ++c) {
+        const double* Grow = G + (3 * static_cast<std::size_t>(red[i]) + c) * S;
+        double* Krow = Kc.data() + (3 * static_cast<std::size_t>(i) + c) * N3;
+        for (int run = run_of[i]; run + 1 < static_cast<int>(run_start.size()); ++run) {
+          const int j0 = std::max(run_start[run], i), j1 = run_start[run + 1];
+          const std::size_t J0 = 3 * static_cast<std::size_t>(j0), J1 = 3 * static_cast<std::size_t>(j1);
+          add_scaled_row(static_cast<int>(J1 - J0), si, column_scale.data() + J0,
+                         Grow + 3 * static_cast<std::size_t>(red[j0]), Krow + J0);
+        }
       }
       if (want_forces)
         for (int c = 0; c < 3; ++c) fc[3 * i + c] += scale[i] * group.g[3 * red[i] + c];
@@ -362,45 +509,86 @@ void enriched_element_stiffness_reference(const EnrichedElementBatch& batch, con
   for (std::int64_t e = 0; e < batch.count; ++e) element_stiffness(batch, quadrature, e, rotations, blocks, forces);
 }
 
-void enriched_element_stiffness(const EnrichedElementBatch& batch, const EnrichedQuadrature& quadrature,
-                                const double* rotations, double* blocks, double* forces, Execution execution) {
+namespace {
+
+// The fast form with rotations given per point, computed from `current`, or none.
+void stiffness_by_chunks(const EnrichedElementBatch& batch, const EnrichedQuadrature& quadrature,
+                         const double* rotations, const double* current, double* blocks, double* forces,
+                         Execution execution) {
   const std::vector<Chunk> chunks = make_chunks(batch, quadrature);
-  const bool want_forces = rotations && forces;
+  const bool want_forces = (rotations || current) && forces;
   std::vector<std::vector<double>> Kc(chunks.size()), fc(chunks.size());
-  forall(
-      static_cast<std::int64_t>(chunks.size()),
-      [&](std::int64_t c) { chunk_stiffness(batch, quadrature, chunks[c], rotations, want_forces, Kc[c], fc[c]); },
-      execution);
-  // Per element: its chunks summed in order, then the padded symmetric layout.
+  // Chunks differ in cost (points, varying textures): handed out dynamically; each writes
+  // only its own Kc, fc, so the result does not depend on which thread ran it.
+  const std::int64_t num_chunks = static_cast<std::int64_t>(chunks.size());
+  auto run = [&](std::int64_t c) {
+    chunk_stiffness(batch, quadrature, chunks[c], rotations, current, want_forces, Kc[c], fc[c]);
+  };
+  if (execution == Execution::parallel) {
+#pragma omp parallel for schedule(dynamic, 1)
+    for (std::int64_t c = 0; c < num_chunks; ++c) run(c);
+  } else {
+    for (std::int64_t c = 0; c < num_chunks; ++c) run(c);
+  }
+  // Per element: its chunks summed in order, then the padded symmetric layout; one work
+  // item per block row (a single element with hundreds of functions uses every thread).
   std::vector<std::int64_t> first_chunk(static_cast<std::size_t>(batch.count) + 1, 0);
   for (const Chunk& c : chunks) ++first_chunk[c.element + 1];
   for (std::int64_t e = 0; e < batch.count; ++e) first_chunk[e + 1] += first_chunk[e];
   const int W = batch.width;
   forall(
-      batch.count,
-      [&](std::int64_t e) {
+      batch.count * W,
+      [&](std::int64_t item) {
+        const std::int64_t e = item / W;
+        const int a = static_cast<int>(item % W);
         const int n = enriched_basis_count(batch, e);
-        std::vector<double>& K = Kc[first_chunk[e]];
-        std::vector<double>& f = fc[first_chunk[e]];
-        for (std::int64_t c = first_chunk[e] + 1; c < first_chunk[e + 1]; ++c) {
-          for (std::size_t i = 0; i < K.size(); ++i) K[i] += Kc[c][i];
-          for (std::size_t i = 0; i < f.size(); ++i) f[i] += fc[c][i];
-        }
-        double* out = blocks + e * W * W * 9;
-        for (int a = 0; a < W; ++a)
-          for (int c = 0; c < W; ++c)
+        const std::int64_t c0 = first_chunk[e], c1 = first_chunk[e + 1];
+        double* out = blocks + (e * W + a) * W * 9;
+        for (int c = 0; c < W; ++c) {
+          double* blk = out + c * 9;
+          if (a >= n || c >= n) {
+            for (int i = 0; i < 9; ++i) blk[i] = 0;
+            continue;
+          }
+          // Kc holds block (min, max) row-major over DOFs: (3 min + i) * 3n + 3 max + j.
+          const bool upper = a <= c;
+          const std::size_t N3 = 3 * static_cast<std::size_t>(n);
+          const std::size_t at = 3 * static_cast<std::size_t>(upper ? a : c) * N3 + 3 * (upper ? c : a);
+          double sum[9];
+          for (int i = 0; i < 3; ++i)
+            for (int j = 0; j < 3; ++j) sum[i * 3 + j] = Kc[c0][at + i * N3 + j];
+          for (std::int64_t ch = c0 + 1; ch < c1; ++ch)
             for (int i = 0; i < 3; ++i)
-              for (int j = 0; j < 3; ++j) {
-                double v = 0;
-                if (a < n && c < n)
-                  v = a <= c ? K[(static_cast<std::size_t>(a) * n + c) * 9 + i * 3 + j]
-                             : K[(static_cast<std::size_t>(c) * n + a) * 9 + j * 3 + i];
-                out[(a * W + c) * 9 + i * 3 + j] = v;
-              }
-        if (forces)
-          for (int i = 0; i < 3 * W; ++i) forces[e * W * 3 + i] = want_forces && i < 3 * n ? f[i] : 0.0;
+              for (int j = 0; j < 3; ++j) sum[i * 3 + j] += Kc[ch][at + i * N3 + j];
+          for (int i = 0; i < 3; ++i)
+            for (int j = 0; j < 3; ++j) blk[i * 3 + j] = upper ? sum[i * 3 + j] : sum[j * 3 + i];
+        }
+        if (forces) {
+          double* fo = forces + (e * W + a) * 3;
+          for (int i = 0; i < 3; ++i) {
+            double sum = 0;
+            if (want_forces && a < n) {
+              sum = fc[c0][3 * a + i];
+              for (std::int64_t ch = c0 + 1; ch < c1; ++ch) sum += fc[ch][3 * a + i];
+            }
+            fo[i] = sum;
+          }
+        }
       },
       execution);
+}
+
+}  // namespace
+
+void enriched_element_stiffness(const EnrichedElementBatch& batch, const EnrichedQuadrature& quadrature,
+                                const double* rotations, double* blocks, double* forces, Execution execution) {
+  stiffness_by_chunks(batch, quadrature, rotations, nullptr, blocks, forces, execution);
+}
+
+void enriched_element_corotated_stiffness(const EnrichedElementBatch& batch, const EnrichedQuadrature& quadrature,
+                                          const double* current, double* blocks, double* forces,
+                                          Execution execution) {
+  stiffness_by_chunks(batch, quadrature, nullptr, current, blocks, forces, execution);
 }
 
 void enriched_element_deformation_gradients(const EnrichedElementBatch& b, const EnrichedQuadrature& quad,
@@ -462,7 +650,7 @@ void enriched_element_mass(const EnrichedElementBatch& b, const EnrichedQuadratu
         const int n = enriched_basis_count(b, e);
         const ShellSection& sec = b.sections[b.element[e]];
         const double rho_h = sec.density * sec.thickness;
-        SymmetricAccumulator M(n);
+        GramAccumulator M(n);
         EnrichedPoint p;
         for (std::int64_t q = quad.start[e]; q < quad.start[e + 1]; ++q) {
           evaluate_point(b, e, quad.points + 3 * q, p);

@@ -5,7 +5,7 @@
 #include <vector>
 
 #include "dgtex/kernels/shell_point.h"
-#include "dgtex/kernels/symmetric_accumulator.h"
+#include "dgtex/kernels/gram_accumulation.h"
 
 namespace dgtex::kernels {
 
@@ -50,7 +50,7 @@ void enriched_element_mass_and_load_weights(const EnrichedElementBatch& b, const
     double* area = area_weights + e * W;
     double* m = mass_weights + e * W;
     for (int a = 0; a < W; ++a) area[a] = m[a] = 0;
-    SymmetricAccumulator M(n);
+    GramAccumulator M(n);
     for (std::int64_t begin = quad.start[e]; begin < quad.start[e + 1]; begin += span) {
       const std::int64_t count = std::min(span, quad.start[e + 1] - begin);
       values.resize(static_cast<std::size_t>(count) * n);

@@ -635,35 +635,39 @@ void ShellModel::assemble_stiffness(const double* current, std::vector<double>& 
   std::vector<const double*> vector_locals = {forces ? w.element_forces.data() : nullptr,
                                               forces ? w.edge_forces.data() : nullptr};
 
-  // Enriched elements and edges: rotations per (texel-resolving) quadrature point.
-  std::vector<double> enriched_blocks, enriched_edge_blocks, enriched_forces, enriched_edge_forces;
+  // Enriched elements and edges: rotations per (texel-resolving) quadrature point. Their
+  // buffers persist in the workspace: the padded edge blocks are large ((2W)^2 x 9 per
+  // edge) and only their used slots are written, so a fresh zero-filled vector per call
+  // would cost more than the kernels.
   if (!enriched_elements_.empty()) {
     const kernels::EnrichedElementBatch xb = enriched_element_batch();
     const kernels::EnrichedEdgeBatch xg = enriched_edge_batch(xb);
     const kernels::EnrichedQuadrature element_quad{element_qp_start_.data(), element_qp_.data()};
     const kernels::EdgeQuadrature edge_quad{edge_qp_start_.data(), edge_qp_.data()};
     const int W = width_;
-    std::vector<double> xrot, xedge_rot;
     if (current) {
-      std::vector<double> gradients(static_cast<size_t>(num_enriched_element_quadrature_points()) * 9);
-      xrot.resize(gradients.size());
-      kernels::enriched_element_deformation_gradients(xb, element_quad, current, gradients.data(), execution);
-      kernels::polar_decomposition_batch(num_enriched_element_quadrature_points(), gradients.data(), xrot.data(), execution);
-      xedge_rot.resize(static_cast<size_t>(num_enriched_edge_quadrature_points()) * 9);
-      kernels::enriched_edge_rotations(xg, edge_quad, current, xedge_rot.data(), execution);
+      w.enriched_edge_rotations.resize(static_cast<size_t>(num_enriched_edge_quadrature_points()) * 9);
+      kernels::enriched_edge_rotations(xg, edge_quad, current, w.enriched_edge_rotations.data(), execution);
     }
-    enriched_blocks.resize(static_cast<size_t>(num_enriched_elements()) * W * W * 9);
-    enriched_edge_blocks.resize(static_cast<size_t>(num_enriched_edges()) * 4 * W * W * 9);
-    if (current && corrective) {
-      enriched_forces.resize(static_cast<size_t>(num_enriched_elements()) * W * 3);
-      enriched_edge_forces.resize(static_cast<size_t>(num_enriched_edges()) * 2 * W * 3);
+    w.enriched_blocks.resize(static_cast<size_t>(num_enriched_elements()) * W * W * 9);
+    w.enriched_edge_blocks.resize(static_cast<size_t>(num_enriched_edges()) * 4 * W * W * 9);
+    if (forces) {
+      w.enriched_forces.resize(static_cast<size_t>(num_enriched_elements()) * W * 3);
+      w.enriched_edge_forces.resize(static_cast<size_t>(num_enriched_edges()) * 2 * W * 3);
     }
-    kernels::enriched_element_stiffness(xb, element_quad, current ? xrot.data() : nullptr, enriched_blocks.data(),
-                                        enriched_forces.empty() ? nullptr : enriched_forces.data(), execution);
-    kernels::enriched_edge_stiffness(xg, edge_quad, current ? xedge_rot.data() : nullptr, enriched_edge_blocks.data(),
-                                     enriched_edge_forces.empty() ? nullptr : enriched_edge_forces.data(), execution);
-    matrix_locals.insert(matrix_locals.end(), {enriched_blocks.data(), enriched_edge_blocks.data()});
-    vector_locals.insert(vector_locals.end(), {enriched_forces.data(), enriched_edge_forces.data()});
+    // Corotated: each point's F and rotation are formed in the stiffness pass (one texture
+    // sampling per point; bitwise the separate gradient, polar and stiffness kernels).
+    if (current)
+      kernels::enriched_element_corotated_stiffness(xb, element_quad, current, w.enriched_blocks.data(),
+                                                    forces ? w.enriched_forces.data() : nullptr, execution);
+    else
+      kernels::enriched_element_stiffness(xb, element_quad, nullptr, w.enriched_blocks.data(), nullptr, execution);
+    kernels::enriched_edge_stiffness(xg, edge_quad, current ? w.enriched_edge_rotations.data() : nullptr,
+                                     w.enriched_edge_blocks.data(), forces ? w.enriched_edge_forces.data() : nullptr,
+                                     execution);
+    matrix_locals.insert(matrix_locals.end(), {w.enriched_blocks.data(), w.enriched_edge_blocks.data()});
+    vector_locals.insert(vector_locals.end(), {forces ? w.enriched_forces.data() : nullptr,
+                                               forces ? w.enriched_edge_forces.data() : nullptr});
   }
   // Material-textured elements: rotations per (texel-resolving) quadrature point.
   std::vector<double> textured_blocks, textured_forces;

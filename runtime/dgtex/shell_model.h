@@ -224,6 +224,8 @@ class ShellModel {
     std::vector<double> gradients, element_rotations, edge_rotations;
     std::vector<double> element_blocks, edge_blocks, element_forces, edge_forces;
     std::vector<double> element_rest_rows, edge_rest_rows, edge_factors;
+    std::vector<double> enriched_edge_rotations;
+    std::vector<double> enriched_blocks, enriched_edge_blocks, enriched_forces, enriched_edge_forces;
     AssemblyWorkspace() = default;
     AssemblyWorkspace(const AssemblyWorkspace&) {}
     AssemblyWorkspace& operator=(const AssemblyWorkspace&) { return *this; }

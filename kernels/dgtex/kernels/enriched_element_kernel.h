@@ -34,13 +34,25 @@ struct EnrichedQuadrature {
 // of standard ones; such points only need the rows of the standard functions and of the
 // textures that vary there. Points with the same varying textures and the same constant
 // values (within the tolerance) form a group whose small matrix sum_q S_q^T S_q is mapped
-// onto the element's basis once (K += T^T G T). Complete cuts' +-1 are exact; harmonic
+// onto the element's basis once (K += T^T G T). A point's six strain rows are five numbers
+// per function times its rotated frame (membrane rows in the tangent plane, bending rows
+// along t0); the rows of up to 16 points of a group are stacked and added to G by one
+// blocked product (register tiles, a path per instruction set, no FMA contraction: every
+// path rounds alike). Complete cuts' +-1 are exact; harmonic
 // tails below the tolerance move K by about that much relative (1e-10, far below the
 // quadrature's merge tolerance). Work items are fixed chunks of enriched_chunk_points
 // points, summed per element in chunk order: bitwise independent of the thread count.
 void enriched_element_stiffness(const EnrichedElementBatch& batch, const EnrichedQuadrature& quadrature,
                                 const double* rotations, double* blocks, double* forces,
                                 Execution execution = Execution::parallel);
+// The corotated stiffness from the current state (#(nodes + virtual nodes) x 3, as for
+// enriched_element_deformation_gradients) in one pass: each point's F and rotation
+// (polar_rotation) are formed where its rows are, sharing the texture samples. Bitwise
+// equal to enriched_element_deformation_gradients, polar_decomposition_batch and
+// enriched_element_stiffness with those rotations.
+void enriched_element_corotated_stiffness(const EnrichedElementBatch& batch, const EnrichedQuadrature& quadrature,
+                                          const double* current, double* blocks, double* forces,
+                                          Execution execution = Execution::parallel);
 // Plain per-point form (every basis function at every point; serial): the reference.
 void enriched_element_stiffness_reference(const EnrichedElementBatch& batch, const EnrichedQuadrature& quadrature,
                                           const double* rotations, double* blocks, double* forces);

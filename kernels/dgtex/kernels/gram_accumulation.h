@@ -1,0 +1,77 @@
+#pragma once
+// For the enriched kernels: G += A^T A for a block of stacked rows A (the strain rows
+// of several quadrature points), upper part only, with register tiles and a code path per
+// instruction set (AVX-512, AVX2, baseline x86-64; chosen at run time). Every entry
+// (i, j >= i) is its own sum over the rows in order, started from 0 and then added to G
+// (or stored, `overwrite`), and the file is compiled without FMA contraction: every path
+// rounds exactly alike, so results depend neither on the machine's vector unit nor on the
+// tile shape. Entries below the diagonal are scratch (never read).
+// Shapes: A is rows x cols, G cols x cols, both row-major with row stride cols; cols must
+// be a multiple of gram_column_multiple (pad A with zero columns). Thread-safe on distinct
+// outputs; keeps nothing. Units: those of the rows' products.
+#include <algorithm>
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+namespace dgtex::kernels {
+
+constexpr int gram_column_multiple = 16;
+
+// best: the widest the machine supports (chosen once); the others for tests (must be
+// supported: gram_path_supported).
+enum class GramPath { best, avx512, avx2, baseline };
+bool gram_path_supported(GramPath path);
+void accumulate_gram_upper(int rows, int cols, const double* A, double* G, bool overwrite,
+                           GramPath path = GramPath::best);
+
+// out[j] += (s * scales[j]) * g[j] for j < count (the scaled gather of a G row into K).
+void add_scaled_row(int count, double s, const double* scales, const double* g, double* out);
+
+// out[j] += x[j] * s for j < count (corrective forces: g += S^T s row by row).
+void add_scaled(int count, double s, const double* x, double* out);
+
+// The same sums, one entry at a time (the reference of the tiled paths).
+void accumulate_gram_upper_reference(int rows, int cols, const double* A, double* G, bool overwrite);
+
+// A = sum_r v_r v_r^T over rows v_r of length n (the API of SymmetricAccumulator), summed
+// by accumulate_gram_upper in fixed blocks of `block_rows` rows (fewer when the caller knows
+// there are fewer rows in all: the same sums): the result depends only on the row sequence,
+// not on threads or the instruction set. Nothing is zero-filled beyond the row padding (the
+// first block stores). One instance per thread.
+class GramAccumulator {
+ public:
+  static constexpr int block_rows = 96;
+
+  explicit GramAccumulator(int n, std::int64_t expected_rows = block_rows)
+      : cols_(std::max(1, (n + gram_column_multiple - 1) / gram_column_multiple) * gram_column_multiple),
+        capacity_(static_cast<int>(std::max<std::int64_t>(1, std::min<std::int64_t>(block_rows, expected_rows)))),
+        rows_data_(static_cast<std::size_t>(capacity_) * cols_, 0.0),
+        sum_(new double[static_cast<std::size_t>(cols_) * cols_]) {}
+
+  // The next row (n entries, all to be written); commit it with push().
+  double* next() { return rows_data_.data() + static_cast<std::size_t>(rows_) * cols_; }
+  void push() {
+    if (++rows_ == capacity_) flush();
+  }
+  void flush() {
+    if (rows_ > 0) accumulate_gram_upper(rows_, cols_, rows_data_.data(), sum_.get(), !written_);
+    written_ = written_ || rows_ > 0;
+    rows_ = 0;
+  }
+  // Entry (i, j) of the sum (call flush() first).
+  double operator()(int i, int j) const {
+    if (!written_) return 0.0;
+    return i <= j ? sum_[static_cast<std::size_t>(i) * cols_ + j] : sum_[static_cast<std::size_t>(j) * cols_ + i];
+  }
+
+ private:
+  int cols_, capacity_;
+  int rows_ = 0;
+  bool written_ = false;
+  std::vector<double> rows_data_;  // padding columns stay 0
+  std::unique_ptr<double[]> sum_;
+};
+
+}  // namespace dgtex::kernels

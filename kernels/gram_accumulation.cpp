@@ -1,0 +1,168 @@
+#include "dgtex/kernels/gram_accumulation.h"
+
+#include <cstddef>
+
+namespace dgtex::kernels {
+namespace {
+
+// Tiles of TR rows of G by NV vectors of V (L doubles each) of columns; tiles start at the
+// tile-column boundary at or left of the diagonal, so every upper entry is covered exactly
+// once. GCC vector extensions keep the accumulators in registers; lanes never mix.
+template <class V, int L, int TR, int NV>
+__attribute__((always_inline)) inline void gram_tiles(int rows, int cols, const double* __restrict A,
+                                                      double* __restrict G, bool overwrite) {
+  constexpr int TC = L * NV;
+  static_assert(gram_column_multiple % TC == 0 && gram_column_multiple % TR == 0, "tiles divide the padding");
+  for (int i0 = 0; i0 < cols; i0 += TR)
+    for (int c0 = i0 / TC * TC; c0 < cols; c0 += TC) {
+      V acc[TR][NV];
+      for (int r = 0; r < TR; ++r)
+        for (int v = 0; v < NV; ++v) acc[r][v] = V{};
+      const double* row = A;
+      for (int k = 0; k < rows; ++k, row += cols) {
+        V b[NV];
+        for (int v = 0; v < NV; ++v) __builtin_memcpy(&b[v], row + c0 + v * L, sizeof(V));
+        for (int r = 0; r < TR; ++r) {
+          const double a = row[i0 + r];
+          for (int v = 0; v < NV; ++v) acc[r][v] += a * b[v];
+        }
+      }
+      for (int r = 0; r < TR; ++r) {
+        double* out = G + static_cast<std::size_t>(i0 + r) * cols + c0;
+        for (int v = 0; v < NV; ++v) {
+          V x = acc[r][v];
+          if (!overwrite) {
+            V old;
+            __builtin_memcpy(&old, out + v * L, sizeof(V));
+            x = old + x;
+          }
+          __builtin_memcpy(out + v * L, &x, sizeof(V));
+        }
+      }
+    }
+}
+
+typedef double V8 __attribute__((vector_size(64)));
+typedef double V4 __attribute__((vector_size(32)));
+typedef double V2 __attribute__((vector_size(16)));
+
+__attribute__((target("avx512f"))) void gram_avx512(int rows, int cols, const double* A, double* G, bool overwrite) {
+  gram_tiles<V8, 8, 8, 2>(rows, cols, A, G, overwrite);
+}
+__attribute__((target("avx2"))) void gram_avx2(int rows, int cols, const double* A, double* G, bool overwrite) {
+  gram_tiles<V4, 4, 4, 2>(rows, cols, A, G, overwrite);
+}
+void gram_baseline(int rows, int cols, const double* A, double* G, bool overwrite) {
+  gram_tiles<V2, 2, 4, 2>(rows, cols, A, G, overwrite);
+}
+
+// out[j] += (s * scales[j]) * g[j]: elementwise, so every path rounds alike.
+template <class V, int L>
+__attribute__((always_inline)) inline void scaled_row(int count, double s, const double* __restrict scales,
+                                                      const double* __restrict g, double* __restrict out) {
+  int j = 0;
+  for (; j + L <= count; j += L) {
+    V c, x, o;
+    __builtin_memcpy(&c, scales + j, sizeof(V));
+    __builtin_memcpy(&x, g + j, sizeof(V));
+    __builtin_memcpy(&o, out + j, sizeof(V));
+    o = o + (s * c) * x;
+    __builtin_memcpy(out + j, &o, sizeof(V));
+  }
+  for (; j < count; ++j) out[j] = out[j] + (s * scales[j]) * g[j];
+}
+
+__attribute__((target("avx512f"))) void scaled_row_avx512(int count, double s, const double* scales, const double* g,
+                                                          double* out) {
+  scaled_row<V8, 8>(count, s, scales, g, out);
+}
+__attribute__((target("avx2"))) void scaled_row_avx2(int count, double s, const double* scales, const double* g,
+                                                     double* out) {
+  scaled_row<V4, 4>(count, s, scales, g, out);
+}
+void scaled_row_baseline(int count, double s, const double* scales, const double* g, double* out) {
+  scaled_row<V2, 2>(count, s, scales, g, out);
+}
+
+// out[j] += x[j] * s.
+template <class V, int L>
+__attribute__((always_inline)) inline void scaled_add(int count, double s, const double* __restrict x,
+                                                      double* __restrict out) {
+  int j = 0;
+  for (; j + L <= count; j += L) {
+    V a, o;
+    __builtin_memcpy(&a, x + j, sizeof(V));
+    __builtin_memcpy(&o, out + j, sizeof(V));
+    o = o + a * s;
+    __builtin_memcpy(out + j, &o, sizeof(V));
+  }
+  for (; j < count; ++j) out[j] = out[j] + x[j] * s;
+}
+
+__attribute__((target("avx512f"))) void scaled_add_avx512(int count, double s, const double* x, double* out) {
+  scaled_add<V8, 8>(count, s, x, out);
+}
+__attribute__((target("avx2"))) void scaled_add_avx2(int count, double s, const double* x, double* out) {
+  scaled_add<V4, 4>(count, s, x, out);
+}
+void scaled_add_baseline(int count, double s, const double* x, double* out) { scaled_add<V2, 2>(count, s, x, out); }
+
+using GramKernel = void (*)(int, int, const double*, double*, bool);
+
+bool supported(GramPath path) {
+  __builtin_cpu_init();
+  switch (path) {
+    case GramPath::avx512: return __builtin_cpu_supports("avx512f");
+    case GramPath::avx2: return __builtin_cpu_supports("avx2");
+    default: return true;
+  }
+}
+
+GramKernel kernel_of(GramPath path) {
+  if (path == GramPath::best) path = supported(GramPath::avx512) ? GramPath::avx512
+                                    : supported(GramPath::avx2)  ? GramPath::avx2
+                                                                 : GramPath::baseline;
+  switch (path) {
+    case GramPath::avx512: return gram_avx512;
+    case GramPath::avx2: return gram_avx2;
+    default: return gram_baseline;
+  }
+}
+
+}  // namespace
+
+bool gram_path_supported(GramPath path) { return supported(path); }
+
+void accumulate_gram_upper(int rows, int cols, const double* A, double* G, bool overwrite, GramPath path) {
+  static const GramKernel best = kernel_of(GramPath::best);
+  (path == GramPath::best ? best : kernel_of(path))(rows, cols, A, G, overwrite);
+}
+
+void add_scaled_row(int count, double s, const double* scales, const double* g, double* out) {
+  using RowKernel = void (*)(int, double, const double*, const double*, double*);
+  static const RowKernel kernel = supported(GramPath::avx512) ? scaled_row_avx512
+                                  : supported(GramPath::avx2) ? scaled_row_avx2
+                                                              : scaled_row_baseline;
+  kernel(count, s, scales, g, out);
+}
+
+void add_scaled(int count, double s, const double* x, double* out) {
+  using AddKernel = void (*)(int, double, const double*, double*);
+  static const AddKernel kernel = supported(GramPath::avx512) ? scaled_add_avx512
+                                  : supported(GramPath::avx2) ? scaled_add_avx2
+                                                              : scaled_add_baseline;
+  kernel(count, s, x, out);
+}
+
+void accumulate_gram_upper_reference(int rows, int cols, const double* A, double* G, bool overwrite) {
+  for (int i = 0; i < cols; ++i)
+    for (int j = i; j < cols; ++j) {
+      double sum = 0;
+      for (int k = 0; k < rows; ++k)
+        sum += A[static_cast<std::size_t>(k) * cols + i] * A[static_cast<std::size_t>(k) * cols + j];
+      double& out = G[static_cast<std::size_t>(i) * cols + j];
+      out = overwrite ? sum : out + sum;
+    }
+}
+
+}  // namespace dgtex::kernels
