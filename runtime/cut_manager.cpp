@@ -3,9 +3,12 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
+#include <exception>
 #include <filesystem>
 #include <set>
 #include <stdexcept>
+
+#include <omp.h>
 
 #include "dgtex/enrichment_span.h"
 #include "dgtex/stage_timer.h"
@@ -230,6 +233,14 @@ bool CutManager::update(double time) {
     return wall_hash_cache[e] = h;
   };
 
+  // Per segment whose H must be (re)solved: its region and what to store with the result.
+  struct SolveJob {
+    std::pair<int, int> key;
+    std::vector<RegionTile> region;
+    std::map<int, std::uint64_t> data_hash;
+    std::vector<int> enriched_nodes;  // nodes of E_i (unsorted, repeated)
+  };
+  std::vector<SolveJob> jobs;
   bool changed_any = false;
   std::set<std::pair<int, int>> alive;
   std::map<std::pair<int, int>, std::size_t> visible_index;
@@ -318,7 +329,11 @@ bool CutManager::update(double time) {
           for (int f : node_elements_[mesh_.element_nodes(e)[a]])
             if (omega.count(f)) solve.insert(f);
     }
-    std::vector<RegionTile> region;
+    SolveJob job;
+    job.key = key;
+    job.data_hash = std::move(data_hash);
+    for (const auto& [e, texels] : data)
+      for (int a = 0; a < mesh_.nodes_per_element(); ++a) job.enriched_nodes.push_back(mesh_.element_nodes(e)[a]);
     for (int e : omega) {
       RegionTile r;
       r.element = e;
@@ -338,28 +353,67 @@ bool CutManager::update(double time) {
         r.frozen = true;
         r.tile.values = state.values.at(e);
       }
-      region.push_back(std::move(r));
+      job.region.push_back(std::move(r));
     }
-    const LaplaceSolver solver =
-        options_.solver == EnrichmentOptions::Solver::multigrid ? LaplaceSolver::multigrid : LaplaceSolver::cholmod;
-    const MeshLaplaceStats stats = solve_mesh_texel_laplace(region, mesh_.type, adjacency_, edge_walls_, solver);
-    last_.solve_ms += stats.ms;
+    jobs.push_back(std::move(job));
+  }
+
+  // The solves of different segments are independent (each reads only the walls and its
+  // own settled values): one per thread when there are several (fewer synchronisations
+  // than a parallel multigrid per tile). Each solve runs the same operations whatever
+  // thread takes it, so the results do not depend on the thread count; the regions that
+  // need CHOLMOD are solved afterwards, serially in segment order (METIS's global random
+  // state makes its orderings depend on the order of the calls).
+  const LaplaceSolver solver =
+      options_.solver == EnrichmentOptions::Solver::multigrid ? LaplaceSolver::multigrid : LaplaceSolver::cholmod;
+  std::vector<MeshLaplaceStats> job_stats(jobs.size());
+  std::vector<std::exception_ptr> failures(jobs.size());
+  const auto solve_start = std::chrono::steady_clock::now();
+  // Inside the concurrent loop each multigrid runs its serial kernels (the same results
+  // as the parallel forms): nested parallel regions would cost a team per kernel call.
+  const bool concurrent = jobs.size() > 1 && omp_get_max_threads() > 1 && !omp_in_parallel();
+  LaplaceMultigridOptions multigrid_options;
+  if (concurrent) multigrid_options.execution = kernels::Execution::serial;
+  auto solve_job = [&](std::size_t k) {
+    try {
+      job_stats[k] = solve_mesh_texel_laplace(jobs[k].region, mesh_.type, adjacency_, edge_walls_, solver,
+                                              multigrid_options, /*direct_fallback=*/jobs.size() == 1);
+    } catch (...) {
+      failures[k] = std::current_exception();
+    }
+  };
+  if (concurrent) {
+    const int count = static_cast<int>(jobs.size());
+#pragma omp parallel for schedule(dynamic, 1)
+    for (int k = 0; k < count; ++k) solve_job(static_cast<std::size_t>(k));
+  } else {
+    for (std::size_t k = 0; k < jobs.size(); ++k) solve_job(k);
+  }
+  for (const std::exception_ptr& failure : failures)
+    if (failure) std::rethrow_exception(failure);
+  for (std::size_t k = 0; k < jobs.size(); ++k)
+    if (job_stats[k].needs_direct)
+      job_stats[k] = solve_mesh_texel_laplace(jobs[k].region, mesh_.type, adjacency_, edge_walls_, LaplaceSolver::cholmod);
+  last_.solve_ms = ms_since(solve_start);
+
+  for (std::size_t k = 0; k < jobs.size(); ++k) {
+    SolveJob& job = jobs[k];
+    const MeshLaplaceStats& stats = job_stats[k];
     last_.solves += 1;
     last_.unknowns += stats.unknowns;
     last_.solved_tiles += stats.solved_tiles;
     last_.frozen_tiles += stats.frozen_tiles;
 
+    SegmentState& state = states_.at(job.key);
     state.values.clear();
     state.wall_hash.clear();
-    state.data_hash = data_hash;
+    state.data_hash = std::move(job.data_hash);
     EnrichmentFunction& f = state.function;
-    f.enriched_nodes.clear();
-    for (const auto& [e, texels] : data)
-      for (int a = 0; a < mesh_.nodes_per_element(); ++a) f.enriched_nodes.push_back(mesh_.element_nodes(e)[a]);
+    f.enriched_nodes = std::move(job.enriched_nodes);
     std::sort(f.enriched_nodes.begin(), f.enriched_nodes.end());
     f.enriched_nodes.erase(std::unique(f.enriched_nodes.begin(), f.enriched_nodes.end()), f.enriched_nodes.end());
     f.elements.clear();
-    for (RegionTile& r : region) {  // region is sorted by element (omega is a set)
+    for (RegionTile& r : job.region) {  // region is sorted by element (omega is a set)
       state.values[r.element] = r.tile.values;
       state.wall_hash[r.element] = wall_hash(r.element);
       ElementTexture texture;

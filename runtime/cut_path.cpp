@@ -51,8 +51,9 @@ double edge_parameter(ElementType type, int k, const std::array<double, 2>& xi) 
 // Traces the surface projection of chord segments between consecutive anchors.
 class PathTracer {
  public:
-  PathTracer(const Mesh& mesh, const ElementAdjacency& adjacency, int resolution, std::string name)
-      : mesh_(mesh), adjacency_(adjacency), resolution_(resolution), name_(std::move(name)) {
+  PathTracer(const Mesh& mesh, const SurfacePointSearch& search, const ElementAdjacency& adjacency, int resolution,
+             std::string name)
+      : mesh_(mesh), search_(search), adjacency_(adjacency), resolution_(resolution), name_(std::move(name)) {
     step_ = 0.0625 * mean_edge_length(mesh);
   }
 
@@ -110,22 +111,10 @@ class PathTracer {
     const double q[3] = {p[0], p[1], p[2]};
     if (mesh_.num_elements() > 32 && near >= 0) {
       const std::vector<int>& patch = patch_around(near);
-      Mesh sub;
-      sub.type = mesh_.type;
-      std::unordered_map<int, int> local;
-      const int npe = mesh_.nodes_per_element();
-      for (int e : patch)
-        for (int a = 0; a < npe; ++a) {
-          const int n = mesh_.element_nodes(e)[a];
-          auto [it, added] = local.emplace(n, sub.num_nodes());
-          if (added) sub.positions.insert(sub.positions.end(), mesh_.node(n), mesh_.node(n) + 3);
-          sub.elements.push_back(it->second);
-        }
-      const SurfacePoint sp = closest_surface_point(sub, q);
-      const int e = patch[sp.element];
-      if (!on_open_border(e, sp.xi, patch)) return vertex_at(mesh_, e, sp.xi[0], sp.xi[1]);
+      const SurfacePoint sp = search_.closest_among(patch, q);  // the patch as a sub-mesh
+      if (!on_open_border(sp.element, sp.xi, patch)) return vertex_at(mesh_, sp.element, sp.xi[0], sp.xi[1]);
     }
-    const SurfacePoint sp = closest_surface_point(mesh_, q);
+    const SurfacePoint sp = search_.closest(q);
     return vertex_at(mesh_, sp.element, sp.xi[0], sp.xi[1]);
   }
 
@@ -250,6 +239,7 @@ class PathTracer {
   }
 
   const Mesh& mesh_;
+  const SurfacePointSearch& search_;
   const ElementAdjacency& adjacency_;
   int resolution_;
   std::string name_, where_;
@@ -309,6 +299,7 @@ MeshCutPath trace_cut_path(const Mesh& mesh, const ElementAdjacency& adjacency, 
 
   std::vector<CutPathVertex> anchors;
   const double tolerance = cut_point_tolerance(mesh);
+  const SurfacePointSearch search(mesh);
   for (std::size_t k = 0; k < count; ++k) {
     const std::string where = name + list + "[" + std::to_string(k) + "]";
     if (given_on_surface) {
@@ -329,7 +320,7 @@ MeshCutPath trace_cut_path(const Mesh& mesh, const ElementAdjacency& adjacency, 
       const Vec3& p = cut.points[k];
       if (!(std::isfinite(p[0]) && std::isfinite(p[1]) && std::isfinite(p[2])))
         throw std::invalid_argument(where + ": not a finite point, got " + vec(p));
-      const SurfacePoint sp = closest_surface_point(mesh, p.data());
+      const SurfacePoint sp = search.closest(p.data());
       if (sp.distance > tolerance)
         throw std::invalid_argument(where + ": off the surface, got " + vec(p) + " at distance " + num(sp.distance) +
                                     " from the nearest surface point " +
@@ -340,7 +331,7 @@ MeshCutPath trace_cut_path(const Mesh& mesh, const ElementAdjacency& adjacency, 
     }
   }
 
-  PathTracer tracer(mesh, adjacency, resolution, name);
+  PathTracer tracer(mesh, search, adjacency, resolution, name);
   tracer.vertices().push_back(anchors.front());
   tracer.samples().push_back(false);
   for (std::size_t k = 1; k < anchors.size(); ++k)

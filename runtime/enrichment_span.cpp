@@ -16,10 +16,16 @@ const kernels::TexelTile* texture_of(const EnrichmentFunction& f, int element) {
   return it != f.elements.end() && it->element == element ? &it->tile : nullptr;
 }
 
+// Eight interleaved partial sums, combined pairwise: one running sum waits on the adder's
+// latency for every texel (accordion's 18 functions on one T=256 tile: 342 dot products,
+// ~30 ms); eight chains vectorize. A fixed order: the same sum on every run and thread.
 double dot(const std::vector<double>& a, const std::vector<double>& b) {
-  double s = 0;
-  for (std::size_t k = 0; k < a.size(); ++k) s += a[k] * b[k];
-  return s;
+  double s[8] = {0, 0, 0, 0, 0, 0, 0, 0};
+  const std::size_t n = a.size(), blocked = n - n % 8;
+  for (std::size_t k = 0; k < blocked; k += 8)
+    for (int l = 0; l < 8; ++l) s[l] += a[k + l] * b[k + l];
+  for (std::size_t k = blocked; k < n; ++k) s[k - blocked] += a[k] * b[k];
+  return ((s[0] + s[1]) + (s[2] + s[3])) + ((s[4] + s[5]) + (s[6] + s[7]));
 }
 
 // Count, mean and sum of squared deviations of one tile's active texel values (two

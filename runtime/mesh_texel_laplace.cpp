@@ -12,6 +12,7 @@
 #include "dgtex/kernels/forall.h"
 #include "dgtex/kernels/multigrid_unknowns.h"
 #include "cholmod_lock.h"
+#include "seamed_patch_laplace.h"
 
 namespace dgtex {
 
@@ -162,11 +163,15 @@ class TexelGraph {
 // coupling of the texel graph is a 5-point coupling of the patch and vice versa: every mesh
 // edge shared by two region tiles pairs edge k with edge (k + 2) % 4 (the neighbour keeps the
 // orientation) and joins tiles that sit side by side across that edge; side-by-side tiles
-// that are not neighbours through those edges get a wall. Fails (returns false) for tri6,
-// regions that turn (a flipped neighbour), close up (a cylinder ring) or fall apart.
+// that are not neighbours through those edges get a wall. A region that closes up (a ring
+// of elements around a cylinder) is cut open: the neighbour pairs whose tiles do not sit
+// side by side become seams (tile, local edge), walled in the patch and coupled by the
+// seamed solve (seamed_patch_laplace.h). Fails (returns false) for tri6, regions that turn
+// (a flipped neighbour) or fall apart.
 struct PatchPlacement {
   std::vector<int> x, y;
   int columns = 0, rows = 0;
+  std::vector<std::array<int, 2>> seams;  // (tile, local edge); each pair listed from both sides
 };
 
 bool place_region_in_plane(const std::vector<RegionTile>& tiles, ElementType type, const ElementAdjacency& adjacency,
@@ -177,6 +182,7 @@ bool place_region_in_plane(const std::vector<RegionTile>& tiles, ElementType typ
   for (int l = 0; l < count; ++l)
     if (!tiles[l].frozen) local.emplace(tiles[l].element, l);
   if (local.empty()) return false;
+  placement.seams.clear();
   constexpr int dx[4] = {0, 1, 0, -1}, dy[4] = {-1, 0, 1, 0};  // quad8 local edges: south, east, north, west
   std::vector<int> x(count, 0), y(count, 0);
   std::vector<char> placed(count, 0);
@@ -194,7 +200,7 @@ bool place_region_in_plane(const std::vector<RegionTile>& tiles, ElementType typ
       const int m = it->second;
       if (nb[1] != (k + 2) % 4) return false;  // the neighbour is turned: no planar 5-point patch
       if (placed[m]) {
-        if (x[m] != x[l] + dx[k] || y[m] != y[l] + dy[k]) return false;  // the region closes up
+        if (x[m] != x[l] + dx[k] || y[m] != y[l] + dy[k]) placement.seams.push_back({l, k});  // closes up
         continue;
       }
       placed[m] = 1, x[m] = x[l] + dx[k], y[m] = y[l] + dy[k];
@@ -225,7 +231,8 @@ int find_root(std::vector<int>& parent, int x) {
 
 MeshLaplaceStats solve_mesh_texel_laplace(std::vector<RegionTile>& tiles, ElementType type,
                                           const ElementAdjacency& adjacency, const MeshEdgeWalls& edge_walls,
-                                          LaplaceSolver solver, const LaplaceMultigridOptions& options) {
+                                          LaplaceSolver solver, const LaplaceMultigridOptions& options,
+                                          bool direct_fallback) {
   const auto start = std::chrono::steady_clock::now();
   MeshLaplaceStats stats;
   if (tiles.empty()) return stats;
@@ -236,11 +243,22 @@ MeshLaplaceStats solve_mesh_texel_laplace(std::vector<RegionTile>& tiles, Elemen
   // Components of free texels; each collects the data values it touches. Union-find
   // links the larger root under the smaller, so parent[v] <= v and one forward pass
   // flattens every texel to its root.
+  const int t = tiles.front().tile.width, tt = t * t;
   std::vector<char> is_free(n), is_data(n);
-  for (int v = 0; v < n; ++v) is_free[v] = graph.free(v), is_data[v] = graph.data(v);
+  for (int l = 0; l < static_cast<int>(tiles.size()); ++l) {  // graph.free / graph.data per tile
+    const std::uint8_t* flags = tiles[l].tile.flags.data();
+    const bool frozen = tiles[l].frozen;
+    char* free_texel = is_free.data() + static_cast<std::size_t>(l) * tt;
+    char* data_texel = is_data.data() + static_cast<std::size_t>(l) * tt;
+    for (int k = 0; k < tt; ++k) {
+      const bool active = !(flags[k] & kernels::inactive);
+      const bool data = active && (frozen || (flags[k] & kernels::dirichlet));
+      data_texel[k] = data;
+      free_texel[k] = active && !data;
+    }
+  }
   std::vector<int> parent(n);
   for (int v = 0; v < n; ++v) parent[v] = v;
-  const int t = tiles.front().tile.width, tt = t * t;
   auto unite = [&](int v, int w) {
     const int a = find_root(parent, v), b = find_root(parent, w);
     if (a != b) parent[std::max(a, b)] = std::min(a, b);
@@ -268,16 +286,34 @@ MeshLaplaceStats solve_mesh_texel_laplace(std::vector<RegionTile>& tiles, Elemen
   enum : std::uint8_t { no_data = 0, constant = 1, varying = 2 };
   std::vector<std::uint8_t> state(n, no_data);
   std::vector<double> constant_value(n, 0.0);
-  for (int v = 0; v < n; ++v) {
-    if (!is_free[v]) continue;
-    const int root = parent[v];
-    if (state[root] == varying) continue;  // nothing more to learn
-    graph.for_each_coupling(v, [&](int w) {
-      if (!is_data[w]) return;
-      const double x = graph.value(w);
-      if (state[root] == no_data) state[root] = constant, constant_value[root] = x;
-      else if (state[root] == constant && x != constant_value[root]) state[root] = varying;
-    });
+  // (The order in which a component meets its data does not matter: it ends constant
+  // with the one value it met, or varying.)
+  for (int l = 0; l < static_cast<int>(tiles.size()); ++l) {
+    const std::uint8_t* flags = tiles[l].tile.flags.data();
+    const double* values = tiles[l].tile.values.data();
+    for (int j = 0; j < t; ++j)
+      for (int i = 0; i < t; ++i) {
+        const int k = j * t + i, v = l * tt + k;
+        if (!is_free[v]) continue;
+        const int root = parent[v];
+        if (state[root] == varying) continue;  // nothing more to learn
+        auto meet = [&](double x) {
+          if (state[root] == no_data) state[root] = constant, constant_value[root] = x;
+          else if (state[root] == constant && x != constant_value[root]) state[root] = varying;
+        };
+        const bool border = i == 0 || j == 0 || i == t - 1 || j == t - 1 || (type == ElementType::tri6 && i + j >= t - 1);
+        if (border) {
+          graph.for_each_coupling(v, [&](int w) {
+            if (is_data[w]) meet(graph.value(w));
+          });
+          continue;
+        }
+        // Interior texel: its four neighbours are in the tile (data implies active).
+        if (is_data[v + 1] && !(flags[k] & kernels::wall_east)) meet(values[k + 1]);
+        if (is_data[v - 1] && !(flags[k - 1] & kernels::wall_east)) meet(values[k - 1]);
+        if (is_data[v + t] && !(flags[k] & kernels::wall_north)) meet(values[k + t]);
+        if (is_data[v - t] && !(flags[k - t] & kernels::wall_north)) meet(values[k - t]);
+      }
   }
   std::vector<int> unknown_of(n, -1);
   std::vector<int> node_of;
@@ -305,7 +341,8 @@ MeshLaplaceStats solve_mesh_texel_laplace(std::vector<RegionTile>& tiles, Elemen
         place_region_in_plane(tiles, type, adjacency, placement)) {
       try {
         // The solved tiles form a planar block: one patch tile, the tile multigrid, the same
-        // discrete problem (every texel-graph coupling is a 5-point coupling there).
+        // discrete problem (every texel-graph coupling is a 5-point coupling there, or a seam
+        // coupling of a ring cut open).
         // A one-texel margin for the ghosts, only where frozen tiles are (else the patch is
         // exactly the block of tiles, the multigrid's coarse grids aligned with them).
         const int margin = stats.frozen_tiles > 0 ? 1 : 0;
@@ -316,6 +353,8 @@ MeshLaplaceStats solve_mesh_texel_laplace(std::vector<RegionTile>& tiles, Elemen
           return (margin + t * placement.y[l] + j) * w + margin + t * placement.x[l] + i;
         };
         std::vector<char> in_tile(patch.flags.size(), 0);
+        std::vector<std::uint8_t> seam_edges(tiles.size(), 0);  // bit k: local edge k is a seam
+        for (const auto& [l, k] : placement.seams) seam_edges[l] |= static_cast<std::uint8_t>(1u << k);
         // Rows in parallel: each writes its own patch texels.
         kernels::forall(static_cast<std::int64_t>(tiles.size()) * t, [&](std::int64_t row) {
           const int l = static_cast<int>(row / t), j = static_cast<int>(row % t);
@@ -327,9 +366,13 @@ MeshLaplaceStats solve_mesh_texel_laplace(std::vector<RegionTile>& tiles, Elemen
             in_tile[g] = 1;
             if (!graph.active(v)) continue;
             std::uint8_t f = flags[j * t + i] & (kernels::wall_east | kernels::wall_north);
-            if (i == t - 1) f = (f & ~kernels::wall_east) | (graph.couples_across(l, 1, j) ? 0 : kernels::wall_east);
+            // Seam edges are walls in the patch (the seamed solve couples them).
+            if (i == t - 1)
+              f = (f & ~kernels::wall_east) |
+                  (graph.couples_across(l, 1, j) && !(seam_edges[l] & 2u) ? 0 : kernels::wall_east);
             if (j == t - 1)
-              f = (f & ~kernels::wall_north) | (graph.couples_across(l, 2, t - 1 - i) ? 0 : kernels::wall_north);
+              f = (f & ~kernels::wall_north) |
+                  (graph.couples_across(l, 2, t - 1 - i) && !(seam_edges[l] & 4u) ? 0 : kernels::wall_north);
             if (unknown_of[v] < 0) f |= kernels::dirichlet;
             patch.flags[g] = f;
             patch.values[g] = graph.value(v);  // data, or the initial guess (the previous H)
@@ -390,7 +433,21 @@ MeshLaplaceStats solve_mesh_texel_laplace(std::vector<RegionTile>& tiles, Elemen
             if (d == 3) patch.flags[q] |= kernels::wall_east;
           }
         }
-        const LaplaceSolveStats s = solve_laplace(patch, LaplaceSolver::multigrid, options);
+        // Seam couplings: texel pairs across each seam edge (listed once, from the lower tile).
+        std::vector<detail::SeamCoupling> seams;
+        for (const auto& [l, k] : placement.seams) {
+          const auto nb = graph.across(l, k);
+          if (nb[0] < l) continue;
+          for (int q = 0; q < t; ++q) {
+            if (!graph.couples_across(l, k, q)) continue;
+            const int v = l * tt + edge_texel_index(type, t, k, q);
+            const int other = nb[0] * tt + edge_texel_index(type, t, nb[1], t - 1 - q);
+            if (!graph.active(v) || !graph.active(other) || (unknown_of[v] < 0 && unknown_of[other] < 0)) continue;
+            seams.push_back({patch_index(l, v % tt % t, v % tt / t), patch_index(nb[0], other % tt % t, other % tt / t)});
+          }
+        }
+        const LaplaceSolveStats s = seams.empty() ? solve_laplace(patch, LaplaceSolver::multigrid, options)
+                                                  : detail::solve_seamed_patch_laplace(patch, seams, options);
         stats.relative_residual = s.relative_residual;
         stats.multigrid = true;
         kernels::forall(static_cast<std::int64_t>(tiles.size()) * t, [&](std::int64_t row) {
@@ -417,7 +474,9 @@ MeshLaplaceStats solve_mesh_texel_laplace(std::vector<RegionTile>& tiles, Elemen
         stats.multigrid = false;
       }
     }
-    if (!stats.multigrid) {
+    if (!stats.multigrid && !direct_fallback) {
+      stats.needs_direct = true;
+    } else if (!stats.multigrid) {
       // Lower triangle, column by column (rows in increasing order: cheap inserts).
       const int m = stats.unknowns;
       Eigen::SparseMatrix<double> a(m, m);
@@ -439,6 +498,10 @@ MeshLaplaceStats solve_mesh_texel_laplace(std::vector<RegionTile>& tiles, Elemen
       }
       a.makeCompressed();
       Eigen::CholmodSupernodalLLT<Eigen::SparseMatrix<double>, Eigen::Lower> cholesky;
+      // CHOLMOD's own choice between simplicial and supernodal (by flops per factor entry):
+      // the texel graphs of a few tri6 elements (fracture: 6k-20k unknowns) factor twice
+      // as fast simplicial, a 65k-unknown ring (slinky) stays supernodal.
+      cholesky.cholmod().supernodal = CHOLMOD_AUTO;
       const auto lock = detail::lock_cholmod();  // held through the solve below
       cholesky.compute(a);
       if (cholesky.info() != Eigen::Success)

@@ -310,4 +310,156 @@ SurfacePoint closest_surface_point(const Mesh& mesh, const double p[3]) {
   return result;
 }
 
+// --- SurfacePointSearch -----------------------------------------------------------------
+// Same seeds (bit for bit: the same operations in the same order), margins, refinement and
+// tie rule as closest_surface_point above. What it skips: an element whose sample box is
+// farther than the nearest seed found cannot hold the first seed, and one whose box
+// distance minus margin exceeds the first refined distance plus the tie tolerance is
+// skipped by the full search too (`best` only falls after the first refinement, and the
+// box distance is a lower bound of the seed distance in floating point as well: the
+// clamped differences are never larger).
+
+SurfacePointSearch::SurfacePointSearch(const Mesh& mesh) : mesh_(mesh) {
+  const int elements = mesh.num_elements();
+  const auto samples = sample_points(mesh.type);
+  samples_ = static_cast<int>(samples.size());
+  std::vector<kernels::ShapeValues> shapes(samples.size());
+  for (size_t s = 0; s < samples.size(); ++s) kernels::evaluate_shape(mesh.type, samples[s][0], samples[s][1], shapes[s]);
+  const int npe = mesh.nodes_per_element();
+  sample_positions_.resize(static_cast<size_t>(elements) * samples_ * 3);
+  margins_.assign(elements, 0.0);
+  sample_boxes_.resize(static_cast<size_t>(elements) * 6);
+  node_boxes_.resize(static_cast<size_t>(elements) * 6);
+  all_.resize(elements);
+  for (int e = 0; e < elements; ++e) {
+    all_[e] = e;
+    const int* en = mesh.element_nodes(e);
+    double margin = 0;
+    for (int a = 0; a < npe; ++a)
+      for (int b = a + 1; b < npe; ++b) {
+        const double* u = mesh.node(en[a]);
+        const double* v = mesh.node(en[b]);
+        margin = std::max(margin, 0.5 * std::sqrt((u[0] - v[0]) * (u[0] - v[0]) + (u[1] - v[1]) * (u[1] - v[1]) +
+                                                  (u[2] - v[2]) * (u[2] - v[2])));
+      }
+    margins_[e] = margin;
+    double* box = &sample_boxes_[6 * static_cast<size_t>(e)];
+    double* nodes = &node_boxes_[6 * static_cast<size_t>(e)];
+    for (int d = 0; d < 3; ++d) {
+      box[d] = nodes[d] = std::numeric_limits<double>::infinity();
+      box[3 + d] = nodes[3 + d] = -std::numeric_limits<double>::infinity();
+    }
+    for (int a = 0; a < npe; ++a)
+      for (int d = 0; d < 3; ++d)
+        nodes[d] = std::min(nodes[d], mesh.node(en[a])[d]), nodes[3 + d] = std::max(nodes[3 + d], mesh.node(en[a])[d]);
+    for (int s = 0; s < samples_; ++s) {
+      double x[3] = {0, 0, 0};
+      for (int a = 0; a < npe; ++a)
+        for (int d = 0; d < 3; ++d) x[d] += shapes[s].N[a] * mesh.node(en[a])[d];
+      double* out = &sample_positions_[(static_cast<size_t>(e) * samples_ + s) * 3];
+      for (int d = 0; d < 3; ++d) out[d] = x[d], box[d] = std::min(box[d], x[d]), box[3 + d] = std::max(box[3 + d], x[d]);
+    }
+  }
+}
+
+SurfacePoint SurfacePointSearch::closest(const double p[3]) const {
+  if (all_.empty()) throw MeshError("closest_surface_point: the mesh has no elements");
+  return closest_among(all_, p);
+}
+
+SurfacePoint SurfacePointSearch::closest_among(const std::vector<int>& elements, const double p[3]) const {
+  if (elements.empty()) throw MeshError("closest_surface_point: no elements to search");
+  if (!std::isfinite(p[0]) || !std::isfinite(p[1]) || !std::isfinite(p[2]))
+    throw MeshError("closest_surface_point: query point (" + mesh_number(p[0]) + ", " + mesh_number(p[1]) + ", " +
+                    mesh_number(p[2]) + ") is not finite");
+  // The bounding box of the searched elements' nodes, as closest_surface_point takes it
+  // from the (sub-)mesh's nodes: min and max are exact, so the tolerance is the same.
+  double lo[3], hi[3];
+  for (int d = 0; d < 3; ++d) lo[d] = hi[d] = node_boxes_[6 * static_cast<size_t>(elements.front()) + d];
+  for (int e : elements)
+    for (int d = 0; d < 3; ++d)
+      lo[d] = std::min(lo[d], node_boxes_[6 * static_cast<size_t>(e) + d]),
+      hi[d] = std::max(hi[d], node_boxes_[6 * static_cast<size_t>(e) + 3 + d]);
+  const double tie_tolerance = 1e-12 * std::sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) +
+                                                 (hi[2] - lo[2]) * (hi[2] - lo[2]));
+  return search(elements.data(), static_cast<int>(elements.size()), p, tie_tolerance);
+}
+
+SurfacePoint SurfacePointSearch::search(const int* elements, int count, const double p[3], double tie_tolerance) const {
+  const auto samples = sample_points(mesh_.type);
+  constexpr double unknown = -1;
+  std::vector<double> lower(count), seed_distance(count, unknown);
+  std::vector<int> seed_sample(count, 0);
+  for (int k = 0; k < count; ++k) {
+    const double* box = &sample_boxes_[6 * static_cast<size_t>(elements[k])];
+    double s = 0;
+    for (int d = 0; d < 3; ++d) {
+      const double gap = p[d] - std::clamp(p[d], box[d], box[3 + d]);
+      s += gap * gap;
+    }
+    lower[k] = std::sqrt(s);
+  }
+  auto seed = [&](int k) {
+    if (seed_distance[k] != unknown) return;
+    const double* x = &sample_positions_[static_cast<size_t>(elements[k]) * samples_ * 3];
+    double best = std::numeric_limits<double>::infinity();
+    for (int s = 0; s < samples_; ++s, x += 3) {
+      const double dist = std::sqrt((x[0] - p[0]) * (x[0] - p[0]) + (x[1] - p[1]) * (x[1] - p[1]) +
+                                    (x[2] - p[2]) * (x[2] - p[2]));
+      if (dist < best) best = dist, seed_sample[k] = s;
+    }
+    seed_distance[k] = best;
+  };
+  // The first seed of the full search: the least (distance, element).
+  int first = static_cast<int>(std::min_element(lower.begin(), lower.end()) - lower.begin());
+  seed(first);
+  for (int k = 0; k < count; ++k) {
+    if (lower[k] > seed_distance[first]) continue;
+    seed(k);
+    if (seed_distance[k] < seed_distance[first] ||
+        (seed_distance[k] == seed_distance[first] && elements[k] < elements[first]))
+      first = k;
+  }
+  struct Candidate {
+    int element;
+    double xi[2], position[3], distance;
+  };
+  auto refine_seed = [&](int k) {
+    const ElementDistance f(mesh_, elements[k], p);
+    Candidate c;
+    c.element = elements[k];
+    c.xi[0] = samples[seed_sample[k]][0];
+    c.xi[1] = samples[seed_sample[k]][1];
+    refine(f, mesh_.type, c.xi);
+    double J[3][2], D[3][3];
+    f.evaluate(c.xi, c.position, J, D);
+    c.distance = std::sqrt(f.squared_gap(c.position));
+    return c;
+  };
+  std::vector<Candidate> candidates = {refine_seed(first)};
+  double best = candidates.front().distance;
+  // Everything the full search could still refine after the first, in its order.
+  std::vector<int> rest;
+  for (int k = 0; k < count; ++k)
+    if (k != first && !(lower[k] - margins_[elements[k]] > best + tie_tolerance)) seed(k), rest.push_back(k);
+  std::sort(rest.begin(), rest.end(), [&](int a, int b) {
+    return seed_distance[a] != seed_distance[b] ? seed_distance[a] < seed_distance[b] : elements[a] < elements[b];
+  });
+  for (int k : rest) {
+    if (seed_distance[k] - margins_[elements[k]] > best + tie_tolerance) continue;
+    candidates.push_back(refine_seed(k));
+    best = std::min(best, candidates.back().distance);
+  }
+  const Candidate* chosen = nullptr;
+  for (const Candidate& c : candidates)
+    if (c.distance <= best + tie_tolerance && (!chosen || c.element < chosen->element)) chosen = &c;
+  SurfacePoint result;
+  result.element = chosen->element;
+  result.xi[0] = chosen->xi[0];
+  result.xi[1] = chosen->xi[1];
+  for (int d = 0; d < 3; ++d) result.position[d] = chosen->position[d];
+  result.distance = chosen->distance;
+  return result;
+}
+
 }  // namespace dgtex

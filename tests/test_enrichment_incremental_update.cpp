@@ -3,8 +3,8 @@
 //  - a region whose solved tiles lie flat but close up only through frozen (settled)
 //    tiles (a cylinder ring with one settled element) is solved by the tile multigrid
 //    with the frozen texels as Dirichlet ghost texels, to CHOLMOD's solution;
-//  - where ghosts cannot fit (the ring closes through solved tiles) it falls back to
-//    CHOLMOD, same answer;
+//  - where the ring closes through solved tiles, it is cut open into a seamed patch
+//    (seamed_patch_laplace.h: CG preconditioned by the open patch's multigrid), same answer;
 //  - the single-function test of independent_enriched_nodes (pooled per-tile moments)
 //    keeps exactly the nodes whose H deviates from its mean by an RMS above tolerance;
 //  - a progressive cut around a cylinder gives the same textures with the multigrid as
@@ -96,10 +96,11 @@ TEST(EnrichmentIncrementalUpdate, GhostBesideATileItMustNotCoupleTo) {
   expect_multigrid_equals_cholmod(mesh, {0, 1, 2, 3}, {2}, walls, true);
 }
 
-TEST(EnrichmentIncrementalUpdate, RingClosedThroughSolvedTilesFallsBackToCholmod) {
-  // Row 1 is solved all around: the solved tiles close up, so no planar patch exists.
+TEST(EnrichmentIncrementalUpdate, RingClosedThroughSolvedTilesSolvesOnASeamedPatch) {
+  // Row 1 is solved all around: the solved tiles close up, so the patch is cut open at a
+  // seam that the seamed solve couples again.
   const Mesh mesh = make_cylinder(1, 2, 0, 360, 4, 2, ElementType::quad8);
-  expect_multigrid_equals_cholmod(mesh, {0, 1, 2, 3, 4, 5, 6, 7}, {3}, MeshEdgeWalls(T), false);
+  expect_multigrid_equals_cholmod(mesh, {0, 1, 2, 3, 4, 5, 6, 7}, {3}, MeshEdgeWalls(T), true);
 }
 
 TEST(EnrichmentIncrementalUpdate, SingleFunctionNodesKeepExactlyTheNonConstantOnes) {

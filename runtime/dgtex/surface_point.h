@@ -2,6 +2,8 @@
 // Closest point on the curved (quadratic) mesh surface: probes and cut paths given as
 // rest-configuration points are projected with this.
 // A pure function (thread-safe). Positions and distances in the mesh's length unit (SI: m).
+#include <vector>
+
 #include "dgtex/mesh.h"
 #include "dgtex/mesh_error.h"
 
@@ -24,5 +26,33 @@ struct SurfacePoint {
 // 1e-12 x the mesh's bounding-box diagonal) go to the lowest element index.
 // Throws MeshError for an empty mesh or a non-finite p. Assumes a validated mesh.
 SurfacePoint closest_surface_point(const Mesh& mesh, const double p[3]);
+
+// The same search for many queries on one mesh, bitwise equal to closest_surface_point:
+// the seed samples, margins and a box around each element's samples are computed once;
+// a query computes the exact seed distance only for elements whose box could hold the
+// nearest seed or whose margin could let them be refined (a lower bound, so the refined
+// candidates, their order and the answer are those of the full search). A cut path of
+// the 544-element bunny projects ~6x faster.
+// Keeps a reference to the mesh (which must outlive it and not change). Thread-safe
+// queries (const).
+class SurfacePointSearch {
+ public:
+  explicit SurfacePointSearch(const Mesh& mesh);
+  // == closest_surface_point(mesh, p).
+  SurfacePoint closest(const double p[3]) const;
+  // == closest_surface_point of the sub-mesh made of these elements (distinct, ascending),
+  // with the element given as a mesh element index. Throws MeshError for an empty list.
+  SurfacePoint closest_among(const std::vector<int>& elements, const double p[3]) const;
+
+ private:
+  SurfacePoint search(const int* elements, int count, const double p[3], double tie_tolerance) const;
+  const Mesh& mesh_;
+  int samples_ = 0;
+  std::vector<double> sample_positions_;  // per element and sample: x, y, z
+  std::vector<double> margins_;           // per element: half its diameter over node pairs
+  std::vector<double> sample_boxes_;      // per element: lo[3], hi[3] of its samples
+  std::vector<double> node_boxes_;        // per element: lo[3], hi[3] of its nodes
+  std::vector<int> all_;                  // 0..elements-1
+};
 
 }  // namespace dgtex

@@ -1,0 +1,134 @@
+#include "seamed_patch_laplace.h"
+
+#include <chrono>
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+#include "dgtex/kernels/forall.h"
+#include "dgtex/kernels/multigrid_unknowns.h"
+#include "dgtex/stage_timer.h"
+
+namespace dgtex::detail {
+namespace {
+
+// Sum over rows, each row summed in order: deterministic for any thread count.
+template <class Term>
+double row_sum(int w, int h, Term term) {
+  std::vector<double> rows(h, 0.0);
+  kernels::forall(h, [&](std::int64_t j) {
+    double s = 0;
+    for (int i = 0; i < w; ++i) s += term(static_cast<int>(j) * w + i);
+    rows[j] = s;
+  });
+  double sum = 0;
+  for (double v : rows) sum += v;
+  return sum;
+}
+
+}  // namespace
+
+LaplaceSolveStats solve_seamed_patch_laplace(kernels::TexelTile& tile, const std::vector<SeamCoupling>& seams,
+                                             const LaplaceMultigridOptions& options) {
+  const auto start = std::chrono::steady_clock::now();
+  validate_laplace_tile(tile);
+  const int w = tile.width, h = tile.height, n = w * h;
+  const auto free_texel = [&](int t) { return !(tile.flags[t] & (kernels::dirichlet | kernels::inactive)); };
+  for (const SeamCoupling& s : seams)
+    if (s.a < 0 || s.b < 0 || s.a >= n || s.b >= n || s.a == s.b || (tile.flags[s.a] & kernels::inactive) ||
+        (tile.flags[s.b] & kernels::inactive) || (!free_texel(s.a) && !free_texel(s.b)))
+      throw std::invalid_argument("seamed patch Laplace: seam (" + std::to_string(s.a) + ", " + std::to_string(s.b) +
+                                  ") must join two active texels of the " + std::to_string(w) + "x" +
+                                  std::to_string(h) + " tile, at least one free");
+
+  LaplaceMultigrid chain(tile, options);
+  std::vector<char> unknown(n, 0);
+  for (int t = 0; t < n; ++t) {
+    unknown[t] = chain.is_unknown(t);
+    if (free_texel(t) && !unknown[t])
+      throw std::runtime_error("seamed patch Laplace: texel " + std::to_string(t) +
+                               " has Dirichlet data only across a seam");
+  }
+  std::vector<std::uint8_t> bits;
+  kernels::classify_laplace_texels(tile, bits);
+  // Seam partners per texel (few: one edge of texels), for the operator and the rhs.
+  std::vector<std::vector<int>> partners(n);
+  for (const SeamCoupling& s : seams) partners[s.a].push_back(s.b), partners[s.b].push_back(s.a);
+
+  // y = A x on the unknowns: the grid couplings (degree counts Dirichlet neighbours too),
+  // then one more coupling per seam partner.
+  const auto apply = [&](const std::vector<double>& x, std::vector<double>& y) {
+    kernels::forall(h, [&](std::int64_t j) {
+      for (int t = static_cast<int>(j) * w; t < (static_cast<int>(j) + 1) * w; ++t) {
+        if (!unknown[t]) {
+          y[t] = 0;
+          continue;
+        }
+        const std::uint8_t m = bits[t];
+        double v = (kernels::laplace_degree(m) + static_cast<double>(partners[t].size())) * x[t];
+        if (m & kernels::couples_west_unknown) v -= x[t - 1];
+        if (m & kernels::couples_east_unknown) v -= x[t + 1];
+        if (m & kernels::couples_south_unknown) v -= x[t - w];
+        if (m & kernels::couples_north_unknown) v -= x[t + w];
+        for (int p : partners[t])
+          if (unknown[p]) v -= x[p];
+        y[t] = v;
+      }
+    });
+  };
+  // b: values of coupled Dirichlet texels, grid neighbours and seam partners.
+  std::vector<double> b(n, 0.0), x(n, 0.0), r(n), z, p, q(n);
+  for (int j = 0; j < h; ++j)
+    for (int i = 0; i < w; ++i) {
+      const int t = tile.index(i, j);
+      if (!unknown[t]) continue;
+      auto data = [&](bool coupled, int o) {
+        if (coupled && (tile.flags[o] & (kernels::dirichlet | kernels::inactive)) == kernels::dirichlet)
+          b[t] += tile.values[o];
+      };
+      data(i > 0 && kernels::texels_coupled_east(tile, i - 1, j), t - 1);
+      data(i + 1 < w && kernels::texels_coupled_east(tile, i, j), t + 1);
+      data(j > 0 && kernels::texels_coupled_north(tile, i, j - 1), t - w);
+      data(j + 1 < h && kernels::texels_coupled_north(tile, i, j), t + w);
+      for (int o : partners[t]) data(true, o);
+      if (options.warm_start && std::isfinite(tile.values[t])) x[t] = tile.values[t];
+    }
+  LaplaceSolveStats stats;
+  const double b_norm = std::sqrt(row_sum(w, h, [&](int t) { return b[t] * b[t]; }));
+  apply(x, q);
+  for (int t = 0; t < n; ++t) r[t] = b[t] - q[t];
+  double relative = b_norm > 0 ? std::sqrt(row_sum(w, h, [&](int t) { return r[t] * r[t]; })) / b_norm : 0.0;
+  if (relative > options.tolerance) {
+    chain.precondition(r, z);
+    p = z;
+    double rz = row_sum(w, h, [&](int t) { return r[t] * z[t]; });
+    while (relative > options.tolerance && stats.iterations < options.max_cycles) {
+      apply(p, q);
+      const double pq = row_sum(w, h, [&](int t) { return p[t] * q[t]; });
+      if (!(pq > 0)) break;
+      const double alpha = rz / pq;
+      for (int t = 0; t < n; ++t) x[t] += alpha * p[t], r[t] -= alpha * q[t];
+      ++stats.iterations;
+      relative = std::sqrt(row_sum(w, h, [&](int t) { return r[t] * r[t]; })) / b_norm;
+      if (relative <= options.tolerance) break;
+      chain.precondition(r, z);
+      const double rz_next = row_sum(w, h, [&](int t) { return r[t] * z[t]; });
+      const double beta = rz_next / rz;
+      rz = rz_next;
+      for (int t = 0; t < n; ++t) p[t] = z[t] + beta * p[t];
+    }
+    // The true residual, not the recursive one.
+    apply(x, q);
+    relative = std::sqrt(row_sum(w, h, [&](int t) { return (b[t] - q[t]) * (b[t] - q[t]); })) / b_norm;
+  }
+  if (!(relative <= options.tolerance))
+    throw std::runtime_error("seamed patch Laplace: relative residual " + std::to_string(relative) + " after " +
+                             std::to_string(stats.iterations) + " iterations");
+  for (int t = 0; t < n; ++t)
+    if (free_texel(t)) tile.values[t] = x[t];
+  stats.relative_residual = relative;
+  stats.ms = ms_since(start);
+  return stats;
+}
+
+}  // namespace dgtex::detail

@@ -1,0 +1,122 @@
+// CutManager solves the Laplace problems of different segments concurrently
+// (cut_manager.cpp): the functions must be bitwise the same for 1, 2 and 4 threads, with
+// multigrid regions (a quad8 rectangle) and regions that need CHOLMOD (tri6, solved after
+// the concurrent part in segment order), static and progressive. And the deferred direct
+// solve of solve_mesh_texel_laplace (direct_fallback = false, then CHOLMOD) equals the
+// one call with the fallback, bitwise.
+#include <gtest/gtest.h>
+
+#include <omp.h>
+
+#include <vector>
+
+#include "cut_test_support.h"
+#include "dgtex/kernels/cut_rasterization.h"
+#include "region_test_support.h"
+#include "dgtex/cut_manager.h"
+#include "dgtex/mesh_generators.h"
+#include "dgtex/topology.h"
+
+using namespace dgtex;
+using namespace dgtex::testing_support;
+
+namespace {
+
+// Every function's values, elements and nodes after each update time, in one list.
+std::vector<double> run(const Mesh& mesh, const std::vector<Cut>& cuts, const EnrichmentOptions& options,
+                        const std::vector<double>& times, int threads, int& solves) {
+  const int saved = omp_get_max_threads();
+  omp_set_num_threads(threads);
+  const Topology topology = build_topology(mesh);
+  CutManager manager(mesh, topology, cuts, options);
+  std::vector<double> out;
+  solves = 0;
+  for (double t : times) {
+    manager.update(t);
+    solves += manager.last_update().solves;
+    for (const EnrichmentFunction& f : manager.functions()) {
+      out.insert(out.end(), f.enriched_nodes.begin(), f.enriched_nodes.end());
+      for (const ElementTexture& texture : f.elements) {
+        out.push_back(texture.element);
+        out.insert(out.end(), texture.tile.values.begin(), texture.tile.values.end());
+      }
+    }
+  }
+  omp_set_num_threads(saved);
+  return out;
+}
+
+void expect_thread_count_independent(const Mesh& mesh, const std::vector<Cut>& cuts, const EnrichmentOptions& options,
+                                     const std::vector<double>& times, int min_solves) {
+  int solves1 = 0, solves2 = 0, solves4 = 0;
+  const std::vector<double> one = run(mesh, cuts, options, times, 1, solves1);
+  const std::vector<double> two = run(mesh, cuts, options, times, 2, solves2);
+  const std::vector<double> four = run(mesh, cuts, options, times, 4, solves4);
+  EXPECT_GE(solves1, min_solves);
+  EXPECT_EQ(solves1, solves2);
+  EXPECT_EQ(solves1, solves4);
+  ASSERT_EQ(one.size(), two.size());
+  ASSERT_EQ(one.size(), four.size());
+  std::size_t differ2 = 0, differ4 = 0;
+  for (std::size_t k = 0; k < one.size(); ++k) differ2 += one[k] != two[k], differ4 += one[k] != four[k];
+  EXPECT_EQ(differ2, 0u) << "of " << one.size();
+  EXPECT_EQ(differ4, 0u) << "of " << one.size();
+}
+
+EnrichmentOptions multigrid_enrichment(int resolution) {
+  EnrichmentOptions o = cholmod_enrichment(resolution);
+  o.solver = EnrichmentOptions::Solver::multigrid;
+  return o;
+}
+
+}  // namespace
+
+TEST(CutsConcurrentSolves, StaticMultigridCutsAreThreadCountIndependent) {
+  const Mesh mesh = make_rectangle(3, 2, 3, 2, ElementType::quad8);
+  const std::vector<Cut> cuts = {points_cut({{0.1, 0.3, 0}, {0.8, 0.6, 0}}), points_cut({{1.2, 0.2, 0}, {1.7, 0.9, 0}}),
+                                 points_cut({{0.3, 1.5, 0}, {1.6, 1.3, 0}}), points_cut({{2.2, 1.1, 0}, {2.8, 1.8, 0}})};
+  expect_thread_count_independent(mesh, cuts, multigrid_enrichment(32), {0.0}, 4);
+}
+
+TEST(CutsConcurrentSolves, ProgressiveTri6CutsNeedingCholmodAreThreadCountIndependent) {
+  const Mesh mesh = make_rectangle(3, 2, 3, 2, ElementType::tri6);
+  std::vector<Cut> cuts = {points_cut({{0.1, 0.35, 0}, {2.6, 0.6, 0}}), points_cut({{0.2, 1.5, 0}, {2.7, 1.3, 0}}),
+                           points_cut({{1.45, 0.9, 0}, {1.55, 1.2, 0}})};
+  for (Cut& cut : cuts) cut.has_schedule = true, cut.speed = 1.0;
+  expect_thread_count_independent(mesh, cuts, multigrid_enrichment(16), {0.5, 1.0, 1.5, 2.0, 3.0}, 8);
+}
+
+TEST(CutsConcurrentSolves, ProgressiveMixedRegionsAreThreadCountIndependent) {
+  // A closed quad8 cylinder: rings (seamed patches) next to planar blocks.
+  const Mesh mesh = make_cylinder(0.5, 2.0, 0, 360, 4, 2, ElementType::quad8);
+  std::vector<Cut> cuts = {points_cut({{0.0, 0.3, 0.5}, {0.5, 0.8, 0.0}, {0.0, 1.2, -0.5}}),
+                           points_cut({{-0.5, 1.5, 0.0}, {0.0, 1.8, 0.5}})};
+  for (Cut& cut : cuts) cut.has_schedule = true, cut.speed = 1.5;
+  expect_thread_count_independent(mesh, cuts, multigrid_enrichment(16), {0.2, 0.6, 1.0, 1.4, 2.0}, 6);
+}
+
+TEST(CutsConcurrentSolves, DeferredDirectSolveEqualsTheFallback) {
+  // tri6 regions have no patch tile (a quad8 ring is a seamed patch now, see
+  // test_laplace_mesh_multigrid.cpp).
+  for (ElementType type : {ElementType::tri6}) {
+    const Mesh mesh = make_rectangle(2, 1, 2, 1, type);
+    const Topology topology = build_topology(mesh);
+    const ElementAdjacency adjacency(mesh, topology);
+    std::vector<int> elements;
+    for (int e = 0; e < mesh.num_elements(); ++e) elements.push_back(e);
+    std::vector<RegionTile> once = make_test_region(mesh, elements, 16), twice = once;
+    const MeshEdgeWalls walls(16);
+    const MeshLaplaceStats a = solve_mesh_texel_laplace(once, type, adjacency, walls, LaplaceSolver::multigrid);
+    const MeshLaplaceStats deferred =
+        solve_mesh_texel_laplace(twice, type, adjacency, walls, LaplaceSolver::multigrid, {}, false);
+    EXPECT_FALSE(a.multigrid);
+    EXPECT_GT(a.unknowns, 100);
+    EXPECT_TRUE(deferred.needs_direct);
+    EXPECT_FALSE(a.needs_direct);
+    const MeshLaplaceStats b = solve_mesh_texel_laplace(twice, type, adjacency, walls, LaplaceSolver::cholmod);
+    EXPECT_EQ(a.unknowns, b.unknowns);
+    for (std::size_t l = 0; l < once.size(); ++l)
+      for (std::size_t k = 0; k < once[l].tile.values.size(); ++k)
+        ASSERT_EQ(once[l].tile.values[k], twice[l].tile.values[k]) << "tile " << l << " texel " << k;
+  }
+}
