@@ -610,32 +610,16 @@ void enriched_element_deformation_gradients(const EnrichedElementBatch& b, const
         TexelCache cache;
         ShapeValues s;
         RestPoint rest;
+        TextureSample samples[max_enrichments_per_element];  // constructed once: it zero-fills
         for (std::int64_t q = chunk.begin; q < chunk.end; ++q) {
           const double* pt = quad.points + 3 * q;
           evaluate_shape(b.type, pt[0], pt[1], s);
           evaluate_rest_point(s, nodes, b.positions, rest);
           int ti, tj;
           cache.at(b, L, pt[0], pt[1], ti, tj);
-          double a1[3] = {0, 0, 0}, a2[3] = {0, 0, 0};
-          for (int a = 0; a < npe; ++a) {
-            const double* x = current + 3 * static_cast<std::int64_t>(global[a]);
-            for (int k = 0; k < 3; ++k) a1[k] += s.dN[a][0] * x[k], a2[k] += s.dN[a][1] * x[k];
-          }
-          for (int k = 0; k < L.count; ++k) {
-            TextureSample h;
-            sample_texel_polynomial(b.type, b.resolution, cache.fd[k], ti, tj, pt[0], pt[1], h);
-            for (int a = 0; a < npe; ++a) {
-              if (L.slot[k][a] < 0) continue;
-              const double psi = h.value - L.shift[k][a];
-              const double d0 = h.d[0] * s.N[a] + psi * s.dN[a][0], d1 = h.d[1] * s.N[a] + psi * s.dN[a][1];
-              const double* x = current + 3 * static_cast<std::int64_t>(global[L.slot[k][a]]);
-              for (int i = 0; i < 3; ++i) a1[i] += d0 * x[i], a2[i] += d1 * x[i];
-            }
-          }
-          double t[3];
-          cross3(a1, a2, t);
-          normalize3(t);
-          surface_deformation_gradient(rest.a1, rest.a2, rest.t0, a1, a2, t, F + 9 * q);
+          for (int k = 0; k < L.count; ++k)
+            sample_texel_polynomial(b.type, b.resolution, cache.fd[k], ti, tj, pt[0], pt[1], samples[k]);
+          point_deformation_gradient(L, s, rest, samples, global, current, F + 9 * q);
         }
       },
       execution);

@@ -224,6 +224,28 @@ std::vector<std::array<double, 2>> sample_points(ElementType type) {
   return s;
 }
 
+// A refined candidate of the closest-point searches. (A private struct: a
+// std::vector<SurfacePoint> here would instantiate templates that clash with scene.h's
+// different dgtex::SurfacePoint.)
+struct Candidate {
+  int element;
+  double xi[2], position[3], distance;
+};
+
+// Lowest element index among the candidates within the tie tolerance of the minimum `best`.
+SurfacePoint lowest_element_within_tie(const std::vector<Candidate>& candidates, double best, double tie_tolerance) {
+  const Candidate* chosen = nullptr;
+  for (const Candidate& c : candidates)
+    if (c.distance <= best + tie_tolerance && (!chosen || c.element < chosen->element)) chosen = &c;
+  SurfacePoint result;
+  result.element = chosen->element;
+  result.xi[0] = chosen->xi[0];
+  result.xi[1] = chosen->xi[1];
+  for (int d = 0; d < 3; ++d) result.position[d] = chosen->position[d];
+  result.distance = chosen->distance;
+  return result;
+}
+
 }  // namespace
 
 SurfacePoint closest_surface_point(const Mesh& mesh, const double p[3]) {
@@ -275,12 +297,6 @@ SurfacePoint closest_surface_point(const Mesh& mesh, const double p[3]) {
     return a.distance != b.distance ? a.distance < b.distance : a.element < b.element;
   });
 
-  // Refined candidates. (Kept as a private struct: a std::vector<SurfacePoint> here would
-  // instantiate templates that clash with scene.h's different dgtex::SurfacePoint.)
-  struct Candidate {
-    int element;
-    double xi[2], position[3], distance;
-  };
   std::vector<Candidate> candidates;
   double best = std::numeric_limits<double>::infinity();
   for (const Seed& seed : seeds) {
@@ -297,17 +313,7 @@ SurfacePoint closest_surface_point(const Mesh& mesh, const double p[3]) {
     best = std::min(best, c.distance);
     candidates.push_back(c);
   }
-  // Lowest element index among those within the tie tolerance of the minimum.
-  const Candidate* chosen = nullptr;
-  for (const Candidate& c : candidates)
-    if (c.distance <= best + tie_tolerance && (!chosen || c.element < chosen->element)) chosen = &c;
-  SurfacePoint result;
-  result.element = chosen->element;
-  result.xi[0] = chosen->xi[0];
-  result.xi[1] = chosen->xi[1];
-  for (int d = 0; d < 3; ++d) result.position[d] = chosen->position[d];
-  result.distance = chosen->distance;
-  return result;
+  return lowest_element_within_tie(candidates, best, tie_tolerance);
 }
 
 // --- SurfacePointSearch -----------------------------------------------------------------
@@ -420,10 +426,6 @@ SurfacePoint SurfacePointSearch::search(const int* elements, int count, const do
         (seed_distance[k] == seed_distance[first] && elements[k] < elements[first]))
       first = k;
   }
-  struct Candidate {
-    int element;
-    double xi[2], position[3], distance;
-  };
   auto refine_seed = [&](int k) {
     const ElementDistance f(mesh_, elements[k], p);
     Candidate c;
@@ -450,16 +452,7 @@ SurfacePoint SurfacePointSearch::search(const int* elements, int count, const do
     candidates.push_back(refine_seed(k));
     best = std::min(best, candidates.back().distance);
   }
-  const Candidate* chosen = nullptr;
-  for (const Candidate& c : candidates)
-    if (c.distance <= best + tie_tolerance && (!chosen || c.element < chosen->element)) chosen = &c;
-  SurfacePoint result;
-  result.element = chosen->element;
-  result.xi[0] = chosen->xi[0];
-  result.xi[1] = chosen->xi[1];
-  for (int d = 0; d < 3; ++d) result.position[d] = chosen->position[d];
-  result.distance = chosen->distance;
-  return result;
+  return lowest_element_within_tie(candidates, best, tie_tolerance);
 }
 
 }  // namespace dgtex

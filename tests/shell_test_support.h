@@ -65,4 +65,23 @@ inline std::vector<double> random_rotations(std::int64_t count, unsigned seed) {
   return R;
 }
 
+// A rotation of up to max_angle rad about a random axis per point (row-major 3x3 each).
+inline std::vector<double> small_random_rotations(std::int64_t count, double max_angle, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> u(-1, 1);
+  std::vector<double> R(static_cast<std::size_t>(count) * 9);
+  for (std::int64_t q = 0; q < count; ++q) {
+    double w[3] = {u(rng), u(rng), u(rng)};
+    const double norm = std::sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2]);
+    const double angle = max_angle * std::abs(u(rng));
+    for (double& x : w) x /= norm;
+    const double c = std::cos(angle), s = std::sin(angle);
+    double* r = &R[9 * q];
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j) r[i * 3 + j] = (i == j ? c : 0) + (1 - c) * w[i] * w[j];
+    r[1] -= s * w[2], r[2] += s * w[1], r[3] += s * w[2], r[5] -= s * w[0], r[6] -= s * w[1], r[7] += s * w[0];
+  }
+  return R;
+}
+
 }  // namespace dgtex::testing_support

@@ -23,6 +23,8 @@
 #include "dgtex/kernels/enriched_quadrature.h"
 #include "dgtex/kernels/polar_decomposition.h"
 #include "dgtex/mesh_generators.h"
+#include "cut_element_fixture.h"
+#include "shell_test_support.h"
 
 using namespace dgtex;
 
@@ -90,71 +92,12 @@ TEST(EnrichedGram, AccumulatorMatchesThePlainSum) {
     for (int j = 0; j < n; ++j) ASSERT_NEAR(B(i, j), A(i, j), 1e-14 * largest);
 }
 
-constexpr int kT = 64;
-
-// One quad8 element with complete and partial cuts (every node enriched by every function),
-// its local basis padded by `extra` unused slots.
-struct PaddedElement {
-  Mesh mesh = make_rectangle(1.0, 0.7, 1, 1, ElementType::quad8);
-  std::vector<kernels::TexelTile> tiles;
-  std::vector<kernels::TextureView> views;
-  std::vector<int> element{0}, start, nodes;
-  std::vector<double> shifts;
-  std::vector<kernels::ShellSection> sections{{2e6, 0.35, 0.02, 900}};
-  kernels::EnrichedElementBatch batch{};
-  std::vector<std::int64_t> qp_start;
-  std::vector<double> qp;
-  int n = 0;
-
-  PaddedElement(int complete, int partial, int extra) {
-    kernels::TexelTile walls = kernels::make_element_tile(ElementType::quad8, kT);
-    const int count = complete + partial;
-    for (int k = 0; k < count; ++k) {
-      const double y = kT * (k + 0.5) / count + 0.4;
-      std::vector<kernels::TexelPoint> line;
-      if (k < complete) line = {{0, y}, {double(kT), y - 3}};
-      else if (k % 2 == 0) line = {{0, y}, {0.55 * kT, y + 1}};
-      else line = {{double(kT), y}, {0.35 * kT, y}};
-      const kernels::CutRaster cut = kernels::rasterize_cut(line, walls);
-      tiles.push_back(k < complete ? complete_cut_heaviside(walls, cut) : harmonic_enrichment(walls, cut).tile);
-    }
-    start = {0, count};
-    int v = mesh.num_nodes();
-    for (int k = 0; k < count; ++k) {
-      views.push_back({tiles[k].values.data(), tiles[k].flags.data()});
-      for (int a = 0; a < 8; ++a) {
-        nodes.push_back(v++);
-        double xi[2];
-        kernels::node_parametric_position(ElementType::quad8, a, xi);
-        kernels::TextureSample s;
-        kernels::sample_texture(ElementType::quad8, kT, views.back(), xi[0], xi[1], s);
-        shifts.push_back(s.value);
-      }
-    }
-    n = 8 * (1 + count);
-    batch = {ElementType::quad8, 1, element.data(), mesh.elements.data(), mesh.positions.data(), sections.data(),
-             kT, n + extra, start.data(), views.data(), nodes.data(), shifts.data()};
-    kernels::enriched_element_quadrature(batch, kernels::EnrichedQuadratureOptions{}, qp_start, qp);
-  }
-  kernels::EnrichedQuadrature quadrature() const { return {qp_start.data(), qp.data()}; }
+// One quad8 element with complete and partial cuts, its local basis padded by unused slots.
+struct PaddedElement : testing_support::CutQuad8Element {
+  PaddedElement(int complete, int partial, int extra) : CutQuad8Element(complete, partial, false, extra) {}
 };
 
-std::vector<double> small_rotations(std::int64_t count) {
-  std::mt19937 rng(5);
-  std::uniform_real_distribution<double> u(-1, 1);
-  std::vector<double> R(static_cast<std::size_t>(count) * 9);
-  for (std::int64_t q = 0; q < count; ++q) {
-    double w[3] = {u(rng), u(rng), u(rng)};
-    const double norm = std::sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2]);
-    for (double& x : w) x /= norm;
-    const double angle = 0.4 * std::abs(u(rng)), c = std::cos(angle), s = std::sin(angle);
-    double* r = &R[9 * q];
-    for (int i = 0; i < 3; ++i)
-      for (int j = 0; j < 3; ++j) r[i * 3 + j] = (i == j ? c : 0) + (1 - c) * w[i] * w[j];
-    r[1] -= s * w[2], r[2] += s * w[1], r[3] += s * w[2], r[5] -= s * w[0], r[6] -= s * w[1], r[7] += s * w[0];
-  }
-  return R;
-}
+std::vector<double> small_rotations(std::int64_t count) { return testing_support::small_random_rotations(count, 0.4, 5); }
 
 void check_against_reference(const PaddedElement& one, double tolerance) {
   const int W = one.batch.width;

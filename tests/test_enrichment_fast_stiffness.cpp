@@ -17,85 +17,18 @@
 #include "dgtex/kernels/enriched_element_kernel.h"
 #include "dgtex/kernels/enriched_quadrature.h"
 #include "dgtex/mesh_generators.h"
+#include "cut_element_fixture.h"
+#include "shell_test_support.h"
 
 using namespace dgtex;
 
 namespace {
 
-constexpr int kT = 64;
-
-// One quad8 element with `complete` cuts across the tile and `partial` cuts from the
-// borders, every node enriched by every function; integrated with the adaptive rule, or
-// with the per-texel rule (many points: several chunks even where the adaptive rule merges).
-struct OneElement {
-  Mesh mesh = make_rectangle(1.0, 0.8, 1, 1, ElementType::quad8);
-  std::vector<kernels::TexelTile> tiles;
-  std::vector<kernels::TextureView> views;
-  std::vector<int> element{0}, start, nodes;
-  std::vector<double> shifts;
-  std::vector<kernels::ShellSection> sections{{1e6, 0.3, 0.01, 1000}};
-  kernels::EnrichedElementBatch batch{};
-  std::vector<std::int64_t> qp_start;
-  std::vector<double> qp;
-
-  OneElement(int complete, int partial, bool per_texel_rule = false) {
-    kernels::TexelTile walls = kernels::make_element_tile(ElementType::quad8, kT);
-    std::vector<kernels::CutRaster> cuts;
-    std::vector<bool> is_partial;
-    const int count = complete + partial;
-    for (int k = 0; k < count; ++k) {
-      const double y = kT * (k + 0.5) / count + 0.3;
-      const bool p = k >= complete;
-      std::vector<kernels::TexelPoint> line;
-      if (!p) line = {{0, y}, {double(kT), y + 2}};
-      else if (k % 2 == 0) line = {{0, y}, {0.6 * kT, y}};
-      else line = {{double(kT), y}, {0.4 * kT, y}};
-      cuts.push_back(kernels::rasterize_cut(line, walls));
-      is_partial.push_back(p);
-    }
-    for (int k = 0; k < count; ++k)
-      tiles.push_back(is_partial[k] ? harmonic_enrichment(walls, cuts[k]).tile : complete_cut_heaviside(walls, cuts[k]));
-    start = {0, count};
-    int v = mesh.num_nodes();
-    for (int k = 0; k < count; ++k) {
-      views.push_back({tiles[k].values.data(), tiles[k].flags.data()});
-      for (int a = 0; a < 8; ++a) {
-        nodes.push_back(v++);
-        double xi[2];
-        kernels::node_parametric_position(ElementType::quad8, a, xi);
-        kernels::TextureSample s;
-        kernels::sample_texture(ElementType::quad8, kT, views.back(), xi[0], xi[1], s);
-        shifts.push_back(s.value);
-      }
-    }
-    batch = {ElementType::quad8, 1, element.data(), mesh.elements.data(), mesh.positions.data(), sections.data(),
-             kT, 8 * (1 + count), start.data(), views.data(), nodes.data(), shifts.data()};
-    kernels::EnrichedQuadratureOptions rule;
-    rule.adaptive = !per_texel_rule;
-    kernels::enriched_element_quadrature(batch, rule, qp_start, qp);
-  }
-  kernels::EnrichedQuadrature quadrature() const { return {qp_start.data(), qp.data()}; }
-  std::int64_t points() const { return qp_start.back(); }
-};
+using testing_support::CutQuad8Element;
+constexpr int kT = CutQuad8Element::T;
 
 // A rotation of up to 0.3 rad about a random axis per point.
-std::vector<double> random_rotations(std::int64_t count) {
-  std::mt19937 rng(7);
-  std::uniform_real_distribution<double> u(-1, 1);
-  std::vector<double> R(static_cast<std::size_t>(count) * 9);
-  for (std::int64_t q = 0; q < count; ++q) {
-    double w[3] = {u(rng), u(rng), u(rng)};
-    const double norm = std::sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2]);
-    const double angle = 0.3 * std::abs(u(rng));
-    for (double& x : w) x /= norm;
-    const double c = std::cos(angle), s = std::sin(angle);
-    double* r = &R[9 * q];
-    for (int i = 0; i < 3; ++i)
-      for (int j = 0; j < 3; ++j) r[i * 3 + j] = (i == j ? c : 0) + (1 - c) * w[i] * w[j];
-    r[1] -= s * w[2], r[2] += s * w[1], r[3] += s * w[2], r[5] -= s * w[0], r[6] -= s * w[1], r[7] += s * w[0];
-  }
-  return R;
-}
+std::vector<double> random_rotations(std::int64_t count) { return testing_support::small_random_rotations(count, 0.3, 7); }
 
 double max_abs(const std::vector<double>& v) {
   double m = 0;
@@ -108,7 +41,7 @@ double max_difference(const std::vector<double>& a, const std::vector<double>& b
   return m;
 }
 
-void compare_with_reference(const OneElement& one, double tolerance) {
+void compare_with_reference(const CutQuad8Element& one, double tolerance) {
   const int W = one.batch.width;
   const std::vector<double> R = random_rotations(one.points());
   for (const double* rotations : {static_cast<const double*>(nullptr), R.data()}) {
@@ -140,19 +73,19 @@ void compare_with_reference(const OneElement& one, double tolerance) {
 TEST(EnrichedFastStiffness, CompleteCutsAgreeWithReferenceToRoundOff) {
   // Per-texel rule: the wall-aware adaptive rule merges the cells on both sides of straight
   // complete cuts (a few hundred points), and this comparison needs several chunks.
-  const OneElement one(3, 0, /*per_texel_rule=*/true);
+  const CutQuad8Element one(3, 0, /*per_texel_rule=*/true);
   ASSERT_GT(one.points(), kernels::enriched_chunk_points);  // several chunks
   compare_with_reference(one, 1e-13);
 }
 
 TEST(EnrichedFastStiffness, PartialAndCompleteCutsAgreeWithReference) {
-  const OneElement one(2, 3);
+  const CutQuad8Element one(2, 3);
   ASSERT_GT(one.points(), kernels::enriched_chunk_points);
   compare_with_reference(one, 1e-9);
 }
 
 TEST(EnrichedFastStiffness, DeformationGradientsIndependentOfThreads) {
-  const OneElement one(1, 2);
+  const CutQuad8Element one(1, 2);
   const int nodes = one.mesh.num_nodes() + static_cast<int>(one.nodes.size());
   std::vector<double> current(3 * static_cast<std::size_t>(nodes), 0.0);
   std::mt19937 rng(3);

@@ -2,6 +2,7 @@
 // CHOLMOD path on the same matrices: solutions, errors for indefinite and non-finite
 // matrices, and which systems take which path.
 #include <gtest/gtest.h>
+#include <omp.h>
 
 #include <cmath>
 #include <limits>
@@ -74,6 +75,24 @@ TEST(DenseCholesky, SolvesLikeCholmodOnSmallSystems) {
     EXPECT_FALSE(cholmod_dense) << n;
     EXPECT_LT(relative_difference(x, reference), 1e-12) << n;
   }
+}
+
+TEST(DenseCholesky, DoesNotDependOnTheThreadCount) {
+  // Eigen may run the LLT's block products on the OpenMP threads; its blocking does not
+  // depend on their number, so neither may the factor.
+  const LowerCsc m = lower_csc(random_spd(441, 441, 19u));
+  std::vector<double> b(441);
+  for (int i = 0; i < 441; ++i) b[i] = std::cos(0.7 * i);
+  std::vector<std::vector<double>> x;
+  for (int threads : {1, 2, 4}) {
+    omp_set_num_threads(threads);
+    bool dense = false;
+    x.push_back(solve_with(512, m, b, &dense));
+    EXPECT_TRUE(dense);
+  }
+  omp_set_num_threads(omp_get_num_procs());
+  EXPECT_EQ(x[0], x[1]);
+  EXPECT_EQ(x[0], x[2]);
 }
 
 TEST(DenseCholesky, LargeOrSparseSystemsStayWithCholmod) {
