@@ -10,23 +10,6 @@
 #include "dgtex/stage_timer.h"
 
 namespace dgtex::detail {
-namespace {
-
-// Sum over rows, each row summed in order: deterministic for any thread count.
-template <class Term>
-double row_sum(int w, int h, Term term) {
-  std::vector<double> rows(h, 0.0);
-  kernels::forall(h, [&](std::int64_t j) {
-    double s = 0;
-    for (int i = 0; i < w; ++i) s += term(static_cast<int>(j) * w + i);
-    rows[j] = s;
-  });
-  double sum = 0;
-  for (double v : rows) sum += v;
-  return sum;
-}
-
-}  // namespace
 
 LaplaceSolveStats solve_seamed_patch_laplace(kernels::TexelTile& tile, const std::vector<SeamCoupling>& seams,
                                              const LaplaceMultigridOptions& options) {
@@ -51,30 +34,58 @@ LaplaceSolveStats solve_seamed_patch_laplace(kernels::TexelTile& tile, const std
   }
   std::vector<std::uint8_t> bits;
   kernels::classify_laplace_texels(tile, bits);
-  // Seam partners per texel (few: one edge of texels), for the operator and the rhs.
-  std::vector<std::vector<int>> partners(n);
-  for (const SeamCoupling& s : seams) partners[s.a].push_back(s.b), partners[s.b].push_back(s.a);
+  // Seam partners in compressed rows (few texels have any: one edge of the patch).
+  std::vector<int> partner_start(static_cast<std::size_t>(n) + 1, 0), partner;
+  for (const SeamCoupling& s : seams) ++partner_start[s.a + 1], ++partner_start[s.b + 1];
+  for (int t = 0; t < n; ++t) partner_start[t + 1] += partner_start[t];
+  partner.resize(partner_start[n]);
+  {
+    std::vector<int> next(partner_start.begin(), partner_start.end() - 1);
+    for (const SeamCoupling& s : seams) partner[next[s.a]++] = s.b, partner[next[s.b]++] = s.a;
+  }
 
-  // y = A x on the unknowns: the grid couplings (degree counts Dirichlet neighbours too),
-  // then one more coupling per seam partner.
-  const auto apply = [&](const std::vector<double>& x, std::vector<double>& y) {
+  // The CG's passes over the patch, one row per work item with per-row partial sums added
+  // in row order (deterministic for any thread count): y = A x at the unknowns (the grid
+  // couplings, the degree counting Dirichlet neighbours too, then one coupling per seam
+  // partner) with sum p . (A p) fused in.
+  std::vector<double> rows(h);
+  const auto sum_rows = [&] {
+    double sum = 0;
+    for (double v : rows) sum += v;
+    return sum;
+  };
+  const auto apply_and_dot = [&](const std::vector<double>& x, std::vector<double>& y) {
     kernels::forall(h, [&](std::int64_t j) {
+      double dot = 0;
       for (int t = static_cast<int>(j) * w; t < (static_cast<int>(j) + 1) * w; ++t) {
         if (!unknown[t]) {
           y[t] = 0;
           continue;
         }
         const std::uint8_t m = bits[t];
-        double v = (kernels::laplace_degree(m) + static_cast<double>(partners[t].size())) * x[t];
+        const int first = partner_start[t], last = partner_start[t + 1];
+        double v = (kernels::laplace_degree(m) + static_cast<double>(last - first)) * x[t];
         if (m & kernels::couples_west_unknown) v -= x[t - 1];
         if (m & kernels::couples_east_unknown) v -= x[t + 1];
         if (m & kernels::couples_south_unknown) v -= x[t - w];
         if (m & kernels::couples_north_unknown) v -= x[t + w];
-        for (int p : partners[t])
-          if (unknown[p]) v -= x[p];
+        for (int k = first; k < last; ++k)
+          if (unknown[partner[k]]) v -= x[partner[k]];
         y[t] = v;
+        dot += x[t] * v;
       }
+      rows[j] = dot;
     });
+    return sum_rows();
+  };
+  // Sum over the patch of f(t), by rows.
+  const auto row_sum = [&](auto f) {
+    kernels::forall(h, [&](std::int64_t j) {
+      double sum = 0;
+      for (int t = static_cast<int>(j) * w; t < (static_cast<int>(j) + 1) * w; ++t) sum += f(t);
+      rows[j] = sum;
+    });
+    return sum_rows();
   };
   // b: values of coupled Dirichlet texels, grid neighbours and seam partners.
   std::vector<double> b(n, 0.0), x(n, 0.0), r(n), z, p, q(n);
@@ -90,36 +101,45 @@ LaplaceSolveStats solve_seamed_patch_laplace(kernels::TexelTile& tile, const std
       data(i + 1 < w && kernels::texels_coupled_east(tile, i, j), t + 1);
       data(j > 0 && kernels::texels_coupled_north(tile, i, j - 1), t - w);
       data(j + 1 < h && kernels::texels_coupled_north(tile, i, j), t + w);
-      for (int o : partners[t]) data(true, o);
+      for (int k = partner_start[t]; k < partner_start[t + 1]; ++k) data(true, partner[k]);
       if (options.warm_start && std::isfinite(tile.values[t])) x[t] = tile.values[t];
     }
   LaplaceSolveStats stats;
-  const double b_norm = std::sqrt(row_sum(w, h, [&](int t) { return b[t] * b[t]; }));
-  apply(x, q);
-  for (int t = 0; t < n; ++t) r[t] = b[t] - q[t];
-  double relative = b_norm > 0 ? std::sqrt(row_sum(w, h, [&](int t) { return r[t] * r[t]; })) / b_norm : 0.0;
+  const double b_norm = std::sqrt(row_sum([&](int t) { return b[t] * b[t]; }));
+  apply_and_dot(x, q);
+  const double r0 = row_sum([&](int t) {
+    r[t] = b[t] - q[t];
+    return r[t] * r[t];
+  });
+  double relative = b_norm > 0 ? std::sqrt(r0) / b_norm : 0.0;
   if (relative > options.tolerance) {
     chain.precondition(r, z);
     p = z;
-    double rz = row_sum(w, h, [&](int t) { return r[t] * z[t]; });
+    double rz = row_sum([&](int t) { return r[t] * z[t]; });
     while (relative > options.tolerance && stats.iterations < options.max_cycles) {
-      apply(p, q);
-      const double pq = row_sum(w, h, [&](int t) { return p[t] * q[t]; });
+      const double pq = apply_and_dot(p, q);
       if (!(pq > 0)) break;
       const double alpha = rz / pq;
-      for (int t = 0; t < n; ++t) x[t] += alpha * p[t], r[t] -= alpha * q[t];
+      // x += alpha p, r -= alpha q, and r . r in one pass.
+      const double rr = row_sum([&](int t) {
+        x[t] += alpha * p[t];
+        r[t] -= alpha * q[t];
+        return r[t] * r[t];
+      });
       ++stats.iterations;
-      relative = std::sqrt(row_sum(w, h, [&](int t) { return r[t] * r[t]; })) / b_norm;
+      relative = std::sqrt(rr) / b_norm;
       if (relative <= options.tolerance) break;
       chain.precondition(r, z);
-      const double rz_next = row_sum(w, h, [&](int t) { return r[t] * z[t]; });
+      const double rz_next = row_sum([&](int t) { return r[t] * z[t]; });
       const double beta = rz_next / rz;
       rz = rz_next;
-      for (int t = 0; t < n; ++t) p[t] = z[t] + beta * p[t];
+      kernels::forall(h, [&](std::int64_t j) {
+        for (int t = static_cast<int>(j) * w; t < (static_cast<int>(j) + 1) * w; ++t) p[t] = z[t] + beta * p[t];
+      });
     }
     // The true residual, not the recursive one.
-    apply(x, q);
-    relative = std::sqrt(row_sum(w, h, [&](int t) { return (b[t] - q[t]) * (b[t] - q[t]); })) / b_norm;
+    apply_and_dot(x, q);
+    relative = std::sqrt(row_sum([&](int t) { return (b[t] - q[t]) * (b[t] - q[t]); })) / b_norm;
   }
   if (!(relative <= options.tolerance))
     throw std::runtime_error("seamed patch Laplace: relative residual " + std::to_string(relative) + " after " +
