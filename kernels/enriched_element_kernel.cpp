@@ -5,11 +5,11 @@
 #include <cstdint>
 #include <vector>
 
+#include "dgtex/kernels/gram_accumulation.h"
 #include "dgtex/kernels/polar_decomposition.h"
 #include "dgtex/kernels/shell_point.h"
 #include "dgtex/kernels/symmetric_accumulator.h"
 #include "dgtex/kernels/vec3.h"
-#include "dgtex/kernels/gram_accumulation.h"
 
 namespace dgtex::kernels {
 namespace {
@@ -299,8 +299,6 @@ void flush(Group& group, std::vector<double>& arena, bool want_forces) {
   group.pending = 0;
 }
 
-// Sums the chunk's points into per-group matrices, then maps the groups onto the element's
-// basis: Kc (3n x 3n, row-major over DOFs, block rows a <= c filled) and fc (3n).
 // F at one point from the whole basis (the rest tangents have no enriched share), the
 // textures sampled at the point: the arithmetic of enriched_element_deformation_gradients.
 void point_deformation_gradient(const ElementLayout& L, const ShapeValues& s, const RestPoint& rest,
@@ -327,6 +325,8 @@ void point_deformation_gradient(const ElementLayout& L, const ShapeValues& s, co
   surface_deformation_gradient(rest.a1, rest.a2, rest.t0, a1, a2, t, F);
 }
 
+// Sums the chunk's points into per-group matrices, then maps the groups onto the element's
+// basis: Kc (3n x 3n, row-major over DOFs, block rows a <= c filled) and fc (3n).
 // Rotations: given per point (`rotations`), or computed here from `current` exactly as
 // enriched_element_deformation_gradients and polar_rotation would (the fused form), or none.
 void chunk_stiffness(const EnrichedElementBatch& b, const EnrichedQuadrature& quad, const Chunk& chunk,
@@ -401,9 +401,8 @@ void chunk_stiffness(const EnrichedElementBatch& b, const EnrichedQuadrature& qu
     double fused_rotation[9];
     const double* R = rotations ? rotations + 9 * q : nullptr;
     if (current) {
-      point_deformation_gradient(L, s, rest, samples, global, current, fused_rotation);
       double F[9];
-      std::copy(fused_rotation, fused_rotation + 9, F);
+      point_deformation_gradient(L, s, rest, samples, global, current, F);
       polar_rotation(F, fused_rotation);
       R = fused_rotation;
     }
