@@ -2,6 +2,7 @@
 
 #include "dgtex/kernels/multigrid_unknowns.h"
 #include "multigrid_lagged_rows.h"
+#include "multigrid_rows.h"
 
 #include <vector>
 
@@ -11,18 +12,8 @@ namespace dgtex::kernels {
 namespace {
 
 // (A x)(t) for the 5-point texel operator: degree * x(t) minus the coupled unknown neighbours.
-inline double texel_operator(std::uint8_t m, const double* x, std::int64_t t, std::int64_t s) {
-  return laplace_degree(m) * x[t] - ((m & couples_west_unknown) ? x[t - 1] : 0.0) -
-         ((m & couples_east_unknown) ? x[t + 1] : 0.0) - ((m & couples_south_unknown) ? x[t - s] : 0.0) -
-         ((m & couples_north_unknown) ? x[t + s] : 0.0);
-}
-
-template <class Real>
-inline Real stencil9_operator(const Stencil9ViewOf<Real>& a, const Real* x, std::int64_t t, std::int64_t s) {
-  return a.c[t] * x[t] + a.e[t - 1] * x[t - 1] + a.e[t] * x[t + 1] + a.n[t - s] * x[t - s] + a.n[t] * x[t + s] +
-         a.ne[t - s - 1] * x[t - s - 1] + a.nw[t - s + 1] * x[t - s + 1] + a.nw[t] * x[t + s - 1] +
-         a.ne[t] * x[t + s + 1];
-}
+using detail::texel_operator;
+using detail::texel_rows;
 
 // The plain form of b - A x at texel (i, j) (0 off the unknowns), for the references.
 double reference_texel_residual(GridShape shape, const std::uint8_t* bits, const double* b, const double* x, int i,
@@ -41,19 +32,11 @@ double reference_texel_residual(GridShape shape, const std::uint8_t* bits, const
 
 void residual_texels(GridShape shape, const std::uint8_t* bits, const double* b, const double* x, double* r,
                      double* row_norm2, Execution execution) {
-  const std::int64_t s = shape.stride();
+  const detail::TexelRowKernels& rows = texel_rows();
   forall(
       shape.ny,
       [&](std::int64_t j) {
-        const std::int64_t row = shape.at(0, static_cast<int>(j));
-        double norm2 = 0;
-        for (int i = 0; i < shape.nx; ++i) {
-          const std::int64_t t = row + i;
-          const std::uint8_t m = bits[t];
-          const double value = (m & is_unknown) ? b[t] - texel_operator(m, x, t, s) : 0.0;
-          r[t] = value;
-          norm2 += value * value;
-        }
+        const double norm2 = rows.residual(shape, bits, b, x, r, static_cast<int>(j));
         if (row_norm2) row_norm2[j] = norm2;
       },
       execution);
@@ -62,30 +45,22 @@ void residual_texels(GridShape shape, const std::uint8_t* bits, const double* b,
 void residual_texels_reference(GridShape shape, const std::uint8_t* bits, const double* b, const double* x, double* r,
                                double* row_norm2) {
   for (int j = 0; j < shape.ny; ++j) {
-    double norm2 = 0;
+    detail::RowSum norm2;
     for (int i = 0; i < shape.nx; ++i) {
       const std::int64_t t = shape.at(i, j);
       const double value = reference_texel_residual(shape, bits, b, x, i, j);
       r[t] = value;
-      norm2 += value * value;
+      norm2.add(i, value * value);
     }
-    if (row_norm2) row_norm2[j] = norm2;
+    if (row_norm2) row_norm2[j] = norm2.total();
   }
 }
 
 void residual_texels_color(GridShape shape, const std::uint8_t* bits, const double* b, const double* x, double* r,
                            int color, Execution execution) {
-  const std::int64_t s = shape.stride();
+  const detail::TexelRowKernels& rows = texel_rows();
   forall(
-      shape.ny,
-      [&](std::int64_t j) {
-        const std::int64_t row = shape.at(0, static_cast<int>(j));
-        for (int i = static_cast<int>((color + j) & 1); i < shape.nx; i += 2) {
-          const std::int64_t t = row + i;
-          const std::uint8_t m = bits[t];
-          r[t] = (m & is_unknown) ? b[t] - texel_operator(m, x, t, s) : 0.0;
-        }
-      },
+      shape.ny, [&](std::int64_t j) { rows.residual_color(shape, bits, b, x, r, static_cast<int>(j), color); },
       execution);
 }
 
@@ -160,19 +135,16 @@ namespace {
 template <class Real>
 void stencil9_residual(GridShape shape, Stencil9ViewOf<Real> a, const Real* b, const Real* x, Real* r,
                        double* row_norm2, Execution execution) {
-  const std::int64_t s = shape.stride();
+  const auto residual_row = detail::stencil9_rows<Real>().residual;
   forall(
       shape.ny,
       [&](std::int64_t j) {
+        residual_row(shape, a, b, x, r, static_cast<int>(j));
+        if (!row_norm2) return;
         const std::int64_t row = shape.at(0, static_cast<int>(j));
         double norm2 = 0;
-        for (int i = 0; i < shape.nx; ++i) {
-          const std::int64_t t = row + i;
-          const Real value = a.c[t] > 0 ? b[t] - stencil9_operator(a, x, t, s) : Real(0);
-          r[t] = value;
-          norm2 += static_cast<double>(value) * value;
-        }
-        if (row_norm2) row_norm2[j] = norm2;
+        for (int i = 0; i < shape.nx; ++i) norm2 += static_cast<double>(r[row + i]) * r[row + i];
+        row_norm2[j] = norm2;
       },
       execution);
 }
@@ -219,19 +191,11 @@ void residual_stencil9_reference(GridShape shape, Stencil9ViewFloat a, const flo
 
 void apply_texels(GridShape shape, const std::uint8_t* bits, const double* x, double* y, double* row_dot,
                   Execution execution) {
-  const std::int64_t s = shape.stride();
+  const detail::TexelRowKernels& rows = texel_rows();
   forall(
       shape.ny,
       [&](std::int64_t j) {
-        const std::int64_t row = shape.at(0, static_cast<int>(j));
-        double dot = 0;
-        for (int i = 0; i < shape.nx; ++i) {
-          const std::int64_t t = row + i;
-          const std::uint8_t m = bits[t];
-          const double value = (m & is_unknown) ? texel_operator(m, x, t, s) : 0.0;
-          y[t] = value;
-          dot += value * x[t];
-        }
+        const double dot = rows.apply(shape, bits, x, y, static_cast<int>(j));
         if (row_dot) row_dot[j] = dot;
       },
       execution);
@@ -239,33 +203,25 @@ void apply_texels(GridShape shape, const std::uint8_t* bits, const double* x, do
 
 void update_direction_and_apply_texels(GridShape shape, const std::uint8_t* bits, const double* z, double beta,
                                        double* p, double* q, double* row_dot, Execution execution) {
-  const std::int64_t s = shape.stride();
+  const detail::TexelRowKernels& rows = texel_rows();
   detail::lagged_rows(
-      shape.ny,
-      [&](int j) {
-        const std::int64_t row = shape.at(0, j);
-        for (int i = 0; i < shape.nx; ++i) p[row + i] = z[row + i] + beta * p[row + i];
-      },
-      [&](int j) {
-        const std::int64_t row = shape.at(0, j);
-        double dot = 0;
-        for (int i = 0; i < shape.nx; ++i) {
-          const std::int64_t t = row + i;
-          const std::uint8_t m = bits[t];
-          const double value = (m & is_unknown) ? texel_operator(m, p, t, s) : 0.0;
-          q[t] = value;
-          dot += value * p[t];
-        }
-        row_dot[j] = dot;
-      },
-      execution);
+      shape.ny, [&](int j) { rows.direction(shape, z, beta, p, j); },
+      [&](int j) { row_dot[j] = rows.apply(shape, bits, p, q, j); }, execution);
 }
 
 void update_direction_and_apply_texels_reference(GridShape shape, const std::uint8_t* bits, const double* z,
                                                  double beta, double* p, double* q, double* row_dot) {
   for (int j = 0; j < shape.ny; ++j)
     for (int i = 0; i < shape.nx; ++i) p[shape.at(i, j)] = z[shape.at(i, j)] + beta * p[shape.at(i, j)];
-  apply_texels(shape, bits, p, q, row_dot, Execution::serial);
+  for (int j = 0; j < shape.ny; ++j) {
+    detail::RowSum dot;
+    for (int i = 0; i < shape.nx; ++i) {
+      const std::int64_t t = shape.at(i, j);
+      q[t] = (bits[t] & is_unknown) ? texel_operator(bits[t], p, t, shape.stride()) : 0.0;
+      dot.add(i, q[t] * p[t]);
+    }
+    row_dot[j] = dot.total();
+  }
 }
 
 }  // namespace dgtex::kernels

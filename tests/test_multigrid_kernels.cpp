@@ -14,6 +14,7 @@
 #include "dgtex/laplace_direct.h"
 #include "dgtex/laplace_domains.h"
 #include "dgtex/laplace_multigrid.h"
+#include "multigrid_rows.h"  // internal: the row loops and their two forms
 
 namespace dgtex {
 namespace {
@@ -342,6 +343,88 @@ TEST(MultigridClassification, RandomTilesWithIsolatedComponentsEqualReference) {
     EXPECT_EQ(classify_laplace_texels(tile, fast, Execution::serial), zr);
     EXPECT_EQ(ref, fast) << "tile " << k << " (" << tile.width << "x" << tile.height << ")";
   }
+}
+
+// The row loops behind the level-0 and 9-point kernels have a baseline (SSE2) and an AVX2
+// form (multigrid_rows.h); the parallel-vs-reference tests above run the form this machine
+// picks, this one checks the two forms give the same bits, row by row, with a partial group
+// of four at the end of every row (width 101).
+TEST_P(MultigridKernels, RowLoopFormsAgreeBitwise) {
+  if (!detail::avx2_supported()) GTEST_SKIP() << "no AVX2: only the baseline form runs here";
+  TwoLevels L(make_laplace_domain(GetParam(), 101));
+  const detail::TexelRowKernels* forms[2] = {&detail::texel_rows(detail::RowPath::baseline),
+                                             &detail::texel_rows(detail::RowPath::avx2)};
+  const std::uint8_t* bits = L.bits.data();
+  std::vector<double> out[2], sums[2];
+  // Runs `body(form, out, sums)` for both forms from the same inputs and compares.
+  auto compare = [&](const char* what, auto body) {
+    for (int f = 0; f < 2; ++f) {
+      out[f] = L.x;
+      sums[f].assign(L.fine.ny, 0.0);
+      body(*forms[f], out[f], sums[f]);
+    }
+    EXPECT_EQ(out[0], out[1]) << what;
+    EXPECT_EQ(sums[0], sums[1]) << what;
+  };
+  const GridShape g = L.fine;
+  for (int color = 0; color < 2; ++color) {
+    compare("smooth_color", [&](const auto& k, auto& x, auto&) {
+      for (int j = 0; j < g.ny; ++j) k.smooth_color(g, bits, L.b.data(), x.data(), j, color);
+    });
+    compare("residual_color", [&](const auto& k, auto& r, auto&) {
+      for (int j = 0; j < g.ny; ++j) k.residual_color(g, bits, L.b.data(), L.x.data(), r.data(), j, color);
+    });
+  }
+  compare("red_from_zero", [&](const auto& k, auto& x, auto&) {
+    for (int j = 0; j < g.ny; ++j) k.red_from_zero(g, bits, L.b.data(), x.data(), j);
+  });
+  compare("residual", [&](const auto& k, auto& r, auto& n) {
+    for (int j = 0; j < g.ny; ++j) n[j] = k.residual(g, bits, L.b.data(), L.x.data(), r.data(), j);
+  });
+  compare("apply", [&](const auto& k, auto& y, auto& d) {
+    for (int j = 0; j < g.ny; ++j) d[j] = k.apply(g, bits, L.x.data(), y.data(), j);
+  });
+  compare("dot", [&](const auto& k, auto&, auto& d) {
+    for (int j = 0; j < g.ny; ++j) d[j] = k.dot(g, L.b.data(), L.x.data(), j);
+  });
+  compare("cg_update", [&](const auto& k, auto& x, auto& n) {
+    std::vector<double> r = L.b;
+    for (int j = 0; j < g.ny; ++j) n[j] = k.cg_update(g, 0.37, L.b.data(), L.x.data(), x.data(), r.data(), j);
+    x.insert(x.end(), r.begin(), r.end());
+  });
+  compare("direction", [&](const auto& k, auto& p, auto&) {
+    for (int j = 0; j < g.ny; ++j) k.direction(g, L.b.data(), -0.61, p.data(), j);
+  });
+  // 9-point rows, double and float.
+  const GridShape c = L.coarse;
+  for (int f = 0; f < 2; ++f) {
+    const auto path = f == 0 ? detail::RowPath::baseline : detail::RowPath::avx2;
+    out[f] = L.xc;
+    sums[f] = std::vector<double>(L.xc.size(), 0.0);
+    const auto& rows = detail::stencil9_rows<double>(path);
+    for (int ci = 0; ci < 2; ++ci)
+      for (int j = 0; j < c.ny; ++j) rows.smooth_color(c, L.A().view(), L.bc.data(), out[f].data(), j, ci);
+    for (int j = 0; j < c.ny; ++j) rows.residual(c, L.A().view(), L.bc.data(), L.xc.data(), sums[f].data(), j);
+  }
+  EXPECT_EQ(out[0], out[1]);
+  EXPECT_EQ(sums[0], sums[1]);
+  auto to_float = [](const std::vector<double>& v) { return std::vector<float>(v.begin(), v.end()); };
+  std::vector<std::vector<float>> af;
+  for (const auto& v : L.a) af.push_back(to_float(v));
+  const Stencil9ViewFloat a_float{af[0].data(), af[1].data(), af[2].data(), af[3].data(), af[4].data()};
+  const std::vector<float> bf = to_float(L.bc);
+  std::vector<float> xf[2], rf[2];
+  for (int f = 0; f < 2; ++f) {
+    const auto path = f == 0 ? detail::RowPath::baseline : detail::RowPath::avx2;
+    xf[f] = to_float(L.xc);
+    rf[f].assign(L.xc.size(), 0.0f);
+    const auto& rows = detail::stencil9_rows<float>(path);
+    for (int ci = 0; ci < 2; ++ci)
+      for (int j = 0; j < c.ny; ++j) rows.smooth_color(c, a_float, bf.data(), xf[f].data(), j, ci);
+    for (int j = 0; j < c.ny; ++j) rows.residual(c, a_float, bf.data(), xf[f].data(), rf[f].data(), j);
+  }
+  EXPECT_EQ(xf[0], xf[1]);
+  EXPECT_EQ(rf[0], rf[1]);
 }
 
 INSTANTIATE_TEST_SUITE_P(Domains, MultigridKernels,

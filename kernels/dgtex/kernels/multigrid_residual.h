@@ -1,7 +1,10 @@
 #pragma once
 // Multigrid residuals r = b - A x (0 at nodes without unknown). Each also writes the sum
-// of r^2 of every grid row into row_norm2[j] (summed left to right), so callers form
-// ||r||^2 by adding the rows in order: a norm that does not depend on the thread count.
+// of r^2 of every grid row into row_norm2[j], so callers form ||r||^2 by adding the rows
+// in order: a norm that does not depend on the thread count. Coarse levels sum a row left
+// to right; level 0 (the texel kernels here and in multigrid_smooth.h) in four interleaved
+// lanes, texel i into lane i mod 4, total (lane 0 + lane 1) + (lane 2 + lane 3), which
+// lets it add four texels per vector instruction.
 // Kernel conventions (dgtex/kernels/forall.h): arrays are the caller's, batch/view structs
 // only point into them, nothing is kept after a call; thread-safe on distinct outputs.
 // Values are dimensionless.
@@ -66,8 +69,8 @@ void apply_texels(GridShape shape, const std::uint8_t* bits, const double* x, do
                   Execution execution = Execution::parallel);
 
 // Conjugate-gradient step on level 0 in one streaming pass: p = z + beta p, then q = A p
-// and row_dot[j] = sum over row j of p * q (left to right). Bitwise equal to the update
-// followed by apply_texels. The reference does exactly that.
+// and row_dot[j] = sum over row j of p * q (four-lane order, above). Bitwise equal to the
+// update followed by apply_texels; the reference runs both as plain loops.
 void update_direction_and_apply_texels(GridShape shape, const std::uint8_t* bits, const double* z, double beta,
                                        double* p, double* q, double* row_dot,
                                        Execution execution = Execution::parallel);

@@ -38,8 +38,8 @@ void smooth_stencil9_color_reference(GridShape shape, Stencil9ViewFloat a, const
 // short pass. Every node sees exactly the inputs of the colour-by-colour order, so these are
 // bitwise equal to the colour kernels above run in order (forward: colours 0, 1 [, 2, 3];
 // backward: the reverse) for any thread count.
-// If row_dot is given, row_dot[j] = sum over row j of b * x after the sweep (left to right;
-// the preconditioned CG's r . z for free).
+// If row_dot is given, row_dot[j] = sum over row j of b * x after the sweep (four-lane order
+// of multigrid_residual.h; the preconditioned CG's r . z for free).
 void smooth_texels_sweep(GridShape shape, const std::uint8_t* bits, const double* b, double* x, bool forward,
                          Execution execution = Execution::parallel, double* row_dot = nullptr);
 // A forward sweep from x = 0 (x need not be initialised): red unknowns get b / degree, black
@@ -52,7 +52,7 @@ void smooth_stencil9_sweep(GridShape shape, Stencil9ViewFloat a, const float* b,
                            Execution execution = Execution::parallel);
 
 // Conjugate-gradient step fused with the first sweep of the next preconditioner application:
-// x += alpha p, r -= alpha q (row_norm2[j] = sum over row j of r^2, left to right), then
+// x += alpha p, r -= alpha q (row_norm2[j] = sum over row j of r^2, four-lane order), then
 // z = smooth_texels_sweep_from_zero with b = r. Bitwise equal to those two steps in turn;
 // saves one pass over r. The reference runs them in turn.
 void cg_update_and_smooth_texels_from_zero(GridShape shape, const std::uint8_t* bits, double alpha, const double* p,
