@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 #include "dgtex/kernels/gram_accumulation.h"
@@ -128,7 +129,9 @@ void element_stiffness(const EnrichedElementBatch& b, const EnrichedQuadrature& 
 
 // --- Fast form ---------------------------------------------------------------------------
 
-// Fixed work items: (element, first point, end point), chunks of enriched_chunk_points.
+// Fixed work items: (element, first point, end point). Each element's points are split
+// into equal chunks of at least enriched_chunk_points, at most enriched_chunks_per_element
+// of them: the split depends only on the quadrature, never on the thread count.
 struct Chunk {
   std::int64_t element, begin, end;
 };
@@ -136,12 +139,11 @@ struct Chunk {
 std::vector<Chunk> make_chunks(const EnrichedElementBatch& b, const EnrichedQuadrature& quad) {
   std::vector<Chunk> chunks;
   for (std::int64_t e = 0; e < b.count; ++e) {
-    std::int64_t p = quad.start[e];
-    do {
-      const std::int64_t end = std::min(quad.start[e + 1], p + enriched_chunk_points);
-      chunks.push_back({e, p, end});
-      p = end;
-    } while (p < quad.start[e + 1]);
+    const std::int64_t first = quad.start[e], points = quad.start[e + 1] - first;
+    const std::int64_t count = std::clamp<std::int64_t>((points + enriched_chunk_points - 1) / enriched_chunk_points, 1,
+                                                        enriched_chunks_per_element);
+    for (std::int64_t c = 0; c < count; ++c)
+      chunks.push_back({e, first + points * c / count, first + points * (c + 1) / count});
   }
   return chunks;
 }
@@ -274,7 +276,8 @@ struct Group {
   std::uint32_t varying = 0;
   double value[max_enrichments_per_element];
   int m = 0, stride = 0;       // reduced basis functions; padded row length (>= 3 m)
-  std::size_t G = 0, rows = 0;  // offsets into the chunk's arena
+  double* G = nullptr;          // stride x stride (upper part used)
+  double* rows = nullptr;       // group_block_rows x stride
   int pending = 0;              // points stacked in rows, not yet in G
   bool written = false;         // G holds a first block
   std::vector<double> g, s;     // g: stride; s: the stacked points' scaled rest strains
@@ -287,12 +290,26 @@ struct Group {
   }
 };
 
+// Per thread, the i-th group of a chunk keeps its G and stacked rows in the i-th buffer
+// (kept between chunks and calls, never copied nor zero-filled: G's first block stores).
+// One growing arena instead moved and zero-filled ~25 MB whenever a chunk had more
+// groups than any before, and paid page faults for it (~13% of accordion's assembly).
+struct GroupStorage {
+  std::unique_ptr<double[]> data;
+  std::size_t capacity = 0;
+
+  double* take(std::size_t size) {
+    if (capacity < size) data.reset(new double[size]), capacity = size;
+    return data.get();
+  }
+};
+
 // Adds the group's stacked points to G (and g), in point order.
-void flush(Group& group, std::vector<double>& arena, bool want_forces) {
+void flush(Group& group, bool want_forces) {
   if (group.pending == 0) return;
   const int rows = 6 * group.pending, S = group.stride;
-  const double* A = arena.data() + group.rows;
-  accumulate_gram_upper(rows, S, A, arena.data() + group.G, !group.written);
+  const double* A = group.rows;
+  accumulate_gram_upper(rows, S, A, group.G, !group.written);
   group.written = true;
   if (want_forces)
     for (int k = 0; k < rows; ++k) add_scaled(S, group.s[k], A + static_cast<std::size_t>(k) * S, group.g.data());
@@ -345,8 +362,7 @@ void chunk_stiffness(const EnrichedElementBatch& b, const EnrichedQuadrature& qu
 
   // Per thread: G and stacked rows of every group (G is never zero-filled: the first block
   // stores, later ones add).
-  static thread_local std::vector<double> arena;
-  std::size_t used = 0;
+  static thread_local std::vector<GroupStorage> storage;
   std::vector<Group> groups;
   int last = -1;
   TexelCache cache;
@@ -382,13 +398,13 @@ void chunk_stiffness(const EnrichedElementBatch& b, const EnrichedQuadrature& qu
           for (int a = 0; a < npe; ++a) fresh.m += L.slot[k][a] >= 0;
       const int S = (3 * fresh.m + gram_column_multiple - 1) / gram_column_multiple * gram_column_multiple;
       fresh.stride = S;
-      fresh.G = used;
-      fresh.rows = used + static_cast<std::size_t>(S) * S;
-      used = fresh.rows + static_cast<std::size_t>(group_block_rows) * S;
-      if (arena.size() < used) arena.resize(used);
+      if (storage.size() <= groups.size()) storage.emplace_back();
+      double* space = storage[groups.size()].take(static_cast<std::size_t>(S) * (S + group_block_rows));
+      fresh.G = space;
+      fresh.rows = space + static_cast<std::size_t>(S) * S;
       // Padding columns of the stacked rows stay 0.
       for (int k = 0; k < group_block_rows; ++k)
-        for (int i = 3 * fresh.m; i < S; ++i) arena[fresh.rows + static_cast<std::size_t>(k) * S + i] = 0;
+        for (int i = 3 * fresh.m; i < S; ++i) fresh.rows[static_cast<std::size_t>(k) * S + i] = 0;
       if (want_forces) fresh.g.assign(S, 0.0), fresh.s.assign(group_block_rows, 0.0);
       groups.push_back(std::move(fresh));
       g = static_cast<int>(groups.size()) - 1;
@@ -407,7 +423,7 @@ void chunk_stiffness(const EnrichedElementBatch& b, const EnrichedQuadrature& qu
       R = fused_rotation;
     }
     pr.set(rest, R, weight, dn, dm, nu);
-    double* block = arena.data() + group.rows + static_cast<std::size_t>(6 * group.pending) * S;
+    double* block = group.rows + static_cast<std::size_t>(6 * group.pending) * S;
     double* const row[6] = {block, block + S, block + 2 * S, block + 3 * S, block + 4 * S, block + 5 * S};
     for (int a = 0; a < npe; ++a) pr.write(s.dN[a], s.d2N[a], row, 3 * a);
     int r = npe;
@@ -440,9 +456,9 @@ void chunk_stiffness(const EnrichedElementBatch& b, const EnrichedQuadrature& qu
       half_constitutive(nu, pr.sm, strain, sv);
       half_constitutive(nu, pr.sb, strain + 3, sv + 3);
     }
-    if (++group.pending == group_block_points) flush(group, arena, want_forces);
+    if (++group.pending == group_block_points) flush(group, want_forces);
   }
-  for (Group& group : groups) flush(group, arena, want_forces);
+  for (Group& group : groups) flush(group, want_forces);
 
   // K += T^T G T per group: basis function i of the element is reduced function red[i]
   // times scale[i] (1, or H_k - H_k(xi^a) for a constant texture k: a multiple of N^a).
@@ -452,7 +468,9 @@ void chunk_stiffness(const EnrichedElementBatch& b, const EnrichedQuadrature& qu
   // only in the standard functions' columns (red < npe) and in diagonal 3x3 blocks: those
   // are mirrored first.
   const std::size_t N3 = 3 * static_cast<std::size_t>(n);
-  Kc.assign(N3 * N3, 0.0);
+  // Only the upper block rows are written and read: zero those (Kc persists between calls).
+  Kc.resize(N3 * N3);
+  for (std::size_t x = 0; x < N3; ++x) std::fill(Kc.begin() + x * N3 + x / 3 * 3, Kc.begin() + (x + 1) * N3, 0.0);
   fc.assign(want_forces ? N3 : 0, 0.0);
   int red[max_enriched_basis];
   double scale[max_enriched_basis];
@@ -476,7 +494,7 @@ void chunk_stiffness(const EnrichedElementBatch& b, const EnrichedQuadrature& qu
     }
     run_start.push_back(n);
     const std::size_t S = group.stride, M = 3 * static_cast<std::size_t>(group.m);
-    double* G = arena.data() + group.G;
+    double* G = group.G;
     const std::size_t standard_columns = 3 * static_cast<std::size_t>(npe);
     for (std::size_t x = 1; x < M; ++x) {
       for (std::size_t y = 0; y < std::min(x, standard_columns); ++y) G[x * S + y] = G[y * S + x];
@@ -516,7 +534,13 @@ void stiffness_by_chunks(const EnrichedElementBatch& batch, const EnrichedQuadra
                          Execution execution) {
   const std::vector<Chunk> chunks = make_chunks(batch, quadrature);
   const bool want_forces = (rotations || current) && forces;
-  std::vector<std::vector<double>> Kc(chunks.size()), fc(chunks.size());
+  // The chunks' sums persist with the calling thread (the workers write distinct entries
+  // through these references; naming the thread_local inside the loops would give each
+  // worker its own): a fresh 3n x 3n matrix per chunk and call costs page faults every step.
+  static thread_local std::vector<std::vector<double>> chunk_matrices, chunk_forces;
+  std::vector<std::vector<double>>& Kc = chunk_matrices;
+  std::vector<std::vector<double>>& fc = chunk_forces;
+  if (Kc.size() < chunks.size()) Kc.resize(chunks.size()), fc.resize(chunks.size());
   // Chunks differ in cost (points, varying textures): handed out dynamically; each writes
   // only its own Kc, fc, so the result does not depend on which thread ran it.
   const std::int64_t num_chunks = static_cast<std::int64_t>(chunks.size());

@@ -40,8 +40,9 @@ struct EnrichedQuadrature {
 // blocked product (register tiles, a path per instruction set, no FMA contraction: every
 // path rounds alike). Complete cuts' +-1 are exact; harmonic
 // tails below the tolerance move K by about that much relative (1e-10, far below the
-// quadrature's merge tolerance). Work items are fixed chunks of enriched_chunk_points
-// points, summed per element in chunk order: bitwise independent of the thread count.
+// quadrature's merge tolerance). Work items are fixed chunks (each element's points split
+// into at most enriched_chunks_per_element equal ranges of at least enriched_chunk_points),
+// summed per element in chunk order: bitwise independent of the thread count.
 void enriched_element_stiffness(const EnrichedElementBatch& batch, const EnrichedQuadrature& quadrature,
                                 const double* rotations, double* blocks, double* forces,
                                 Execution execution = Execution::parallel);
@@ -58,6 +59,12 @@ void enriched_element_stiffness_reference(const EnrichedElementBatch& batch, con
                                           const double* rotations, double* blocks, double* forces);
 constexpr double enriched_flat_tolerance = 1e-10;
 constexpr std::int64_t enriched_chunk_points = 2048;
+// Each chunk maps its groups onto a 3n x 3n sum of its own and keeps their G matrices
+// (up to ~2 MB each for accordion's 150 functions): fewer, longer chunks map less and
+// reduce less. Accordion (1 element, 35k points, 2 threads, loaded machine): 2048-point
+// chunks (18) ~250 ms per assembly, 16 chunks ~230, 8 ~230, 4 ~188. Caps the threads
+// one element can use in the point phase at 4 (the block-row reduction uses them all).
+constexpr std::int64_t enriched_chunks_per_element = 4;
 
 void enriched_element_deformation_gradients(const EnrichedElementBatch& batch, const EnrichedQuadrature& quadrature,
                                             const double* current, double* F,
