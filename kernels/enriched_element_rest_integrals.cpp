@@ -6,16 +6,22 @@
 
 #include "dgtex/kernels/shell_point.h"
 #include "dgtex/kernels/gram_accumulation.h"
+#include "dgtex/kernels/vec3.h"
 
 namespace dgtex::kernels {
 
 int enriched_shape_values(const EnrichedElementBatch& b, std::int64_t e, double xi1, double xi2, const ShapeValues& s,
-                          EnrichedTexelCache& cache, double* N) {
+                          EnrichedTexelCache& cache, double* N, const TexelDerivativeTile* const* derivatives) {
   int ti = 0, tj = 0;
   containing_texel(b.type, b.resolution, xi1, xi2, ti, tj);
   const int first = b.enrichment_start[e], count = b.enrichment_start[e + 1] - first;
   if (cache.element != e || cache.i != ti || cache.j != tj) {
-    for (int k = 0; k < count; ++k) texel_derivatives(b.type, b.resolution, b.textures[first + k], ti, tj, cache.fields[k]);
+    for (int k = 0; k < count; ++k) {
+      const TextureView& texture = b.textures[first + k];
+      const TexelDerivativeTile* tile = derivatives ? derivatives[first + k] : nullptr;
+      if (tile && texel_in_domain(b.type, b.resolution, texture.flags, ti, tj)) tile->at(ti, tj, cache.fields[k]);
+      else texel_derivatives(b.type, b.resolution, texture, ti, tj, cache.fields[k]);
+    }
     cache.element = e, cache.i = ti, cache.j = tj;
   }
   const int npe = s.count;
@@ -34,9 +40,30 @@ int enriched_shape_values(const EnrichedElementBatch& b, std::int64_t e, double 
   return n;
 }
 
+double rest_area_factor(const ShapeValues& s, const int* nodes, const double* X) {
+  // evaluate_rest_point's sums for a1 and a2, in its order.
+  double a1[3] = {0, 0, 0}, a2[3] = {0, 0, 0};
+  for (int a = 0; a < s.count; ++a) {
+    const double* x = X + 3 * static_cast<long>(nodes[a]);
+    for (int d = 0; d < 3; ++d) {
+      a1[d] += s.dN[a][0] * x[d];
+      a2[d] += s.dN[a][1] * x[d];
+    }
+  }
+  double n[3];
+  cross3(a1, a2, n);
+  return std::sqrt(dot3(n, n));
+}
+
 void enriched_element_mass_and_load_weights(const EnrichedElementBatch& b, const EnrichedQuadrature& quad,
                                             double* mass, double* area_weights, double* mass_weights,
                                             Execution execution) {
+  enriched_element_mass_and_load_weights(b, quad, nullptr, mass, area_weights, mass_weights, execution);
+}
+
+void enriched_element_mass_and_load_weights(const EnrichedElementBatch& b, const EnrichedQuadrature& quad,
+                                            const TexelDerivativeTile* const* derivatives, double* mass,
+                                            double* area_weights, double* mass_weights, Execution execution) {
   const int W = b.width;
   const int npe = nodes_per_element(b.type);
   constexpr std::int64_t block = rest_integral_block_points;
@@ -63,10 +90,8 @@ void enriched_element_mass_and_load_weights(const EnrichedElementBatch& b, const
               const double* q = quad.points + 3 * (begin + p);
               ShapeValues s;
               evaluate_shape(b.type, q[0], q[1], s);
-              enriched_shape_values(b, e, q[0], q[1], s, cache, values.data() + p * n);
-              RestPoint rest;
-              evaluate_rest_point(s, nodes, b.positions, rest);
-              weights[p] = q[2] * rest.j0;
+              enriched_shape_values(b, e, q[0], q[1], s, cache, values.data() + p * n, derivatives);
+              weights[p] = q[2] * rest_area_factor(s, nodes, b.positions);
             }
           },
           execution);

@@ -75,9 +75,9 @@ struct ElementInputs {
   int t = 0;
   const TextureView* textures = nullptr;
   int texture_count = 0;
-  // Planar texel derivatives (texel_derivative_rows.h) of row block b and texture k at
-  // [b * texture_count + k]: six planes of row_block x T each.
-  std::vector<std::unique_ptr<double[]>> field_blocks;
+  // Planar texel derivatives (texel_derivative_rows.h) of texture k in row blocks of
+  // row_block rows (texel_derivative_tile.h), which the caller may keep.
+  std::vector<std::shared_ptr<TexelDerivativeTile>> field_tiles;
   // Row prefix sums (row j at j * (T + 1), texel i at + i) of texels outside the domain of
   // some texture, east walls and north walls (any texture) among texels (0..i-1, j);
   // interleaved, as the merge test reads all three at the same places.
@@ -98,20 +98,15 @@ struct ElementInputs {
     const std::size_t prefix = static_cast<std::size_t>(t) * (t + 1);
     row_prefix.reset(new RowCounts[prefix]);
     east_column_prefix.reset(new int[prefix]);
-    field_blocks.resize(static_cast<std::size_t>((t + row_block - 1) / row_block) * texture_count);
+    for (int k = 0; k < texture_count; ++k) field_tiles.push_back(std::make_shared<TexelDerivativeTile>(t, row_block));
   }
   // The planes of row j of texture k.
-  TexelDerivativePlanes field_row(int k, int j) const {
-    double* block = field_blocks[static_cast<std::size_t>(j / row_block) * texture_count + k].get();
-    const std::size_t plane = static_cast<std::size_t>(row_block) * t, row = static_cast<std::size_t>(j % row_block) * t;
-    return {block + row, {block + plane + row, block + 2 * plane + row},
-            {block + 3 * plane + row, block + 4 * plane + row, block + 5 * plane + row}};
-  }
+  TexelDerivativePlanes field_row(int k, int j) const { return field_tiles[k]->row(j); }
 
   void build_block(int block) {
     const int row_begin = block * row_block, row_end = std::min(row_begin + row_block, t);
     for (int k = 0; k < texture_count; ++k) {
-      std::unique_ptr<double[]>& planes = field_blocks[static_cast<std::size_t>(block) * texture_count + k];
+      std::unique_ptr<double[]>& planes = field_tiles[k]->blocks[block];
       planes.reset(new double[6 * static_cast<std::size_t>(row_block) * t]);  // filled just below
       texel_derivative_rows(type, t, textures[k], row_begin, row_end, field_row(k, row_begin));
     }
@@ -289,6 +284,13 @@ bool texels_share_one_quadratic(ElementType type, int t, const TextureView* text
 
 void enriched_element_quadrature(const EnrichedElementBatch& batch, const EnrichedQuadratureOptions& options,
                                  std::vector<std::int64_t>& start, std::vector<double>& points, Execution execution) {
+  enriched_element_quadrature(batch, options, start, points, nullptr, execution);
+}
+
+void enriched_element_quadrature(const EnrichedElementBatch& batch, const EnrichedQuadratureOptions& options,
+                                 std::vector<std::int64_t>& start, std::vector<double>& points,
+                                 std::vector<std::shared_ptr<const TexelDerivativeTile>>* derivatives,
+                                 Execution execution) {
   const std::int64_t n = batch.count;
   const int t = batch.resolution;
   // 1. Per-texel inputs of every element, in row blocks (parallel even for one element).
@@ -345,6 +347,13 @@ void enriched_element_quadrature(const EnrichedElementBatch& batch, const Enrich
       from = task.position;
     }
     std::copy(plan.begin() + from, plan.end(), dst);
+  }
+  if (derivatives) {
+    derivatives->assign(static_cast<std::size_t>(batch.enrichment_start[n] - batch.enrichment_start[0]), nullptr);
+    if (options.adaptive)
+      for (std::int64_t e = 0; e < n; ++e)
+        for (int k = 0; k < inputs[e].texture_count; ++k)
+          (*derivatives)[batch.enrichment_start[e] - batch.enrichment_start[0] + k] = std::move(inputs[e].field_tiles[k]);
   }
 }
 

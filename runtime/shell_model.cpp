@@ -167,6 +167,7 @@ void ShellModel::rebuild() {
     enriched_area_weights_.clear();
     enriched_mass_weights_.clear();
     element_integrals_.clear();
+    texture_derivatives_.clear();
   }
   textured_area_weights_.assign(static_cast<size_t>(num_textured_elements()) * npe, 0.0);
   textured_mass_weights_.assign(textured_area_weights_.size(), 0.0);
@@ -414,6 +415,12 @@ void ShellModel::integrate_enriched_elements(const kernels::EnrichedElementBatch
   // Quadrature: reused where only the shifts changed.
   std::vector<std::int64_t> sub_start(1, 0);
   std::vector<double> sub_points;
+  // Texel derivatives of the quadrature, per texture of sub, kept up to a memory budget (48
+  // bytes a texel and texture: 3 MB at T = 256); past it mass and moments recompute them
+  // (the same values).
+  constexpr double derivative_budget_bytes = 256.0 * 1024 * 1024;
+  const bool keep_derivatives = 48.0 * static_cast<double>(texels) * static_cast<double>(textures_.size()) <= derivative_budget_bytes;
+  std::vector<std::shared_ptr<const kernels::TexelDerivativeTile>> sub_derivatives;
   {
     std::vector<int> quad_index;
     for (std::int64_t t = 0; t < todo; ++t)
@@ -432,23 +439,31 @@ void ShellModel::integrate_enriched_elements(const kernels::EnrichedElementBatch
     qb.textures = q_textures.data();
     std::vector<std::int64_t> q_point_start;
     std::vector<double> q_points;
-    kernels::enriched_element_quadrature(qb, options_.enrichment_quadrature, q_point_start, q_points);
+    std::vector<std::shared_ptr<const kernels::TexelDerivativeTile>> q_derivatives;
+    kernels::enriched_element_quadrature(qb, options_.enrichment_quadrature, q_point_start, q_points,
+                                         keep_derivatives ? &q_derivatives : nullptr);
     for (std::int64_t t = 0, next = 0; t < todo; ++t) {
+      const int textures_of_t = todo_start[t + 1] - todo_start[t];
       if (next < qb.count && quad_index[next] == t) {
         sub_points.insert(sub_points.end(), q_points.begin() + 3 * q_point_start[next],
                           q_points.begin() + 3 * q_point_start[next + 1]);
+        for (int k = 0; k < textures_of_t; ++k)
+          sub_derivatives.push_back(keep_derivatives ? q_derivatives[q_start[next] + k] : nullptr);
         ++next;
       } else {
-        const std::vector<double>& old = element_integrals_[todo_element[t]]->points;
-        sub_points.insert(sub_points.end(), old.begin(), old.end());
+        const ElementIntegrals& old = *element_integrals_[todo_element[t]];
+        sub_points.insert(sub_points.end(), old.points.begin(), old.points.end());
+        for (int k = 0; k < textures_of_t; ++k) sub_derivatives.push_back(keep_derivatives ? old.derivatives[k] : nullptr);
       }
       sub_start.push_back(static_cast<std::int64_t>(sub_points.size() / 3));
     }
   }
+  std::vector<const kernels::TexelDerivativeTile*> sub_tiles;
+  for (const auto& tile : sub_derivatives) sub_tiles.push_back(tile.get());
   std::vector<double> sub_mass(static_cast<size_t>(todo) * W * W), sub_area(static_cast<size_t>(todo) * W),
       sub_mass_weights(sub_area.size());
-  kernels::enriched_element_mass_and_load_weights(sub, {sub_start.data(), sub_points.data()}, sub_mass.data(),
-                                                  sub_area.data(), sub_mass_weights.data());
+  kernels::enriched_element_mass_and_load_weights(sub, {sub_start.data(), sub_points.data()}, sub_tiles.data(),
+                                                  sub_mass.data(), sub_area.data(), sub_mass_weights.data());
   for (std::int64_t t = 0; t < todo; ++t) {
     auto entry = std::make_shared<ElementIntegrals>();
     const int x = todo_index[t];
@@ -458,6 +473,7 @@ void ShellModel::integrate_enriched_elements(const kernels::EnrichedElementBatch
       for (int a = 0; a < npe; ++a)
         entry->shifts.push_back(enriched_node_[k * npe + a] >= 0 ? enriched_shift_[k * npe + a] : std::nan(""));
     }
+    entry->derivatives.assign(sub_derivatives.begin() + todo_start[t], sub_derivatives.begin() + todo_start[t + 1]);
     const int n = kernels::enriched_basis_count(sub, t);
     entry->count = n;
     entry->points.assign(sub_points.begin() + 3 * sub_start[t], sub_points.begin() + 3 * sub_start[t + 1]);
@@ -475,8 +491,10 @@ void ShellModel::integrate_enriched_elements(const kernels::EnrichedElementBatch
   mass.assign(static_cast<size_t>(count) * W * W, 0.0);
   enriched_area_weights_.assign(static_cast<size_t>(count) * W, 0.0);
   enriched_mass_weights_.assign(enriched_area_weights_.size(), 0.0);
+  texture_derivatives_.clear();
   for (std::int64_t x = 0; x < count; ++x) {
     const ElementIntegrals& in = *reused[x];
+    for (const auto& tile : in.derivatives) texture_derivatives_.push_back(tile.get());
     element_qp_.insert(element_qp_.end(), in.points.begin(), in.points.end());
     element_qp_start_.push_back(static_cast<std::int64_t>(element_qp_.size() / 3));
     const int n = in.count;
@@ -743,17 +761,20 @@ void ShellModel::set_enrichments(std::vector<EnrichmentFunction> functions) {
       if (pattern().column()[k] == column) return mass_blocks_[9 * k];
     return 0.0;
   };
-  std::vector<EnrichmentFunction> kept = enrichments_;
-  for (auto& f : kept) f.enriched_nodes.clear();
+  // The nodes kept per function first; the textures are moved (not copied) only if any go.
+  std::vector<std::vector<int>> kept_nodes(enrichments_.size());
   int pruned = 0;
   for (int v = num_nodes(); v < pattern().num_nodes(); ++v) {
     const int node = virtual_node_mesh_node(v);
     const double m_av = coupling(v, node);
     const double independent = diagonal[v] - m_av * m_av / diagonal[node];
     if (independent < options_.min_enrichment_mass_ratio * diagonal[node]) ++pruned;
-    else kept[virtual_node_function(v)].enriched_nodes.push_back(node);
+    else kept_nodes[virtual_node_function(v)].push_back(node);
   }
   if (pruned == 0) return;
+  // install_enrichments below replaces every member derived from enrichments_.
+  std::vector<EnrichmentFunction> kept = std::move(enrichments_);
+  for (size_t i = 0; i < kept.size(); ++i) kept[i].enriched_nodes = std::move(kept_nodes[i]);
   // Functions left without nodes go; the others keep the elements of Omega_i that still
   // touch one of their nodes.
   std::vector<EnrichmentFunction> functions_left;
@@ -857,7 +878,7 @@ int ShellModel::basis_values_at(int element, const double xi[2], const kernels::
   }
   const kernels::EnrichedElementBatch eb = enriched_element_batch();
   kernels::enriched_global_nodes(eb, index, global);
-  return kernels::enriched_shape_values(eb, index, xi[0], xi[1], s, cache, values);
+  return kernels::enriched_shape_values(eb, index, xi[0], xi[1], s, cache, values, texture_derivatives_.data());
 }
 
 std::vector<std::vector<double>> ShellModel::moments_of_fields(const ShellModel& source,
@@ -909,10 +930,9 @@ std::vector<std::vector<double>> ShellModel::moments_of_fields(const ShellModel&
           const kernels::ShellSection& section = point(first + begin + p, xi, weight);
           kernels::ShapeValues shape;
           kernels::evaluate_shape(mesh_.type, xi[0], xi[1], shape);
-          kernels::RestPoint rest;
-          kernels::evaluate_rest_point(shape, mesh_.element_nodes(e), mesh_.positions.data(), rest);
           double* d = data.data() + p * per_point;
-          d[0] = weight * rest.j0 * section.density * section.thickness;
+          d[0] = weight * kernels::rest_area_factor(shape, mesh_.element_nodes(e), mesh_.positions.data()) *
+                 section.density * section.thickness;
           const int m = source.basis_values_at(e, xi, shape, source_cache, source_global, source_values);
           counts[p] = basis_values_at(e, xi, shape, cache, globals.data() + p * stride, d + 1);
           for (int f = 0; f < nf; ++f) {

@@ -26,6 +26,7 @@
 #include "dgtex/kernels/shell_edge_kernel.h"
 #include "dgtex/kernels/shell_element_kernel.h"
 #include "dgtex/kernels/material_texture_kernel.h"
+#include "dgtex/kernels/texel_derivative_tile.h"
 #include "dgtex/element_material_texture.h"
 #include "dgtex/mesh.h"
 #include "dgtex/topology.h"
@@ -240,12 +241,17 @@ class ShellModel {
     std::vector<std::vector<double>> values;         // per enrichment: texture values
     std::vector<std::vector<std::uint8_t>> flags;    // per enrichment: texture flags
     std::vector<double> shifts;                      // per enrichment x npe; NaN: node not enriched
+    // Per enrichment: the texel derivatives the adaptive quadrature computed (null: none),
+    // read by the mass and the projection moments instead of recomputing them per point.
+    std::vector<std::shared_ptr<const kernels::TexelDerivativeTile>> derivatives;
     int count = 0;                                   // local basis functions
     std::vector<double> points;                      // quadrature: (xi1, xi2, weight) per point
     std::vector<double> mass;                        // count x count
     std::vector<double> area_weights, mass_weights;  // count
   };
   std::vector<std::shared_ptr<const ElementIntegrals>> element_integrals_;  // per mesh element, may be null
+  // Per element enrichment (like textures_): its ElementIntegrals' texel derivatives or null.
+  std::vector<const kernels::TexelDerivativeTile*> texture_derivatives_;
   // Fills element_qp_start_/element_qp_, the enriched load weights and `mass` (#enriched
   // elements x width^2), computing only the elements whose inputs changed.
   void integrate_enriched_elements(const kernels::EnrichedElementBatch& eb, std::vector<double>& mass);

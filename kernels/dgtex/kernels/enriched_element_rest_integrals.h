@@ -12,6 +12,7 @@
 // the caller's, nothing is kept after a call; thread-safe on distinct outputs.
 // Units: consistent (SI: kg for mass and mass weights, m^2 for area weights).
 #include "dgtex/kernels/enriched_element_kernel.h"
+#include "dgtex/kernels/texel_derivative_tile.h"
 
 namespace dgtex::kernels {
 
@@ -20,6 +21,12 @@ constexpr std::int64_t rest_integral_block_points = 256;
 
 void enriched_element_mass_and_load_weights(const EnrichedElementBatch& batch, const EnrichedQuadrature& quadrature,
                                             double* mass, double* area_weights, double* mass_weights,
+                                            Execution execution = Execution::parallel);
+// The same (bitwise), reading texel derivatives from derivatives[m] for the batch's texture
+// m (enrichment_start order) where that is not null (texel_derivative_tile.h).
+void enriched_element_mass_and_load_weights(const EnrichedElementBatch& batch, const EnrichedQuadrature& quadrature,
+                                            const TexelDerivativeTile* const* derivatives, double* mass,
+                                            double* area_weights, double* mass_weights,
                                             Execution execution = Execution::parallel);
 
 // evaluate_enriched_shape's N (bitwise) at xi of enriched element e, standard shape s;
@@ -30,7 +37,15 @@ struct EnrichedTexelCache {
   int i = -1, j = -1;
   TexelDerivatives fields[max_enrichments_per_element];
 };
+// derivatives (optional): per texture of the batch (like batch.textures), a tile to read
+// the texel derivatives from, or null; texels outside the domain are computed regardless.
 int enriched_shape_values(const EnrichedElementBatch& batch, std::int64_t e, double xi1, double xi2,
-                          const ShapeValues& s, EnrichedTexelCache& cache, double* N);
+                          const ShapeValues& s, EnrichedTexelCache& cache, double* N,
+                          const TexelDerivativeTile* const* derivatives = nullptr);
+
+// The area factor j0 = |a1 x a2| of evaluate_rest_point (shell_point.h), bitwise, without
+// the curvature terms and dual basis that mass and moments do not read (evaluate_rest_point
+// was ~9% of a basis change's instructions). nodes: the element's npe = s.count nodes.
+double rest_area_factor(const ShapeValues& s, const int* nodes, const double* positions);
 
 }  // namespace dgtex::kernels

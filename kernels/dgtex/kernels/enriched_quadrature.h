@@ -36,10 +36,12 @@
 // only point into them, nothing is kept after a call; thread-safe on distinct outputs.
 // Points are element parameters (dimensionless); merge_tolerance is in units of H (O(1)).
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 #include "dgtex/kernels/enriched_basis.h"
 #include "dgtex/kernels/forall.h"
+#include "dgtex/kernels/texel_derivative_tile.h"
 
 namespace dgtex::kernels {
 
@@ -55,6 +57,12 @@ struct EnrichedQuadratureOptions {
 // the arrays are bitwise those of the reference for any thread count.
 void enriched_element_quadrature(const EnrichedElementBatch& batch, const EnrichedQuadratureOptions& options,
                                  std::vector<std::int64_t>& start, std::vector<double>& points,
+                                 Execution execution = Execution::parallel);
+// The same, also handing out the texel derivatives it computed: (*derivatives)[m] for the
+// batch's texture m (enrichment_start order), null where it computed none (adaptive false).
+void enriched_element_quadrature(const EnrichedElementBatch& batch, const EnrichedQuadratureOptions& options,
+                                 std::vector<std::int64_t>& start, std::vector<double>& points,
+                                 std::vector<std::shared_ptr<const TexelDerivativeTile>>* derivatives,
                                  Execution execution = Execution::parallel);
 // The serial reference twin: the rule written plainly (each candidate cell re-tests all its
 // texels for domain, walls and polynomial agreement). For tests.
