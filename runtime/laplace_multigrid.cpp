@@ -75,6 +75,11 @@
 //   open T = 1024: solve part 126 -> 110 ms (coarse sweeps/residuals ~20% faster, level 0
 //   unchanged: it is ~60% of a cycle). Not done: level-0 z in float, float arithmetic in the
 //   Galerkin product, an F-cycle / nested-iteration start, one parallel region per cycle.
+// - Session 7 (vector rows, kernels/multigrid_rows.h): groups of four interior texels and
+//   all 9-point groups as 4-lane vectors, no gathers (unlike the rejected omp simd rows
+//   above), same-row neighbours from registers. Callgrind, open T = 256: level-0 loops 626M
+//   -> 175M instructions per 10 solves; idle machine, active policy, 2 threads, old/new
+//   alternating: open T = 1024 64-77 -> 49-67 ms (README has the table).
 namespace dgtex {
 using kernels::Execution;
 using kernels::GridShape;
