@@ -19,6 +19,17 @@ DGTEX_ROW_INLINE bool four_interior(const std::uint8_t* bits) {
   return word == 0x01010101u * interior_texel;
 }
 DGTEX_ROW_INLINE double lanes_total(Lanes4 v) { return (v[0] + v[1]) + (v[2] + v[3]); }
+// Stores lanes first and first + 2 of v (one colour of a group) and nothing else: the other
+// lanes belong to the other colour, which other threads may read right now (lagged rows).
+DGTEX_ROW_INLINE void store_colour_lanes(double* out, int first, Lanes4 v) {
+  if (first == 0) {
+    out[0] = v[0];
+    out[2] = v[2];
+  } else {
+    out[1] = v[1];
+    out[3] = v[3];
+  }
+}
 
 // The group loop every kernel below shares: groups of four texels from i = 0; `full(i0)` for
 // a complete group of four interior texels (when `needs_interior`), else `one(i, lane)` per
@@ -81,15 +92,7 @@ DGTEX_ROW_INLINE void smooth_color_impl(GridShape g, const std::uint8_t* bits, c
           ((((load4(b + t) + west_of(previous, current)) + east_of(current, next)) + load4(x + t - s)) +
            load4(x + t + s)) *
           0.25;
-      // Only the colour's lanes are written: the others belong to the other colour, which
-      // other threads may read right now (lagged rows).
-      if (first == 0) {
-        x[t] = v[0];
-        x[t + 2] = v[2];
-      } else {
-        x[t + 1] = v[1];
-        x[t + 3] = v[3];
-      }
+      store_colour_lanes(x + t, first, v);
     } else {
       for (int lane = first; lane < 4; lane += 2)
         if (bits[t + lane] & is_unknown) x[t + lane] = texel_smoothed(bits[t + lane], b, x, t + lane, s);
@@ -131,14 +134,7 @@ DGTEX_ROW_INLINE void residual_color_impl(GridShape g, const std::uint8_t* bits,
       g, bits + row,
       [&](int i0) {
         const std::int64_t t = row + i0;
-        const Lanes4 v = load4(b + t) - interior_operator(x, t, s);
-        if (first == 0) {
-          r[t] = v[0];
-          r[t + 2] = v[2];
-        } else {
-          r[t + 1] = v[1];
-          r[t + 3] = v[3];
-        }
+        store_colour_lanes(r + t, first, load4(b + t) - interior_operator(x, t, s));
       },
       [&](int i, int lane) {
         const std::int64_t t = row + i;
