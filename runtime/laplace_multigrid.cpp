@@ -668,16 +668,24 @@ LaplaceSolveStats LaplaceMultigrid::solve(kernels::TexelTile& tile, std::vector<
           const int k = tile.index(i, j);
           // Coupled Dirichlet neighbours (the unknown itself is active), in the order west,
           // east, south, north, written out on the flags (kernels::texels_coupled_east/north).
+          // An unknown coupled to four unknowns (most texels) has none: its flags are not read
+          // (callgrind, open T = 256: this pass ~75 -> ~30 instructions a texel).
           const std::uint8_t* f = tile.flags.data();
           constexpr std::uint8_t dirichlet = kernels::dirichlet, inactive = kernels::inactive;
+          constexpr std::uint8_t four_unknown_neighbours = kernels::couples_west_unknown |
+                                                           kernels::couples_east_unknown |
+                                                           kernels::couples_south_unknown |
+                                                           kernels::couples_north_unknown;
           double b = 0;
-          if (i > 0 && (f[k - 1] & (kernels::wall_east | inactive | dirichlet)) == dirichlet) b += tile.values[k - 1];
-          if (i + 1 < g.nx && !(f[k] & kernels::wall_east) && (f[k + 1] & (inactive | dirichlet)) == dirichlet)
-            b += tile.values[k + 1];
-          if (j > 0 && (f[k - g.nx] & (kernels::wall_north | inactive | dirichlet)) == dirichlet)
-            b += tile.values[k - g.nx];
-          if (j + 1 < g.ny && !(f[k] & kernels::wall_north) && (f[k + g.nx] & (inactive | dirichlet)) == dirichlet)
-            b += tile.values[k + g.nx];
+          if ((h.bits[t] & four_unknown_neighbours) != four_unknown_neighbours) {
+            if (i > 0 && (f[k - 1] & (kernels::wall_east | inactive | dirichlet)) == dirichlet) b += tile.values[k - 1];
+            if (i + 1 < g.nx && !(f[k] & kernels::wall_east) && (f[k + 1] & (inactive | dirichlet)) == dirichlet)
+              b += tile.values[k + 1];
+            if (j > 0 && (f[k - g.nx] & (kernels::wall_north | inactive | dirichlet)) == dirichlet)
+              b += tile.values[k - g.nx];
+            if (j + 1 < g.ny && !(f[k] & kernels::wall_north) && (f[k + g.nx] & (inactive | dirichlet)) == dirichlet)
+              b += tile.values[k + g.nx];
+          }
           fine.b[t] = b;
           fine.r[t] = b;
           b2 += b * b;
