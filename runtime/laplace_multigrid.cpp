@@ -20,6 +20,7 @@
 #include "dgtex/kernels/multigrid_transfer.h"
 #include "dgtex/kernels/multigrid_unknowns.h"
 #include "dgtex/stage_timer.h"
+#include "banded_cholesky.h"
 #include "cholmod_lock.h"
 #include "multigrid_buffer.h"
 
@@ -109,8 +110,11 @@ long parallel_min_nodes() {
 // cheaper (the one-pass form evaluates cell-centre residuals twice). Setup + solve, CPU,
 // 1 thread, open: T = 256 6.9 -> 7.4 ms one-pass, T = 512 33 ms both, T = 1024 188 -> 180 ms.
 constexpr long fused_restriction_min_nodes = 1l << 19;
-// Coarsest levels up to this many unknowns are factored densely.
+// Coarsest levels up to this many unknowns are factored densely; larger ones in band form
+// while n * bandwidth^2 stays below banded_coarsest_max_work (a 64 x 64 grid: ~1.7e7, a few
+// ms), else by CHOLMOD (nested dissection wins on wide grids).
 constexpr int dense_coarsest_max = 400;
+constexpr double banded_coarsest_max_work = 2e7;
 
 using detail::FloatMultigridBuffer;
 using detail::MultigridBuffer;
@@ -206,7 +210,8 @@ struct LaplaceMultigrid::Hierarchy {
   std::vector<std::int64_t> coarsest_nodes;
   Eigen::CholmodSupernodalLLT<Eigen::SparseMatrix<double>, Eigen::Lower> coarsest_factor;
   Eigen::LLT<Eigen::MatrixXd> coarsest_dense;  // used up to dense_coarsest_max unknowns
-  bool coarsest_is_dense = false;
+  detail::BandedCholesky coarsest_banded;       // then while its band is narrow
+  enum class CoarsestFactor { dense, banded, cholmod } coarsest_kind = CoarsestFactor::dense;
   MultigridBuffer cg_x, cg_r;                // preconditioned CG iterate and residual
   MultigridBuffer k_x, k_r, k_z, k_p, k_q, k_b, k_zero;  // level-1 CG of the robust cycle
   std::vector<double> coarse_rows;
@@ -387,11 +392,16 @@ struct LaplaceMultigrid::Hierarchy {
     m.setFromTriplets(entries.begin(), entries.end());
     // A dense factor for small coarsest levels: CHOLMOD's analysis alone costs more than
     // factoring a few hundred unknowns densely (measured ~0.2 ms vs ~0.02 ms for 64).
-    coarsest_is_dense = n <= dense_coarsest_max;
+    const double band = detail::BandedCholesky::bandwidth(m);
+    coarsest_kind = n <= dense_coarsest_max                       ? CoarsestFactor::dense
+                    : n * band * band <= banded_coarsest_max_work ? CoarsestFactor::banded
+                                                                  : CoarsestFactor::cholmod;
     bool ok = true;
-    if (n > 0 && coarsest_is_dense) {
+    if (n > 0 && coarsest_kind == CoarsestFactor::dense) {
       coarsest_dense.compute(Eigen::MatrixXd(m));
       ok = coarsest_dense.info() == Eigen::Success;
+    } else if (n > 0 && coarsest_kind == CoarsestFactor::banded) {
+      ok = coarsest_banded.factorize(m);
     } else if (n > 0) {
       const auto lock = detail::lock_cholmod();
       coarsest_factor.compute(m);
@@ -424,8 +434,10 @@ struct LaplaceMultigrid::Hierarchy {
     Eigen::VectorXd rhs(n);
     for (int k = 0; k < n; ++k) rhs[k] = level.b[coarsest_nodes[k]];
     Eigen::VectorXd solution;
-    if (coarsest_is_dense) {
+    if (coarsest_kind == CoarsestFactor::dense) {
       solution = coarsest_dense.solve(rhs);
+    } else if (coarsest_kind == CoarsestFactor::banded) {
+      coarsest_banded.solve(rhs, solution);
     } else {
       const auto lock = detail::lock_cholmod();
       solution = coarsest_factor.solve(rhs);
