@@ -2,9 +2,9 @@
 // Geometric multigrid for the harmonic texel problem (dgtex/kernels/multigrid_unknowns.h):
 // red-black Gauss-Seidel on the texel level (5-point operator applied straight from one
 // flag byte per texel, nothing stored), black-box (operator-dependent, Galerkin) 9-point
-// coarse levels that keep cuts as walls, a dense (small) or CHOLMOD (large) Cholesky on
-// the coarsest level, used as V/F-cycles or as the preconditioner of conjugate gradients
-// (the default: see laplace_multigrid.cpp for the measurements behind it).
+// coarse levels that keep cuts as walls, a dense (small), band (narrow) or CHOLMOD (large)
+// Cholesky on the coarsest level, used as V/F-cycles or as the preconditioner of conjugate
+// gradients (the default: see laplace_multigrid.cpp for the measurements behind it).
 // LaplaceMultigrid owns its level hierarchy (built from the tile at construction, no
 // reference kept to it). Not thread-safe per instance; solve() uses all OpenMP threads.
 // Values dimensionless, times in ms.
