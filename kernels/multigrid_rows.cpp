@@ -48,10 +48,6 @@ DGTEX_ROW_INLINE void for_groups(GridShape g, const std::uint8_t* row_bits, Full
   for (int l = 0; i0 + l < nx; ++l) one(i0 + l, l);
 }
 
-// (((b + west) + east) + south) + north, the order of texel_smoothed.
-DGTEX_ROW_INLINE Lanes4 neighbour_sum(const double* b, const double* x, std::int64_t t, std::int64_t s) {
-  return (((load4(b + t) + load4(x + t - 1)) + load4(x + t + 1)) + load4(x + t - s)) + load4(x + t + s);
-}
 // (((4 x - west) - east) - south) - north, the order of texel_operator.
 DGTEX_ROW_INLINE Lanes4 interior_operator(const double* x, std::int64_t t, std::int64_t s) {
   return (((4.0 * load4(x + t) - load4(x + t - 1)) - load4(x + t + 1)) - load4(x + t - s)) - load4(x + t + s);
@@ -88,6 +84,7 @@ DGTEX_ROW_INLINE void smooth_color_impl(GridShape g, const std::uint8_t* bits, c
     // x(t + 4) is the east ghost when the group ends the row; lanes past it are not used.
     const Lanes4 next = i0 + 8 <= nx ? load4(x + t + 4) : Lanes4{x[t + 4], 0.0, 0.0, 0.0};
     if (four_interior(bits + t)) {
+      // ((((b + west) + east) + south) + north) / 4, in texel_smoothed's order.
       const Lanes4 v =
           ((((load4(b + t) + west_of(previous, current)) + east_of(current, next)) + load4(x + t - s)) +
            load4(x + t + s)) *
