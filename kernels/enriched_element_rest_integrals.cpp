@@ -6,7 +6,6 @@
 
 #include "dgtex/kernels/shell_point.h"
 #include "dgtex/kernels/gram_accumulation.h"
-#include "dgtex/kernels/vec3.h"
 
 namespace dgtex::kernels {
 
@@ -38,21 +37,6 @@ int enriched_shape_values(const EnrichedElementBatch& b, std::int64_t e, double 
     }
   }
   return n;
-}
-
-double rest_area_factor(const ShapeValues& s, const int* nodes, const double* X) {
-  // evaluate_rest_point's sums for a1 and a2, in its order.
-  double a1[3] = {0, 0, 0}, a2[3] = {0, 0, 0};
-  for (int a = 0; a < s.count; ++a) {
-    const double* x = X + 3 * static_cast<long>(nodes[a]);
-    for (int d = 0; d < 3; ++d) {
-      a1[d] += s.dN[a][0] * x[d];
-      a2[d] += s.dN[a][1] * x[d];
-    }
-  }
-  double n[3];
-  cross3(a1, a2, n);
-  return std::sqrt(dot3(n, n));
 }
 
 void enriched_element_mass_and_load_weights(const EnrichedElementBatch& b, const EnrichedQuadrature& quad,

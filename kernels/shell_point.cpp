@@ -4,20 +4,40 @@
 #include <cmath>
 
 namespace dgtex::kernels {
-void evaluate_rest_point(const ShapeValues& s, const int* nodes, const double* X, RestPoint& p) {
-  for (int d = 0; d < 3; ++d) p.a1[d] = p.a2[d] = p.a11[d] = p.a22[d] = p.a12[d] = 0;
+namespace {
+// The rest tangents a1, a2 and their cross product a1 x a2 (its length is j0).
+void rest_tangents(const ShapeValues& s, const int* nodes, const double* X, double a1[3], double a2[3],
+                   double n[3]) {
+  for (int d = 0; d < 3; ++d) a1[d] = a2[d] = 0;
   for (int a = 0; a < s.count; ++a) {
     const double* x = X + 3 * static_cast<long>(nodes[a]);
     for (int d = 0; d < 3; ++d) {
-      p.a1[d] += s.dN[a][0] * x[d];
-      p.a2[d] += s.dN[a][1] * x[d];
+      a1[d] += s.dN[a][0] * x[d];
+      a2[d] += s.dN[a][1] * x[d];
+    }
+  }
+  cross3(a1, a2, n);
+}
+}  // namespace
+
+double rest_area_factor(const ShapeValues& s, const int* nodes, const double* X) {
+  double a1[3], a2[3], n[3];
+  rest_tangents(s, nodes, X, a1, a2, n);
+  return std::sqrt(dot3(n, n));
+}
+
+void evaluate_rest_point(const ShapeValues& s, const int* nodes, const double* X, RestPoint& p) {
+  double n[3];
+  rest_tangents(s, nodes, X, p.a1, p.a2, n);
+  for (int d = 0; d < 3; ++d) p.a11[d] = p.a22[d] = p.a12[d] = 0;
+  for (int a = 0; a < s.count; ++a) {
+    const double* x = X + 3 * static_cast<long>(nodes[a]);
+    for (int d = 0; d < 3; ++d) {
       p.a11[d] += s.d2N[a][0] * x[d];
       p.a22[d] += s.d2N[a][1] * x[d];
       p.a12[d] += s.d2N[a][2] * x[d];
     }
   }
-  double n[3];
-  cross3(p.a1, p.a2, n);
   p.j0 = std::sqrt(dot3(n, n));
   for (int d = 0; d < 3; ++d) p.t0[d] = n[d] / p.j0;
   // Dual basis: phi0^1 = (a2 x t0) / j0, phi0^2 = (t0 x a1) / j0 (so phi0^a . a_b = delta).

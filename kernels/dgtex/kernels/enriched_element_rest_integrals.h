@@ -43,9 +43,4 @@ int enriched_shape_values(const EnrichedElementBatch& batch, std::int64_t e, dou
                           const ShapeValues& s, EnrichedTexelCache& cache, double* N,
                           const TexelDerivativeTile* const* derivatives = nullptr);
 
-// The area factor j0 = |a1 x a2| of evaluate_rest_point (shell_point.h), bitwise, without
-// the curvature terms and dual basis that mass and moments do not read (evaluate_rest_point
-// was ~9% of a basis change's instructions). nodes: the element's npe = s.count nodes.
-double rest_area_factor(const ShapeValues& s, const int* nodes, const double* positions);
-
 }  // namespace dgtex::kernels

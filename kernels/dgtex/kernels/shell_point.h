@@ -28,6 +28,10 @@ struct RestPoint {
 // Interpolates the geometry from the element's node positions (#nodes x 3 flat array).
 void evaluate_rest_point(const ShapeValues& shape, const int* element_nodes, const double* positions,
                          RestPoint& out);
+// Its area factor j0 = |a1 x a2| alone, bitwise the same, without the curvature terms and
+// dual basis (mass and projection moments read only j0; evaluate_rest_point was ~9% of a
+// basis change's instructions).
+double rest_area_factor(const ShapeValues& shape, const int* element_nodes, const double* positions);
 
 // Tangent of the mid-surface along a parametric direction d (dphi = a1 d1 + a2 d2).
 void tangent_along(const RestPoint& p, const double d[2], double out[3]);
