@@ -1,9 +1,24 @@
 #include "dgtex/kernels/multigrid_galerkin.h"
 
+#include <optional>
+#include <vector>
+
 #include "dgtex/kernels/multigrid_unknowns.h"
+#include "multigrid_rows.h"
+#include "multigrid_uniform_window.h"
 
 namespace dgtex::kernels {
 namespace {
+
+// Values of one node's interpolation weights and of a translation-invariant 9-point row.
+template <class Real>
+struct InterpolationWeights {
+  Real xw, xe, ys, yn, sw, se, nw, ne;
+};
+template <class Real>
+struct Stencil9Row {
+  Real c, e, n, ne, nw;
+};
 
 // Entry A(t, t + dx + dy * stride) of the level-0 texel operator (dx, dy in -1..1).
 struct TexelOperator {
@@ -73,12 +88,18 @@ inline double weight(double numerator, double denominator, double diagonal) {
   return (diagonal > 0 && denominator > 1e-12 * diagonal) ? -numerator / denominator : 0.0;
 }
 
+template <class Real>
+struct UniformRegion;  // below
+
 // Black-box interpolation for a 5-point operator a(t, dx, dy) (centre and axis entries).
 // Weights are formed in double and stored as Real (pass 2 reads the stored pass-1 weights).
+// With `uniform`: coarse nodes whose window is uniform get the uniform weights.
 template <class Operator, class Real>
-void build_interpolation(GridShape fine, const Operator& a, InterpolationArraysOf<Real> p, Execution execution) {
+void build_interpolation(GridShape fine, const Operator& a, InterpolationArraysOf<Real> p, Execution execution,
+                         const UniformRegion<Real>* uniform = nullptr) {
   const GridShape coarse = fine.coarser();
   const std::int64_t cs = coarse.stride();
+  const std::uint8_t* fast = uniform ? uniform->windows.data() : nullptr;
   // Pass 1: fine nodes on coarse grid lines, from the stencil collapsed across the line.
   forall(
       coarse.ny,
@@ -86,6 +107,11 @@ void build_interpolation(GridShape fine, const Operator& a, InterpolationArraysO
         const int J = static_cast<int>(J64);
         for (int I = 0; I < coarse.nx; ++I) {
           const std::int64_t c = coarse.at(I, J);
+          if (fast && fast[c]) {
+            p.xw[c] = uniform->weights.xw, p.xe[c] = uniform->weights.xe;
+            p.ys[c] = uniform->weights.ys, p.yn[c] = uniform->weights.yn;
+            continue;
+          }
           p.xw[c] = p.xe[c] = p.ys[c] = p.yn[c] = Real(0);
           if (2 * I + 1 < fine.nx) {
             const std::int64_t f = fine.at(2 * I + 1, 2 * J);
@@ -109,6 +135,11 @@ void build_interpolation(GridShape fine, const Operator& a, InterpolationArraysO
         const int J = static_cast<int>(J64);
         for (int I = 0; I < coarse.nx; ++I) {
           const std::int64_t c = coarse.at(I, J);
+          if (fast && fast[c]) {
+            p.sw[c] = uniform->weights.sw, p.se[c] = uniform->weights.se;
+            p.nw[c] = uniform->weights.nw, p.ne[c] = uniform->weights.ne;
+            continue;
+          }
           p.sw[c] = p.se[c] = p.nw[c] = p.ne[c] = Real(0);
           if (2 * I + 1 >= fine.nx || 2 * J + 1 >= fine.ny) continue;
           const std::int64_t f = fine.at(2 * I + 1, 2 * J + 1);
@@ -230,20 +261,47 @@ struct GalerkinRow {
   }
 };
 
+// 1 per coarse node whose eight interpolation weights equal `w` bitwise (ghosts: 0).
+template <class Real>
+std::vector<std::uint8_t> weights_equal(GridShape coarse, InterpolationViewOf<Real> p,
+                                        const InterpolationWeights<Real>& w, Execution execution) {
+  std::vector<std::uint8_t> equal(coarse.padded_size(), 0);
+  forall(
+      coarse.ny,
+      [&, p, w](std::int64_t J) {  // copies: the byte stores below may alias them
+        const std::int64_t row = coarse.at(0, static_cast<int>(J));
+        for (std::int64_t c = row; c < row + coarse.nx; ++c)
+          equal[c] = (p.xw[c] == w.xw) & (p.xe[c] == w.xe) & (p.ys[c] == w.ys) & (p.yn[c] == w.yn) &
+                     (p.sw[c] == w.sw) & (p.se[c] == w.se) & (p.nw[c] == w.nw) & (p.ne[c] == w.ne);
+      },
+      execution);
+  return equal;
+}
+
 // Fine nodes outside the fine grid have P(f, C) = 0 (the interpolation arrays hold 0 there
 // and at ghosts), and ghost operator entries are 0, so no bounds checks are needed.
-// Sums in double, stored as Real.
+// Sums in double, stored as Real. With `uniform`: a coarse node whose window is uniform and
+// whose 3 x 3 coarse neighbours (all whose weights GalerkinRow reads) are marked in
+// `uniform_weights` (their weights are the uniform ones) gets the uniform row.
 template <class Entries, class Real>
 void galerkin(GridShape fine, const Entries& a, InterpolationViewOf<Real> p, Stencil9ArraysOf<Real> out,
-              Execution execution) {
+              Execution execution, const UniformRegion<Real>* uniform = nullptr,
+              const std::uint8_t* uniform_weights = nullptr) {
   const GridShape coarse = fine.coarser();
   const std::int64_t cs = coarse.stride(), fs = fine.stride();
+  const std::uint8_t* w = uniform_weights;
   forall(
       coarse.ny,
       [&](std::int64_t J64) {
         const int J = static_cast<int>(J64);
         for (int I = 0; I < coarse.nx; ++I) {
           const std::int64_t c = coarse.at(I, J);
+          if (w && uniform->windows[c] && (w[c - cs - 1] & w[c - cs] & w[c - cs + 1] & w[c - 1] & w[c] &
+                                                 w[c + 1] & w[c + cs - 1] & w[c + cs] & w[c + cs + 1])) {
+            out.c[c] = uniform->row.c, out.e[c] = uniform->row.e, out.n[c] = uniform->row.n;
+            out.ne[c] = uniform->row.ne, out.nw[c] = uniform->row.nw;
+            continue;
+          }
           GalerkinRow<Entries, Real> row{a, p, c, cs, fine.at(2 * I, 2 * J), fs};
           row.run();
           out.c[c] = static_cast<Real>(row.acc[1][1]);
@@ -256,37 +314,218 @@ void galerkin(GridShape fine, const Entries& a, InterpolationViewOf<Real> p, Ste
       execution);
 }
 
+// Uniform regions. Why: away from walls, Dirichlet texels and the tile's edge every fine
+// row is the same translation-invariant stencil, so the interpolation weights and the
+// Galerkin row of every coarse node there are the same too. They are computed once, by the code above, on a small
+// grid filled with that stencil (ghosts included), and copied wherever every value the code
+// would read equals the small grid's (the window of multigrid_uniform_window.h, and for the
+// Galerkin row also the interpolation weights it reads, compared as stored). The general
+// code gives such a node the same bits (same operations on the same values; this file is
+// compiled without FMA contraction), so results do not depend on which path a node takes.
+// Measured (callgrind, `dgtex bench laplace --sizes 1024 --domains open spiral --solvers
+// multigrid --repeat 1`, 1 thread): building the coarse levels 737M -> 276M instructions;
+// the whole setup with the classification's rework 1129M -> 340M.
+template <class Real>
+struct UniformRegion {
+  std::vector<std::uint8_t> windows;  // per coarse node (padded): its window is uniform
+  InterpolationWeights<Real> weights;
+  Stencil9Row<Real> row;  // the coarse operator's row there (c, e, n, ne, nw)
+};
+
+// The uniform weights and coarse row: those of coarse node (1, 1) when `interpolate` and
+// `multiply` run the general code on a fine 8 x 8 grid that holds the uniform stencil
+// everywhere, ghosts included (every value that node's results read lies in that grid).
+template <class Real, class Interpolate, class Multiply>
+void uniform_results(UniformRegion<Real>& region, const Interpolate& interpolate, const Multiply& multiply) {
+  const GridShape fine{8, 8}, coarse = fine.coarser();
+  std::vector<Real> p[8], a[5];
+  for (auto& v : p) v.assign(coarse.padded_size(), Real(0));
+  for (auto& v : a) v.assign(coarse.padded_size(), Real(0));
+  const InterpolationArraysOf<Real> pa{p[0].data(), p[1].data(), p[2].data(), p[3].data(),
+                                      p[4].data(), p[5].data(), p[6].data(), p[7].data()};
+  interpolate(fine, pa);
+  multiply(fine, pa.view(), Stencil9ArraysOf<Real>{a[0].data(), a[1].data(), a[2].data(), a[3].data(), a[4].data()});
+  const std::int64_t c = coarse.at(1, 1);
+  region.weights = {p[0][c], p[1][c], p[2][c], p[3][c], p[4][c], p[5][c], p[6][c], p[7][c]};
+  region.row = {a[0][c], a[1][c], a[2][c], a[3][c], a[4][c]};
+}
+
+// Level 0: the uniform fine row is an unknown texel coupled to four unknowns.
+template <class Real>
+UniformRegion<Real> uniform_texel_region(GridShape fine, const std::uint8_t* bits, Execution execution) {
+  UniformRegion<Real> region;
+  const std::vector<std::uint8_t> filled(GridShape{8, 8}.padded_size(), detail::interior_texel);
+  uniform_results(
+      region,
+      [&](GridShape g, InterpolationArraysOf<Real> p) {
+        build_interpolation(g, TexelOperator{filled.data()}, p, Execution::serial);
+      },
+      [&](GridShape g, InterpolationViewOf<Real> p, Stencil9ArraysOf<Real> out) {
+        galerkin(g, TexelEntries{filled.data()}, p, out, Execution::serial);
+      });
+  region.windows =
+      detail::uniform_windows(fine, [bits](std::int64_t f) { return bits[f] == detail::interior_texel; }, execution);
+  return region;
+}
+
+// A 9-point level: the uniform row is taken from the first of a few sample nodes whose
+// 3 x 3 neighbourhood holds its values (none found: no uniform region, all nodes general).
+template <class Real>
+std::optional<UniformRegion<Real>> uniform_stencil9_region(GridShape fine, Stencil9ViewOf<Real> a,
+                                                           Execution execution) {
+  auto same = [&](std::int64_t f, std::int64_t g) {
+    return a.c[f] == a.c[g] && a.e[f] == a.e[g] && a.n[f] == a.n[g] && a.ne[f] == a.ne[g] && a.nw[f] == a.nw[g];
+  };
+  constexpr int samples = 5;
+  std::int64_t found = -1;
+  for (int sj = 1; sj <= samples && found < 0; ++sj)
+    for (int si = 1; si <= samples && found < 0; ++si) {
+      const int i = fine.nx * si / (samples + 1), j = fine.ny * sj / (samples + 1);
+      if (i < 1 || j < 1 || i + 1 >= fine.nx || j + 1 >= fine.ny) continue;
+      const std::int64_t f = fine.at(i, j);
+      bool uniform = a.c[f] > 0;
+      for (int dj = -1; dj <= 1 && uniform; ++dj)
+        for (int di = -1; di <= 1 && uniform; ++di) uniform = same(fine.at(i + di, j + dj), f);
+      if (uniform) found = f;
+    }
+  if (found < 0) return std::nullopt;
+  const Stencil9Row<Real> r{a.c[found], a.e[found], a.n[found], a.ne[found], a.nw[found]};
+  UniformRegion<Real> region;
+  const GridShape small{8, 8};
+  std::vector<Real> filled[5];
+  const Real values[5] = {r.c, r.e, r.n, r.ne, r.nw};
+  for (int k = 0; k < 5; ++k) filled[k].assign(small.padded_size(), values[k]);
+  const Stencil9ViewOf<Real> sa{filled[0].data(), filled[1].data(), filled[2].data(), filled[3].data(),
+                                filled[4].data()};
+  uniform_results(
+      region,
+      [&](GridShape g, InterpolationArraysOf<Real> p) {
+        build_interpolation(g, LumpedStencil9Operator<Real>{{sa, g.stride()}}, p, Execution::serial);
+      },
+      [&](GridShape g, InterpolationViewOf<Real> p, Stencil9ArraysOf<Real> out) {
+        galerkin(g, Stencil9Entries<Real>{sa, g.stride()}, p, out, Execution::serial);
+      });
+  region.windows = detail::uniform_windows(
+      fine,
+      [a, r](std::int64_t f) {
+        return (a.c[f] == r.c) & (a.e[f] == r.e) & (a.n[f] == r.n) & (a.ne[f] == r.ne) & (a.nw[f] == r.nw);
+      },
+      execution);
+  return region;
+}
+
+// The Galerkin product alone: which weights are the uniform ones is read off the weights.
+template <class Entries, class Real>
+void galerkin_checking_weights(GridShape fine, const Entries& a, InterpolationViewOf<Real> p,
+                               Stencil9ArraysOf<Real> out, Execution execution, const UniformRegion<Real>* uniform) {
+  std::vector<std::uint8_t> uniform_weights;
+  if (uniform) uniform_weights = weights_equal(fine.coarser(), p, uniform->weights, execution);
+  galerkin(fine, a, p, out, execution, uniform, uniform ? uniform_weights.data() : nullptr);
+}
+
+// Interpolation, then the Galerkin product, from one uniform-region analysis: the
+// interpolation has just written the uniform weights wherever a coarse node's window is
+// uniform, so the windows mark (some of) the nodes with uniform weights.
+template <class Operator, class Entries, class Real>
+void coarsen(GridShape fine, const Operator& op, const Entries& a, InterpolationArraysOf<Real> p,
+             Stencil9ArraysOf<Real> out, Execution execution, const UniformRegion<Real>* uniform) {
+  build_interpolation(fine, op, p, execution, uniform);
+  galerkin(fine, a, p.view(), out, execution, uniform, uniform ? uniform->windows.data() : nullptr);
+}
+
 }  // namespace
 
 void build_interpolation_texels(GridShape fine, const std::uint8_t* bits, InterpolationArrays p, Execution execution) {
-  build_interpolation(fine, TexelOperator{bits}, p, execution);
+  const auto uniform = uniform_texel_region<double>(fine, bits, execution);
+  build_interpolation(fine, TexelOperator{bits}, p, execution, &uniform);
 }
 void build_interpolation_stencil9(GridShape fine, Stencil9View a, InterpolationArrays p, Execution execution) {
-  build_interpolation(fine, LumpedStencil9Operator<double>{{a, fine.stride()}}, p, execution);
+  const auto uniform = uniform_stencil9_region(fine, a, execution);
+  build_interpolation(fine, LumpedStencil9Operator<double>{{a, fine.stride()}}, p, execution,
+                      uniform ? &*uniform : nullptr);
 }
 void build_interpolation_texels(GridShape fine, const std::uint8_t* bits, InterpolationArraysFloat p,
                                 Execution execution) {
-  build_interpolation(fine, TexelOperator{bits}, p, execution);
+  const auto uniform = uniform_texel_region<float>(fine, bits, execution);
+  build_interpolation(fine, TexelOperator{bits}, p, execution, &uniform);
 }
 void build_interpolation_stencil9(GridShape fine, Stencil9ViewFloat a, InterpolationArraysFloat p,
                                   Execution execution) {
-  build_interpolation(fine, LumpedStencil9Operator<float>{{a, fine.stride()}}, p, execution);
+  const auto uniform = uniform_stencil9_region(fine, a, execution);
+  build_interpolation(fine, LumpedStencil9Operator<float>{{a, fine.stride()}}, p, execution,
+                      uniform ? &*uniform : nullptr);
 }
 void galerkin_texels(GridShape fine, const std::uint8_t* bits, InterpolationView p, Stencil9Arrays coarse_a,
                      Execution execution) {
-  galerkin(fine, TexelEntries{bits}, p, coarse_a, execution);
+  const auto uniform = uniform_texel_region<double>(fine, bits, execution);
+  galerkin_checking_weights(fine, TexelEntries{bits}, p, coarse_a, execution, &uniform);
 }
 void galerkin_stencil9(GridShape fine, Stencil9View a, InterpolationView p, Stencil9Arrays coarse_a,
                        Execution execution) {
-  galerkin(fine, Stencil9Entries<double>{a, fine.stride()}, p, coarse_a, execution);
+  const auto uniform = uniform_stencil9_region(fine, a, execution);
+  galerkin_checking_weights(fine, Stencil9Entries<double>{a, fine.stride()}, p, coarse_a, execution,
+                            uniform ? &*uniform : nullptr);
 }
 void galerkin_texels(GridShape fine, const std::uint8_t* bits, InterpolationViewFloat p,
                      Stencil9ArraysFloat coarse_a, Execution execution) {
-  galerkin(fine, TexelEntries{bits}, p, coarse_a, execution);
+  const auto uniform = uniform_texel_region<float>(fine, bits, execution);
+  galerkin_checking_weights(fine, TexelEntries{bits}, p, coarse_a, execution, &uniform);
 }
 void galerkin_stencil9(GridShape fine, Stencil9ViewFloat a, InterpolationViewFloat p, Stencil9ArraysFloat coarse_a,
                        Execution execution) {
-  galerkin(fine, Stencil9Entries<float>{a, fine.stride()}, p, coarse_a, execution);
+  const auto uniform = uniform_stencil9_region(fine, a, execution);
+  galerkin_checking_weights(fine, Stencil9Entries<float>{a, fine.stride()}, p, coarse_a, execution,
+                            uniform ? &*uniform : nullptr);
+}
+
+void coarsen_texels(GridShape fine, const std::uint8_t* bits, InterpolationArrays p, Stencil9Arrays coarse_a,
+                    Execution execution) {
+  const auto uniform = uniform_texel_region<double>(fine, bits, execution);
+  coarsen(fine, TexelOperator{bits}, TexelEntries{bits}, p, coarse_a, execution, &uniform);
+}
+void coarsen_stencil9(GridShape fine, Stencil9View a, InterpolationArrays p, Stencil9Arrays coarse_a,
+                      Execution execution) {
+  const auto uniform = uniform_stencil9_region(fine, a, execution);
+  coarsen(fine, LumpedStencil9Operator<double>{{a, fine.stride()}}, Stencil9Entries<double>{a, fine.stride()}, p,
+          coarse_a, execution, uniform ? &*uniform : nullptr);
+}
+void coarsen_texels(GridShape fine, const std::uint8_t* bits, InterpolationArraysFloat p, Stencil9ArraysFloat coarse_a,
+                    Execution execution) {
+  const auto uniform = uniform_texel_region<float>(fine, bits, execution);
+  coarsen(fine, TexelOperator{bits}, TexelEntries{bits}, p, coarse_a, execution, &uniform);
+}
+void coarsen_stencil9(GridShape fine, Stencil9ViewFloat a, InterpolationArraysFloat p, Stencil9ArraysFloat coarse_a,
+                      Execution execution) {
+  const auto uniform = uniform_stencil9_region(fine, a, execution);
+  coarsen(fine, LumpedStencil9Operator<float>{{a, fine.stride()}}, Stencil9Entries<float>{a, fine.stride()}, p,
+          coarse_a, execution, uniform ? &*uniform : nullptr);
+}
+
+void build_interpolation_texels_reference(GridShape fine, const std::uint8_t* bits, InterpolationArrays p) {
+  build_interpolation(fine, TexelOperator{bits}, p, Execution::serial);
+}
+void build_interpolation_stencil9_reference(GridShape fine, Stencil9View a, InterpolationArrays p) {
+  build_interpolation(fine, LumpedStencil9Operator<double>{{a, fine.stride()}}, p, Execution::serial);
+}
+void galerkin_texels_reference(GridShape fine, const std::uint8_t* bits, InterpolationView p, Stencil9Arrays coarse_a) {
+  galerkin(fine, TexelEntries{bits}, p, coarse_a, Execution::serial);
+}
+void galerkin_stencil9_reference(GridShape fine, Stencil9View a, InterpolationView p, Stencil9Arrays coarse_a) {
+  galerkin(fine, Stencil9Entries<double>{a, fine.stride()}, p, coarse_a, Execution::serial);
+}
+void build_interpolation_texels_reference(GridShape fine, const std::uint8_t* bits, InterpolationArraysFloat p) {
+  build_interpolation(fine, TexelOperator{bits}, p, Execution::serial);
+}
+void build_interpolation_stencil9_reference(GridShape fine, Stencil9ViewFloat a, InterpolationArraysFloat p) {
+  build_interpolation(fine, LumpedStencil9Operator<float>{{a, fine.stride()}}, p, Execution::serial);
+}
+void galerkin_texels_reference(GridShape fine, const std::uint8_t* bits, InterpolationViewFloat p,
+                               Stencil9ArraysFloat coarse_a) {
+  galerkin(fine, TexelEntries{bits}, p, coarse_a, Execution::serial);
+}
+void galerkin_stencil9_reference(GridShape fine, Stencil9ViewFloat a, InterpolationViewFloat p,
+                                 Stencil9ArraysFloat coarse_a) {
+  galerkin(fine, Stencil9Entries<float>{a, fine.stride()}, p, coarse_a, Execution::serial);
 }
 
 }  // namespace dgtex::kernels

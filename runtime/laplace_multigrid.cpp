@@ -301,13 +301,10 @@ struct LaplaceMultigrid::Hierarchy {
     const kernels::InterpolationArraysOf<Real> p{w[5]->data(),  w[6]->data(),  w[7]->data(),  w[8]->data(),
                                                  w[9]->data(), w[10]->data(), w[11]->data(), w[12]->data()};
     const Execution ex = fine.execution;
-    if (texels) {
-      kernels::build_interpolation_texels(fine.shape, bits.data(), p, ex);
-      kernels::galerkin_texels(fine.shape, bits.data(), p.view(), a, ex);
-    } else {
-      kernels::build_interpolation_stencil9(fine.shape, arrays<Real>(fine).a, p, ex);
-      kernels::galerkin_stencil9(fine.shape, arrays<Real>(fine).a, p.view(), a, ex);
-    }
+    if (texels)
+      kernels::coarsen_texels(fine.shape, bits.data(), p, a, ex);
+    else
+      kernels::coarsen_stencil9(fine.shape, arrays<Real>(fine).a, p, a, ex);
     coarse.active.assign(size, 0);
     return count_orphans_and_mark_active<Real>(fine, coarse, ex);
   }
@@ -321,21 +318,25 @@ struct LaplaceMultigrid::Hierarchy {
     const kernels::InterpolationViewOf<Real> p = arrays_c.p;
     const Real* coarse_c = arrays_c.a.c;
     row_orphans.assign(coarse.shape.ny, 0);
+    // Fine nodes outside the fine grid are ghosts (inactive), so no bounds checks; weights
+    // are compared with 0 one by one (|a| + |b| == 0 iff both are), branch-free.
     kernels::forall(
         coarse.shape.ny,
         [&](std::int64_t J64) {
           const int J = static_cast<int>(J64);
+          // Local copies: the byte stores to coarse_active may alias what they point to.
+          const kernels::InterpolationViewOf<Real> w = p;
+          const Real* diagonal = coarse_c;
+          const std::uint8_t* active = fine.active.data();
+          std::uint8_t* coarse_active = coarse.active.data();
+          const std::int64_t fs = fine.shape.stride();
           int orphans = 0;
           for (int I = 0; I < coarse.shape.nx; ++I) {
-            const std::int64_t c = coarse.shape.at(I, J);
-            coarse.active[c] = coarse_c[c] > 0 ? 1 : 0;
-            auto check = [&](int i, int j, Real weight_sum) {
-              if (i < fine.shape.nx && j < fine.shape.ny && fine.active[fine.shape.at(i, j)] && weight_sum == 0)
-                ++orphans;
-            };
-            check(2 * I + 1, 2 * J, std::abs(p.xw[c]) + std::abs(p.xe[c]));
-            check(2 * I, 2 * J + 1, std::abs(p.ys[c]) + std::abs(p.yn[c]));
-            check(2 * I + 1, 2 * J + 1, std::abs(p.sw[c]) + std::abs(p.se[c]) + std::abs(p.nw[c]) + std::abs(p.ne[c]));
+            const std::int64_t c = coarse.shape.at(I, J), f = fine.shape.at(2 * I, 2 * J);
+            coarse_active[c] = diagonal[c] > 0 ? 1 : 0;
+            orphans += active[f + 1] & (w.xw[c] == 0) & (w.xe[c] == 0);
+            orphans += active[f + fs] & (w.ys[c] == 0) & (w.yn[c] == 0);
+            orphans += active[f + fs + 1] & (w.sw[c] == 0) & (w.se[c] == 0) & (w.nw[c] == 0) & (w.ne[c] == 0);
           }
           row_orphans[J] = orphans;
         },

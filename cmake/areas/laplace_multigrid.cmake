@@ -10,3 +10,9 @@ target_link_libraries(dgtex PRIVATE MPI::MPI_C)
 # about the AVX calling convention of such functions all the same).
 set_source_files_properties(${CMAKE_CURRENT_SOURCE_DIR}/kernels/multigrid_rows.cpp
                             PROPERTIES COMPILE_OPTIONS "-ffp-contract=off;-Wno-psabi")
+
+# The setup kernels copy the results of one small uniform grid to every node of a uniform
+# region (kernels/multigrid_galerkin.cpp); that they equal the general code's bits there
+# needs the same rounding in both, so no FMA contraction either.
+set_source_files_properties(${CMAKE_CURRENT_SOURCE_DIR}/kernels/multigrid_galerkin.cpp
+                            PROPERTIES COMPILE_OPTIONS "-ffp-contract=off")

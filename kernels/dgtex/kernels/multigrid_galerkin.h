@@ -30,7 +30,7 @@
 // earlier rule) on top of the lumped form (no gain). Remaining: chad T = 256 0.111 per
 // cycle (7 iterations), the 0.1 elsewhere.
 //
-// Both setup kernels write the coarse arrays (padded layout, ghosts must be zero on entry
+// Both setup kernels (and their references, below) write the coarse arrays (padded layout, ghosts must be zero on entry
 // and stay zero) for every coarse node and are gathers, so serial and parallel agree bitwise.
 // Kernel conventions (dgtex/kernels/forall.h): arrays are the caller's, batch/view structs
 // only point into them, nothing is kept after a call; thread-safe on distinct outputs.
@@ -82,5 +82,30 @@ void galerkin_texels(GridShape fine, const std::uint8_t* bits, InterpolationView
                      Execution execution = Execution::parallel);
 void galerkin_stencil9(GridShape fine, Stencil9ViewFloat a, InterpolationViewFloat p, Stencil9ArraysFloat coarse_a,
                        Execution execution = Execution::parallel);
+
+// Both of the above for one coarse level (what the multigrid setup calls): the same results,
+// with the uniform regions of the fine level found once.
+void coarsen_texels(GridShape fine, const std::uint8_t* bits, InterpolationArrays p, Stencil9Arrays coarse_a,
+                    Execution execution = Execution::parallel);
+void coarsen_stencil9(GridShape fine, Stencil9View a, InterpolationArrays p, Stencil9Arrays coarse_a,
+                      Execution execution = Execution::parallel);
+void coarsen_texels(GridShape fine, const std::uint8_t* bits, InterpolationArraysFloat p, Stencil9ArraysFloat coarse_a,
+                    Execution execution = Execution::parallel);
+void coarsen_stencil9(GridShape fine, Stencil9ViewFloat a, InterpolationArraysFloat p, Stencil9ArraysFloat coarse_a,
+                      Execution execution = Execution::parallel);
+
+// Serial references: the general formulas at every coarse node. The kernels above copy the
+// results of one small uniform grid into the uniform regions of a level (most of it away
+// from walls; multigrid_galerkin.cpp) and agree with these bitwise (tested).
+void build_interpolation_texels_reference(GridShape fine, const std::uint8_t* bits, InterpolationArrays p);
+void build_interpolation_stencil9_reference(GridShape fine, Stencil9View a, InterpolationArrays p);
+void galerkin_texels_reference(GridShape fine, const std::uint8_t* bits, InterpolationView p, Stencil9Arrays coarse_a);
+void galerkin_stencil9_reference(GridShape fine, Stencil9View a, InterpolationView p, Stencil9Arrays coarse_a);
+void build_interpolation_texels_reference(GridShape fine, const std::uint8_t* bits, InterpolationArraysFloat p);
+void build_interpolation_stencil9_reference(GridShape fine, Stencil9ViewFloat a, InterpolationArraysFloat p);
+void galerkin_texels_reference(GridShape fine, const std::uint8_t* bits, InterpolationViewFloat p,
+                               Stencil9ArraysFloat coarse_a);
+void galerkin_stencil9_reference(GridShape fine, Stencil9ViewFloat a, InterpolationViewFloat p,
+                                 Stencil9ArraysFloat coarse_a);
 
 }  // namespace dgtex::kernels
