@@ -80,29 +80,10 @@ template <class Real>
 void red_residual_texels_restricted(GridShape fine, GridShape coarse, InterpolationViewOf<Real> p,
                                     const std::uint8_t* bits, const double* b, const double* x, Real* b_coarse,
                                     Execution execution) {
-  const std::int64_t s = fine.stride(), cs = coarse.stride();
-  // The red residual at fine node t; 0 at nodes without unknown, ghosts included (their bits
-  // are 0), as residual_texels_color leaves them in r.
-  auto red_residual = [&](std::int64_t t) {
-    const std::uint8_t m = bits[t];
-    return (m & is_unknown) ? b[t] - texel_operator(m, x, t, s) : 0.0;
-  };
+  const auto restricted_row = detail::texel_transfer_rows<Real>().red_residual_restricted;
   forall(
       coarse.ny,
-      [&](std::int64_t J64) {
-        const int J = static_cast<int>(J64);
-        const std::int64_t row = coarse.at(0, J), f0 = fine.at(0, 2 * J);
-        // Cell centres (2I - 1, 2J +- 1) of I = 0: the ghost column.
-        double west_north = red_residual(f0 + s - 1), west_south = red_residual(f0 - s - 1);
-        for (int I = 0; I < coarse.nx; ++I) {
-          const std::int64_t c = row + I, f = f0 + 2 * I;
-          const double east_north = red_residual(f + s + 1), east_south = red_residual(f - s + 1);
-          b_coarse[c] = static_cast<Real>(red_residual(f) + p.sw[c] * east_north + p.se[c - 1] * west_north +
-                                          p.nw[c - cs] * east_south + p.ne[c - cs - 1] * west_south);
-          west_north = east_north;
-          west_south = east_south;
-        }
-      },
+      [&](std::int64_t J) { restricted_row(fine, coarse, p, bits, b, x, b_coarse, static_cast<int>(J)); },
       execution);
 }
 }  // namespace

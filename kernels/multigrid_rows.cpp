@@ -337,6 +337,137 @@ DGTEX_ROW_INLINE void stencil9_residual_impl(GridShape g, Stencil9ViewOf<Real> a
   }
 }
 
+// Coarse row J of the red residual restricted to level 1 (restrict_red_residual_texels):
+//   b_c(I, J) = r(2I, 2J) + sw(I, J) r(2I+1, 2J+1) + se(I-1, J) r(2I-1, 2J+1)
+//             + nw(I, J-1) r(2I+1, 2J-1) + ne(I-1, J-1) r(2I-1, 2J-1),
+// summed left to right in double and rounded once to Real. Four coarse nodes at a time read
+// eight texels of each of the rows 2J and 2J -+ 1; when all 24 are interior texels their
+// residuals are two vectors a row (the odd or even lanes are the ones needed), else the four
+// nodes go one by one through the flag bytes. The cell centres west of a group are the last
+// lanes of the group before (the ghost column's for I = 0).
+template <class Real>
+DGTEX_ROW_INLINE Lanes4 widen_lanes(const Real* p) {
+  if constexpr (std::is_same_v<Real, float>)
+    return __builtin_convertvector(load_lanes(p), Lanes4);
+  else
+    return load4(p);
+}
+DGTEX_ROW_INLINE Lanes4 widen_lanes_of(typename LanesOf<float>::type v) { return __builtin_convertvector(v, Lanes4); }
+DGTEX_ROW_INLINE Lanes4 widen_lanes_of(Lanes4 v) { return v; }
+DGTEX_ROW_INLINE bool eight_interior_active(const std::uint8_t* active) {  // 0/1 bytes
+  std::uint64_t word;
+  std::memcpy(&word, active, sizeof word);
+  return word == 0x0101010101010101u;
+}
+DGTEX_ROW_INLINE bool eight_interior(const std::uint8_t* bits) {
+  std::uint64_t word;
+  std::memcpy(&word, bits, sizeof word);
+  return word == 0x0101010101010101u * interior_texel;
+}
+DGTEX_ROW_INLINE Lanes4 interior_residual(const double* b, const double* x, std::int64_t t, std::int64_t s) {
+  return load4(b + t) - interior_operator(x, t, s);
+}
+
+template <class Real>
+DGTEX_ROW_INLINE void red_residual_restricted_impl(GridShape fine, GridShape coarse, InterpolationViewOf<Real> p,
+                                                   const std::uint8_t* bits, const double* b, const double* x,
+                                                   Real* b_coarse, int J) {
+  const std::int64_t s = fine.stride(), cs = coarse.stride();
+  const std::int64_t row = coarse.at(0, J), f0 = fine.at(0, 2 * J);
+  auto red_residual = [&](std::int64_t t) {
+    const std::uint8_t m = bits[t];
+    return (m & is_unknown) ? b[t] - texel_operator(m, x, t, s) : 0.0;
+  };
+  double west_north = red_residual(f0 + s - 1), west_south = red_residual(f0 - s - 1);
+  auto one = [&](int I) {
+    const std::int64_t c = row + I, f = f0 + 2 * I;
+    const double east_north = red_residual(f + s + 1), east_south = red_residual(f - s + 1);
+    b_coarse[c] = static_cast<Real>(red_residual(f) + p.sw[c] * east_north + p.se[c - 1] * west_north +
+                                    p.nw[c - cs] * east_south + p.ne[c - cs - 1] * west_south);
+    west_north = east_north;
+    west_south = east_south;
+  };
+  int I0 = 0;
+  for (; I0 + 4 <= coarse.nx && 2 * I0 + 8 <= fine.nx; I0 += 4) {
+    const std::int64_t c = row + I0, f = f0 + 2 * I0;
+    if (!(eight_interior(bits + f) && eight_interior(bits + f + s) && eight_interior(bits + f - s))) {
+      for (int I = I0; I < I0 + 4; ++I) one(I);
+      continue;
+    }
+    const Lanes4 centre = __builtin_shuffle(interior_residual(b, x, f, s), interior_residual(b, x, f + 4, s),
+                                            Lanes4Index{0, 2, 4, 6});
+    const Lanes4 north = __builtin_shuffle(interior_residual(b, x, f + s, s), interior_residual(b, x, f + s + 4, s),
+                                           Lanes4Index{1, 3, 5, 7});
+    const Lanes4 south = __builtin_shuffle(interior_residual(b, x, f - s, s), interior_residual(b, x, f - s + 4, s),
+                                           Lanes4Index{1, 3, 5, 7});
+    const Lanes4 north_west = __builtin_shuffle(Lanes4{0.0, 0.0, 0.0, west_north}, north, Lanes4Index{3, 4, 5, 6});
+    const Lanes4 south_west = __builtin_shuffle(Lanes4{0.0, 0.0, 0.0, west_south}, south, Lanes4Index{3, 4, 5, 6});
+    const Lanes4 sum = (((centre + widen_lanes(p.sw + c) * north) + widen_lanes(p.se + c - 1) * north_west) +
+                        widen_lanes(p.nw + c - cs) * south) +
+                       widen_lanes(p.ne + c - cs - 1) * south_west;
+    if constexpr (std::is_same_v<Real, float>) {
+      const typename LanesOf<float>::type rounded = __builtin_convertvector(sum, typename LanesOf<float>::type);
+      std::memcpy(b_coarse + c, &rounded, sizeof rounded);
+    } else {
+      store4(b_coarse + c, sum);
+    }
+    west_north = north[3];
+    west_south = south[3];
+  }
+  for (; I0 < coarse.nx; ++I0) one(I0);
+}
+
+// Fine row j of the coarse correction added at level 0's red nodes (prolong_correction_red):
+// even rows get x_c(I, J) at (2I, 2J), odd rows the cell-centre interpolation at (2I+1, 2J+1),
+// formed in Real as ((sw x_c + se x_c(east)) + nw x_c(north)) + ne x_c(north-east), both
+// added in double. Four coarse nodes at a time cover eight texels; when all eight are active
+// the two vectors of x are updated whole, their other lanes rewritten unchanged (selected
+// from the loaded values, not added to zero, which would turn -0 into +0: no other thread
+// writes this row meanwhile), else the texels go one by one.
+template <class Real>
+DGTEX_ROW_INLINE void prolong_correction_red_impl(GridShape fine, GridShape coarse, InterpolationViewOf<Real> p,
+                                                  const Real* x_coarse, const std::uint8_t* fine_active,
+                                                  double* x_fine, int j) {
+  const std::int64_t cs = coarse.stride(), row = fine.at(0, j), crow = coarse.at(0, j >> 1);
+  const bool odd = j & 1;
+  auto one = [&](int i) {
+    const std::int64_t t = row + i, c = crow + (i >> 1);
+    if (!fine_active[t]) return;
+    if (odd)
+      x_fine[t] += p.sw[c] * x_coarse[c] + p.se[c] * x_coarse[c + 1] + p.nw[c] * x_coarse[c + cs] +
+                   p.ne[c] * x_coarse[c + cs + 1];
+    else
+      x_fine[t] += x_coarse[c];
+  };
+  int i0 = 0;
+  for (; i0 + 8 <= fine.nx; i0 += 8) {
+    const std::int64_t t = row + i0, c = crow + (i0 >> 1);
+    if (!eight_interior_active(fine_active + t)) {
+      for (int i = i0 + odd; i < i0 + 8; i += 2) one(i);
+      continue;
+    }
+    using V = typename LanesOf<Real>::type;
+    Lanes4 correction;
+    if (odd) {
+      const V formed = load_lanes(p.sw + c) * load_lanes(x_coarse + c) + load_lanes(p.se + c) * load_lanes(x_coarse + c + 1) +
+                       load_lanes(p.nw + c) * load_lanes(x_coarse + c + cs) +
+                       load_lanes(p.ne + c) * load_lanes(x_coarse + c + cs + 1);
+      correction = widen_lanes_of(formed);
+    } else {
+      correction = widen_lanes(x_coarse + c);
+    }
+    const Lanes4 low = load4(x_fine + t), high = load4(x_fine + t + 4);
+    // Lane k of the correction goes to texel i0 + 2k + odd.
+    const Lanes4 spread_low = __builtin_shuffle(correction, Lanes4Index{0, 0, 1, 1});
+    const Lanes4 spread_high = __builtin_shuffle(correction, Lanes4Index{2, 2, 3, 3});
+    const Lanes4 sum_low = low + spread_low, sum_high = high + spread_high;
+    const Lanes4Index keep = odd ? Lanes4Index{4, 1, 6, 3} : Lanes4Index{0, 5, 2, 7};
+    store4(x_fine + t, __builtin_shuffle(sum_low, low, keep));
+    store4(x_fine + t + 4, __builtin_shuffle(sum_high, high, keep));
+  }
+  for (int i = i0 + odd; i < fine.nx; i += 2) one(i);
+}
+
 // One set of row functions per instruction set: the same source, compiled for baseline
 // x86-64 (SSE2: a 4-lane vector is two registers) and for AVX2 (one register).
 #define DGTEX_TEXEL_ROW_KERNELS(ATTRIBUTE, NAME)                                                                     \
@@ -379,7 +510,23 @@ DGTEX_ROW_INLINE void stencil9_residual_impl(GridShape g, Stencil9ViewOf<Real> a
   }                                                                                                                  \
   const Stencil9RowKernels<double> NAME##_stencil9_double = {NAME##_smooth9_color<double>,                          \
                                                             NAME##_residual9<double>};                              \
-  const Stencil9RowKernels<float> NAME##_stencil9_float = {NAME##_smooth9_color<float>, NAME##_residual9<float>};
+  const Stencil9RowKernels<float> NAME##_stencil9_float = {NAME##_smooth9_color<float>, NAME##_residual9<float>};     \
+  template <class Real>                                                                                              \
+  ATTRIBUTE void NAME##_red_residual_restricted(GridShape fine, GridShape coarse, InterpolationViewOf<Real> p,       \
+                                                const std::uint8_t* bits, const double* b, const double* x,          \
+                                                Real* b_coarse, int J) {                                             \
+    red_residual_restricted_impl(fine, coarse, p, bits, b, x, b_coarse, J);                                          \
+  }                                                                                                                  \
+  template <class Real>                                                                                              \
+  ATTRIBUTE void NAME##_prolong_correction_red(GridShape fine, GridShape coarse, InterpolationViewOf<Real> p,        \
+                                               const Real* x_coarse, const std::uint8_t* fine_active,               \
+                                               double* x_fine, int j) {                                              \
+    prolong_correction_red_impl(fine, coarse, p, x_coarse, fine_active, x_fine, j);                                   \
+  }                                                                                                                  \
+  const TexelTransferRowKernels<double> NAME##_transfer_double = {NAME##_red_residual_restricted<double>,            \
+                                                                  NAME##_prolong_correction_red<double>};           \
+  const TexelTransferRowKernels<float> NAME##_transfer_float = {NAME##_red_residual_restricted<float>,              \
+                                                                NAME##_prolong_correction_red<float>};
 
 DGTEX_TEXEL_ROW_KERNELS(, baseline_rows)
 DGTEX_TEXEL_ROW_KERNELS(__attribute__((target("avx2"))), avx2_rows)
@@ -411,6 +558,21 @@ template <class Real>
 const Stencil9RowKernels<Real>& stencil9_rows() {
   return stencil9_rows<Real>(avx2_supported() ? RowPath::avx2 : RowPath::baseline);
 }
+template <class Real>
+const TexelTransferRowKernels<Real>& texel_transfer_rows(RowPath path) {
+  if constexpr (std::is_same_v<Real, float>)
+    return path == RowPath::avx2 ? avx2_rows_transfer_float : baseline_rows_transfer_float;
+  else
+    return path == RowPath::avx2 ? avx2_rows_transfer_double : baseline_rows_transfer_double;
+}
+template <class Real>
+const TexelTransferRowKernels<Real>& texel_transfer_rows() {
+  return texel_transfer_rows<Real>(avx2_supported() ? RowPath::avx2 : RowPath::baseline);
+}
+template const TexelTransferRowKernels<double>& texel_transfer_rows<double>(RowPath);
+template const TexelTransferRowKernels<float>& texel_transfer_rows<float>(RowPath);
+template const TexelTransferRowKernels<double>& texel_transfer_rows<double>();
+template const TexelTransferRowKernels<float>& texel_transfer_rows<float>();
 template const Stencil9RowKernels<double>& stencil9_rows<double>(RowPath);
 template const Stencil9RowKernels<float>& stencil9_rows<float>(RowPath);
 template const Stencil9RowKernels<double>& stencil9_rows<double>();

@@ -84,6 +84,22 @@ const Stencil9RowKernels<Real>& stencil9_rows();
 template <class Real>
 const Stencil9RowKernels<Real>& stencil9_rows(RowPath path);
 
+// Level 0 to level 1 (Real = level 1's type).
+template <class Real>
+struct TexelTransferRowKernels {
+  // Coarse row J of P^T r, r = b - A x at the red unknowns ((i + j) even) and 0 elsewhere
+  // (restrict_red_residual_texels).
+  void (*red_residual_restricted)(GridShape fine, GridShape coarse, InterpolationViewOf<Real> p,
+                                  const std::uint8_t* bits, const double* b, const double* x, Real* b_coarse, int J);
+  // Fine row j: x += P x_c at the red nodes whose fine_active byte is 1 (prolong_correction_red).
+  void (*prolong_correction_red)(GridShape fine, GridShape coarse, InterpolationViewOf<Real> p, const Real* x_coarse,
+                                 const std::uint8_t* fine_active, double* x_fine, int j);
+};
+template <class Real>
+const TexelTransferRowKernels<Real>& texel_transfer_rows();
+template <class Real>
+const TexelTransferRowKernels<Real>& texel_transfer_rows(RowPath path);
+
 // Scalar per-texel forms shared by the fast paths and the references.
 // 1 / degree by the degree bits (computed as 1.0 / d, as the references divide).
 constexpr double inverse_degree[8] = {0.0, 1.0, 1.0 / 2.0, 1.0 / 3.0, 1.0 / 4.0, 0.0, 0.0, 0.0};

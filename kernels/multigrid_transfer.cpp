@@ -1,5 +1,7 @@
 #include "dgtex/kernels/multigrid_transfer.h"
 
+#include "multigrid_rows.h"
+
 namespace dgtex::kernels {
 namespace {
 
@@ -128,28 +130,15 @@ void restrict_red_residual_plain(GridShape fine, GridShape coarse, Interpolation
     }
 }
 
-// Level 0 (double) from a double or float coarse level: the correction is formed in Real.
+// Level 0 (double) from a double or float coarse level: the correction is formed in Real
+// (row loops with a vector fast path: multigrid_rows.h).
 template <class Real>
 void prolong_correction_red_rows(GridShape fine, GridShape coarse, InterpolationViewOf<Real> p, const Real* x_coarse,
                                  const std::uint8_t* fine_active, double* x_fine, Execution execution) {
-  const std::int64_t cs = coarse.stride();
+  const auto row_kernel = detail::texel_transfer_rows<Real>().prolong_correction_red;
   forall(
       fine.ny,
-      [&](std::int64_t j64) {
-        const int j = static_cast<int>(j64);
-        const std::int64_t row = fine.at(0, j), crow = coarse.at(0, j >> 1);
-        if ((j & 1) == 0) {
-          for (int i = 0; i < fine.nx; i += 2)
-            if (fine_active[row + i]) x_fine[row + i] += x_coarse[crow + (i >> 1)];
-        } else {
-          for (int i = 1; i < fine.nx; i += 2) {
-            if (!fine_active[row + i]) continue;
-            const std::int64_t c = crow + (i >> 1);
-            x_fine[row + i] += p.sw[c] * x_coarse[c] + p.se[c] * x_coarse[c + 1] + p.nw[c] * x_coarse[c + cs] +
-                               p.ne[c] * x_coarse[c + cs + 1];
-          }
-        }
-      },
+      [&](std::int64_t j) { row_kernel(fine, coarse, p, x_coarse, fine_active, x_fine, static_cast<int>(j)); },
       execution);
 }
 
