@@ -7,6 +7,7 @@
 #include <string>
 #include <cstdint>
 #include <cstdlib>
+#include <cstring>
 #include <strings.h>
 #include <type_traits>
 
@@ -667,6 +668,14 @@ LaplaceSolveStats LaplaceMultigrid::solve(kernels::TexelTile& tile, std::vector<
   // over level 0 fewer (of ~50 per solve at 6 iterations), bitwise the same results.
   h.row_partial.resize(g.ny);
   std::vector<std::uint8_t> row_has_guess(g.ny, 0);
+  auto four_interior_texels = [](const std::uint8_t* bits) {
+    constexpr std::uint32_t interior = kernels::is_unknown | kernels::couples_west_unknown |
+                                       kernels::couples_east_unknown | kernels::couples_south_unknown |
+                                       kernels::couples_north_unknown | (4u << kernels::degree_shift);
+    std::uint32_t word;
+    std::memcpy(&word, bits, sizeof word);
+    return word == 0x01010101u * interior;
+  };
   kernels::forall(
       g.ny,
       [&](std::int64_t j64) {
@@ -674,6 +683,14 @@ LaplaceSolveStats LaplaceMultigrid::solve(kernels::TexelTile& tile, std::vector<
         double b2 = 0;
         for (int i = 0; i < g.nx; ++i) {
           const std::int64_t t = g.at(i, j);
+          // Four unknowns coupled to four unknowns each and no guess to read: b = r = x = 0
+          // (b2 += 0 changes nothing). Callgrind, open T = 1024: this pass 41 -> 15
+          // instructions a texel.
+          if (!o.warm_start && (i & 3) == 0 && i + 4 <= g.nx && four_interior_texels(&h.bits[t])) {
+            for (int l = 0; l < 4; ++l) fine.b[t + l] = fine.r[t + l] = fine.x[t + l] = 0.0;
+            i += 3;
+            continue;
+          }
           fine.b[t] = 0.0;
           fine.r[t] = 0.0;
           fine.x[t] = 0.0;
@@ -806,10 +823,18 @@ LaplaceSolveStats LaplaceMultigrid::solve(kernels::TexelTile& tile, std::vector<
       g.ny,
       [&](std::int64_t j64) {
         const int j = static_cast<int>(j64);
+        const std::uint8_t* flags = tile.flags.data() + tile.index(0, j);
+        double* values = tile.values.data() + tile.index(0, j);
+        const std::uint8_t* bits = h.bits.data() + g.at(0, j);
+        const double* x = fine.x.data() + g.at(0, j);
         for (int i = 0; i < g.nx; ++i) {
-          const int k = tile.index(i, j);
-          if (tile.flags[k] & (kernels::dirichlet | kernels::inactive)) continue;
-          tile.values[k] = (h.bits[g.at(i, j)] & kernels::is_unknown) ? fine.x[g.at(i, j)] : 0.0;
+          if ((i & 3) == 0 && i + 4 <= g.nx && four_interior_texels(bits + i)) {  // four unknowns
+            std::memcpy(values + i, x + i, 4 * sizeof(double));
+            i += 3;
+            continue;
+          }
+          if (flags[i] & (kernels::dirichlet | kernels::inactive)) continue;
+          values[i] = (bits[i] & kernels::is_unknown) ? x[i] : 0.0;
         }
       },
       fine.execution);
