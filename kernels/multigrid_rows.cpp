@@ -513,6 +513,54 @@ DGTEX_ROW_INLINE void prolong_correction_red_impl(GridShape fine, GridShape coar
   for (int i = i0 + odd; i < fine.nx; i += 2) one(i);
 }
 
+// Fine row j of the coarse correction between 9-point levels (prolong_correction): every
+// active fine node gets (P x_c) formed in Real as prolong_correction_plain forms it. Four
+// coarse nodes at a time cover eight fine nodes; when all eight are active, the corrections
+// of the even and odd fine columns are two vectors, interleaved and added to x whole.
+template <class Real>
+DGTEX_ROW_INLINE void prolong_correction_impl(GridShape fine, GridShape coarse, InterpolationViewOf<Real> p,
+                                              const Real* x_coarse, const std::uint8_t* fine_active, Real* x_fine,
+                                              int j) {
+  using V = typename LanesOf<Real>::type;
+  using I = typename LanesOf<Real>::index;
+  const std::int64_t cs = coarse.stride(), row = fine.at(0, j), crow = coarse.at(0, j >> 1);
+  const bool odd_row = j & 1;
+  const Real* x = x_coarse;
+  auto one = [&](int i) {
+    const std::int64_t c = crow + (i >> 1), t = row + i;
+    if (!fine_active[t]) return;
+    if (!odd_row)
+      x_fine[t] += (i & 1) ? p.xw[c] * x[c] + p.xe[c] * x[c + 1] : x[c];
+    else if (!(i & 1))
+      x_fine[t] += p.ys[c] * x[c] + p.yn[c] * x[c + cs];
+    else
+      x_fine[t] += p.sw[c] * x[c] + p.se[c] * x[c + 1] + p.nw[c] * x[c + cs] + p.ne[c] * x[c + cs + 1];
+  };
+  int i0 = 0;
+  for (; i0 + 8 <= fine.nx; i0 += 8) {
+    const std::int64_t c = crow + (i0 >> 1), t = row + i0;
+    if (!eight_interior_active(fine_active + t)) {
+      for (int i = i0; i < i0 + 8; ++i) one(i);
+      continue;
+    }
+    auto L = [](const Real* q) { return load_lanes(q); };
+    V even, odd;
+    if (!odd_row) {
+      even = L(x + c);
+      odd = L(p.xw + c) * L(x + c) + L(p.xe + c) * L(x + c + 1);
+    } else {
+      even = L(p.ys + c) * L(x + c) + L(p.yn + c) * L(x + c + cs);
+      odd = L(p.sw + c) * L(x + c) + L(p.se + c) * L(x + c + 1) + L(p.nw + c) * L(x + c + cs) +
+            L(p.ne + c) * L(x + c + cs + 1);
+    }
+    const V low = L(x_fine + t) + __builtin_shuffle(even, odd, I{0, 4, 1, 5});
+    const V high = L(x_fine + t + 4) + __builtin_shuffle(even, odd, I{2, 6, 3, 7});
+    std::memcpy(x_fine + t, &low, sizeof low);
+    std::memcpy(x_fine + t + 4, &high, sizeof high);
+  }
+  for (; i0 < fine.nx; ++i0) one(i0);
+}
+
 // One set of row functions per instruction set: the same source, compiled for baseline
 // x86-64 (SSE2: a 4-lane vector is two registers) and for AVX2 (one register).
 #define DGTEX_TEXEL_ROW_KERNELS(ATTRIBUTE, NAME)                                                                     \
@@ -553,9 +601,15 @@ DGTEX_ROW_INLINE void prolong_correction_red_impl(GridShape fine, GridShape coar
                                   int j) {                                                                          \
     stencil9_residual_impl(g, a, b, x, r, j);                                                                       \
   }                                                                                                                  \
-  const Stencil9RowKernels<double> NAME##_stencil9_double = {NAME##_smooth9_color<double>,                          \
-                                                            NAME##_residual9<double>};                              \
-  const Stencil9RowKernels<float> NAME##_stencil9_float = {NAME##_smooth9_color<float>, NAME##_residual9<float>};     \
+  template <class Real>                                                                                              \
+  ATTRIBUTE void NAME##_prolong9(GridShape fine, GridShape coarse, InterpolationViewOf<Real> p, const Real* x_coarse, \
+                                 const std::uint8_t* fine_active, Real* x_fine, int j) {                             \
+    prolong_correction_impl(fine, coarse, p, x_coarse, fine_active, x_fine, j);                                     \
+  }                                                                                                                  \
+  const Stencil9RowKernels<double> NAME##_stencil9_double = {NAME##_smooth9_color<double>, NAME##_residual9<double>, \
+                                                            NAME##_prolong9<double>};                               \
+  const Stencil9RowKernels<float> NAME##_stencil9_float = {NAME##_smooth9_color<float>, NAME##_residual9<float>,     \
+                                                          NAME##_prolong9<float>};                                  \
   template <class Real>                                                                                              \
   ATTRIBUTE void NAME##_red_residual_restricted(GridShape fine, GridShape coarse, InterpolationViewOf<Real> p,       \
                                                 const std::uint8_t* bits, const double* b, const double* x,          \

@@ -78,6 +78,10 @@ struct Stencil9RowKernels {
   void (*smooth_color)(GridShape, Stencil9ViewOf<Real> a, const Real* b, Real* x, int j, int ci);
   // r = b - A x (0 where c = 0).
   void (*residual)(GridShape, Stencil9ViewOf<Real> a, const Real* b, const Real* x, Real* r, int j);
+  // Fine row j (a 9-point level): x += P x_c at the nodes whose fine_active byte is 1
+  // (prolong_correction; the coarse level is fine.coarser()).
+  void (*prolong_correction)(GridShape fine, GridShape coarse, InterpolationViewOf<Real> p, const Real* x_coarse,
+                             const std::uint8_t* fine_active, Real* x_fine, int j);
 };
 template <class Real>
 const Stencil9RowKernels<Real>& stencil9_rows();

@@ -49,31 +49,15 @@ void restrict_residual_plain(GridShape fine, GridShape coarse, InterpolationView
     }
 }
 
+// (P x) at each fine node by its parity, as prolong_correction_plain forms it (row loops with
+// a vector fast path: multigrid_rows.h).
 template <class Real>
 void prolong_correction_rows(GridShape fine, GridShape coarse, InterpolationViewOf<Real> p, const Real* x_coarse,
                              const std::uint8_t* fine_active, Real* x_fine, Execution execution) {
-  // (P x) at each fine node by its parity, as prolong_correction_plain forms it; the parity
-  // is known per row and column pair, so no per-node switch (callgrind: ~2x fewer
-  // instructions than a switch per node).
-  const std::int64_t cs = coarse.stride();
+  const auto row_kernel = detail::stencil9_rows<Real>().prolong_correction;
   forall(
       fine.ny,
-      [&](std::int64_t j64) {
-        const int j = static_cast<int>(j64);
-        const std::int64_t row = fine.at(0, j), crow = coarse.at(0, j >> 1);
-        const Real* x = x_coarse;
-        for (int i = 0; i < fine.nx; i += 2) {
-          const std::int64_t c = crow + (i >> 1), t = row + i;
-          if ((j & 1) == 0) {
-            if (fine_active[t]) x_fine[t] += x[c];
-            if (i + 1 < fine.nx && fine_active[t + 1]) x_fine[t + 1] += p.xw[c] * x[c] + p.xe[c] * x[c + 1];
-          } else {
-            if (fine_active[t]) x_fine[t] += p.ys[c] * x[c] + p.yn[c] * x[c + cs];
-            if (i + 1 < fine.nx && fine_active[t + 1])
-              x_fine[t + 1] += p.sw[c] * x[c] + p.se[c] * x[c + 1] + p.nw[c] * x[c + cs] + p.ne[c] * x[c + cs + 1];
-          }
-        }
-      },
+      [&](std::int64_t j) { row_kernel(fine, coarse, p, x_coarse, fine_active, x_fine, static_cast<int>(j)); },
       execution);
 }
 
