@@ -4,7 +4,11 @@
 #include <omp.h>
 
 #include <Eigen/SparseCore>
+#include <iterator>
+#include <limits>
 #include <random>
+#include <stdexcept>
+#include <string>
 
 #include "dgtex/kernels/multigrid_galerkin.h"
 #include "dgtex/kernels/multigrid_residual.h"
@@ -14,6 +18,7 @@
 #include "dgtex/laplace_direct.h"
 #include "dgtex/laplace_domains.h"
 #include "dgtex/laplace_multigrid.h"
+#include "dgtex/laplace_problem.h"
 #include "multigrid_rows.h"  // internal: the row loops and their two forms
 
 namespace dgtex {
@@ -342,6 +347,85 @@ TEST(MultigridClassification, RandomTilesWithIsolatedComponentsEqualReference) {
     const int zr = classify_laplace_texels_reference(tile, ref);
     EXPECT_EQ(classify_laplace_texels(tile, fast, Execution::serial), zr);
     EXPECT_EQ(ref, fast) << "tile " << k << " (" << tile.width << "x" << tile.height << ")";
+  }
+}
+
+TEST(MultigridClassification, LargeRandomTilesWithLongRunsEqualReferenceInEveryForm) {
+  // Few walls (in segments), sparse Dirichlet texels and inactive blocks: long runs, few
+  // components, some without data; widths around the fast form's 16- and 64-texel chunks.
+  std::mt19937 rng(11);
+  const int widths[] = {1, 2, 3, 15, 16, 17, 18, 31, 33, 63, 64, 65, 66, 100, 127, 128, 129, 130, 191, 257, 300};
+  int tiles_with_zeroed = 0;
+  for (int k = 0; k < 80; ++k) {
+    const int w = widths[k % std::size(widths)], h = 1 + static_cast<int>(rng() % 150);
+    TexelTile tile(w, h);
+    const int segments = static_cast<int>(rng() % 12);
+    for (int s = 0; s < segments; ++s) {  // a wall segment along a row or a column
+      const bool vertical = rng() % 2;
+      const int i0 = static_cast<int>(rng() % w), j0 = static_cast<int>(rng() % h);
+      const int length = 1 + static_cast<int>(rng() % std::max(w, h));
+      for (int l = 0; l < length; ++l) {
+        const int i = vertical ? i0 : i0 + l, j = vertical ? j0 + l : j0;
+        if (i < w && j < h) tile.flags[tile.index(i, j)] |= vertical ? wall_east : wall_north;
+      }
+    }
+    const int blocks = static_cast<int>(rng() % 4);
+    for (int b = 0; b < blocks; ++b) {  // an inactive rectangle
+      const int i0 = static_cast<int>(rng() % w), j0 = static_cast<int>(rng() % h);
+      const int bw = 1 + static_cast<int>(rng() % 20), bh = 1 + static_cast<int>(rng() % 20);
+      for (int j = j0; j < std::min(h, j0 + bh); ++j)
+        for (int i = i0; i < std::min(w, i0 + bw); ++i) tile.flags[tile.index(i, j)] |= inactive;
+    }
+    for (auto& f : tile.flags) {
+      if (rng() % 400 == 0) f |= dirichlet;
+      if (rng() % 300 == 0) f |= inactive;
+    }
+    std::vector<std::uint8_t> ref, serial;
+    const int zr = classify_laplace_texels_reference(tile, ref);
+    tiles_with_zeroed += zr > 0;
+    EXPECT_EQ(classify_laplace_texels(tile, serial, Execution::serial), zr);
+    EXPECT_EQ(ref, serial) << "tile " << k << " (" << w << "x" << h << ")";
+    for (int threads : {2, 3}) {
+      omp_set_num_threads(threads);
+      std::vector<std::uint8_t> parallel(7, 0xff);  // resized (not cleared) by the kernel
+      EXPECT_EQ(classify_laplace_texels(tile, parallel, Execution::parallel), zr);
+      EXPECT_EQ(ref, parallel) << "tile " << k << ", " << threads << " threads";
+      const GridShape g{w, h};
+      std::vector<std::uint8_t> padded(g.padded_size(), 0xff);
+      EXPECT_EQ(classify_laplace_texels_padded(tile, padded.data(), Execution::parallel), zr);
+      for (int j = -1; j <= h; ++j)
+        for (int i = -1; i <= w; ++i) {
+          const bool inside = i >= 0 && j >= 0 && i < w && j < h;
+          ASSERT_EQ(padded[g.at(i, j)], inside ? ref[tile.index(i, j)] : 0) << "tile " << k << " at " << i << "," << j;
+        }
+    }
+  }
+  // Both kinds of tile occur: with and without components lacking data.
+  EXPECT_GT(tiles_with_zeroed, 10);
+  EXPECT_LT(tiles_with_zeroed, 70);
+}
+
+TEST(LaplaceTileValidation, NamesTheFirstDirichletTexelWithANonFiniteValue) {
+  // Widths that are and are not multiples of the validation's 8-texel groups.
+  for (int w : {3, 8, 13}) {
+    TexelTile tile(w, 5);
+    for (int j = 0; j < 5; ++j) tile.flags[tile.index(w - 1, j)] |= dirichlet;
+    tile.values[tile.index(1, 1)] = std::numeric_limits<double>::quiet_NaN();  // not Dirichlet: fine
+    EXPECT_NO_THROW(validate_laplace_tile(tile));
+    for (double bad : {std::numeric_limits<double>::infinity(), -std::numeric_limits<double>::infinity(),
+                       std::numeric_limits<double>::quiet_NaN()})
+      for (int j : {4, 2}) {  // the last texel of the tile, then one before it: the first is named
+        TexelTile broken = tile;
+        broken.values[broken.index(w - 1, j)] = bad;
+        if (j == 2) broken.values[broken.index(w - 1, 4)] = bad;
+        try {
+          validate_laplace_tile(broken);
+          ADD_FAILURE() << "no exception for width " << w << ", row " << j;
+        } catch (const std::invalid_argument& e) {
+          EXPECT_EQ(std::string(e.what()), "Laplace solve: Dirichlet texel " + std::to_string(w - 1) + "," +
+                                               std::to_string(j) + " has a non-finite value");
+        }
+      }
   }
 }
 

@@ -43,10 +43,12 @@ inline bool texels_coupled_north(const TexelTile& tile, int i, int j) {
 
 // Writes one LaplaceTexelBits byte per texel into `bits` (width * height). Returns the
 // number of free texels in components without Dirichlet data (not unknowns, value 0).
-// Couplings and degrees are per-texel gathers (parallel rows); the components of free
-// texels are found by union-find over runs of east-coupled free texels (serial, a few
-// operations per run and per north link), so setup costs a few passes over the flags
-// instead of a per-texel flood fill. The result does not depend on the execution.
+// One branch-free pass over the flags (parallel rows, 16 texels a vector) writes the bytes
+// as if every component had Dirichlet data, and bitsets of run ends, south links and
+// Dirichlet contacts; the components of free texels are then found by union-find over runs
+// of east-coupled free texels (intervals of a row, united where they overlap a south link),
+// and only the texels of components without data are rewritten. The result does not
+// depend on the execution.
 int classify_laplace_texels(const TexelTile& tile, std::vector<std::uint8_t>& bits,
                             Execution execution = Execution::parallel);
 // The same bytes written into a padded grid (multigrid_grid.h layout: (width+2) x
