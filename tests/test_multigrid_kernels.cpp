@@ -429,7 +429,7 @@ TEST(LaplaceTileValidation, NamesTheFirstDirichletTexelWithANonFiniteValue) {
   }
 }
 
-// The row loops behind the level-0 and 9-point kernels have a baseline (SSE2) and an AVX2
+// The row loops behind the level-0, 9-point and transfer kernels have a baseline (SSE2) and an AVX2
 // form (multigrid_rows.h); the parallel-vs-reference tests above run the form this machine
 // picks, this one checks the two forms give the same bits, row by row, with a partial group
 // of four at the end of every row (width 101).
@@ -509,6 +509,46 @@ TEST_P(MultigridKernels, RowLoopFormsAgreeBitwise) {
   }
   EXPECT_EQ(xf[0], xf[1]);
   EXPECT_EQ(rf[0], rf[1]);
+  // Level-0 transfers and the 9-point prolongation (here on level 0's grid and P), with the
+  // coarse level in double and in float.
+  std::vector<std::uint8_t> active(L.bits.size());
+  for (std::size_t t = 0; t < active.size(); ++t) active[t] = (L.bits[t] & is_unknown) ? 1 : 0;
+  std::vector<std::vector<float>> pf;
+  for (const auto& v : L.p) pf.push_back(to_float(v));
+  const InterpolationViewFloat p_float{pf[0].data(), pf[1].data(), pf[2].data(), pf[3].data(),
+                                       pf[4].data(), pf[5].data(), pf[6].data(), pf[7].data()};
+  const std::vector<float> xcf = to_float(L.xc);
+  std::vector<double> bc[2], xd[2], x9[2];
+  std::vector<float> bcf[2], x9f[2];
+  for (int f = 0; f < 2; ++f) {
+    const auto path = f == 0 ? detail::RowPath::baseline : detail::RowPath::avx2;
+    const auto& transfer = detail::texel_transfer_rows<double>(path);
+    const auto& transfer_float = detail::texel_transfer_rows<float>(path);
+    bc[f].assign(L.xc.size(), 0.0);
+    bcf[f].assign(L.xc.size(), 0.0f);
+    xd[f] = L.x;
+    x9[f] = L.x;
+    x9f[f] = to_float(L.x);
+    std::vector<double> x_from_float = L.x;
+    for (int J = 0; J < c.ny; ++J) {
+      transfer.red_residual_restricted(g, c, L.P().view(), bits, L.b.data(), L.x.data(), bc[f].data(), J);
+      transfer_float.red_residual_restricted(g, c, p_float, bits, L.b.data(), L.x.data(), bcf[f].data(), J);
+    }
+    for (int j = 0; j < g.ny; ++j) {
+      transfer.prolong_correction_red(g, c, L.P().view(), L.xc.data(), active.data(), xd[f].data(), j);
+      transfer_float.prolong_correction_red(g, c, p_float, xcf.data(), active.data(), x_from_float.data(), j);
+      detail::stencil9_rows<double>(path).prolong_correction(g, c, L.P().view(), L.xc.data(), active.data(),
+                                                              x9[f].data(), j);
+      detail::stencil9_rows<float>(path).prolong_correction(g, c, p_float, xcf.data(), active.data(), x9f[f].data(),
+                                                             j);
+    }
+    xd[f].insert(xd[f].end(), x_from_float.begin(), x_from_float.end());
+  }
+  EXPECT_EQ(bc[0], bc[1]);
+  EXPECT_EQ(bcf[0], bcf[1]);
+  EXPECT_EQ(xd[0], xd[1]);
+  EXPECT_EQ(x9[0], x9[1]);
+  EXPECT_EQ(x9f[0], x9f[1]);
 }
 
 INSTANTIATE_TEST_SUITE_P(Domains, MultigridKernels,
