@@ -322,6 +322,12 @@ void galerkin(GridShape fine, const Entries& a, InterpolationViewOf<Real> p, Ste
 // Galerkin row also the interpolation weights it reads, compared as stored). The general
 // code gives such a node the same bits (same operations on the same values; this file is
 // compiled without FMA contraction), so results do not depend on which path a node takes.
+// What the window (x, y in 2I - 2 .. 2I + 3) must cover: a 9-point row of fine node f is read
+// from the arrays at f, f - 1, f - s and f - s -+ 1. The weights of (I, J) read the rows of
+// (2I+1, 2J), (2I, 2J+1), (2I+1, 2J+1) and, through the pass-1 weights of (I+1, J) and
+// (I, J+1), of (2I+2, 2J+1) and (2I+1, 2J+2): arrays within 2I - 1 .. 2I + 3. The Galerkin
+// row reads the rows of the 3 x 3 fine nodes around (2I, 2J) (arrays within 2I - 2 .. 2I + 2)
+// and the weights of the 3 x 3 coarse nodes around (I, J), checked on their own.
 // Measured (callgrind, `dgtex bench laplace --sizes 1024 --domains open spiral --solvers
 // multigrid --repeat 1`, 1 thread): building the coarse levels 737M -> 276M instructions;
 // the whole setup with the classification's rework 1129M -> 340M.

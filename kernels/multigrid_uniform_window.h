@@ -4,7 +4,7 @@
 //   x in [2I - 2, 2I + 3], y in [2J - 2, 2J + 3]
 // around coarse node (I, J) satisfies a predicate (its stencil values are those of one
 // translation-invariant row). The window covers every fine value that the interpolation
-// weights and the Galerkin row of (I, J) read (multigrid_galerkin.cpp says which); fine
+// weights and the Galerkin row of (I, J) read (multigrid_galerkin.cpp lists them); fine
 // nodes outside the grid never qualify.
 #include <cstdint>
 #include <vector>
