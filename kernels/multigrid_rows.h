@@ -74,7 +74,9 @@ const TexelRowKernels& texel_rows(RowPath path);
 // 9-point levels, Real = double or float.
 template <class Real>
 struct Stencil9RowKernels {
-  // Gauss-Seidel update of the nodes with i % 2 == ci and c > 0 (one colour of row j).
+  // Gauss-Seidel update of the nodes with i % 2 == ci and c > 0 (one colour of row j). It
+  // rewrites row j's other nodes with their own values: no other thread may access row j
+  // during the call.
   void (*smooth_color)(GridShape, Stencil9ViewOf<Real> a, const Real* b, Real* x, int j, int ci);
   // r = b - A x (0 where c = 0).
   void (*residual)(GridShape, Stencil9ViewOf<Real> a, const Real* b, const Real* x, Real* r, int j);
