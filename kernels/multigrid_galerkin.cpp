@@ -360,7 +360,7 @@ void uniform_results(UniformRegion<Real>& region, const Interpolate& interpolate
 template <class Real>
 UniformRegion<Real> uniform_texel_region(GridShape fine, const std::uint8_t* bits, Execution execution) {
   UniformRegion<Real> region;
-  const std::vector<std::uint8_t> filled(GridShape{8, 8}.padded_size(), detail::interior_texel);
+  const std::vector<std::uint8_t> filled(GridShape{8, 8}.padded_size(), interior_texel);
   uniform_results(
       region,
       [&](GridShape g, InterpolationArraysOf<Real> p) {
@@ -370,7 +370,7 @@ UniformRegion<Real> uniform_texel_region(GridShape fine, const std::uint8_t* bit
         galerkin(g, TexelEntries{filled.data()}, p, out, Execution::serial);
       });
   region.windows =
-      detail::uniform_windows(fine, [bits](std::int64_t f) { return bits[f] == detail::interior_texel; }, execution);
+      detail::uniform_windows(fine, [bits](std::int64_t f) { return bits[f] == interior_texel; }, execution);
   return region;
 }
 

@@ -13,11 +13,6 @@ DGTEX_ROW_INLINE Lanes4 load4(const double* p) {
   return v;
 }
 DGTEX_ROW_INLINE void store4(double* p, Lanes4 v) { std::memcpy(p, &v, sizeof v); }
-DGTEX_ROW_INLINE bool four_interior(const std::uint8_t* bits) {
-  std::uint32_t word;
-  std::memcpy(&word, bits, sizeof word);
-  return word == 0x01010101u * interior_texel;
-}
 DGTEX_ROW_INLINE double lanes_total(Lanes4 v) { return (v[0] + v[1]) + (v[2] + v[3]); }
 // Stores lanes first and first + 2 of v (one colour of a group) and nothing else: the other
 // lanes belong to the other colour, which other threads may read right now (lagged rows).
@@ -39,7 +34,7 @@ DGTEX_ROW_INLINE void for_groups(GridShape g, const std::uint8_t* row_bits, Full
   const int nx = g.nx;
   int i0 = 0;
   for (; i0 + 4 <= nx; i0 += 4) {
-    if (!needs_interior || four_interior(row_bits + i0)) {
+    if (!needs_interior || four_interior_texels(row_bits + i0)) {
       full(i0);
     } else {
       for (int l = 0; l < 4; ++l) one(i0 + l, l);
@@ -51,6 +46,10 @@ DGTEX_ROW_INLINE void for_groups(GridShape g, const std::uint8_t* row_bits, Full
 // (((4 x - west) - east) - south) - north, the order of texel_operator.
 DGTEX_ROW_INLINE Lanes4 interior_operator(const double* x, std::int64_t t, std::int64_t s) {
   return (((4.0 * load4(x + t) - load4(x + t - 1)) - load4(x + t + 1)) - load4(x + t - s)) - load4(x + t + s);
+}
+// b - A x of four interior texels (texel_residual's order).
+DGTEX_ROW_INLINE Lanes4 interior_residual(const double* b, const double* x, std::int64_t t, std::int64_t s) {
+  return load4(b + t) - interior_operator(x, t, s);
 }
 
 typedef std::int64_t Lanes4Index __attribute__((vector_size(32)));
@@ -83,7 +82,7 @@ DGTEX_ROW_INLINE void smooth_color_impl(GridShape g, const std::uint8_t* bits, c
     const std::int64_t t = row + i0;
     // x(t + 4) is the east ghost when the group ends the row; lanes past it are not used.
     const Lanes4 next = i0 + 8 <= nx ? load4(x + t + 4) : Lanes4{x[t + 4], 0.0, 0.0, 0.0};
-    if (four_interior(bits + t)) {
+    if (four_interior_texels(bits + t)) {
       // ((((b + west) + east) + south) + north) / 4, in texel_smoothed's order.
       const Lanes4 v =
           ((((load4(b + t) + west_of(previous, current)) + east_of(current, next)) + load4(x + t - s)) +
@@ -131,12 +130,12 @@ DGTEX_ROW_INLINE void residual_color_impl(GridShape g, const std::uint8_t* bits,
       g, bits + row,
       [&](int i0) {
         const std::int64_t t = row + i0;
-        store_colour_lanes(r + t, first, load4(b + t) - interior_operator(x, t, s));
+        store_colour_lanes(r + t, first, interior_residual(b, x, t, s));
       },
       [&](int i, int lane) {
         const std::int64_t t = row + i;
         const std::uint8_t m = bits[t];
-        if ((lane & 1) == first) r[t] = (m & is_unknown) ? b[t] - texel_operator(m, x, t, s) : 0.0;
+        if ((lane & 1) == first) r[t] = texel_residual(m, b, x, t, s);
       });
 }
 
@@ -148,14 +147,14 @@ DGTEX_ROW_INLINE double residual_impl(GridShape g, const std::uint8_t* bits, con
       g, bits + row,
       [&](int i0) {
         const std::int64_t t = row + i0;
-        const Lanes4 v = load4(b + t) - interior_operator(x, t, s);
+        const Lanes4 v = interior_residual(b, x, t, s);
         store4(r + t, v);
         norm2 += v * v;
       },
       [&](int i, int lane) {
         const std::int64_t t = row + i;
         const std::uint8_t m = bits[t];
-        const double value = (m & is_unknown) ? b[t] - texel_operator(m, x, t, s) : 0.0;
+        const double value = texel_residual(m, b, x, t, s);
         r[t] = value;
         norm2[lane] += value * value;
       });
@@ -406,16 +405,14 @@ DGTEX_ROW_INLINE void stencil9_residual_impl(GridShape g, Stencil9ViewOf<Real> a
 // residuals are two vectors a row (the odd or even lanes are the ones needed), else the four
 // nodes go one by one through the flag bytes. The cell centres west of a group are the last
 // lanes of the group before (the ghost column's for I = 0).
-template <class Real>
-DGTEX_ROW_INLINE Lanes4 widen_lanes(const Real* p) {
-  if constexpr (std::is_same_v<Real, float>)
-    return __builtin_convertvector(load_lanes(p), Lanes4);
-  else
-    return load4(p);
-}
+// Four Real lanes as doubles.
 DGTEX_ROW_INLINE Lanes4 widen_lanes_of(typename LanesOf<float>::type v) { return __builtin_convertvector(v, Lanes4); }
 DGTEX_ROW_INLINE Lanes4 widen_lanes_of(Lanes4 v) { return v; }
-DGTEX_ROW_INLINE bool eight_interior_active(const std::uint8_t* active) {  // 0/1 bytes
+template <class Real>
+DGTEX_ROW_INLINE Lanes4 widen_lanes(const Real* p) {
+  return widen_lanes_of(load_lanes(p));
+}
+DGTEX_ROW_INLINE bool eight_active(const std::uint8_t* active) {  // 0/1 bytes
   std::uint64_t word;
   std::memcpy(&word, active, sizeof word);
   return word == 0x0101010101010101u;
@@ -425,9 +422,6 @@ DGTEX_ROW_INLINE bool eight_interior(const std::uint8_t* bits) {
   std::memcpy(&word, bits, sizeof word);
   return word == 0x0101010101010101u * interior_texel;
 }
-DGTEX_ROW_INLINE Lanes4 interior_residual(const double* b, const double* x, std::int64_t t, std::int64_t s) {
-  return load4(b + t) - interior_operator(x, t, s);
-}
 
 template <class Real>
 DGTEX_ROW_INLINE void red_residual_restricted_impl(GridShape fine, GridShape coarse, InterpolationViewOf<Real> p,
@@ -435,10 +429,7 @@ DGTEX_ROW_INLINE void red_residual_restricted_impl(GridShape fine, GridShape coa
                                                    Real* b_coarse, int J) {
   const std::int64_t s = fine.stride(), cs = coarse.stride();
   const std::int64_t row = coarse.at(0, J), f0 = fine.at(0, 2 * J);
-  auto red_residual = [&](std::int64_t t) {
-    const std::uint8_t m = bits[t];
-    return (m & is_unknown) ? b[t] - texel_operator(m, x, t, s) : 0.0;
-  };
+  auto red_residual = [&](std::int64_t t) { return texel_residual(bits[t], b, x, t, s); };
   double west_north = red_residual(f0 + s - 1), west_south = red_residual(f0 - s - 1);
   auto one = [&](int I) {
     const std::int64_t c = row + I, f = f0 + 2 * I;
@@ -503,7 +494,7 @@ DGTEX_ROW_INLINE void prolong_correction_red_impl(GridShape fine, GridShape coar
   int i0 = 0;
   for (; i0 + 8 <= fine.nx; i0 += 8) {
     const std::int64_t t = row + i0, c = crow + (i0 >> 1);
-    if (!eight_interior_active(fine_active + t)) {
+    if (!eight_active(fine_active + t)) {
       for (int i = i0 + odd; i < i0 + 8; i += 2) one(i);
       continue;
     }
@@ -556,7 +547,7 @@ DGTEX_ROW_INLINE void prolong_correction_impl(GridShape fine, GridShape coarse, 
   int i0 = 0;
   for (; i0 + 8 <= fine.nx; i0 += 8) {
     const std::int64_t c = crow + (i0 >> 1), t = row + i0;
-    if (!eight_interior_active(fine_active + t)) {
+    if (!eight_active(fine_active + t)) {
       for (int i = i0; i < i0 + 8; ++i) one(i);
       continue;
     }

@@ -39,10 +39,6 @@ struct RowSum {
   double total() const { return (lane[0] + lane[1]) + (lane[2] + lane[3]); }
 };
 
-// The flag byte of an unknown coupled to four unknown neighbours (degree 4).
-constexpr std::uint8_t interior_texel = is_unknown | couples_west_unknown | couples_east_unknown |
-                                        couples_south_unknown | couples_north_unknown | (4u << degree_shift);
-
 // The row loops; `j` is the row, arrays are in the padded level layout (multigrid_grid.h).
 struct TexelRowKernels {
   // Gauss-Seidel update of the unknowns with (i + j) % 2 == color.
@@ -119,6 +115,10 @@ inline double texel_operator(std::uint8_t m, const double* x, std::int64_t t, st
   return laplace_degree(m) * x[t] - ((m & couples_west_unknown) ? x[t - 1] : 0.0) -
          ((m & couples_east_unknown) ? x[t + 1] : 0.0) - ((m & couples_south_unknown) ? x[t - s] : 0.0) -
          ((m & couples_north_unknown) ? x[t + s] : 0.0);
+}
+// b - A x at texel t, 0 off the unknowns.
+inline double texel_residual(std::uint8_t m, const double* b, const double* x, std::int64_t t, std::int64_t s) {
+  return (m & is_unknown) ? b[t] - texel_operator(m, x, t, s) : 0.0;
 }
 
 }  // namespace dgtex::kernels::detail

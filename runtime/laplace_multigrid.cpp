@@ -668,14 +668,6 @@ LaplaceSolveStats LaplaceMultigrid::solve(kernels::TexelTile& tile, std::vector<
   // over level 0 fewer (of ~50 per solve at 6 iterations), bitwise the same results.
   h.row_partial.resize(g.ny);
   std::vector<std::uint8_t> row_has_guess(g.ny, 0);
-  auto four_interior_texels = [](const std::uint8_t* bits) {
-    constexpr std::uint32_t interior = kernels::is_unknown | kernels::couples_west_unknown |
-                                       kernels::couples_east_unknown | kernels::couples_south_unknown |
-                                       kernels::couples_north_unknown | (4u << kernels::degree_shift);
-    std::uint32_t word;
-    std::memcpy(&word, bits, sizeof word);
-    return word == 0x01010101u * interior;
-  };
   kernels::forall(
       g.ny,
       [&](std::int64_t j64) {
@@ -686,7 +678,7 @@ LaplaceSolveStats LaplaceMultigrid::solve(kernels::TexelTile& tile, std::vector<
           // Four unknowns coupled to four unknowns each and no guess to read: b = r = x = 0
           // (b2 += 0 changes nothing). Callgrind, open T = 1024: this pass 41 -> 15
           // instructions a texel.
-          if (!o.warm_start && (i & 3) == 0 && i + 4 <= g.nx && four_interior_texels(&h.bits[t])) {
+          if (!o.warm_start && (i & 3) == 0 && i + 4 <= g.nx && kernels::four_interior_texels(&h.bits[t])) {
             for (int l = 0; l < 4; ++l) fine.b[t + l] = fine.r[t + l] = fine.x[t + l] = 0.0;
             i += 3;
             continue;
@@ -828,7 +820,7 @@ LaplaceSolveStats LaplaceMultigrid::solve(kernels::TexelTile& tile, std::vector<
         const std::uint8_t* bits = h.bits.data() + g.at(0, j);
         const double* x = fine.x.data() + g.at(0, j);
         for (int i = 0; i < g.nx; ++i) {
-          if ((i & 3) == 0 && i + 4 <= g.nx && four_interior_texels(bits + i)) {  // four unknowns
+          if ((i & 3) == 0 && i + 4 <= g.nx && kernels::four_interior_texels(bits + i)) {  // four unknowns
             std::memcpy(values + i, x + i, 4 * sizeof(double));
             i += 3;
             continue;

@@ -12,6 +12,7 @@
 // Values are dimensionless (texel units).
 #include <cstddef>  // texel_grid.h uses size_t without including it
 #include <cstdint>
+#include <cstring>
 #include <vector>
 
 #include "dgtex/kernels/forall.h"
@@ -30,6 +31,17 @@ enum LaplaceTexelBits : std::uint8_t {
 };
 constexpr std::uint8_t laplace_degree_mask = 7u << degree_shift;
 inline int laplace_degree(std::uint8_t bits) { return (bits & laplace_degree_mask) >> degree_shift; }
+
+// The byte of an unknown coupled to four unknown neighbours (degree 4): most texels of a
+// tile, whose row is 4 x(t) minus the four neighbours (the multigrid's fast paths).
+constexpr std::uint8_t interior_texel = is_unknown | couples_west_unknown | couples_east_unknown |
+                                        couples_south_unknown | couples_north_unknown | (4u << degree_shift);
+// Whether bits[0 .. 3] are all interior_texel (one 4-byte compare).
+inline bool four_interior_texels(const std::uint8_t* bits) {
+  std::uint32_t word;
+  std::memcpy(&word, bits, sizeof word);
+  return word == 0x01010101u * interior_texel;
+}
 
 // Whether texel (i, j) is coupled to (i+1, j) / (i, j+1) (both active, no wall, in the tile).
 inline bool texels_coupled_east(const TexelTile& tile, int i, int j) {
