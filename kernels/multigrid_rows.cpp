@@ -2,6 +2,8 @@
 
 #include <type_traits>
 
+#include <immintrin.h>
+
 namespace dgtex::kernels::detail {
 namespace {
 
@@ -569,6 +571,180 @@ DGTEX_ROW_INLINE void prolong_correction_impl(GridShape fine, GridShape coarse, 
   for (; i0 < fine.nx; ++i0) one(i0);
 }
 
+// The level-0 colour sweep in AVX-512 (8 doubles a vector). Masked stores write the colour's
+// unknowns only, so the other colour's values, which another thread may read at a lagged
+// block edge, are never rewritten. West and east neighbours come from registers (valignq), as
+// in smooth_color_impl. Groups with other texels than interior ones (walls, cuts, Dirichlet
+// data) stay vectors too: each neighbour term is masked to 0 by its coupling bit and the
+// degree picks 1 / degree from inverse_degree, exactly texel_smoothed's operations per lane.
+// Why: in cut domains such groups are common, and the texel-by-texel loop of the 4-lane form
+// took most of the sweep's time there (perf, spiral and accordion T = 256).
+// GCC 12's AVX-512 intrinsics fill unused operands with _mm512_undefined_*(), which its
+// -Wmaybe-uninitialized reports at every use (a header bug, fixed in GCC 13).
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+namespace avx512 {
+#define DGTEX_AVX512 __attribute__((target("avx512f"), always_inline)) inline
+
+// x(t - 1 .. t + 6) and x(t + 1 .. t + 8) from x(t - 8 .. t - 1), x(t .. t + 7), x(t + 8 .. t + 15).
+DGTEX_AVX512 __m512d west_of(__m512d previous, __m512d current) {
+  return _mm512_castsi512_pd(_mm512_alignr_epi64(_mm512_castpd_si512(current), _mm512_castpd_si512(previous), 7));
+}
+DGTEX_AVX512 __m512d east_of(__m512d current, __m512d next) {
+  return _mm512_castsi512_pd(_mm512_alignr_epi64(_mm512_castpd_si512(next), _mm512_castpd_si512(current), 1));
+}
+// Lane l: bits[l] as a 64-bit integer.
+DGTEX_AVX512 __m512i widened_bits(const std::uint8_t* bits) {
+  return _mm512_cvtepu8_epi64(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(bits)));
+}
+DGTEX_AVX512 __mmask8 lanes_with(__m512i bits, std::uint8_t flag) {
+  return _mm512_test_epi64_mask(bits, _mm512_set1_epi64(flag));
+}
+// Lane l: inverse_degree[laplace_degree(bits[l])].
+DGTEX_AVX512 __m512d inverse_degrees(__m512i bits) {
+  const __m512i degree = _mm512_and_si512(_mm512_srli_epi64(bits, degree_shift), _mm512_set1_epi64(7));
+  return _mm512_permutexvar_pd(degree, _mm512_loadu_pd(inverse_degree));
+}
+
+__attribute__((target("avx512f"))) void smooth_color(GridShape g, const std::uint8_t* bits, const double* b, double* x,
+                                                     int j, int color) {
+  const std::int64_t s = g.stride(), row = g.at(0, j);
+  const int nx = g.nx;
+  const int first = (color + j) & 1;
+  const __mmask8 colour_lanes = first ? 0xAA : 0x55;
+  __m512d previous = _mm512_maskz_broadcastsd_pd(0x80, _mm_set_sd(x[row - 1]));
+  __m512d current = nx >= 8 ? _mm512_loadu_pd(x + row) : _mm512_setzero_pd();
+  int i0 = 0;
+  for (; i0 + 8 <= nx; i0 += 8) {
+    const std::int64_t t = row + i0;
+    // x(t + 8) is the east ghost when the group ends the row; lanes past it are not used.
+    const __m512d next =
+        i0 + 16 <= nx ? _mm512_loadu_pd(x + t + 8) : _mm512_maskz_broadcastsd_pd(0x01, _mm_set_sd(x[t + 8]));
+    const __m512d west = west_of(previous, current), east = east_of(current, next);
+    const __m512d south = _mm512_loadu_pd(x + t - s), north = _mm512_loadu_pd(x + t + s);
+    __m512d sum = _mm512_loadu_pd(b + t);
+    if (eight_interior(bits + t)) {
+      // ((((b + west) + east) + south) + north) / 4, in texel_smoothed's order.
+      sum = _mm512_add_pd(_mm512_add_pd(_mm512_add_pd(_mm512_add_pd(sum, west), east), south), north);
+      _mm512_mask_storeu_pd(x + t, colour_lanes, _mm512_mul_pd(sum, _mm512_set1_pd(0.25)));
+    } else {
+      const __m512i m = widened_bits(bits + t);
+      sum = _mm512_add_pd(sum, _mm512_maskz_mov_pd(lanes_with(m, couples_west_unknown), west));
+      sum = _mm512_add_pd(sum, _mm512_maskz_mov_pd(lanes_with(m, couples_east_unknown), east));
+      sum = _mm512_add_pd(sum, _mm512_maskz_mov_pd(lanes_with(m, couples_south_unknown), south));
+      sum = _mm512_add_pd(sum, _mm512_maskz_mov_pd(lanes_with(m, couples_north_unknown), north));
+      _mm512_mask_storeu_pd(x + t, colour_lanes & lanes_with(m, is_unknown), _mm512_mul_pd(sum, inverse_degrees(m)));
+    }
+    previous = current;
+    current = next;
+  }
+  for (int i = i0 + first; i < nx; i += 2) {
+    const std::int64_t t = row + i;
+    if (bits[t] & is_unknown) x[t] = texel_smoothed(bits[t], b, x, t, s);
+  }
+}
+
+// b - A x of eight texels: (((degree x - west) - east) - south) - north, each neighbour term
+// masked to 0 by its coupling bit as in texel_operator; 0 off the unknowns.
+DGTEX_AVX512 __m512d degrees(__m512i bits) {
+  const __m512i degree = _mm512_and_si512(_mm512_srli_epi64(bits, degree_shift), _mm512_set1_epi64(7));
+  return _mm512_permutexvar_pd(degree, _mm512_set_pd(7, 6, 5, 4, 3, 2, 1, 0));
+}
+DGTEX_AVX512 __m512d texel_operators(__m512i m, const double* x, std::int64_t t, std::int64_t s) {
+  __m512d v = _mm512_mul_pd(degrees(m), _mm512_loadu_pd(x + t));
+  v = _mm512_sub_pd(v, _mm512_maskz_loadu_pd(lanes_with(m, couples_west_unknown), x + t - 1));
+  v = _mm512_sub_pd(v, _mm512_maskz_loadu_pd(lanes_with(m, couples_east_unknown), x + t + 1));
+  v = _mm512_sub_pd(v, _mm512_maskz_loadu_pd(lanes_with(m, couples_south_unknown), x + t - s));
+  return _mm512_sub_pd(v, _mm512_maskz_loadu_pd(lanes_with(m, couples_north_unknown), x + t + s));
+}
+// interior_operator's order for eight interior texels.
+DGTEX_AVX512 __m512d interior_operators(const double* x, std::int64_t t, std::int64_t s) {
+  __m512d v = _mm512_mul_pd(_mm512_set1_pd(4.0), _mm512_loadu_pd(x + t));
+  v = _mm512_sub_pd(v, _mm512_loadu_pd(x + t - 1));
+  v = _mm512_sub_pd(v, _mm512_loadu_pd(x + t + 1));
+  v = _mm512_sub_pd(v, _mm512_loadu_pd(x + t - s));
+  return _mm512_sub_pd(v, _mm512_loadu_pd(x + t + s));
+}
+DGTEX_AVX512 __m512d operators(const std::uint8_t* bits, const double* x, std::int64_t t, std::int64_t s,
+                               __mmask8& unknowns) {
+  if (eight_interior(bits + t)) {
+    unknowns = 0xff;
+    return interior_operators(x, t, s);
+  }
+  const __m512i m = widened_bits(bits + t);
+  unknowns = lanes_with(m, is_unknown);
+  return texel_operators(m, x, t, s);
+}
+
+__attribute__((target("avx512f"))) void residual_color(GridShape g, const std::uint8_t* bits, const double* b,
+                                                       const double* x, double* r, int j, int color) {
+  const std::int64_t s = g.stride(), row = g.at(0, j);
+  const int first = (color + j) & 1;
+  const __mmask8 colour_lanes = first ? 0xAA : 0x55;
+  int i0 = 0;
+  for (; i0 + 8 <= g.nx; i0 += 8) {
+    const std::int64_t t = row + i0;
+    __mmask8 unknowns;
+    const __m512d ax = operators(bits, x, t, s, unknowns);
+    _mm512_mask_storeu_pd(r + t, colour_lanes, _mm512_maskz_sub_pd(unknowns, _mm512_loadu_pd(b + t), ax));
+  }
+  for (int i = i0 + first; i < g.nx; i += 2) r[row + i] = texel_residual(bits[row + i], b, x, row + i, s);
+}
+
+__attribute__((target("avx512f"))) void red_from_zero(GridShape g, const std::uint8_t* bits, const double* b,
+                                                      double* x, int j) {
+  const std::int64_t row = g.at(0, j);
+  const __mmask8 red_lanes = (j & 1) ? 0xAA : 0x55;
+  int i0 = 0;
+  for (; i0 + 8 <= g.nx; i0 += 8) {
+    const std::int64_t t = row + i0;
+    if (eight_interior(bits + t)) {
+      _mm512_storeu_pd(x + t, _mm512_maskz_mul_pd(red_lanes, _mm512_loadu_pd(b + t), _mm512_set1_pd(0.25)));
+    } else {
+      const __m512i m = widened_bits(bits + t);
+      _mm512_storeu_pd(x + t, _mm512_maskz_mul_pd(red_lanes & lanes_with(m, is_unknown), _mm512_loadu_pd(b + t),
+                                                  inverse_degrees(m)));
+    }
+  }
+  for (int i = i0; i < g.nx; ++i) {
+    const std::int64_t t = row + i;
+    const std::uint8_t m = bits[t];
+    x[t] = ((m & is_unknown) && ((i + j) & 1) == 0) ? b[t] * inverse_degree[laplace_degree(m)] : 0.0;
+  }
+}
+
+// Row sums keep RowSum's four chains: texel i is added to chain i mod 4 in increasing i, so
+// the low half of a group goes in before the high half.
+__attribute__((target("avx512f"))) double apply(GridShape g, const std::uint8_t* bits, const double* x, double* y,
+                                               int j) {
+  const std::int64_t s = g.stride(), row = g.at(0, j);
+  __m256d dot = _mm256_setzero_pd();
+  int i0 = 0;
+  for (; i0 + 8 <= g.nx; i0 += 8) {
+    const std::int64_t t = row + i0;
+    __mmask8 unknowns;
+    const __m512d ax = operators(bits, x, t, s, unknowns);
+    const __m512d value = _mm512_maskz_mov_pd(unknowns, ax);
+    _mm512_storeu_pd(y + t, value);
+    const __m512d product = _mm512_mul_pd(value, _mm512_loadu_pd(x + t));
+    dot = _mm256_add_pd(dot, _mm512_castpd512_pd256(product));
+    dot = _mm256_add_pd(dot, _mm512_extractf64x4_pd(product, 1));
+  }
+  alignas(32) double lane[4];
+  _mm256_store_pd(lane, dot);
+  for (int i = i0; i < g.nx; ++i) {
+    const std::int64_t t = row + i;
+    const std::uint8_t m = bits[t];
+    const double value = (m & is_unknown) ? texel_operator(m, x, t, s) : 0.0;
+    y[t] = value;
+    lane[i & 3] += value * x[t];
+  }
+  return (lane[0] + lane[1]) + (lane[2] + lane[3]);
+}
+#undef DGTEX_AVX512
+}  // namespace avx512
+#pragma GCC diagnostic pop
+
 // One set of row functions per instruction set: the same source, compiled for baseline
 // x86-64 (SSE2: a 4-lane vector is two registers) and for AVX2 (one register).
 #define DGTEX_TEXEL_ROW_KERNELS(ATTRIBUTE, NAME)                                                                     \
@@ -651,15 +827,40 @@ bool avx2_supported() {
   return supported;
 }
 
-const TexelRowKernels& texel_rows(RowPath path) { return path == RowPath::avx2 ? avx2_rows : baseline_rows; }
-const TexelRowKernels& texel_rows() { return texel_rows(avx2_supported() ? RowPath::avx2 : RowPath::baseline); }
+bool avx512_supported() {
+  static const bool supported = [] {
+    __builtin_cpu_init();
+    return __builtin_cpu_supports("avx512f") != 0;
+  }();
+  return supported;
+}
+
+namespace {
+// The AVX2 set with the AVX-512 forms of the level-0 loops that read flag bytes.
+TexelRowKernels avx512_texel_rows() {
+  TexelRowKernels rows = avx2_rows;
+  rows.smooth_color = avx512::smooth_color;
+  rows.red_from_zero = avx512::red_from_zero;
+  rows.residual_color = avx512::residual_color;
+  rows.apply = avx512::apply;
+  return rows;
+}
+const TexelRowKernels avx512_rows = avx512_texel_rows();
+}  // namespace
+
+const TexelRowKernels& texel_rows(RowPath path) {
+  return path == RowPath::avx512 ? avx512_rows : path == RowPath::avx2 ? avx2_rows : baseline_rows;
+}
+const TexelRowKernels& texel_rows() {
+  return texel_rows(avx512_supported() ? RowPath::avx512 : avx2_supported() ? RowPath::avx2 : RowPath::baseline);
+}
 
 template <class Real>
 const Stencil9RowKernels<Real>& stencil9_rows(RowPath path) {
   if constexpr (std::is_same_v<Real, float>)
-    return path == RowPath::avx2 ? avx2_rows_stencil9_float : baseline_rows_stencil9_float;
+    return path != RowPath::baseline ? avx2_rows_stencil9_float : baseline_rows_stencil9_float;
   else
-    return path == RowPath::avx2 ? avx2_rows_stencil9_double : baseline_rows_stencil9_double;
+    return path != RowPath::baseline ? avx2_rows_stencil9_double : baseline_rows_stencil9_double;
 }
 template <class Real>
 const Stencil9RowKernels<Real>& stencil9_rows() {
@@ -668,9 +869,9 @@ const Stencil9RowKernels<Real>& stencil9_rows() {
 template <class Real>
 const TexelTransferRowKernels<Real>& texel_transfer_rows(RowPath path) {
   if constexpr (std::is_same_v<Real, float>)
-    return path == RowPath::avx2 ? avx2_rows_transfer_float : baseline_rows_transfer_float;
+    return path != RowPath::baseline ? avx2_rows_transfer_float : baseline_rows_transfer_float;
   else
-    return path == RowPath::avx2 ? avx2_rows_transfer_double : baseline_rows_transfer_double;
+    return path != RowPath::baseline ? avx2_rows_transfer_double : baseline_rows_transfer_double;
 }
 template <class Real>
 const TexelTransferRowKernels<Real>& texel_transfer_rows() {

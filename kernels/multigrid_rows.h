@@ -63,8 +63,9 @@ struct TexelRowKernels {
 // The fastest form this processor runs (chosen once per process).
 const TexelRowKernels& texel_rows();
 // A given form, for the tests that check the forms agree bitwise; avx2 needs avx2_supported().
-enum class RowPath { baseline, avx2 };
+enum class RowPath { baseline, avx2, avx512 };
 bool avx2_supported();
+bool avx512_supported();
 const TexelRowKernels& texel_rows(RowPath path);
 
 // 9-point levels, Real = double or float.

@@ -430,25 +430,29 @@ TEST(LaplaceTileValidation, NamesTheFirstDirichletTexelWithANonFiniteValue) {
 }
 
 // The row loops behind the level-0, 9-point and transfer kernels have a baseline (SSE2) and an AVX2
-// form (multigrid_rows.h); the parallel-vs-reference tests above run the form this machine
-// picks, this one checks the two forms give the same bits, row by row, with a partial group
-// of four at the end of every row (width 101).
+// form, and the level-0 loops that read flag bytes an AVX-512 form (multigrid_rows.h); the
+// parallel-vs-reference tests above run the form this machine picks, this one checks every
+// form this machine runs gives the baseline's bits, row by row, with a partial group at the
+// end of every row (width 101).
 TEST_P(MultigridKernels, RowLoopFormsAgreeBitwise) {
   if (!detail::avx2_supported()) GTEST_SKIP() << "no AVX2: only the baseline form runs here";
   TwoLevels L(make_laplace_domain(GetParam(), 101));
-  const detail::TexelRowKernels* forms[2] = {&detail::texel_rows(detail::RowPath::baseline),
-                                             &detail::texel_rows(detail::RowPath::avx2)};
+  std::vector<const detail::TexelRowKernels*> forms = {&detail::texel_rows(detail::RowPath::baseline),
+                                                       &detail::texel_rows(detail::RowPath::avx2)};
+  if (detail::avx512_supported()) forms.push_back(&detail::texel_rows(detail::RowPath::avx512));
   const std::uint8_t* bits = L.bits.data();
-  std::vector<double> out[2], sums[2];
-  // Runs `body(form, out, sums)` for both forms from the same inputs and compares.
+  std::vector<double> out[3], sums[3];
+  // Runs `body(form, out, sums)` for every form from the same inputs and compares.
   auto compare = [&](const char* what, auto body) {
-    for (int f = 0; f < 2; ++f) {
+    for (std::size_t f = 0; f < forms.size(); ++f) {
       out[f] = L.x;
       sums[f].assign(L.fine.ny, 0.0);
       body(*forms[f], out[f], sums[f]);
     }
-    EXPECT_EQ(out[0], out[1]) << what;
-    EXPECT_EQ(sums[0], sums[1]) << what;
+    for (std::size_t f = 1; f < forms.size(); ++f) {
+      EXPECT_EQ(out[0], out[f]) << what << ", form " << f;
+      EXPECT_EQ(sums[0], sums[f]) << what << ", form " << f;
+    }
   };
   const GridShape g = L.fine;
   for (int color = 0; color < 2; ++color) {

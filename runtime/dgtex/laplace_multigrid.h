@@ -31,7 +31,7 @@ struct LaplaceMultigridOptions {
   // its residual test stay double (CG reaches 1e-12 in the same iterations). Only with
   // use_as_cg_preconditioner and the plain cycle (coarse_solve_tolerance = 0). 0: always;
   // below the default (T = 256) the float setup costs more than the cycles save.
-  long single_precision_min_texels = 1l << 17;
+  long single_precision_min_texels = 1l << 16;
   bool warm_start = true;         // initial guess = tile.values of the unknowns (else 0)
   kernels::Execution execution = kernels::Execution::parallel;
   // Robust cycle for domains with features narrower than the coarse grids (a 2-texel
