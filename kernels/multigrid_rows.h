@@ -11,6 +11,11 @@
 // multigrid_rows.cpp is compiled with -ffp-contract=off, its AVX2 path enables no FMA), so
 // the results are bitwise those of the plain loops on every machine.
 //
+// On processors with AVX-512 the level-0 loops that read flag bytes (colour sweep, colour
+// residual, first sweep from zero, operator) take 8 texels a vector, and groups with walls,
+// cuts or Dirichlet neighbours stay vectors: each neighbour term is masked to 0 by its
+// coupling bit and the degree byte picks 1 / degree, the references' operations per lane.
+//
 // Coarse levels (9-point, double or float): groups of four nodes are computed as vectors
 // whatever their operator (a node without unknown has c = 0 and is left alone), in the
 // references' order of terms; a colour sweep stores only its own lanes.
@@ -62,7 +67,9 @@ struct TexelRowKernels {
 
 // The fastest form this processor runs (chosen once per process).
 const TexelRowKernels& texel_rows();
-// A given form, for the tests that check the forms agree bitwise; avx2 needs avx2_supported().
+// A given form, for the tests that check the forms agree bitwise; avx2 needs avx2_supported(),
+// avx512 avx512_supported() (the 9-point and transfer loops have no AVX-512 form: avx512
+// gives their AVX2 form).
 enum class RowPath { baseline, avx2, avx512 };
 bool avx2_supported();
 bool avx512_supported();

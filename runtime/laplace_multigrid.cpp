@@ -82,6 +82,14 @@
 //   above), same-row neighbours from registers. Callgrind, open T = 256: level-0 loops 626M
 //   -> 175M instructions per 10 solves; idle machine, active policy, 2 threads, old/new
 //   alternating: open T = 1024 64-77 -> 49-67 ms (README has the table).
+// - Session 9: AVX-512 forms of the level-0 loops that read flag bytes (multigrid_rows.h), and
+//   the float cycle from 2^16 texels (T = 256; since session 8's uniform regions the float
+//   setup no longer costs more than it saves). Idle machine, active policy, 2 threads, best
+//   of 20, old (8aa86c3) / new alternating three times, T = 256 ms: open 2.68-2.79 -> 2.39,
+//   slit 2.65-3.40 -> 2.37-2.45, spiral 3.67-3.87 -> 3.33-3.41, accordion 3.70-3.83 ->
+//   3.33-3.41, chad 3.12-3.40 -> 2.71-2.77. T = 1024 unchanged (31-38 ms). Tried and
+//   reverted: four partial sums in the band factor and a row-oriented back substitution
+//   (spiral and accordion T = 256 4.31-4.41 -> 4.27-4.39 ms, noise), as in session 8.
 namespace dgtex {
 using kernels::Execution;
 using kernels::GridShape;

@@ -29,8 +29,9 @@ struct LaplaceMultigridOptions {
   // Tiles with at least this many texels keep the preconditioner's levels >= 1 (operators,
   // interpolation, x, b, r) in float: half their memory traffic; level 0, the outer CG and
   // its residual test stay double (CG reaches 1e-12 in the same iterations). Only with
-  // use_as_cg_preconditioner and the plain cycle (coarse_solve_tolerance = 0). 0: always;
-  // below the default (T = 256) the float setup costs more than the cycles save.
+  // use_as_cg_preconditioner and the plain cycle (coarse_solve_tolerance = 0). 0: always.
+  // The default takes T = 256 tiles in (it was 2^17 before the setup's uniform regions made
+  // the float setup cheap: see laplace_multigrid.cpp, session 9); smaller tiles not measured.
   long single_precision_min_texels = 1l << 16;
   bool warm_start = true;         // initial guess = tile.values of the unknowns (else 0)
   kernels::Execution execution = kernels::Execution::parallel;
