@@ -571,14 +571,12 @@ DGTEX_ROW_INLINE void prolong_correction_impl(GridShape fine, GridShape coarse, 
   for (; i0 < fine.nx; ++i0) one(i0);
 }
 
-// The level-0 colour sweep in AVX-512 (8 doubles a vector). Masked stores write the colour's
-// unknowns only, so the other colour's values, which another thread may read at a lagged
-// block edge, are never rewritten. West and east neighbours come from registers (valignq), as
-// in smooth_color_impl. Groups with other texels than interior ones (walls, cuts, Dirichlet
-// data) stay vectors too: each neighbour term is masked to 0 by its coupling bit and the
-// degree picks 1 / degree from inverse_degree, exactly texel_smoothed's operations per lane.
-// Why: in cut domains such groups are common, and the texel-by-texel loop of the 4-lane form
-// took most of the sweep's time there (perf, spiral and accordion T = 256).
+// The level-0 loops that read flag bytes, in AVX-512 (8 doubles a vector). Groups with other
+// texels than interior ones (walls, cuts, Dirichlet data) stay vectors too: each neighbour
+// term is masked to 0 by its coupling bit and the degree byte picks 1 / degree (or the
+// degree), exactly the scalar forms' operations per lane. Why: in cut domains such groups are
+// common, and the texel-by-texel loop of the 4-lane form took most of the colour sweep's time
+// there (perf, spiral and accordion T = 256).
 // GCC 12's AVX-512 intrinsics fill unused operands with _mm512_undefined_*(), which its
 // -Wmaybe-uninitialized reports at every use (a header bug, fixed in GCC 13).
 #pragma GCC diagnostic push
@@ -600,12 +598,21 @@ DGTEX_AVX512 __m512i widened_bits(const std::uint8_t* bits) {
 DGTEX_AVX512 __mmask8 lanes_with(__m512i bits, std::uint8_t flag) {
   return _mm512_test_epi64_mask(bits, _mm512_set1_epi64(flag));
 }
-// Lane l: inverse_degree[laplace_degree(bits[l])].
+// Lane l: laplace_degree(bits[l]) as an index, and the degree's entry of inverse_degree or
+// the degree itself.
+DGTEX_AVX512 __m512i degree_indices(__m512i bits) {
+  return _mm512_and_si512(_mm512_srli_epi64(bits, degree_shift), _mm512_set1_epi64(7));
+}
 DGTEX_AVX512 __m512d inverse_degrees(__m512i bits) {
-  const __m512i degree = _mm512_and_si512(_mm512_srli_epi64(bits, degree_shift), _mm512_set1_epi64(7));
-  return _mm512_permutexvar_pd(degree, _mm512_loadu_pd(inverse_degree));
+  return _mm512_permutexvar_pd(degree_indices(bits), _mm512_loadu_pd(inverse_degree));
+}
+DGTEX_AVX512 __m512d degrees(__m512i bits) {
+  return _mm512_permutexvar_pd(degree_indices(bits), _mm512_set_pd(7, 6, 5, 4, 3, 2, 1, 0));
 }
 
+// The colour sweep. Masked stores write the colour's unknowns only, so the other colour's
+// values, which another thread may read at a lagged block edge, are never rewritten. West and
+// east neighbours come from registers, as in smooth_color_impl.
 __attribute__((target("avx512f"))) void smooth_color(GridShape g, const std::uint8_t* bits, const double* b, double* x,
                                                      int j, int color) {
   const std::int64_t s = g.stride(), row = g.at(0, j);
@@ -644,12 +651,8 @@ __attribute__((target("avx512f"))) void smooth_color(GridShape g, const std::uin
   }
 }
 
-// b - A x of eight texels: (((degree x - west) - east) - south) - north, each neighbour term
-// masked to 0 by its coupling bit as in texel_operator; 0 off the unknowns.
-DGTEX_AVX512 __m512d degrees(__m512i bits) {
-  const __m512i degree = _mm512_and_si512(_mm512_srli_epi64(bits, degree_shift), _mm512_set1_epi64(7));
-  return _mm512_permutexvar_pd(degree, _mm512_set_pd(7, 6, 5, 4, 3, 2, 1, 0));
-}
+// A x of eight texels: (((degree x - west) - east) - south) - north, each neighbour term
+// masked to 0 by its coupling bit, as texel_operator forms it.
 DGTEX_AVX512 __m512d texel_operators(__m512i m, const double* x, std::int64_t t, std::int64_t s) {
   __m512d v = _mm512_mul_pd(degrees(m), _mm512_loadu_pd(x + t));
   v = _mm512_sub_pd(v, _mm512_maskz_loadu_pd(lanes_with(m, couples_west_unknown), x + t - 1));
@@ -665,6 +668,7 @@ DGTEX_AVX512 __m512d interior_operators(const double* x, std::int64_t t, std::in
   v = _mm512_sub_pd(v, _mm512_loadu_pd(x + t - s));
   return _mm512_sub_pd(v, _mm512_loadu_pd(x + t + s));
 }
+// A x of eight texels by the fast or the masked form; `unknowns` gets the lanes that are unknowns.
 DGTEX_AVX512 __m512d operators(const std::uint8_t* bits, const double* x, std::int64_t t, std::int64_t s,
                                __mmask8& unknowns) {
   if (eight_interior(bits + t)) {

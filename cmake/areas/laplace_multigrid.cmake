@@ -4,10 +4,10 @@ find_package(MPI REQUIRED COMPONENTS C)
 target_link_libraries(dgtex PRIVATE MPI::MPI_C)
 
 # The texel-level row loops (kernels/multigrid_rows.cpp) have a baseline, an AVX2 and (for
-# the level-0 loops) an AVX-512 path, chosen at run time; without contraction into FMA both round exactly like the scalar
-# references, so multigrid results do not depend on the machine's vector unit. Its 4-double
-# vector helpers are always inlined, so no vector crosses a call (-Wno-psabi: GCC warns
-# about the AVX calling convention of such functions all the same).
+# some level-0 loops) an AVX-512 path, chosen at run time; without contraction into FMA all
+# round exactly like the scalar references, so multigrid results do not depend on the
+# machine's vector unit. Its vector helpers are always inlined, so no vector crosses a call
+# (-Wno-psabi: GCC warns about the AVX calling convention of such functions all the same).
 set_source_files_properties(${CMAKE_CURRENT_SOURCE_DIR}/kernels/multigrid_rows.cpp
                             PROPERTIES COMPILE_OPTIONS "-ffp-contract=off;-Wno-psabi")
 
