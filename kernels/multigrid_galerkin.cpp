@@ -484,27 +484,38 @@ void galerkin_stencil9(GridShape fine, Stencil9ViewFloat a, InterpolationViewFlo
                             uniform ? &*uniform : nullptr);
 }
 
+namespace {
+// One region analysis per level, then interpolation and Galerkin operator (coarsen_* below).
+template <class Real>
+void coarsen_texels_as(GridShape fine, const std::uint8_t* bits, InterpolationArraysOf<Real> p,
+                       Stencil9ArraysOf<Real> coarse_a, Execution execution) {
+  const auto uniform = uniform_texel_region<Real>(fine, bits, execution);
+  coarsen(fine, TexelOperator{bits}, TexelEntries{bits}, p, coarse_a, execution, &uniform);
+}
+template <class Real>
+void coarsen_stencil9_as(GridShape fine, Stencil9ViewOf<Real> a, InterpolationArraysOf<Real> p,
+                         Stencil9ArraysOf<Real> coarse_a, Execution execution) {
+  const auto uniform = uniform_stencil9_region(fine, a, execution);
+  coarsen(fine, LumpedStencil9Operator<Real>{{a, fine.stride()}}, Stencil9Entries<Real>{a, fine.stride()}, p,
+          coarse_a, execution, uniform ? &*uniform : nullptr);
+}
+}  // namespace
+
 void coarsen_texels(GridShape fine, const std::uint8_t* bits, InterpolationArrays p, Stencil9Arrays coarse_a,
                     Execution execution) {
-  const auto uniform = uniform_texel_region<double>(fine, bits, execution);
-  coarsen(fine, TexelOperator{bits}, TexelEntries{bits}, p, coarse_a, execution, &uniform);
+  coarsen_texels_as<double>(fine, bits, p, coarse_a, execution);
 }
 void coarsen_stencil9(GridShape fine, Stencil9View a, InterpolationArrays p, Stencil9Arrays coarse_a,
                       Execution execution) {
-  const auto uniform = uniform_stencil9_region(fine, a, execution);
-  coarsen(fine, LumpedStencil9Operator<double>{{a, fine.stride()}}, Stencil9Entries<double>{a, fine.stride()}, p,
-          coarse_a, execution, uniform ? &*uniform : nullptr);
+  coarsen_stencil9_as<double>(fine, a, p, coarse_a, execution);
 }
 void coarsen_texels(GridShape fine, const std::uint8_t* bits, InterpolationArraysFloat p, Stencil9ArraysFloat coarse_a,
                     Execution execution) {
-  const auto uniform = uniform_texel_region<float>(fine, bits, execution);
-  coarsen(fine, TexelOperator{bits}, TexelEntries{bits}, p, coarse_a, execution, &uniform);
+  coarsen_texels_as<float>(fine, bits, p, coarse_a, execution);
 }
 void coarsen_stencil9(GridShape fine, Stencil9ViewFloat a, InterpolationArraysFloat p, Stencil9ArraysFloat coarse_a,
                       Execution execution) {
-  const auto uniform = uniform_stencil9_region(fine, a, execution);
-  coarsen(fine, LumpedStencil9Operator<float>{{a, fine.stride()}}, Stencil9Entries<float>{a, fine.stride()}, p,
-          coarse_a, execution, uniform ? &*uniform : nullptr);
+  coarsen_stencil9_as<float>(fine, a, p, coarse_a, execution);
 }
 
 void build_interpolation_texels_reference(GridShape fine, const std::uint8_t* bits, InterpolationArrays p) {
