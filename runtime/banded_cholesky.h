@@ -11,24 +11,40 @@
 
 #include <Eigen/SparseCore>
 
+#include "multigrid_buffer.h"
+
 namespace dgtex::detail {
 
 class BandedCholesky {
  public:
   // Half bandwidth of a symmetric matrix: the largest |row - column| of a nonzero.
   static int bandwidth(const Eigen::SparseMatrix<double>& a);
-  // Factors the SPD matrix a (both triangles or the lower one given); false if a pivot is
-  // not positive.
+  // Starts an n x n matrix of half bandwidth bw, all zero; set its lower triangle with
+  // set_lower(), then factorize().
+  void reset(int n, int bw);
+  // A(row, column) = value, for column <= row <= column + bw.
+  void set_lower(int row, int column, double value) {
+    lower_[static_cast<std::size_t>(column) * stride_ + (row - column)] = value;
+  }
+  // Factors the matrix set since reset(); false if a pivot is not positive.
+  bool factorize();
+  // reset(), set_lower() and factorize() for the lower triangle of a (both may be given).
   bool factorize(const Eigen::SparseMatrix<double>& a);
   // x = A^-1 b.
   void solve(const Eigen::VectorXd& b, Eigen::VectorXd& x) const;
   int size() const { return n_; }
 
+  // The numeric loops work in chunks of this many entries over zero padding.
+  static constexpr int chunk = 8;
+
  private:
-  int n_ = 0, bw_ = 0;
-  std::vector<double> band_;  // row i: L(i, i - bw) .. L(i, i), entries left of column 0 unused
-  double& at(int i, int j) { return band_[static_cast<std::size_t>(i) * (bw_ + 1) + (j - i + bw_)]; }
-  double at(int i, int j) const { return band_[static_cast<std::size_t>(i) * (bw_ + 1) + (j - i + bw_)]; }
+  int n_ = 0, bw_ = 0, stride_ = 0;
+  // Column j: L(j + d, j) at j * stride + d for d = 0 .. bw, then zeros; bw + 1 columns of
+  // zeros past the last take the updates that run off the end. Cached blocks (a hierarchy
+  // is built per solve; fresh pages cost ~50 us at spiral T = 256).
+  MultigridBuffer lower_;
+  MultigridBuffer rows_;           // row j: L(j, j - bw' + e) at j * bw' + e (bw' = bw rounded up)
+  MultigridBuffer inverse_pivot_;  // 1 / L(j, j)
 };
 
 }  // namespace dgtex::detail

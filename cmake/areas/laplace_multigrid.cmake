@@ -16,3 +16,8 @@ set_source_files_properties(${CMAKE_CURRENT_SOURCE_DIR}/kernels/multigrid_rows.c
 # needs the same rounding in both, so no FMA contraction either.
 set_source_files_properties(${CMAKE_CURRENT_SOURCE_DIR}/kernels/multigrid_galerkin.cpp
                             PROPERTIES COMPILE_OPTIONS "-ffp-contract=off")
+
+# The coarsest level's band Cholesky (runtime/banded_cholesky.cpp) is cloned for AVX-512, AVX2
+# and the baseline; without contraction all clones give the same bits.
+set_source_files_properties(${CMAKE_CURRENT_SOURCE_DIR}/runtime/banded_cholesky.cpp
+                            PROPERTIES COMPILE_OPTIONS "-ffp-contract=off")
