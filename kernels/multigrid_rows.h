@@ -48,6 +48,9 @@ struct RowSum {
 struct TexelRowKernels {
   // Gauss-Seidel update of the unknowns with (i + j) % 2 == color.
   void (*smooth_color)(GridShape, const std::uint8_t* bits, const double* b, double* x, int j, int color);
+  // smooth_color(j, color), then smooth_color(j - 1, 1 - color) (j >= 1), the same bits: a
+  // sweep's first colour on row j with its lagged second colour (lagged_rows).
+  void (*smooth_color_pair)(GridShape, const std::uint8_t* bits, const double* b, double* x, int j, int color);
   // First forward sweep from x = 0: red unknowns b / degree, every other node 0.
   void (*red_from_zero)(GridShape, const std::uint8_t* bits, const double* b, double* x, int j);
   // r = b - A x at the unknowns with (i + j) % 2 == color (0 at other nodes of that colour).

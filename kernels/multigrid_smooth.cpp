@@ -22,6 +22,10 @@ void smooth_texels_sweep(GridShape shape, const std::uint8_t* bits, const double
         rows.smooth_color(shape, bits, b, x, j, second);
         if (row_dot) row_dot[j] = rows.dot(shape, b, x, j);  // row j is final now
       },
+      [&](int j) {
+        rows.smooth_color_pair(shape, bits, b, x, j, first);
+        if (row_dot) row_dot[j - 1] = rows.dot(shape, b, x, j - 1);
+      },
       execution);
 }
 

@@ -459,6 +459,18 @@ TEST_P(MultigridKernels, RowLoopFormsAgreeBitwise) {
     compare("smooth_color", [&](const auto& k, auto& x, auto&) {
       for (int j = 0; j < g.ny; ++j) k.smooth_color(g, bits, L.b.data(), x.data(), j, color);
     });
+    // The lagged sweep of lagged_rows with the fused pair, against the two colours one after
+    // the other (the same bits: red-black updates of one colour are independent).
+    std::vector<double> two_passes = L.x;
+    for (int pass = 0; pass < 2; ++pass)
+      for (int j = 0; j < g.ny; ++j)
+        forms[0]->smooth_color(g, bits, L.b.data(), two_passes.data(), j, pass == 0 ? color : 1 - color);
+    compare("smooth_color_pair", [&](const auto& k, auto& x, auto&) {
+      k.smooth_color(g, bits, L.b.data(), x.data(), 0, color);
+      for (int j = 1; j < g.ny; ++j) k.smooth_color_pair(g, bits, L.b.data(), x.data(), j, color);
+      k.smooth_color(g, bits, L.b.data(), x.data(), g.ny - 1, 1 - color);
+    });
+    EXPECT_EQ(out[0], two_passes) << "smooth_color_pair, colour " << color;
     compare("residual_color", [&](const auto& k, auto& r, auto&) {
       for (int j = 0; j < g.ny; ++j) k.residual_color(g, bits, L.b.data(), L.x.data(), r.data(), j, color);
     });
