@@ -53,6 +53,8 @@ struct TexelRowKernels {
   void (*smooth_color_pair)(GridShape, const std::uint8_t* bits, const double* b, double* x, int j, int color);
   // First forward sweep from x = 0: red unknowns b / degree, every other node 0.
   void (*red_from_zero)(GridShape, const std::uint8_t* bits, const double* b, double* x, int j);
+  // red_from_zero(j), then smooth_color(j - 1, 1) (j >= 1), the same bits (as smooth_color_pair).
+  void (*red_from_zero_pair)(GridShape, const std::uint8_t* bits, const double* b, double* x, int j);
   // r = b - A x at the unknowns with (i + j) % 2 == color (0 at other nodes of that colour).
   void (*residual_color)(GridShape, const std::uint8_t* bits, const double* b, const double* x, double* r, int j,
                          int color);

@@ -34,7 +34,8 @@ void smooth_texels_sweep_from_zero(GridShape shape, const std::uint8_t* bits, co
   const detail::TexelRowKernels& rows = texel_rows();
   lagged_rows(
       shape.ny, [&](int j) { rows.red_from_zero(shape, bits, b, x, j); },
-      [&](int j) { rows.smooth_color(shape, bits, b, x, j, 1); }, execution);
+      [&](int j) { rows.smooth_color(shape, bits, b, x, j, 1); },
+      [&](int j) { rows.red_from_zero_pair(shape, bits, b, x, j); }, execution);
 }
 
 void cg_update_and_smooth_texels_from_zero(GridShape shape, const std::uint8_t* bits, double alpha, const double* p,
@@ -47,7 +48,12 @@ void cg_update_and_smooth_texels_from_zero(GridShape shape, const std::uint8_t* 
         row_norm2[j] = rows.cg_update(shape, alpha, p, q, x, r, j);
         rows.red_from_zero(shape, bits, r, z, j);
       },
-      [&](int j) { rows.smooth_color(shape, bits, r, z, j, 1); }, execution);
+      [&](int j) { rows.smooth_color(shape, bits, r, z, j, 1); },
+      [&](int j) {
+        row_norm2[j] = rows.cg_update(shape, alpha, p, q, x, r, j);
+        rows.red_from_zero_pair(shape, bits, r, z, j);
+      },
+      execution);
 }
 
 void cg_update_and_smooth_texels_from_zero_reference(GridShape shape, const std::uint8_t* bits, double alpha,

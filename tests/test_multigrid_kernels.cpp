@@ -478,6 +478,15 @@ TEST_P(MultigridKernels, RowLoopFormsAgreeBitwise) {
   compare("red_from_zero", [&](const auto& k, auto& x, auto&) {
     for (int j = 0; j < g.ny; ++j) k.red_from_zero(g, bits, L.b.data(), x.data(), j);
   });
+  std::vector<double> from_zero = L.x;
+  for (int j = 0; j < g.ny; ++j) forms[0]->red_from_zero(g, bits, L.b.data(), from_zero.data(), j);
+  for (int j = 0; j < g.ny; ++j) forms[0]->smooth_color(g, bits, L.b.data(), from_zero.data(), j, 1);
+  compare("red_from_zero_pair", [&](const auto& k, auto& x, auto&) {
+    k.red_from_zero(g, bits, L.b.data(), x.data(), 0);
+    for (int j = 1; j < g.ny; ++j) k.red_from_zero_pair(g, bits, L.b.data(), x.data(), j);
+    k.smooth_color(g, bits, L.b.data(), x.data(), g.ny - 1, 1);
+  });
+  EXPECT_EQ(out[0], from_zero) << "red_from_zero_pair";
   compare("residual", [&](const auto& k, auto& r, auto& n) {
     for (int j = 0; j < g.ny; ++j) n[j] = k.residual(g, bits, L.b.data(), L.x.data(), r.data(), j);
   });
