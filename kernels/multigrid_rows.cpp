@@ -652,10 +652,10 @@ __attribute__((target("avx512f"))) void smooth_color(GridShape g, const std::uin
 }
 
 // Eight texels of one colour: the smoothed values of smooth_color and the lanes it stores.
-DGTEX_AVX512 __m512d smoothed_group(const std::uint8_t* bits, const double* b, std::int64_t t, __m512d west,
+DGTEX_AVX512 __m512d smoothed_group(const std::uint8_t* bits, __m512d b, std::int64_t t, __m512d west,
                                     __m512d east, __m512d south, __m512d north, __mmask8 colour_lanes,
                                     __mmask8& stored) {
-  __m512d sum = _mm512_loadu_pd(b + t);
+  __m512d sum = b;
   if (eight_interior(bits + t)) {
     stored = colour_lanes;
     sum = _mm512_add_pd(_mm512_add_pd(_mm512_add_pd(_mm512_add_pd(sum, west), east), south), north);
@@ -709,14 +709,17 @@ __attribute__((target("avx512f"))) void smooth_color_pair(GridShape g, const std
     _mm_prefetch(reinterpret_cast<const char*>(x + tu + s + pair_prefetch_distance), _MM_HINT_T0);
     _mm_prefetch(reinterpret_cast<const char*>(b + tu + pair_prefetch_distance), _MM_HINT_T0);
     if ((i0 & 63) == 0) _mm_prefetch(reinterpret_cast<const char*>(bits + tu + pair_prefetch_distance), _MM_HINT_T0);
+    // b of both rows before the group's stores (4K aliasing: from T = 1024 on, b(j - 1) lies
+    // 4096 bytes + 16 from x(j) when both arrays are page aligned, as large level arrays are).
+    const __m512d b_upper = _mm512_loadu_pd(b + tu), b_lower = _mm512_loadu_pd(b + tl);
     __mmask8 stored;
     const __m512d smoothed_upper =
-        smoothed_group(bits, b, tu, west_of(previous_upper, current_upper), east_of(current_upper, next_upper),
+        smoothed_group(bits, b_upper, tu, west_of(previous_upper, current_upper), east_of(current_upper, next_upper),
                        current_lower, _mm512_loadu_pd(x + tu + s), colour_lanes, stored);
     _mm512_mask_storeu_pd(x + tu, stored, smoothed_upper);
     const __m512d updated_upper = _mm512_mask_mov_pd(current_upper, stored, smoothed_upper);
     const __m512d smoothed_lower =
-        smoothed_group(bits, b, tl, west_of(previous_lower, current_lower), east_of(current_lower, next_lower),
+        smoothed_group(bits, b_lower, tl, west_of(previous_lower, current_lower), east_of(current_lower, next_lower),
                        south_lower, updated_upper, colour_lanes, stored);
     _mm512_mask_storeu_pd(x + tl, stored, smoothed_lower);
     previous_upper = current_upper, current_upper = next_upper;
@@ -749,17 +752,18 @@ __attribute__((target("avx512f"))) void red_from_zero_pair(GridShape g, const st
     _mm_prefetch(reinterpret_cast<const char*>(x + tu + pair_prefetch_distance), _MM_HINT_T0);
     _mm_prefetch(reinterpret_cast<const char*>(b + tu + pair_prefetch_distance), _MM_HINT_T0);
     if ((i0 & 63) == 0) _mm_prefetch(reinterpret_cast<const char*>(bits + tu + pair_prefetch_distance), _MM_HINT_T0);
+    const __m512d b_upper = _mm512_loadu_pd(b + tu), b_lower = _mm512_loadu_pd(b + tl);  // before the stores
     __m512d red;
     if (eight_interior(bits + tu)) {
-      red = _mm512_maskz_mul_pd(colour_lanes, _mm512_loadu_pd(b + tu), _mm512_set1_pd(0.25));
+      red = _mm512_maskz_mul_pd(colour_lanes, b_upper, _mm512_set1_pd(0.25));
     } else {
       const __m512i m = widened_bits(bits + tu);
-      red = _mm512_maskz_mul_pd(colour_lanes & lanes_with(m, is_unknown), _mm512_loadu_pd(b + tu), inverse_degrees(m));
+      red = _mm512_maskz_mul_pd(colour_lanes & lanes_with(m, is_unknown), b_upper, inverse_degrees(m));
     }
     _mm512_storeu_pd(x + tu, red);
     __mmask8 stored;
     const __m512d smoothed_lower =
-        smoothed_group(bits, b, tl, west_of(previous_lower, current_lower), east_of(current_lower, next_lower),
+        smoothed_group(bits, b_lower, tl, west_of(previous_lower, current_lower), east_of(current_lower, next_lower),
                        south_lower, red, colour_lanes, stored);
     _mm512_mask_storeu_pd(x + tl, stored, smoothed_lower);
     previous_lower = current_lower, current_lower = next_lower, south_lower = next_south_lower;
