@@ -101,7 +101,8 @@ void build_interpolation(GridShape fine, const Operator& a, InterpolationArraysO
   const std::int64_t cs = coarse.stride();
   const std::uint8_t* fast = uniform ? uniform->windows.data() : nullptr;
   // Pass 1: fine nodes on coarse grid lines, from the stencil collapsed across the line.
-  forall(
+  // Pass 2: cell-centre fine nodes, from their axis couplings and the pass-1 weights.
+  forall_then(
       coarse.ny,
       [&](std::int64_t J64) {
         const int J = static_cast<int>(J64);
@@ -127,9 +128,6 @@ void build_interpolation(GridShape fine, const Operator& a, InterpolationArraysO
           }
         }
       },
-      execution);
-  // Pass 2: cell-centre fine nodes, from their axis couplings and the pass-1 weights.
-  forall(
       coarse.ny,
       [&](std::int64_t J64) {
         const int J = static_cast<int>(J64);

@@ -19,7 +19,7 @@ constexpr int lagged_block_rows = 32;
 template <class First, class Second, class Both>
 void lagged_rows(int ny, First first, Second second, Both both, Execution execution) {
   const int blocks = (ny + lagged_block_rows - 1) / lagged_block_rows;
-  forall(
+  forall_then(
       blocks,
       [&](std::int64_t k) {
         const int j0 = static_cast<int>(k) * lagged_block_rows, j1 = std::min(ny, j0 + lagged_block_rows);
@@ -30,8 +30,6 @@ void lagged_rows(int ny, First first, Second second, Both both, Execution execut
             first(j);
         }
       },
-      execution);
-  forall(
       blocks,
       [&](std::int64_t k) {
         const int j0 = static_cast<int>(k) * lagged_block_rows, j1 = std::min(ny, j0 + lagged_block_rows);

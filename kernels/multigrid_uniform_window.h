@@ -25,7 +25,8 @@ std::vector<std::uint8_t> uniform_windows(GridShape fine, const Uniform& uniform
   constexpr int width = 6, reach_low = 2, reach_high = 3;  // the window spans 2I - 2 .. 2I + 3
   // Per fine row y and coarse column I: 1 if the window's columns of row y all qualify.
   std::vector<std::uint8_t> row_windows(static_cast<std::size_t>(fine.ny) * coarse.nx, 0);
-  forall(
+  std::vector<std::uint8_t> windows(coarse.padded_size(), 0);
+  forall_then(
       fine.ny,
       [&](std::int64_t y64) {
         const int y = static_cast<int>(y64);
@@ -42,9 +43,6 @@ std::vector<std::uint8_t> uniform_windows(GridShape fine, const Uniform& uniform
           if (x + 1 >= reach_high) out[(x + 1 - reach_high) / 2] = run >= width;
         }
       },
-      execution);
-  std::vector<std::uint8_t> windows(coarse.padded_size(), 0);
-  forall(
       coarse.ny,
       [&](std::int64_t J64) {
         const int J = static_cast<int>(J64);

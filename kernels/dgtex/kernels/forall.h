@@ -24,4 +24,24 @@ void forall(std::int64_t n, Body&& body, Execution execution = Execution::parall
   }
 }
 
+// forall(n1, first), then forall(n2, second), with every first(i) done before any second(i):
+// in one parallel region, the two loops separated by a barrier instead of two regions (the
+// 2-core machine, OMP_WAIT_POLICY=active: ~3.5 us a region, ~1.4 us a barrier).
+template <class First, class Second>
+void forall_then(std::int64_t n1, First&& first, std::int64_t n2, Second&& second,
+                 Execution execution = Execution::parallel) {
+  if (execution == Execution::parallel) {
+#pragma omp parallel
+    {
+#pragma omp for schedule(static)
+      for (std::int64_t i = 0; i < n1; ++i) first(i);
+#pragma omp for schedule(static)
+      for (std::int64_t i = 0; i < n2; ++i) second(i);
+    }
+  } else {
+    for (std::int64_t i = 0; i < n1; ++i) first(i);
+    for (std::int64_t i = 0; i < n2; ++i) second(i);
+  }
+}
+
 }  // namespace dgtex::kernels
