@@ -677,11 +677,17 @@ DGTEX_AVX512 __m512d smoothed_group(const std::uint8_t* bits, __m512d b, std::in
 // updated values, from registers: 8 loads per eight texels instead of 10. Each texel sees
 // the values it sees in the two separate calls (its neighbours of the other colour), so the
 // bits are theirs.
-// The row pairs' data that comes from beyond L2 (rows j + 1 of x, j of b and of the flags,
-// first touched by the pair at row j) is prefetched this many texels ahead (16 lines): open T =
-// 1024, one thread, the sweep 0.95 -> 0.69 ms, two threads 0.34 -> 0.32 ms; 256 texels
-// ahead gave the same.
+// The row pairs' data that comes from beyond L2 (row j + 1 of x, or row j for
+// red_from_zero_pair, and row j of b and of the flags: first touched by the pair at row j) is
+// prefetched this many texels ahead (16 lines): open T = 1024, one thread, the sweep 0.95 ->
+// 0.69 ms, two threads 0.34 -> 0.32 ms; 256 texels ahead gave the same.
 constexpr int pair_prefetch_distance = 128;
+// A prefetch hint for p + offset elements; the address is formed as an integer because it
+// may lie past the end of the array on the last rows (a prefetch never faults).
+template <class T>
+DGTEX_AVX512 void prefetch_ahead(const T* p, std::int64_t offset) {
+  _mm_prefetch(reinterpret_cast<const char*>(reinterpret_cast<std::uintptr_t>(p) + offset * sizeof(T)), _MM_HINT_T0);
+}
 __attribute__((target("avx512f"))) void smooth_color_pair(GridShape g, const std::uint8_t* bits, const double* b,
                                                           double* x, int j, int color) {
   const std::int64_t s = g.stride(), upper = g.at(0, j), lower = upper - s;
@@ -706,11 +712,12 @@ __attribute__((target("avx512f"))) void smooth_color_pair(GridShape g, const std
     const __m512d next_lower =
         full ? _mm512_loadu_pd(x + tl + 8) : _mm512_maskz_broadcastsd_pd(0x01, _mm_set_sd(x[tl + 8]));
     const __m512d next_south_lower = full ? _mm512_loadu_pd(x + tl + 8 - s) : _mm512_setzero_pd();
-    _mm_prefetch(reinterpret_cast<const char*>(x + tu + s + pair_prefetch_distance), _MM_HINT_T0);
-    _mm_prefetch(reinterpret_cast<const char*>(b + tu + pair_prefetch_distance), _MM_HINT_T0);
-    if ((i0 & 63) == 0) _mm_prefetch(reinterpret_cast<const char*>(bits + tu + pair_prefetch_distance), _MM_HINT_T0);
-    // b of both rows before the group's stores (4K aliasing: from T = 1024 on, b(j - 1) lies
-    // 4096 bytes + 16 from x(j) when both arrays are page aligned, as large level arrays are).
+    prefetch_ahead(x, tu + s + pair_prefetch_distance);
+    prefetch_ahead(b, tu + pair_prefetch_distance);
+    if ((i0 & 63) == 0) prefetch_ahead(bits, tu + pair_prefetch_distance);
+    // b of both rows before the group's stores (4K aliasing: at T = 512 and 1024, b(j - 1, t) and
+    // x(j, t) lie 16 bytes apart modulo 4096 when both arrays are page aligned, as large level
+    // arrays are).
     const __m512d b_upper = _mm512_loadu_pd(b + tu), b_lower = _mm512_loadu_pd(b + tl);
     __mmask8 stored;
     const __m512d smoothed_upper =
@@ -749,9 +756,9 @@ __attribute__((target("avx512f"))) void red_from_zero_pair(GridShape g, const st
     const __m512d next_lower =
         full ? _mm512_loadu_pd(x + tl + 8) : _mm512_maskz_broadcastsd_pd(0x01, _mm_set_sd(x[tl + 8]));
     const __m512d next_south_lower = full ? _mm512_loadu_pd(x + tl + 8 - s) : _mm512_setzero_pd();
-    _mm_prefetch(reinterpret_cast<const char*>(x + tu + pair_prefetch_distance), _MM_HINT_T0);
-    _mm_prefetch(reinterpret_cast<const char*>(b + tu + pair_prefetch_distance), _MM_HINT_T0);
-    if ((i0 & 63) == 0) _mm_prefetch(reinterpret_cast<const char*>(bits + tu + pair_prefetch_distance), _MM_HINT_T0);
+    prefetch_ahead(x, tu + pair_prefetch_distance);
+    prefetch_ahead(b, tu + pair_prefetch_distance);
+    if ((i0 & 63) == 0) prefetch_ahead(bits, tu + pair_prefetch_distance);
     const __m512d b_upper = _mm512_loadu_pd(b + tu), b_lower = _mm512_loadu_pd(b + tl);  // before the stores
     __m512d red;
     if (eight_interior(bits + tu)) {

@@ -54,17 +54,21 @@ DGTEX_BAND_CLONES bool factor_columns(double* lower, double* inverse_pivot, int 
 DGTEX_BAND_CLONES void substitute(const double* lower, const double* rows, const double* inverse_pivot, int n,
                                   int bw, int stride, double* x) {
   const int below = round_up(bw);
-  auto subtract_scaled = [below](double* __restrict y, const double* __restrict from, double s) {
-    for (int c = 0; c < below; c += chunk)
-      for (int v = 0; v < chunk; ++v) y[c + v] -= from[c + v] * s;
-  };
   for (int j = 0; j < n; ++j) {
-    x[j] *= inverse_pivot[j];
-    subtract_scaled(x + j + 1, lower + static_cast<std::size_t>(j) * stride + 1, x[j]);
+    const double xj = x[j] * inverse_pivot[j];
+    x[j] = xj;
+    double* __restrict y = x + j + 1;
+    const double* __restrict l = lower + static_cast<std::size_t>(j) * stride + 1;
+    for (int c = 0; c < below; c += chunk)
+      for (int v = 0; v < chunk; ++v) y[c + v] -= l[c + v] * xj;
   }
   for (int j = n - 1; j >= 0; --j) {
-    x[j] *= inverse_pivot[j];
-    subtract_scaled(x + j - below, rows + static_cast<std::size_t>(j) * below, x[j]);
+    const double xj = x[j] * inverse_pivot[j];
+    x[j] = xj;
+    double* __restrict y = x + j - below;
+    const double* __restrict l = rows + static_cast<std::size_t>(j) * below;
+    for (int c = 0; c < below; c += chunk)
+      for (int v = 0; v < chunk; ++v) y[c + v] -= l[c + v] * xj;
   }
 }
 
@@ -81,9 +85,10 @@ int BandedCholesky::bandwidth(const Eigen::SparseMatrix<double>& a) {
 void BandedCholesky::reset(int n, int bw) {
   n_ = n;
   bw_ = bw;
-  stride_ = bw_ + chunk;  // a column (bw + 1) plus the overrun of its last chunk (< chunk)
-  // Columns past n (zero) take the updates that run off the end.
-  lower_ = MultigridBuffer(static_cast<std::size_t>(n_ + bw_ + 1) * stride_);
+  // A column (bw + 1 entries) plus the overrun of its last chunk (< chunk entries): every
+  // chunked read or update of column j stays in column j's zeros.
+  stride_ = bw_ + chunk;
+  lower_ = MultigridBuffer(static_cast<std::size_t>(n_) * stride_);
   inverse_pivot_ = MultigridBuffer(n_);
 }
 

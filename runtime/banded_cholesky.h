@@ -28,7 +28,8 @@ class BandedCholesky {
   }
   // Factors the matrix set since reset(); false if a pivot is not positive.
   bool factorize();
-  // reset(), set_lower() and factorize() for the lower triangle of a (both may be given).
+  // reset(), set_lower() and factorize() for the lower triangle of a (both may be given);
+  // the tests' entry point (the multigrid fills the band from its stencil).
   bool factorize(const Eigen::SparseMatrix<double>& a);
   // x = A^-1 b.
   void solve(const Eigen::VectorXd& b, Eigen::VectorXd& x) const;
@@ -39,9 +40,8 @@ class BandedCholesky {
 
  private:
   int n_ = 0, bw_ = 0, stride_ = 0;
-  // Column j: L(j + d, j) at j * stride + d for d = 0 .. bw, then zeros; bw + 1 columns of
-  // zeros past the last take the updates that run off the end. Cached blocks (a hierarchy
-  // is built per solve; fresh pages cost ~50 us at spiral T = 256).
+  // Column j: L(j + d, j) at j * stride + d for d = 0 .. bw, then zeros (stride = bw + chunk).
+  // Cached blocks (a hierarchy is built per solve; fresh pages cost ~50 us at spiral T = 256).
   MultigridBuffer lower_;
   MultigridBuffer rows_;           // row j: L(j, j - bw' + e) at j * bw' + e (bw' = bw rounded up)
   MultigridBuffer inverse_pivot_;  // 1 / L(j, j)

@@ -372,9 +372,9 @@ struct LaplaceMultigrid::Hierarchy {
           coarsest_nodes.push_back(g.at(i, j));
         }
     const int n = static_cast<int>(coarsest_nodes.size());
-    // The lower triangle (row >= column) straight from the stencil into each factor's own
-    // storage: with a sparse matrix from triplets in between (and fresh band pages), spiral
-    // T = 256's coarsest factor took 180 us instead of 110 (2 threads, idle machine).
+    // The lower triangle (row >= column) straight from the stencil into the dense and band
+    // factors' storage: with a sparse matrix from triplets in between (and fresh band pages),
+    // spiral T = 256's coarsest factor took 180 us instead of 110 (2 threads, idle machine).
     const std::int64_t s = g.stride();
     auto for_each_lower_entry = [&](auto&& add) {
       for (int k = 0; k < n; ++k) {

@@ -576,6 +576,48 @@ TEST_P(MultigridKernels, RowLoopFormsAgreeBitwise) {
   EXPECT_EQ(x9f[0], x9f[1]);
 }
 
+// The fused row pairs against the two calls they replace, at widths below one group of 8,
+// of whole groups and with partial groups, on a tile with walls and Dirichlet texels.
+TEST(MultigridRowPairs, GiveTheTwoCallsBitsAtEveryWidth) {
+  std::vector<const detail::TexelRowKernels*> forms = {&detail::texel_rows(detail::RowPath::baseline)};
+  if (detail::avx2_supported()) forms.push_back(&detail::texel_rows(detail::RowPath::avx2));
+  if (detail::avx512_supported()) forms.push_back(&detail::texel_rows(detail::RowPath::avx512));
+  for (int w : {5, 8, 13, 16, 24, 37}) {
+    TexelTile tile(w, 11);
+    for (int j = 0; j < 11; ++j) {
+      tile.flags[tile.index(0, j)] |= kernels::dirichlet;
+      tile.values[tile.index(0, j)] = 1.0;
+    }
+    for (int i = 1; i < w - 1; ++i) tile.flags[tile.index(i, 5)] |= kernels::wall_north;  // a cut across
+    for (int j = 2; j < 9; ++j) tile.flags[tile.index(w / 2, j)] |= kernels::wall_east;
+    TwoLevels L(tile);
+    const GridShape g = L.fine;
+    const std::uint8_t* bits = L.bits.data();
+    for (int color = 0; color < 2; ++color) {
+      std::vector<double> two_calls = L.x;
+      for (int j = 0; j < g.ny; ++j) forms[0]->smooth_color(g, bits, L.b.data(), two_calls.data(), j, color);
+      for (int j = 0; j < g.ny; ++j) forms[0]->smooth_color(g, bits, L.b.data(), two_calls.data(), j, 1 - color);
+      for (const auto* k : forms) {
+        std::vector<double> x = L.x;
+        k->smooth_color(g, bits, L.b.data(), x.data(), 0, color);
+        for (int j = 1; j < g.ny; ++j) k->smooth_color_pair(g, bits, L.b.data(), x.data(), j, color);
+        k->smooth_color(g, bits, L.b.data(), x.data(), g.ny - 1, 1 - color);
+        EXPECT_EQ(x, two_calls) << "smooth_color_pair, width " << w << ", colour " << color;
+      }
+    }
+    std::vector<double> two_calls = L.x;
+    for (int j = 0; j < g.ny; ++j) forms[0]->red_from_zero(g, bits, L.b.data(), two_calls.data(), j);
+    for (int j = 0; j < g.ny; ++j) forms[0]->smooth_color(g, bits, L.b.data(), two_calls.data(), j, 1);
+    for (const auto* k : forms) {
+      std::vector<double> x = L.x;
+      k->red_from_zero(g, bits, L.b.data(), x.data(), 0);
+      for (int j = 1; j < g.ny; ++j) k->red_from_zero_pair(g, bits, L.b.data(), x.data(), j);
+      k->smooth_color(g, bits, L.b.data(), x.data(), g.ny - 1, 1);
+      EXPECT_EQ(x, two_calls) << "red_from_zero_pair, width " << w;
+    }
+  }
+}
+
 INSTANTIATE_TEST_SUITE_P(Domains, MultigridKernels,
                          ::testing::Values(LaplaceDomain::open, LaplaceDomain::slit, LaplaceDomain::spiral,
                                            LaplaceDomain::accordion, LaplaceDomain::chad),
