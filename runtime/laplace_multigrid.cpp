@@ -90,6 +90,15 @@
 //   3.33-3.41, chad 3.12-3.40 -> 2.71-2.77. T = 1024 unchanged (31-38 ms). Tried and
 //   reverted: four partial sums in the band factor and a row-oriented back substitution
 //   (spiral and accordion T = 256 4.31-4.41 -> 4.27-4.39 ms, noise), as in session 8.
+// - Session 10: the band factor right-looking with chunked vector axpys (banded_cholesky.h),
+//   filled straight from the stencil; fused AVX-512 row pairs for the level-0 sweeps (first
+//   colour on row j with the lagged second colour on row j - 1), with prefetches; loads
+//   ordered against 4K aliasing between the page-aligned level arrays; two dependent loops
+//   in one parallel region (forall_then). Same sitting as session 9's method, T = 256 ms:
+//   spiral 3.12-3.19 -> 2.58-2.70, accordion 3.12-3.26 -> 2.54-2.64, open 2.20-2.25 ->
+//   2.11-2.61; T = 1024 open 30-33 -> 28-30; smoother at T = 1024 45-49 % -> 54-67 % of the
+//   copy bandwidth (README). Tried, no gain: the coarse cycle as one thread team whose
+//   kernels share loops (`omp for`) instead of a parallel region each.
 namespace dgtex {
 using kernels::Execution;
 using kernels::GridShape;
