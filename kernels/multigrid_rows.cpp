@@ -670,13 +670,6 @@ DGTEX_AVX512 __m512d smoothed_group(const std::uint8_t* bits, __m512d b, std::in
   return _mm512_mul_pd(sum, inverse_degrees(m));
 }
 
-// smooth_color(j, color), then smooth_color(j - 1, 1 - color), group by group: the sweep's
-// first colour on row j and its lagged second colour on row j - 1 (lagged_rows). Both update
-// the same columns' lanes. Row j - 1 is loaded once for both (the first colour's south
-// neighbours, the second's own row), and the second colour's north neighbours are row j's
-// updated values, from registers: 8 loads per eight texels instead of 10. Each texel sees
-// the values it sees in the two separate calls (its neighbours of the other colour), so the
-// bits are theirs.
 // The row pairs' data that comes from beyond L2 (row j + 1 of x, or row j for
 // red_from_zero_pair, and row j of b and of the flags: first touched by the pair at row j) is
 // prefetched this many texels ahead (16 lines): open T = 1024, one thread, the sweep 0.95 ->
@@ -688,6 +681,14 @@ template <class T>
 DGTEX_AVX512 void prefetch_ahead(const T* p, std::int64_t offset) {
   _mm_prefetch(reinterpret_cast<const char*>(reinterpret_cast<std::uintptr_t>(p) + offset * sizeof(T)), _MM_HINT_T0);
 }
+
+// smooth_color(j, color), then smooth_color(j - 1, 1 - color), group by group: the sweep's
+// first colour on row j and its lagged second colour on row j - 1 (lagged_rows). Both update
+// the same columns' lanes. Row j - 1 is loaded once for both (the first colour's south
+// neighbours, the second's own row), and the second colour's north neighbours are row j's
+// updated values, from registers: 8 loads per eight texels instead of 10. Each texel sees
+// the values it sees in the two separate calls (its neighbours of the other colour), so the
+// bits are theirs.
 __attribute__((target("avx512f"))) void smooth_color_pair(GridShape g, const std::uint8_t* bits, const double* b,
                                                           double* x, int j, int color) {
   const std::int64_t s = g.stride(), upper = g.at(0, j), lower = upper - s;
@@ -699,9 +700,10 @@ __attribute__((target("avx512f"))) void smooth_color_pair(GridShape g, const std
   __m512d current_upper = nx >= 8 ? _mm512_loadu_pd(x + upper) : _mm512_setzero_pd();
   __m512d current_lower = nx >= 8 ? _mm512_loadu_pd(x + lower) : _mm512_setzero_pd();
   // Row j - 2 is loaded a group ahead, before the group's stores to row j: with the padded
-  // stride (T + 2) rows j and j - 2 lie 4096 bytes + 32 apart, so a load of row j - 2 right
-  // after a store to the same columns of row j looks like a read of that store (4K aliasing)
-  // and waits for it (the sweep ran 20% slower than the two calls at T = 256, one thread).
+  // stride (T + 2), x(j - 2, t) and x(j, t) lie 32 bytes apart modulo 4096 (T = 256, 1024),
+  // so a load of row j - 2 right after a store to the same columns of row j looks like a
+  // read of that store (4K aliasing) and waits for it (the sweep ran 20% slower than the two
+  // calls at T = 256, one thread).
   __m512d south_lower = nx >= 8 ? _mm512_loadu_pd(x + lower - s) : _mm512_setzero_pd();
   int i0 = 0;
   for (; i0 + 8 <= nx; i0 += 8) {
@@ -821,7 +823,8 @@ __attribute__((target("avx512f"))) void residual_color(GridShape g, const std::u
   // Each group's result is stored after the next group's loads: r and x are page aligned
   // alike, so the next group's x(t + 7 ..) read right after r(t ..) is written would look
   // like a read of that store (4K aliasing) and wait for it. One thread, best of 6 runs:
-  // T = 256 35 -> 32 us, T = 512 154 -> 120 us (the operator below: 46 -> 38, 190 -> 144 us).
+  // T = 256 35 -> 32 us, T = 512 154 -> 120 us (direction + operator, below: 46 -> 38 and
+  // 190 -> 144 us).
   __m512d pending = _mm512_setzero_pd();
   std::int64_t pending_t = -1;
   int i0 = 0;

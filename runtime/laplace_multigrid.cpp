@@ -94,7 +94,8 @@
 //   filled straight from the stencil; fused AVX-512 row pairs for the level-0 sweeps (first
 //   colour on row j with the lagged second colour on row j - 1), with prefetches; loads
 //   ordered against 4K aliasing between the page-aligned level arrays; two dependent loops
-//   in one parallel region (forall_then). Same sitting as session 9's method, T = 256 ms:
+//   in one parallel region (forall_then). Idle machine, active policy, 2 threads, best of
+//   20, old (6a04959) / new alternating three times, T = 256 ms:
 //   spiral 3.12-3.19 -> 2.58-2.70, accordion 3.12-3.26 -> 2.54-2.64, open 2.20-2.25 ->
 //   2.11-2.61; T = 1024 open 30-33 -> 28-30; smoother at T = 1024 45-49 % -> 54-67 % of the
 //   copy bandwidth (README). Tried, no gain: the coarse cycle as one thread team whose
