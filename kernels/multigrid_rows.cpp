@@ -610,48 +610,8 @@ DGTEX_AVX512 __m512d degrees(__m512i bits) {
   return _mm512_permutexvar_pd(degree_indices(bits), _mm512_set_pd(7, 6, 5, 4, 3, 2, 1, 0));
 }
 
-// The colour sweep. Masked stores write the colour's unknowns only, so the other colour's
-// values, which another thread may read at a lagged block edge, are never rewritten. West and
-// east neighbours come from registers, as in smooth_color_impl.
-__attribute__((target("avx512f"))) void smooth_color(GridShape g, const std::uint8_t* bits, const double* b, double* x,
-                                                     int j, int color) {
-  const std::int64_t s = g.stride(), row = g.at(0, j);
-  const int nx = g.nx;
-  const int first = (color + j) & 1;
-  const __mmask8 colour_lanes = first ? 0xAA : 0x55;
-  __m512d previous = _mm512_maskz_broadcastsd_pd(0x80, _mm_set_sd(x[row - 1]));
-  __m512d current = nx >= 8 ? _mm512_loadu_pd(x + row) : _mm512_setzero_pd();
-  int i0 = 0;
-  for (; i0 + 8 <= nx; i0 += 8) {
-    const std::int64_t t = row + i0;
-    // x(t + 8) is the east ghost when the group ends the row; lanes past it are not used.
-    const __m512d next =
-        i0 + 16 <= nx ? _mm512_loadu_pd(x + t + 8) : _mm512_maskz_broadcastsd_pd(0x01, _mm_set_sd(x[t + 8]));
-    const __m512d west = west_of(previous, current), east = east_of(current, next);
-    const __m512d south = _mm512_loadu_pd(x + t - s), north = _mm512_loadu_pd(x + t + s);
-    __m512d sum = _mm512_loadu_pd(b + t);
-    if (eight_interior(bits + t)) {
-      // ((((b + west) + east) + south) + north) / 4, in texel_smoothed's order.
-      sum = _mm512_add_pd(_mm512_add_pd(_mm512_add_pd(_mm512_add_pd(sum, west), east), south), north);
-      _mm512_mask_storeu_pd(x + t, colour_lanes, _mm512_mul_pd(sum, _mm512_set1_pd(0.25)));
-    } else {
-      const __m512i m = widened_bits(bits + t);
-      sum = _mm512_add_pd(sum, _mm512_maskz_mov_pd(lanes_with(m, couples_west_unknown), west));
-      sum = _mm512_add_pd(sum, _mm512_maskz_mov_pd(lanes_with(m, couples_east_unknown), east));
-      sum = _mm512_add_pd(sum, _mm512_maskz_mov_pd(lanes_with(m, couples_south_unknown), south));
-      sum = _mm512_add_pd(sum, _mm512_maskz_mov_pd(lanes_with(m, couples_north_unknown), north));
-      _mm512_mask_storeu_pd(x + t, colour_lanes & lanes_with(m, is_unknown), _mm512_mul_pd(sum, inverse_degrees(m)));
-    }
-    previous = current;
-    current = next;
-  }
-  for (int i = i0 + first; i < nx; i += 2) {
-    const std::int64_t t = row + i;
-    if (bits[t] & is_unknown) x[t] = texel_smoothed(bits[t], b, x, t, s);
-  }
-}
-
-// Eight texels of one colour: the smoothed values of smooth_color and the lanes it stores.
+// Eight texels of one colour (b: their right-hand side): the smoothed values, in
+// texel_smoothed's order ((((b + west) + east) + south) + north) / degree, and the lanes to store.
 DGTEX_AVX512 __m512d smoothed_group(const std::uint8_t* bits, __m512d b, std::int64_t t, __m512d west,
                                     __m512d east, __m512d south, __m512d north, __mmask8 colour_lanes,
                                     __mmask8& stored) {
@@ -670,16 +630,48 @@ DGTEX_AVX512 __m512d smoothed_group(const std::uint8_t* bits, __m512d b, std::in
   return _mm512_mul_pd(sum, inverse_degrees(m));
 }
 
+// The colour sweep. Masked stores write the colour's unknowns only, so the other colour's
+// values, which another thread may read at a lagged block edge, are never rewritten. West and
+// east neighbours come from registers, as in smooth_color_impl.
+__attribute__((target("avx512f"))) void smooth_color(GridShape g, const std::uint8_t* bits, const double* b, double* x,
+                                                     int j, int color) {
+  const std::int64_t s = g.stride(), row = g.at(0, j);
+  const int nx = g.nx;
+  const int first = (color + j) & 1;
+  const __mmask8 colour_lanes = first ? 0xAA : 0x55;
+  __m512d previous = _mm512_maskz_broadcastsd_pd(0x80, _mm_set_sd(x[row - 1]));
+  __m512d current = nx >= 8 ? _mm512_loadu_pd(x + row) : _mm512_setzero_pd();
+  int i0 = 0;
+  for (; i0 + 8 <= nx; i0 += 8) {
+    const std::int64_t t = row + i0;
+    // x(t + 8) is the east ghost when the group ends the row; lanes past it are not used.
+    const __m512d next =
+        i0 + 16 <= nx ? _mm512_loadu_pd(x + t + 8) : _mm512_maskz_broadcastsd_pd(0x01, _mm_set_sd(x[t + 8]));
+    __mmask8 stored;
+    const __m512d smoothed =
+        smoothed_group(bits, _mm512_loadu_pd(b + t), t, west_of(previous, current), east_of(current, next),
+                       _mm512_loadu_pd(x + t - s), _mm512_loadu_pd(x + t + s), colour_lanes, stored);
+    _mm512_mask_storeu_pd(x + t, stored, smoothed);
+    previous = current;
+    current = next;
+  }
+  for (int i = i0 + first; i < nx; i += 2) {
+    const std::int64_t t = row + i;
+    if (bits[t] & is_unknown) x[t] = texel_smoothed(bits[t], b, x, t, s);
+  }
+}
+
 // The row pairs' data that comes from beyond L2 (row j + 1 of x, or row j for
 // red_from_zero_pair, and row j of b and of the flags: first touched by the pair at row j) is
 // prefetched this many texels ahead (16 lines): open T = 1024, one thread, the sweep 0.95 ->
 // 0.69 ms, two threads 0.34 -> 0.32 ms; 256 texels ahead gave the same.
 constexpr int pair_prefetch_distance = 128;
-// A prefetch hint for p + offset elements; the address is formed as an integer because it
-// may lie past the end of the array on the last rows (a prefetch never faults).
+// A prefetch hint for p + offset. On the last rows the address lies past the array (a
+// prefetch never faults); forming it as an integer, or clamping it to the array, made the
+// pair's code slower: the T = 256 and 512 sweep ~10-15 % (one thread, best of 5, twice).
 template <class T>
 DGTEX_AVX512 void prefetch_ahead(const T* p, std::int64_t offset) {
-  _mm_prefetch(reinterpret_cast<const char*>(reinterpret_cast<std::uintptr_t>(p) + offset * sizeof(T)), _MM_HINT_T0);
+  _mm_prefetch(reinterpret_cast<const char*>(p + offset), _MM_HINT_T0);
 }
 
 // smooth_color(j, color), then smooth_color(j - 1, 1 - color), group by group: the sweep's
@@ -740,6 +732,24 @@ __attribute__((target("avx512f"))) void smooth_color_pair(GridShape g, const std
     if (bits[lower + i] & is_unknown) x[lower + i] = texel_smoothed(bits[lower + i], b, x, lower + i, s);
 }
 
+// Eight texels of the first sweep from zero (b: their right-hand side): b / degree at the
+// red unknowns (`red_lanes`), 0 in the other lanes.
+DGTEX_AVX512 __m512d red_from_zero_group(const std::uint8_t* bits, __m512d b, std::int64_t t, __mmask8 red_lanes) {
+  if (eight_interior(bits + t)) return _mm512_maskz_mul_pd(red_lanes, b, _mm512_set1_pd(0.25));
+  const __m512i m = widened_bits(bits + t);
+  return _mm512_maskz_mul_pd(red_lanes & lanes_with(m, is_unknown), b, inverse_degrees(m));
+}
+// The first sweep from zero on row j's texels from i0 on (those past the last whole group).
+DGTEX_AVX512 void red_from_zero_tail(GridShape g, const std::uint8_t* bits, const double* b, double* x, int j,
+                                     int i0) {
+  const std::int64_t row = g.at(0, j);
+  for (int i = i0; i < g.nx; ++i) {
+    const std::int64_t t = row + i;
+    const std::uint8_t m = bits[t];
+    x[t] = ((m & is_unknown) && ((i + j) & 1) == 0) ? b[t] * inverse_degree[laplace_degree(m)] : 0.0;
+  }
+}
+
 // red_from_zero(j), then smooth_color(j - 1, 1), group by group: the first sweep from zero
 // with its lagged black colour, as smooth_color_pair (row j - 1's black texels lie under row
 // j's red ones; their north neighbours are row j's new values, from registers).
@@ -762,13 +772,7 @@ __attribute__((target("avx512f"))) void red_from_zero_pair(GridShape g, const st
     prefetch_ahead(b, tu + pair_prefetch_distance);
     if ((i0 & 63) == 0) prefetch_ahead(bits, tu + pair_prefetch_distance);
     const __m512d b_upper = _mm512_loadu_pd(b + tu), b_lower = _mm512_loadu_pd(b + tl);  // before the stores
-    __m512d red;
-    if (eight_interior(bits + tu)) {
-      red = _mm512_maskz_mul_pd(colour_lanes, b_upper, _mm512_set1_pd(0.25));
-    } else {
-      const __m512i m = widened_bits(bits + tu);
-      red = _mm512_maskz_mul_pd(colour_lanes & lanes_with(m, is_unknown), b_upper, inverse_degrees(m));
-    }
+    const __m512d red = red_from_zero_group(bits, b_upper, tu, colour_lanes);
     _mm512_storeu_pd(x + tu, red);
     __mmask8 stored;
     const __m512d smoothed_lower =
@@ -777,11 +781,7 @@ __attribute__((target("avx512f"))) void red_from_zero_pair(GridShape g, const st
     _mm512_mask_storeu_pd(x + tl, stored, smoothed_lower);
     previous_lower = current_lower, current_lower = next_lower, south_lower = next_south_lower;
   }
-  for (int i = i0; i < nx; ++i) {
-    const std::int64_t t = upper + i;
-    const std::uint8_t m = bits[t];
-    x[t] = ((m & is_unknown) && ((i + j) & 1) == 0) ? b[t] * inverse_degree[laplace_degree(m)] : 0.0;
-  }
+  red_from_zero_tail(g, bits, b, x, j, i0);
   for (int i = i0 + (j & 1); i < nx; i += 2)
     if (bits[lower + i] & is_unknown) x[lower + i] = texel_smoothed(bits[lower + i], b, x, lower + i, s);
 }
@@ -815,28 +815,40 @@ DGTEX_AVX512 __m512d operators(const std::uint8_t* bits, const double* x, std::i
   return texel_operators(m, x, t, s);
 }
 
+// Writes each group's result one group late, after the next group's loads: the output and x
+// are page aligned alike, so the next group's x(t + 7 ..) read right after out(t ..) is
+// written would look like a read of that store (4K aliasing) and wait for it. One thread,
+// best of 6 runs: colour residual T = 256 35 -> 32 us, T = 512 154 -> 120 us; direction +
+// operator 46 -> 38 and 190 -> 144 us.
+struct LateStores {
+  double* out;
+  __mmask8 lanes;  // the lanes written
+  __m512d pending = _mm512_setzero_pd();
+  std::int64_t pending_t = -1;
+  DGTEX_AVX512 void add(std::int64_t t, __m512d value) {
+    flush();
+    pending = value, pending_t = t;
+  }
+  DGTEX_AVX512 void flush() {
+    if (pending_t >= 0) _mm512_mask_storeu_pd(out + pending_t, lanes, pending);
+    pending_t = -1;
+  }
+};
+
 __attribute__((target("avx512f"))) void residual_color(GridShape g, const std::uint8_t* bits, const double* b,
                                                        const double* x, double* r, int j, int color) {
   const std::int64_t s = g.stride(), row = g.at(0, j);
   const int first = (color + j) & 1;
   const __mmask8 colour_lanes = first ? 0xAA : 0x55;
-  // Each group's result is stored after the next group's loads: r and x are page aligned
-  // alike, so the next group's x(t + 7 ..) read right after r(t ..) is written would look
-  // like a read of that store (4K aliasing) and wait for it. One thread, best of 6 runs:
-  // T = 256 35 -> 32 us, T = 512 154 -> 120 us (direction + operator, below: 46 -> 38 and
-  // 190 -> 144 us).
-  __m512d pending = _mm512_setzero_pd();
-  std::int64_t pending_t = -1;
+  LateStores stores{r, colour_lanes};
   int i0 = 0;
   for (; i0 + 8 <= g.nx; i0 += 8) {
     const std::int64_t t = row + i0;
     __mmask8 unknowns;
     const __m512d ax = operators(bits, x, t, s, unknowns);
-    const __m512d value = _mm512_maskz_sub_pd(unknowns, _mm512_loadu_pd(b + t), ax);
-    if (pending_t >= 0) _mm512_mask_storeu_pd(r + pending_t, colour_lanes, pending);
-    pending = value, pending_t = t;
+    stores.add(t, _mm512_maskz_sub_pd(unknowns, _mm512_loadu_pd(b + t), ax));
   }
-  if (pending_t >= 0) _mm512_mask_storeu_pd(r + pending_t, colour_lanes, pending);
+  stores.flush();
   for (int i = i0 + first; i < g.nx; i += 2) r[row + i] = texel_residual(bits[row + i], b, x, row + i, s);
 }
 
@@ -845,21 +857,9 @@ __attribute__((target("avx512f"))) void red_from_zero(GridShape g, const std::ui
   const std::int64_t row = g.at(0, j);
   const __mmask8 red_lanes = (j & 1) ? 0xAA : 0x55;
   int i0 = 0;
-  for (; i0 + 8 <= g.nx; i0 += 8) {
-    const std::int64_t t = row + i0;
-    if (eight_interior(bits + t)) {
-      _mm512_storeu_pd(x + t, _mm512_maskz_mul_pd(red_lanes, _mm512_loadu_pd(b + t), _mm512_set1_pd(0.25)));
-    } else {
-      const __m512i m = widened_bits(bits + t);
-      _mm512_storeu_pd(x + t, _mm512_maskz_mul_pd(red_lanes & lanes_with(m, is_unknown), _mm512_loadu_pd(b + t),
-                                                  inverse_degrees(m)));
-    }
-  }
-  for (int i = i0; i < g.nx; ++i) {
-    const std::int64_t t = row + i;
-    const std::uint8_t m = bits[t];
-    x[t] = ((m & is_unknown) && ((i + j) & 1) == 0) ? b[t] * inverse_degree[laplace_degree(m)] : 0.0;
-  }
+  for (; i0 + 8 <= g.nx; i0 += 8)
+    _mm512_storeu_pd(x + row + i0, red_from_zero_group(bits, _mm512_loadu_pd(b + row + i0), row + i0, red_lanes));
+  red_from_zero_tail(g, bits, b, x, j, i0);
 }
 
 // Row sums keep RowSum's four chains: texel i is added to chain i mod 4 in increasing i, so
@@ -868,9 +868,7 @@ __attribute__((target("avx512f"))) double apply(GridShape g, const std::uint8_t*
                                                int j) {
   const std::int64_t s = g.stride(), row = g.at(0, j);
   __m256d dot = _mm256_setzero_pd();
-  // Stores one group late, after the next group's loads (4K aliasing, as in residual_color).
-  __m512d pending = _mm512_setzero_pd();
-  std::int64_t pending_t = -1;
+  LateStores stores{y, 0xff};
   int i0 = 0;
   for (; i0 + 8 <= g.nx; i0 += 8) {
     const std::int64_t t = row + i0;
@@ -878,12 +876,11 @@ __attribute__((target("avx512f"))) double apply(GridShape g, const std::uint8_t*
     const __m512d ax = operators(bits, x, t, s, unknowns);
     const __m512d value = _mm512_maskz_mov_pd(unknowns, ax);
     const __m512d product = _mm512_mul_pd(value, _mm512_loadu_pd(x + t));
-    if (pending_t >= 0) _mm512_storeu_pd(y + pending_t, pending);
-    pending = value, pending_t = t;
+    stores.add(t, value);
     dot = _mm256_add_pd(dot, _mm512_castpd512_pd256(product));
     dot = _mm256_add_pd(dot, _mm512_extractf64x4_pd(product, 1));
   }
-  if (pending_t >= 0) _mm512_storeu_pd(y + pending_t, pending);
+  stores.flush();
   alignas(32) double lane[4];
   _mm256_store_pd(lane, dot);
   for (int i = i0; i < g.nx; ++i) {
