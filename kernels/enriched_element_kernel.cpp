@@ -131,9 +131,13 @@ void element_stiffness(const EnrichedElementBatch& b, const EnrichedQuadrature& 
 
 // Fixed work items: (element, first point, end point). Each element's points are split
 // into equal chunks of at least enriched_chunk_points, at most enriched_chunks_per_element
-// of them: the split depends only on the quadrature, never on the thread count.
+// of them: the split depends only on the quadrature, never on the thread count. With
+// `points` set, the item is the listed points points[begin..end) instead of a range.
 struct Chunk {
   std::int64_t element, begin, end;
+  const std::int64_t* points = nullptr;
+
+  std::int64_t point(std::int64_t k) const { return points ? points[k] : k; }
 };
 
 std::vector<Chunk> make_chunks(const EnrichedElementBatch& b, const EnrichedQuadrature& quad) {
@@ -371,7 +375,8 @@ void chunk_stiffness(const EnrichedElementBatch& b, const EnrichedQuadrature& qu
   PointRows pr;
   double values[max_enrichments_per_element];
   TextureSample samples[max_enrichments_per_element];  // constructed once: it zero-fills
-  for (std::int64_t q = chunk.begin; q < chunk.end; ++q) {
+  for (std::int64_t k = chunk.begin; k < chunk.end; ++k) {
+    const std::int64_t q = chunk.point(k);
     const double* pt = quad.points + 3 * q;
     evaluate_shape(b.type, pt[0], pt[1], s);
     evaluate_rest_point(s, nodes, b.positions, rest);
@@ -612,6 +617,13 @@ void enriched_element_corotated_stiffness(const EnrichedElementBatch& batch, con
                                           const double* current, double* blocks, double* forces,
                                           Execution execution) {
   stiffness_by_chunks(batch, quadrature, nullptr, current, blocks, forces, execution);
+}
+
+void enriched_element_point_set_stiffness(const EnrichedElementBatch& batch, const EnrichedQuadrature& quadrature,
+                                          std::int64_t e, const std::int64_t* points, std::int64_t count,
+                                          std::vector<double>& K) {
+  std::vector<double> unused_forces;
+  chunk_stiffness(batch, quadrature, Chunk{e, 0, count, points}, nullptr, nullptr, false, K, unused_forces);
 }
 
 void enriched_element_deformation_gradients(const EnrichedElementBatch& b, const EnrichedQuadrature& quad,

@@ -52,6 +52,8 @@ SceneCounts count(const Scene& scene, const SceneRun& run) {
   c.enrichments = static_cast<std::int64_t>(model.enrichments().size());
   c.texture_resolution = model.enrichments().empty() ? 0 : scene.enrichment.texture_resolution;
   c.basis_changes = run.basis_changes();
+  c.rotation_clusters = model.num_rotation_clusters();
+  c.rotation_cluster_bytes = model.rotation_cluster_bytes();
   return c;
 }
 

@@ -632,7 +632,8 @@ class SceneReader {
   }
 
   EnrichmentOptions read_enrichment(const json& v, const std::string& path) const {
-    check_keys(v, path, {"texture_resolution", "solver", "new_cut_length", "new_cut_angle_deg", "quadrature_tolerance"});
+    check_keys(v, path, {"texture_resolution", "solver", "new_cut_length", "new_cut_angle_deg", "quadrature_tolerance",
+                       "rotation_cluster_texels"});
     EnrichmentOptions e;
     if (const json* r = find(v, "texture_resolution")) {
       const std::string p = child(path, "texture_resolution");
@@ -647,6 +648,8 @@ class SceneReader {
     if (const json* a = find(v, "new_cut_angle_deg")) e.new_cut_angle_deg = positive(*a, child(path, "new_cut_angle_deg"));
     if (const json* q = find(v, "quadrature_tolerance"))
       e.quadrature_tolerance = positive(*q, child(path, "quadrature_tolerance"));
+    if (const json* c = find(v, "rotation_cluster_texels"))
+      e.rotation_cluster_texels = integer(*c, child(path, "rotation_cluster_texels"), 0, 4096);
     return e;
   }
 
@@ -935,6 +938,7 @@ std::string scene_to_json_text(const Scene& scene) {
   if (e.new_cut_length) out["enrichment"]["new_cut_length"] = *e.new_cut_length;
   if (e.new_cut_angle_deg) out["enrichment"]["new_cut_angle_deg"] = *e.new_cut_angle_deg;
   out["enrichment"]["quadrature_tolerance"] = e.quadrature_tolerance;
+  out["enrichment"]["rotation_cluster_texels"] = e.rotation_cluster_texels;
   if (scene.render) {
     const RenderOptions& r = *scene.render;
     json camera = {{"up", to_json(r.camera_up)}, {"fov_deg", r.fov_deg}};

@@ -42,6 +42,7 @@ SceneModel build_scene_model(const Scene& scene, const Mesh& mesh) {
   ShellModelOptions options;
   options.penalty = scene.penalty;
   options.enrichment_quadrature.merge_tolerance = scene.enrichment.quadrature_tolerance;
+  options.rotation_cluster_texels = scene.enrichment.rotation_cluster_texels;
   SceneModel out;
   out.model = std::make_unique<ShellModel>(mesh, topology, sections, clamped, options);
   if (!scene.material_textures.empty()) out.model->set_material_textures(scene_material_textures(scene, mesh));

@@ -15,6 +15,12 @@ namespace dgtex {
 
 using kernels::Execution;
 
+namespace {
+// Rotation clusters' rest sums beyond this (4 GiB) are refused: ~0.8 MB per cluster for the
+// accordion's 150 functions, so blocks of 8 texels there already take 1.2 GB.
+constexpr std::int64_t max_rotation_cluster_doubles = std::int64_t{1} << 29;
+}  // namespace
+
 ShellModel::ShellModel(Mesh mesh, const Topology& topology, std::vector<kernels::ShellSection> sections,
                        const std::vector<int>& clamped_edges, ShellModelOptions options)
     : mesh_(std::move(mesh)), sections_(std::move(sections)), options_(options) {
@@ -133,6 +139,7 @@ void ShellModel::rebuild() {
   assembly_ = BlockAssembly(mesh_.num_nodes() + num_enriched_nodes(), families);
   workspace_.element_rest_rows.clear();  // the plain elements and edges may have changed
   workspace_.edge_rest_rows.clear();
+  workspace_.cluster_rest.clear();  // the enriched quadrature may have changed
 
   // Mass and load weights depend on the rest geometry only.
   std::vector<double> element_mass(static_cast<size_t>(num_plain) * npe * npe);
@@ -675,7 +682,26 @@ void ShellModel::assemble_stiffness(const double* current, std::vector<double>& 
     }
     // Corotated: each point's F and rotation are formed in the stiffness pass (one texture
     // sampling per point; bitwise the separate gradient, polar and stiffness kernels).
-    if (current)
+    if (current && options_.rotation_cluster_texels > 0) {
+      if (w.cluster_rest.empty()) {
+        w.clusters = kernels::enriched_rotation_clusters(xb, element_quad, options_.rotation_cluster_texels);
+        const std::int64_t size = w.clusters.count() * kernels::enriched_cluster_rest_stride(W);
+        if (size > max_rotation_cluster_doubles)
+          throw std::runtime_error("rotation clusters of " + std::to_string(options_.rotation_cluster_texels) +
+                                   " texels: " + std::to_string(w.clusters.count()) + " clusters would take " +
+                                   std::to_string(size * 8 >> 20) + " MiB of rest sums (limit " +
+                                   std::to_string(max_rotation_cluster_doubles * 8 >> 20) +
+                                   " MiB); use larger blocks (enrichment.rotation_cluster_texels) or 0 (per point)");
+        w.cluster_rest.resize(static_cast<size_t>(size));
+        kernels::enriched_cluster_rest_stiffness(xb, element_quad, w.clusters, w.cluster_rest.data(), execution);
+      }
+      w.cluster_rotations.resize(static_cast<size_t>(w.clusters.count()) * 9);
+      kernels::enriched_cluster_rotations(xb, w.clusters, w.cluster_rest.data(), current, w.cluster_rotations.data(),
+                                          execution);
+      kernels::enriched_element_clustered_stiffness(xb, w.clusters, w.cluster_rest.data(), w.cluster_rotations.data(),
+                                                    w.enriched_blocks.data(),
+                                                    forces ? w.enriched_forces.data() : nullptr, execution);
+    } else if (current)
       kernels::enriched_element_corotated_stiffness(xb, element_quad, current, w.enriched_blocks.data(),
                                                     forces ? w.enriched_forces.data() : nullptr, execution);
     else

@@ -52,7 +52,8 @@ ReducedRun run_reduced() {
       " bench accuracy --threads 1 --repeat 1 --plate-divisions 4,8,16 --quadrature-resolution 32"
       " --quadrature-tolerances 1,1e-2 --texture-sizes 16,32,64 --shell-scene " DGTEX_SOURCE_DIR
       "/examples/scenes/cylinder_buckling.json --shell-steps 3 --shell-tolerances 1e-2,1e-8 --multigrid-size 64"
-      " --multigrid-tolerances 1e-1,1e-8 --out " +
+      " --multigrid-tolerances 1e-1,1e-8 --rotation-scene " DGTEX_SOURCE_DIR
+      "/examples/scenes/accordion.json --rotation-steps 3 --rotation-blocks 64,32 --out " +
       run.dir.string() + " > " + (run.dir.string() + ".log") + " 2>&1";
   run.status = std::system(command.c_str());
   std::ifstream in(run.dir / "accuracy.json");
@@ -62,7 +63,7 @@ ReducedRun run_reduced() {
 
 void check_WritesChartsJsonAndTable(const ReducedRun& run) {
   SCOPED_TRACE("WritesChartsJsonAndTable");
-  for (const char* name : {"plate", "quadrature", "texture", "tolerance"}) {
+  for (const char* name : {"plate", "quadrature", "texture", "tolerance", "rotation"}) {
     EXPECT_TRUE(fs::exists(run.dir / (std::string("accuracy_") + name + ".png"))) << name;
     const auto& c = run.chart(name);
     for (const char* key : {"title", "time_label", "error_label", "points"}) EXPECT_TRUE(c.contains(key)) << name << key;
@@ -147,6 +148,26 @@ void check_ToleranceErrorsWithinBounds(const ReducedRun& run) {
   }
 }
 
+// Rotation clusters: per point is the reference (error 0); blocks of 64 and 32 texels stay
+// within 1 % of it over the accordion's first 3 steps (measured: 2.3e-3 and 4.0e-3), and
+// the smaller blocks make more clusters.
+void check_RotationClustersWithinBounds(const ReducedRun& run) {
+  SCOPED_TRACE("RotationClustersWithinBounds");
+  const auto series = by_series(run.chart("rotation"));
+  ASSERT_EQ(series.size(), 1u);
+  const auto& points = series.begin()->second;
+  ASSERT_EQ(points.size(), 3u);
+  EXPECT_EQ(points[0].at("label"), "per point");
+  EXPECT_EQ(points[0].at("error").get<double>(), 0.0);
+  EXPECT_EQ(points[0].at("clusters").get<double>(), 0.0);
+  for (std::size_t k = 1; k < 3; ++k) {
+    EXPECT_GT(points[k].at("error").get<double>(), 0.0) << k;
+    EXPECT_LT(points[k].at("error").get<double>(), 0.01) << k;
+    EXPECT_GT(points[k].at("cluster_mb").get<double>(), 0.0) << k;
+  }
+  EXPECT_GT(points[2].at("clusters").get<double>(), points[1].at("clusters").get<double>());
+}
+
 TEST(BenchAccuracy, ReducedRunMeetsInvariants) {
   const ReducedRun run = run_reduced();
   ASSERT_EQ(run.status, 0) << "see " << run.dir.string() << ".log";
@@ -155,6 +176,7 @@ TEST(BenchAccuracy, ReducedRunMeetsInvariants) {
   check_QuadratureReferenceAndBounds(run);
   check_TipErrorFallsWithTextureResolution(run);
   check_ToleranceErrorsWithinBounds(run);
+  check_RotationClustersWithinBounds(run);
   fs::remove_all(run.dir);
   fs::remove(run.dir.string() + ".log");
 }

@@ -252,6 +252,10 @@ TEST(SceneErrors, EnrichmentTextureResolution) {
   expect_error(with(valid_scene(), "/enrichment"_json_pointer, {{"texture_resolution", 4}}),
                "enrichment.texture_resolution", "4");
   expect_error(with(valid_scene(), "/enrichment"_json_pointer, {{"new_cut_length", 0}}), "enrichment.new_cut_length", "0");
+  expect_error(with(valid_scene(), "/enrichment"_json_pointer, {{"rotation_cluster_texels", -1}}),
+               "enrichment.rotation_cluster_texels", "-1", "0..4096");
+  expect_error(with(valid_scene(), "/enrichment"_json_pointer, {{"rotation_cluster_texels", 2.5}}),
+               "enrichment.rotation_cluster_texels", "2.5");
   for (int r : {8, 16, 1024, 4096})
     EXPECT_EQ(error_of_text(with(valid_scene(), "/enrichment"_json_pointer, {{"texture_resolution", r}}).dump()), "");
 }

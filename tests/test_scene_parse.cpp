@@ -88,6 +88,7 @@ TEST(SceneParse, FullSceneHasEveryValue) {
   EXPECT_EQ(s.enrichment.solver, EnrichmentOptions::Solver::cholmod);
   EXPECT_EQ(s.enrichment.new_cut_length.value_or(-1), 0.3);
   EXPECT_EQ(s.enrichment.new_cut_angle_deg.value_or(-1), 45.0);
+  EXPECT_EQ(s.enrichment.rotation_cluster_texels, 16);
 
   ASSERT_TRUE(s.render.has_value());
   const RenderOptions& r = *s.render;
@@ -120,6 +121,7 @@ TEST(SceneParse, MinimalSceneGetsDocumentedDefaults) {
   EXPECT_EQ(s.enrichment.solver, EnrichmentOptions::Solver::multigrid);
   EXPECT_FALSE(s.enrichment.new_cut_length.has_value());
   EXPECT_FALSE(s.enrichment.new_cut_angle_deg.has_value());
+  EXPECT_EQ(s.enrichment.rotation_cluster_texels, 0);  // per point
   EXPECT_FALSE(s.render.has_value());
   EXPECT_EQ(s.output.report, "report.json");
 }

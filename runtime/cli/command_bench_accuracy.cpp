@@ -81,10 +81,11 @@ bool write_chart(const std::string& path, const AccuracyChart& chart, const std:
 }
 
 std::vector<std::string> split_names(const std::vector<std::string>& names) {
-  static const std::vector<std::string> valid = {"plate", "quadrature", "texture", "tolerance"};
+  static const std::vector<std::string> valid = {"plate", "quadrature", "texture", "tolerance", "rotation"};
   for (const std::string& n : names)
     if (std::find(valid.begin(), valid.end(), n) == valid.end())
-      throw std::invalid_argument("--charts: unknown chart '" + n + "'; valid: plate, quadrature, texture, tolerance");
+      throw std::invalid_argument("--charts: unknown chart '" + n +
+                                  "'; valid: plate, quadrature, texture, tolerance, rotation");
   return names;
 }
 
@@ -92,16 +93,17 @@ std::vector<std::string> split_names(const std::vector<std::string>& names) {
 
 int bench_accuracy_command(int argc, char** argv) {
   CLI::App app{"Speed against accuracy: error against time for mesh refinement, enriched quadrature, texture "
-               "resolution and solver tolerance",
+               "resolution, solver tolerance and rotation clusters",
                "dgtex bench accuracy"};
-  std::vector<std::string> charts = {"plate", "quadrature", "texture", "tolerance"};
+  std::vector<std::string> charts = {"plate", "quadrature", "texture", "tolerance", "rotation"};
   std::string out_dir = "accuracy", format = "png", clock = "cpu";
   int threads = 1, repeat = 3;
   PlateAccuracyOptions plate;
   QuadratureAccuracyOptions quadrature;
   TextureAccuracyOptions texture;
   ToleranceAccuracyOptions tolerance;
-  app.add_option("--charts", charts, "plate, quadrature, texture, tolerance")->delimiter(',')->capture_default_str();
+  RotationAccuracyOptions rotation;
+  app.add_option("--charts", charts, "plate, quadrature, texture, tolerance, rotation")->delimiter(',')->capture_default_str();
   app.add_option("--out", out_dir, "output folder (charts, accuracy.json, accuracy.md)")->capture_default_str();
   app.add_option("--format", format, "chart format: png or svg")->capture_default_str()->check(CLI::IsMember({"png", "svg"}));
   app.add_option("--clock", clock, "cpu (process CPU time; robust on a shared machine with 1 thread) or wall")
@@ -124,6 +126,11 @@ int bench_accuracy_command(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--multigrid-tolerances", tolerance.multigrid_tolerances, "multigrid relative tolerances")
       ->delimiter(',')->capture_default_str();
+  app.add_option("--rotation-scene", rotation.scene, "dynamic corotated scene with cuts of the rotation sweep")
+      ->capture_default_str();
+  app.add_option("--rotation-steps", rotation.steps, "steps per rotation run")->capture_default_str();
+  app.add_option("--rotation-blocks", rotation.block_texels, "rotation cluster blocks B (texels; per point is the reference)")
+      ->delimiter(',')->capture_default_str();
   app.add_flag("!--no-shell", tolerance.shell, "tolerance chart without the shell PCG series");
   app.add_flag("!--no-multigrid", tolerance.multigrid, "tolerance chart without the multigrid series");
   try {
@@ -137,7 +144,7 @@ int bench_accuracy_command(int argc, char** argv) {
     split_names(charts);
     plate.repeat = quadrature.repeat = texture.repeat = tolerance.repeat = repeat;
     const AccuracyClock which = clock == "cpu" ? AccuracyClock::cpu : AccuracyClock::wall;
-    plate.clock = quadrature.clock = texture.clock = tolerance.clock = which;
+    plate.clock = quadrature.clock = texture.clock = tolerance.clock = rotation.clock = which;
     omp_set_num_threads(threads);
     std::filesystem::create_directories(out_dir);
     const std::string machine = describe_machine();
@@ -154,6 +161,7 @@ int bench_accuracy_command(int argc, char** argv) {
       if (name == "quadrature") results.push_back(run_quadrature_accuracy(quadrature, progress));
       if (name == "texture") results.push_back(run_texture_accuracy(texture, progress));
       if (name == "tolerance") results.push_back(run_tolerance_accuracy(tolerance, progress));
+      if (name == "rotation") results.push_back(run_rotation_accuracy(rotation, progress));
     }
     const std::filesystem::path dir(out_dir);
     {

@@ -61,7 +61,9 @@ nlohmann::json counts_json(const SceneCounts& c) {
           {"enriched_quadrature_points", c.enriched_quadrature_points},
           {"enrichments", c.enrichments},
           {"texture_resolution", c.texture_resolution},
-          {"basis_changes", c.basis_changes}};
+          {"basis_changes", c.basis_changes},
+          {"rotation_clusters", c.rotation_clusters},
+          {"rotation_cluster_bytes", c.rotation_cluster_bytes}};
 }
 
 // Table 5.1 time / ours: the thesis's peak enrichment against our peak, its mean assembly

@@ -157,7 +157,9 @@ int run_command(int argc, char** argv) {
                                                          model.num_enriched_edge_quadrature_points()},
                       {"enrichments", static_cast<int>(model.enrichments().size())},
                       {"texture_resolution", model.enrichments().empty() ? 0 : scene.enrichment.texture_resolution},
-                      {"basis_changes", run->basis_changes()}};
+                      {"basis_changes", run->basis_changes()},
+                      {"rotation_clusters", model.num_rotation_clusters()},
+                      {"rotation_cluster_bytes", model.rotation_cluster_bytes()}};
   report["timings_ms"] = {{"enrichment", stage_json(timings, "enrichment")},
                           {"projection", stage_json(timings, "projection")},
                           {"assembly", stage_json(timings, "assembly")},

@@ -1,5 +1,5 @@
 #pragma once
-// Speed against accuracy (dgtex bench accuracy): four sweeps, each a list of (time, error)
+// Speed against accuracy (dgtex bench accuracy): five sweeps, each a list of (time, error)
 // points in one or more series, for charts of error against milliseconds.
 //  - plate:      simply supported square plate under uniform load, quad8 and tri6, n x n
 //                meshes; relative error of the centre deflection against the Navier series;
@@ -14,6 +14,9 @@
 //  - tolerance:  relative tolerance of the corotated dynamic step's PCG (cylinder scene,
 //                against factorising every step) and of the texel multigrid (against
 //                CHOLMOD); solve time (accuracy_tolerance.cpp).
+//  - rotation:   rotation clusters of enriched elements (blocks of B texels) in a dynamic
+//                corotated scene, final displacement against per-point rotations; time of
+//                the whole run (accuracy_rotation.cpp).
 // Times are milliseconds of the chosen clock (AccuracyClock), best of `repeat` runs where a
 // case is cheap enough to repeat. All sweeps run with the current OpenMP thread count.
 // Plain functions that return their results (nothing kept); each sweep uses all OpenMP
@@ -112,6 +115,19 @@ struct ToleranceAccuracyOptions {
 // one solve from zero (setup included); extra "iterations". The references appear with
 // error 0. Throws what run_shell_benchmark throws for a bad scene.
 AccuracyChart run_tolerance_accuracy(const ToleranceAccuracyOptions& options, const AccuracyProgress& progress = {});
+
+struct RotationAccuracyOptions {
+  std::string scene = "examples/scenes/accordion.json";  // dynamic, corotated, with cuts
+  int steps = 60;
+  std::vector<int> block_texels = {64, 32, 16, 8};  // enrichment.rotation_cluster_texels
+  AccuracyClock clock = AccuracyClock::cpu;
+};
+// error = |u - u_ref| / |u_ref| of the final displacement (all DOFs) against per-point
+// rotations (the reference, error 0; the scene's own setting is overridden), ms = the
+// whole run (set-up, cuts, steps); extra "clusters", "cluster_mb" (their rest sums) and
+// "assembly_wall_ms". std::invalid_argument for steps < 1, a block < 1 or a scene that is
+// not dynamic and corotated; what load_scene and SceneRun throw for a bad scene.
+AccuracyChart run_rotation_accuracy(const RotationAccuracyOptions& options, const AccuracyProgress& progress = {});
 
 // "MODEL NAME, N cores" from /proc/cpuinfo (or "unknown CPU"), plus the OpenMP threads.
 std::string describe_machine();

@@ -142,6 +142,10 @@ struct EnrichmentOptions {
   // deviates from one quadratic by at most this (in units of H, which is O(1)); default
   // 1e-2, > 0. Larger is faster and less accurate (ShellModelOptions::enrichment_quadrature).
   double quadrature_tolerance = 1e-2;
+  // Enriched elements turn per cluster of quadrature points (the points of one block of this
+  // many texels on one side of every cut) instead of per point; 0 (default): per point.
+  // Larger is faster and less accurate (ShellModelOptions::rotation_cluster_texels).
+  int rotation_cluster_texels = 0;
 };
 
 // "render" (optional block; without it no frames are written).

@@ -42,7 +42,7 @@ struct SceneCounts {
   std::int64_t elements = 0, nodes = 0, dofs = 0, enriched_dofs = 0, free_dofs = 0, nonzeros = 0,
                factor_nonzeros = 0, interior_edges = 0, clamped_edges = 0, quadrature_points = 0,
                enriched_elements = 0, enriched_quadrature_points = 0, enrichments = 0, texture_resolution = 0,
-               basis_changes = 0;
+               basis_changes = 0, rotation_clusters = 0, rotation_cluster_bytes = 0;
 };
 
 // Milliseconds per step, one entry per step taken.

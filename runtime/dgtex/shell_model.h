@@ -23,6 +23,7 @@
 #include "dgtex/kernels/enriched_element_kernel.h"
 #include "dgtex/kernels/enriched_element_rest_integrals.h"
 #include "dgtex/kernels/enriched_quadrature.h"
+#include "dgtex/kernels/enriched_rotation_clusters.h"
 #include "dgtex/kernels/shell_edge_kernel.h"
 #include "dgtex/kernels/shell_element_kernel.h"
 #include "dgtex/kernels/material_texture_kernel.h"
@@ -45,6 +46,10 @@ struct ShellModelOptions {
   // its node's own, M_vv - M_av^2 / M_aa < ratio M_aa (fragments a few texels wide), are
   // dropped (set_enrichments); 0 keeps all.
   double min_enrichment_mass_ratio = 1e-3;
+  // Corotation of enriched elements: 0, per quadrature point; B > 0, one rotation per cluster
+  // of points (those of a block of B x B texels on one side of every cut), their rest
+  // stiffness summed once per enrichment (kernels/dgtex/kernels/enriched_rotation_clusters.h).
+  int rotation_cluster_texels = 0;
 };
 
 class ShellModel {
@@ -114,6 +119,14 @@ class ShellModel {
   double node_shift(int virtual_node) const { return virtual_node_shift_[virtual_node - num_nodes()]; }
   int num_enriched_elements() const { return static_cast<int>(enriched_elements_.size()); }
   int num_enriched_edges() const { return static_cast<int>(enriched_edges_.size() / 4); }
+  // Rotation clusters of the enriched elements (options().rotation_cluster_texels > 0) as of
+  // the last corotated assembly, 0 before one or per point; their rest sums' size in bytes.
+  std::int64_t num_rotation_clusters() const {
+    return workspace_.cluster_rest.empty() ? 0 : workspace_.clusters.count();
+  }
+  std::int64_t rotation_cluster_bytes() const {
+    return static_cast<std::int64_t>(workspace_.cluster_rest.size() * sizeof(double));
+  }
   std::int64_t num_enriched_element_quadrature_points() const { return element_qp_start_.empty() ? 0 : element_qp_start_.back(); }
   std::int64_t num_enriched_edge_quadrature_points() const { return edge_qp_start_.empty() ? 0 : edge_qp_start_.back(); }
   // Rest state (#dofs): node positions, then 0 for every enriched DOF. A current state for
@@ -227,6 +240,10 @@ class ShellModel {
     std::vector<double> element_rest_rows, edge_rest_rows, edge_factors;
     std::vector<double> enriched_edge_rotations;
     std::vector<double> enriched_blocks, enriched_edge_blocks, enriched_forces, enriched_edge_forces;
+    // Rotation clusters (options.rotation_cluster_texels > 0) and their rest sums: built at
+    // the first corotated assembly after the enrichment changed (rebuild clears them).
+    kernels::EnrichedRotationClusters clusters;
+    std::vector<double> cluster_rest, cluster_rotations;
     AssemblyWorkspace() = default;
     AssemblyWorkspace(const AssemblyWorkspace&) {}
     AssemblyWorkspace& operator=(const AssemblyWorkspace&) { return *this; }

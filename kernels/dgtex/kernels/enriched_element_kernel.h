@@ -17,6 +17,7 @@
 // only point into them, nothing is kept after a call; thread-safe on distinct outputs.
 // Units: consistent (SI: positions m, E Pa, h m, density kg/m^3; blocks N/m, forces N, mass kg).
 #include <cstdint>
+#include <vector>
 
 #include "dgtex/kernels/enriched_basis.h"
 #include "dgtex/kernels/forall.h"
@@ -57,6 +58,13 @@ void enriched_element_corotated_stiffness(const EnrichedElementBatch& batch, con
 // Plain per-point form (every basis function at every point; serial): the reference.
 void enriched_element_stiffness_reference(const EnrichedElementBatch& batch, const EnrichedQuadrature& quadrature,
                                           const double* rotations, double* blocks, double* forces);
+// The rest (unrotated) stiffness of element e summed over the listed quadrature points
+// only, by the fast form's arithmetic: K is 3n x 3n row-major over the element's DOFs
+// (n = enriched_basis_count), of which block rows a <= c are written (each 3 x 3 block
+// (a, c), a <= c, whole); the rest is left as it was. Serial.
+void enriched_element_point_set_stiffness(const EnrichedElementBatch& batch, const EnrichedQuadrature& quadrature,
+                                          std::int64_t e, const std::int64_t* points, std::int64_t count,
+                                          std::vector<double>& K);
 constexpr double enriched_flat_tolerance = 1e-10;
 constexpr std::int64_t enriched_chunk_points = 2048;
 // Each chunk maps its groups onto a 3n x 3n sum of its own and keeps their G matrices

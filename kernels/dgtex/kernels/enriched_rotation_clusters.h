@@ -1,0 +1,76 @@
+#pragma once
+// Rotation clusters of texture-enriched elements: a coarser corotation than the per-point
+// one of enriched_element_kernel.h, for elements whose enrichment stays fixed for many steps.
+//
+// Per point, K = sum_q R^_q K0_q R^_q^T (R^ = I_n (x) R, K0_q the rest stiffness of point q)
+// is summed afresh every step from all of an element's texel-resolving quadrature points
+// (accordion: 35k points, 450 DOFs, ~0.4 s). Here the points are grouped into clusters, and
+// all points of a cluster turn with one rotation R_c:
+//   K = sum_c R^_c K0_c R^_c^T,   K0_c = sum_{q in c} K0_q   (fixed: summed once),
+//   f = sum_c R^_c K0_c (X0 - R^_c^T X0)                      (enriched X0 = 0),
+// so a step costs one rotation of the 3 x 3 blocks of K0_c per cluster instead of the point
+// sums. With one point per cluster this is the per-point corotation exactly.
+//
+// Clusters: the texels of one block of B x B texels that are connected without crossing a
+// wall (so a cluster never straddles a cut: the two sides of a cut turn apart), holding the
+// points whose texel (containing_texel) is among them. R_c is the polar rotation of the
+// cluster's mean deformation gradient: the current tangents are linear in the DOFs, so their
+// weighted means over the cluster are sum_f D_f x_f with D_f = sum_q w_q dN_f(q) (stored
+// with K0_c); the rest ones likewise from the rest positions. The error against per-point
+// rotations is of the order of the rotation's spread inside a cluster (B = 1: per texel).
+//
+// Shapes (W = batch.width): rest data per cluster, enriched_cluster_rest_stride(W) doubles:
+// 9 planes (entry i*3+j of a block) of the packed upper blocks (a, c), a <= c < W, at
+// a*W - a*(a-1)/2 + (c-a), each plane enriched_cluster_packed_blocks(W) long (padded); then
+// D_f (xi1 and xi2 parts) for f < W. Rotations: 3 x 3 row-major per cluster. Blocks and
+// forces as enriched_element_stiffness's (#elements x W x W x 9, #elements x W x 3).
+// Kernel conventions (dgtex/kernels/forall.h); every entry is a sum in cluster order, so
+// the parallel forms equal the serial ones bitwise for any thread count.
+#include <cstdint>
+#include <vector>
+
+#include "dgtex/kernels/enriched_element_kernel.h"
+
+namespace dgtex::kernels {
+
+struct EnrichedRotationClusters {
+  std::vector<std::int64_t> element_start;  // #elements + 1: the clusters of each element
+  std::vector<std::int64_t> point_start;    // #clusters + 1: into points
+  std::vector<std::int64_t> points;         // quadrature point indices by cluster, ascending
+
+  std::int64_t count() const { return static_cast<std::int64_t>(point_start.size()) - 1; }
+};
+
+// The clusters of blocks of block_texels x block_texels texels (>= 1). Clusters of an
+// element are ordered by their first texel (row-major); points keep their order.
+EnrichedRotationClusters enriched_rotation_clusters(const EnrichedElementBatch& batch,
+                                                    const EnrichedQuadrature& quadrature, int block_texels);
+
+std::int64_t enriched_cluster_packed_blocks(int width);
+std::int64_t enriched_cluster_rest_stride(int width);
+
+// K0_c and D_f of every cluster (rest data, #clusters x enriched_cluster_rest_stride(W)).
+void enriched_cluster_rest_stiffness(const EnrichedElementBatch& batch, const EnrichedQuadrature& quadrature,
+                                     const EnrichedRotationClusters& clusters, double* rest,
+                                     Execution execution = Execution::parallel);
+
+// R_c of every cluster from the current state (#(nodes + virtual nodes) x 3, as for
+// enriched_element_corotated_stiffness).
+void enriched_cluster_rotations(const EnrichedElementBatch& batch, const EnrichedRotationClusters& clusters,
+                                const double* rest, const double* current, double* rotations,
+                                Execution execution = Execution::parallel);
+
+// K and the corrective forces (may be null) from the rest data and the clusters' rotations.
+void enriched_element_clustered_stiffness(const EnrichedElementBatch& batch, const EnrichedRotationClusters& clusters,
+                                          const double* rest, const double* rotations, double* blocks,
+                                          double* forces, Execution execution = Execution::parallel);
+
+// Serial reference of the three kernels above from scratch: D_f summed over each cluster's
+// points, R_c as above, and K, f as the per-point reference kernel with every point of a
+// cluster given R_c. Rotations (may be null) receives R_c.
+void enriched_element_clustered_stiffness_reference(const EnrichedElementBatch& batch,
+                                                    const EnrichedQuadrature& quadrature,
+                                                    const EnrichedRotationClusters& clusters, const double* current,
+                                                    double* blocks, double* forces, double* rotations = nullptr);
+
+}  // namespace dgtex::kernels

@@ -1,0 +1,311 @@
+#include "dgtex/kernels/enriched_rotation_clusters.h"
+
+#include <algorithm>
+#include <cstddef>
+#include <cstdint>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "dgtex/kernels/polar_decomposition.h"
+#include "dgtex/kernels/shell_point.h"
+#include "dgtex/kernels/texel_grid.h"
+#include "dgtex/kernels/vec3.h"
+
+namespace dgtex::kernels {
+namespace {
+
+// Packed blocks per work item of the rotated sum: its 9 partial sums (144 KB) stay in L2
+// while every cluster streams its stretch of the 9 planes.
+constexpr std::int64_t cluster_tile_blocks = 2048;
+
+std::int64_t packed_row_start(int W, int a) {
+  return static_cast<std::int64_t>(a) * W - static_cast<std::int64_t>(a) * (a - 1) / 2;
+}
+
+// Labels the texels of one element: texels of one block connected without crossing a wall
+// share a label; labels are numbered in row-major order of their first texel. Texels outside
+// the domain are labelled among themselves the same way.
+std::vector<int> block_components(ElementType type, int T, const std::uint8_t* flags, int B) {
+  std::vector<int> label(static_cast<std::size_t>(T) * T, -1);
+  std::vector<int> stack;
+  int next = 0;
+  for (int j0 = 0; j0 < T; ++j0)
+    for (int i0 = 0; i0 < T; ++i0) {
+      if (label[j0 * T + i0] >= 0) continue;
+      const bool inside = texel_in_domain(type, T, flags, i0, j0);
+      const int bi = i0 / B, bj = j0 / B;
+      label[j0 * T + i0] = next;
+      stack.assign(1, j0 * T + i0);
+      auto visit = [&](int i, int j) {
+        if (i < 0 || j < 0 || i >= T || j >= T || i / B != bi || j / B != bj) return;
+        if (label[j * T + i] >= 0 || texel_in_domain(type, T, flags, i, j) != inside) return;
+        label[j * T + i] = next;
+        stack.push_back(j * T + i);
+      };
+      while (!stack.empty()) {
+        const int t = stack.back();
+        stack.pop_back();
+        const int i = t % T, j = t / T;
+        if (!(flags[t] & wall_east)) visit(i + 1, j);
+        if (!(flags[t] & wall_north)) visit(i, j + 1);
+        if (i > 0 && !(flags[t - 1] & wall_east)) visit(i - 1, j);
+        if (j > 0 && !(flags[t - T] & wall_north)) visit(i, j - 1);
+      }
+      ++next;
+    }
+  return label;
+}
+
+// Mean-tangent weights D_f = sum_q w_q dN_f(q) of one cluster (2 per function, W slots).
+void tangent_weights(const EnrichedElementBatch& b, const EnrichedQuadrature& quad, std::int64_t e,
+                     const std::int64_t* points, std::int64_t count, double* D) {
+  const int W = b.width;
+  const int npe = nodes_per_element(b.type);
+  const int* nodes = b.connectivity + static_cast<std::int64_t>(b.element[e]) * npe;
+  std::fill(D, D + 2 * W, 0.0);
+  ShapeValues s;
+  EnrichedShapeValues shape;
+  RestPoint rest;
+  for (std::int64_t k = 0; k < count; ++k) {
+    const double* pt = quad.points + 3 * points[k];
+    evaluate_shape(b.type, pt[0], pt[1], s);
+    evaluate_enriched_shape(b, e, pt[0], pt[1], s, shape);
+    evaluate_rest_point(s, nodes, b.positions, rest);
+    const double w = pt[2] * rest.j0;
+    for (int f = 0; f < shape.count; ++f) D[2 * f] += w * shape.dN[f][0], D[2 * f + 1] += w * shape.dN[f][1];
+  }
+}
+
+// R_c: the polar rotation of the mean F, [a1 a2 t][A1 A2 T0]^-1 from the mean tangents.
+void cluster_rotation(const EnrichedElementBatch& b, std::int64_t e, const double* D, const double* current,
+                      double R[9]) {
+  const int npe = nodes_per_element(b.type);
+  const int n = enriched_basis_count(b, e);
+  const int* nodes = b.connectivity + static_cast<std::int64_t>(b.element[e]) * npe;
+  int global[max_enriched_basis];
+  enriched_global_nodes(b, e, global);
+  double A1[3] = {0, 0, 0}, A2[3] = {0, 0, 0}, a1[3] = {0, 0, 0}, a2[3] = {0, 0, 0};
+  for (int f = 0; f < n; ++f) {
+    const double* x = current + 3 * static_cast<std::int64_t>(global[f]);
+    for (int k = 0; k < 3; ++k) a1[k] += D[2 * f] * x[k], a2[k] += D[2 * f + 1] * x[k];
+    if (f >= npe) continue;
+    const double* X = b.positions + 3 * static_cast<std::int64_t>(nodes[f]);
+    for (int k = 0; k < 3; ++k) A1[k] += D[2 * f] * X[k], A2[k] += D[2 * f + 1] * X[k];
+  }
+  double T0[3], t[3], F[9];
+  cross3(A1, A2, T0);
+  normalize3(T0);
+  cross3(a1, a2, t);
+  normalize3(t);
+  surface_deformation_gradient(A1, A2, T0, a1, a2, t, F);
+  polar_rotation(F, R);
+}
+
+// acc[ij][p] += sum_kl R_ik B_kl[p] R_jl over a stretch of packed blocks (planes of stride
+// `plane`): one cluster's share of `count` blocks. Compiled for AVX-512, AVX2 and baseline
+// x86-64 without FMA contraction (cmake/areas/enriched_assembly.cmake): every clone rounds
+// alike, so K does not depend on the machine's vector unit.
+__attribute__((target_clones("avx512f", "avx2", "default")))
+void add_rotated_blocks(int count, const double* B, std::int64_t plane, const double R[9], double* acc,
+                        int acc_plane) {
+  for (int p = 0; p < count; ++p) {
+    double T[9];  // T = B R^T
+    for (int k = 0; k < 3; ++k)
+      for (int j = 0; j < 3; ++j)
+        T[k * 3 + j] = B[(k * 3 + 0) * plane + p] * R[j * 3 + 0] + B[(k * 3 + 1) * plane + p] * R[j * 3 + 1] +
+                       B[(k * 3 + 2) * plane + p] * R[j * 3 + 2];
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j)
+        acc[(i * 3 + j) * acc_plane + p] += R[i * 3 + 0] * T[0 * 3 + j] + R[i * 3 + 1] * T[1 * 3 + j] +
+                                            R[i * 3 + 2] * T[2 * 3 + j];
+  }
+}
+
+}  // namespace
+
+std::int64_t enriched_cluster_packed_blocks(int width) {
+  const std::int64_t blocks = static_cast<std::int64_t>(width) * (width + 1) / 2;
+  return (blocks + 7) / 8 * 8;
+}
+
+std::int64_t enriched_cluster_rest_stride(int width) {
+  return 9 * enriched_cluster_packed_blocks(width) + 2 * static_cast<std::int64_t>(width);
+}
+
+EnrichedRotationClusters enriched_rotation_clusters(const EnrichedElementBatch& batch,
+                                                    const EnrichedQuadrature& quadrature, int block_texels) {
+  if (block_texels < 1)
+    throw std::invalid_argument("enriched_rotation_clusters: block_texels is " + std::to_string(block_texels) +
+                                "; it must be >= 1");
+  const int T = batch.resolution;
+  EnrichedRotationClusters out;
+  out.element_start.push_back(0);
+  out.point_start.push_back(0);
+  for (std::int64_t e = 0; e < batch.count; ++e) {
+    const std::uint8_t* flags = batch.textures[batch.enrichment_start[e]].flags;
+    const std::vector<int> label = block_components(batch.type, T, flags, block_texels);
+    // Points bucketed by label (stable), empty labels dropped.
+    const std::int64_t first = quadrature.start[e], last = quadrature.start[e + 1];
+    std::vector<int> point_label(static_cast<std::size_t>(last - first));
+    int labels = 0;
+    for (int l : label) labels = std::max(labels, l + 1);
+    std::vector<std::int64_t> bucket(static_cast<std::size_t>(labels) + 1, 0);
+    for (std::int64_t q = first; q < last; ++q) {
+      int i, j;
+      containing_texel(batch.type, T, quadrature.points[3 * q], quadrature.points[3 * q + 1], i, j);
+      point_label[q - first] = label[j * T + i];
+      ++bucket[point_label[q - first] + 1];
+    }
+    const std::size_t base = out.points.size();
+    for (int l = 0; l < labels; ++l) {
+      if (bucket[l + 1] > 0) out.point_start.push_back(static_cast<std::int64_t>(base) + bucket[l] + bucket[l + 1]);
+      bucket[l + 1] += bucket[l];
+    }
+    out.points.resize(base + static_cast<std::size_t>(last - first));
+    for (std::int64_t q = first; q < last; ++q) out.points[base + bucket[point_label[q - first]]++] = q;
+    out.element_start.push_back(out.count());
+  }
+  return out;
+}
+
+void enriched_cluster_rest_stiffness(const EnrichedElementBatch& batch, const EnrichedQuadrature& quadrature,
+                                     const EnrichedRotationClusters& clusters, double* rest, Execution execution) {
+  const int W = batch.width;
+  const std::int64_t stride = enriched_cluster_rest_stride(W), plane = enriched_cluster_packed_blocks(W);
+  std::vector<std::int64_t> element_of(static_cast<std::size_t>(clusters.count()));
+  for (std::int64_t e = 0; e < batch.count; ++e)
+    for (std::int64_t c = clusters.element_start[e]; c < clusters.element_start[e + 1]; ++c) element_of[c] = e;
+  forall(
+      clusters.count(),
+      [&](std::int64_t c) {
+        const std::int64_t e = element_of[c];
+        const int n = enriched_basis_count(batch, e);
+        const std::int64_t* points = clusters.points.data() + clusters.point_start[c];
+        const std::int64_t count = clusters.point_start[c + 1] - clusters.point_start[c];
+        static thread_local std::vector<double> K;
+        enriched_element_point_set_stiffness(batch, quadrature, e, points, count, K);
+        double* out = rest + c * stride;
+        std::fill(out, out + 9 * plane, 0.0);
+        const std::size_t N3 = 3 * static_cast<std::size_t>(n);
+        for (int a = 0; a < n; ++a)
+          for (int b = a; b < n; ++b) {
+            const std::int64_t p = packed_row_start(W, a) + (b - a);
+            for (int i = 0; i < 3; ++i)
+              for (int j = 0; j < 3; ++j) out[(i * 3 + j) * plane + p] = K[(3 * a + i) * N3 + 3 * b + j];
+          }
+        tangent_weights(batch, quadrature, e, points, count, out + 9 * plane);
+      },
+      execution);
+}
+
+void enriched_cluster_rotations(const EnrichedElementBatch& batch, const EnrichedRotationClusters& clusters,
+                                const double* rest, const double* current, double* rotations, Execution execution) {
+  const int W = batch.width;
+  const std::int64_t stride = enriched_cluster_rest_stride(W), plane = enriched_cluster_packed_blocks(W);
+  forall(
+      batch.count,
+      [&](std::int64_t e) {
+        for (std::int64_t c = clusters.element_start[e]; c < clusters.element_start[e + 1]; ++c)
+          cluster_rotation(batch, e, rest + c * stride + 9 * plane, current, rotations + 9 * c);
+      },
+      execution);
+}
+
+void enriched_element_clustered_stiffness(const EnrichedElementBatch& batch, const EnrichedRotationClusters& clusters,
+                                          const double* rest, const double* rotations, double* blocks,
+                                          double* forces, Execution execution) {
+  const int W = batch.width;
+  const int npe = nodes_per_element(batch.type);
+  const std::int64_t stride = enriched_cluster_rest_stride(W), plane = enriched_cluster_packed_blocks(W);
+  const std::int64_t packed = static_cast<std::int64_t>(W) * (W + 1) / 2;
+  const std::int64_t tiles = (packed + cluster_tile_blocks - 1) / cluster_tile_blocks;
+  // Blocks: one work item per tile of an element's packed upper blocks; every cluster adds
+  // its rotated stretch of the tile, in cluster order, to a sum that stays in cache, which
+  // is then written as blocks (a, c) and their mirrors (c, a). Padding blocks are 0 in the
+  // rest sums, so they come out 0.
+  forall(
+      batch.count * tiles,
+      [&](std::int64_t item) {
+        const std::int64_t e = item / tiles;
+        const std::int64_t p0 = item % tiles * cluster_tile_blocks;
+        const int length = static_cast<int>(std::min(packed - p0, cluster_tile_blocks));
+        static thread_local std::vector<double> acc;
+        acc.assign(static_cast<std::size_t>(9) * length, 0.0);
+        for (std::int64_t c = clusters.element_start[e]; c < clusters.element_start[e + 1]; ++c)
+          add_rotated_blocks(length, rest + c * stride + p0, plane, rotations + 9 * c, acc.data(), length);
+        int a = 0;
+        while (packed_row_start(W, a + 1) <= p0) ++a;
+        for (std::int64_t p = p0; p < p0 + length; ++p) {
+          if (p == packed_row_start(W, a + 1)) ++a;
+          const std::int64_t c = a + (p - packed_row_start(W, a));
+          double* upper = blocks + ((e * W + a) * W + c) * 9;
+          double* lower = blocks + ((e * W + c) * W + a) * 9;
+          for (int i = 0; i < 3; ++i)
+            for (int j = 0; j < 3; ++j) upper[i * 3 + j] = lower[j * 3 + i] = acc[(i * 3 + j) * length + (p - p0)];
+        }
+      },
+      execution);
+  if (!forces) return;
+  // Forces: f_a = sum_c R_c sum_b K0_c(a, b) z_b, z = X0 - R_c^T X0 on the standard functions.
+  forall(
+      batch.count * W,
+      [&](std::int64_t item) {
+        const std::int64_t e = item / W;
+        const int a = static_cast<int>(item % W);
+        const int* nodes = batch.connectivity + static_cast<std::int64_t>(batch.element[e]) * npe;
+        double* fa = forces + (e * W + a) * 3;
+        fa[0] = fa[1] = fa[2] = 0;
+        if (a >= enriched_basis_count(batch, e)) return;
+        for (std::int64_t c = clusters.element_start[e]; c < clusters.element_start[e + 1]; ++c) {
+          const double* B = rest + c * stride;
+          const double* R = rotations + 9 * c;
+          double g[3] = {0, 0, 0};
+          for (int b = 0; b < npe; ++b) {
+            const double* X = batch.positions + 3 * static_cast<std::int64_t>(nodes[b]);
+            double z[3];
+            for (int k = 0; k < 3; ++k) z[k] = X[k] - (R[0 * 3 + k] * X[0] + R[1 * 3 + k] * X[1] + R[2 * 3 + k] * X[2]);
+            const bool upper = b >= a;  // block (a, b), or the transpose of the stored (b, a)
+            const std::int64_t p = upper ? packed_row_start(W, a) + (b - a) : packed_row_start(W, b) + (a - b);
+            for (int i = 0; i < 3; ++i)
+              for (int j = 0; j < 3; ++j) g[i] += B[(upper ? i * 3 + j : j * 3 + i) * plane + p] * z[j];
+          }
+          for (int i = 0; i < 3; ++i) fa[i] += R[i * 3 + 0] * g[0] + R[i * 3 + 1] * g[1] + R[i * 3 + 2] * g[2];
+        }
+      },
+      execution);
+}
+
+void enriched_element_clustered_stiffness_reference(const EnrichedElementBatch& batch,
+                                                    const EnrichedQuadrature& quadrature,
+                                                    const EnrichedRotationClusters& clusters, const double* current,
+                                                    double* blocks, double* forces, double* rotations) {
+  const int W = batch.width;
+  const std::size_t element_blocks = static_cast<std::size_t>(W) * W * 9;
+  std::fill(blocks, blocks + batch.count * element_blocks, 0.0);
+  if (forces) std::fill(forces, forces + batch.count * W * 3, 0.0);
+  std::vector<double> D(2 * static_cast<std::size_t>(W)), K(batch.count * element_blocks), f(batch.count * W * 3);
+  for (std::int64_t e = 0; e < batch.count; ++e)
+    for (std::int64_t c = clusters.element_start[e]; c < clusters.element_start[e + 1]; ++c) {
+      const std::int64_t* points = clusters.points.data() + clusters.point_start[c];
+      const std::int64_t count = clusters.point_start[c + 1] - clusters.point_start[c];
+      tangent_weights(batch, quadrature, e, points, count, D.data());
+      double R[9];
+      cluster_rotation(batch, e, D.data(), current, R);
+      if (rotations) std::copy(R, R + 9, rotations + 9 * c);
+      // The cluster's points alone, on element e, each turned by R.
+      std::vector<std::int64_t> start(static_cast<std::size_t>(batch.count) + 1, 0);
+      for (std::int64_t x = e + 1; x <= batch.count; ++x) start[x] = count;
+      std::vector<double> sub(3 * static_cast<std::size_t>(count)), Rs(9 * static_cast<std::size_t>(count));
+      for (std::int64_t k = 0; k < count; ++k) {
+        std::copy(quadrature.points + 3 * points[k], quadrature.points + 3 * points[k] + 3, sub.begin() + 3 * k);
+        std::copy(R, R + 9, Rs.begin() + 9 * k);
+      }
+      enriched_element_stiffness_reference(batch, {start.data(), sub.data()}, Rs.data(), K.data(), f.data());
+      for (std::size_t i = 0; i < element_blocks; ++i) blocks[e * element_blocks + i] += K[e * element_blocks + i];
+      if (forces)
+        for (int i = 0; i < 3 * W; ++i) forces[e * W * 3 + i] += f[e * W * 3 + i];
+    }
+}
+
+}  // namespace dgtex::kernels

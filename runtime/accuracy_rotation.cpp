@@ -1,0 +1,88 @@
+// Rotation sweep of dgtex bench accuracy: what the rotation clusters of enriched elements
+// (enrichment.rotation_cluster_texels, dgtex/kernels/enriched_rotation_clusters.h) cost in
+// accuracy against the per-point corotation, and what they save in time.
+#include <cmath>
+#include <cstdio>
+#include <stdexcept>
+#include <string>
+
+#include "dgtex/accuracy_benchmark.h"
+#include "dgtex/scene_io.h"
+#include "dgtex/scene_run.h"
+
+namespace dgtex {
+namespace {
+
+struct RotationRun {
+  std::vector<double> displacement;
+  double ms = 0, assembly_wall_ms = 0;
+  std::int64_t clusters = 0, cluster_bytes = 0;
+};
+
+// The scene's first `steps` steps with the given clusters (0: per point), timed whole.
+RotationRun run_scene(const Scene& base, int block_texels, int steps, AccuracyClock clock) {
+  Scene scene = base;
+  scene.enrichment.rotation_cluster_texels = block_texels;
+  RotationRun out;
+  const double start = accuracy_clock_ms(clock);
+  SceneRun run(scene);
+  for (int k = 0; k < steps; ++k) run.step();
+  out.ms = accuracy_clock_ms(clock) - start;
+  out.displacement = run.displacement();
+  const StageTimings timings = run.timings();
+  if (const auto it = timings.find("assembly"); it != timings.end()) out.assembly_wall_ms = it->second.total_ms;
+  out.clusters = run.model().num_rotation_clusters();
+  out.cluster_bytes = run.model().rotation_cluster_bytes();
+  return out;
+}
+
+}  // namespace
+
+AccuracyChart run_rotation_accuracy(const RotationAccuracyOptions& options, const AccuracyProgress& progress) {
+  if (options.steps < 1)
+    throw std::invalid_argument("rotation accuracy: steps = " + std::to_string(options.steps) + "; need >= 1");
+  for (int b : options.block_texels)
+    if (b < 1)
+      throw std::invalid_argument("rotation accuracy: block of " + std::to_string(b) + " texels; need >= 1");
+  const Scene base = load_scene(options.scene);
+  if (!base.analysis.is_dynamic() || !base.analysis.corotational)
+    throw std::invalid_argument("rotation accuracy: " + options.scene + " is not a dynamic corotated scene");
+  AccuracyChart chart;
+  chart.name = "rotation";
+  chart.title = "rotation clusters of enriched elements against time";
+  chart.time_label = accuracy_clock_name(options.clock) + " ms: the whole run (" + std::to_string(options.steps) +
+                     " steps, rest sums of the clusters included)";
+  chart.error_label = "|u - u_ref| / |u_ref| vs per-point rotations";
+  const std::string series = options.scene.substr(options.scene.find_last_of('/') + 1);
+  const RotationRun reference = run_scene(base, 0, options.steps, options.clock);
+  double norm = 0;
+  for (double v : reference.displacement) norm += v * v;
+  norm = std::sqrt(norm);
+  auto add = [&](const std::string& label, const RotationRun& run) {
+    if (run.displacement.size() != reference.displacement.size())
+      throw std::logic_error("rotation accuracy: DOF counts of the runs differ");
+    double diff = 0;
+    for (std::size_t k = 0; k < run.displacement.size(); ++k)
+      diff += (run.displacement[k] - reference.displacement[k]) * (run.displacement[k] - reference.displacement[k]);
+    AccuracyPoint p;
+    p.series = series;
+    p.label = label;
+    p.ms = run.ms;
+    p.error = norm > 0 ? std::sqrt(diff) / norm : std::sqrt(diff);
+    p.extra = {{"clusters", static_cast<double>(run.clusters)},
+               {"cluster_mb", run.cluster_bytes / 1e6},
+               {"assembly_wall_ms", run.assembly_wall_ms}};
+    chart.points.push_back(p);
+    if (progress) {
+      char line[200];
+      std::snprintf(line, sizeof line, "rotation %-12s: %9.1f ms, %5lld clusters (%7.1f MB), error %.3e", label.c_str(),
+                    p.ms, static_cast<long long>(run.clusters), run.cluster_bytes / 1e6, p.error);
+      progress(line);
+    }
+  };
+  add("per point", reference);
+  for (int b : options.block_texels) add("B=" + std::to_string(b), run_scene(base, b, options.steps, options.clock));
+  return chart;
+}
+
+}  // namespace dgtex

@@ -1,0 +1,213 @@
+// Rotation clusters of enriched elements (enriched_rotation_clusters.h): the fast kernels
+// (rest sums once, then rotations and rotated blocks) against the serial reference that sums
+// the per-point reference kernel with each cluster's rotation; bitwise independence of the
+// thread count; the per-point corotation reproduced where every point turns alike (a rigid
+// rotation) and approached as the blocks shrink under bending; no cluster across a cut.
+#include <gtest/gtest.h>
+#include <omp.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <random>
+#include <vector>
+
+#include "dgtex/kernels/enriched_rotation_clusters.h"
+#include "dgtex/topology.h"
+#include "cut_element_fixture.h"
+#include "enrichment_test_support.h"
+#include "shell_test_support.h"
+
+using namespace dgtex;
+
+namespace {
+
+using testing_support::CutQuad8Element;
+constexpr int kT = CutQuad8Element::T;
+
+double max_abs(const std::vector<double>& v) {
+  double m = 0;
+  for (double x : v) m = std::max(m, std::abs(x));
+  return m;
+}
+double max_difference(const std::vector<double>& a, const std::vector<double>& b) {
+  double m = 0;
+  for (std::size_t i = 0; i < a.size(); ++i) m = std::max(m, std::abs(a[i] - b[i]));
+  return m;
+}
+
+// Current positions of the nodes, then the enriched DOFs: the element bent about its xi2
+// axis (z = bend x^2) and turned by R, the enriched DOFs `opening` times random numbers.
+std::vector<double> deformed_state(const CutQuad8Element& one, double bend, const double R[9], double opening) {
+  const int nodes = one.mesh.num_nodes() + static_cast<int>(one.nodes.size());
+  std::vector<double> x(3 * static_cast<std::size_t>(nodes), 0.0);
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> u(-1, 1);
+  for (int n = 0; n < nodes; ++n) {
+    double p[3] = {0, 0, 0};
+    if (n < one.mesh.num_nodes()) {
+      const double* X = one.mesh.node(n);
+      p[0] = X[0], p[1] = X[1], p[2] = X[2] + bend * X[0] * X[0];
+    } else {
+      for (double& c : p) c = opening * u(rng);
+    }
+    for (int i = 0; i < 3; ++i) x[3 * n + i] = R[i * 3] * p[0] + R[i * 3 + 1] * p[1] + R[i * 3 + 2] * p[2];
+  }
+  return x;
+}
+
+struct Clustered {
+  std::vector<double> K, f, R;
+};
+
+Clustered clustered(const CutQuad8Element& one, const kernels::EnrichedRotationClusters& clusters,
+                    const std::vector<double>& current, kernels::Execution execution) {
+  const int W = one.batch.width;
+  std::vector<double> rest(static_cast<std::size_t>(clusters.count()) * kernels::enriched_cluster_rest_stride(W));
+  kernels::enriched_cluster_rest_stiffness(one.batch, one.quadrature(), clusters, rest.data(), execution);
+  Clustered out{std::vector<double>(static_cast<std::size_t>(W) * W * 9), std::vector<double>(3 * W),
+                std::vector<double>(9 * static_cast<std::size_t>(clusters.count()))};
+  kernels::enriched_cluster_rotations(one.batch, clusters, rest.data(), current.data(), out.R.data(), execution);
+  kernels::enriched_element_clustered_stiffness(one.batch, clusters, rest.data(), out.R.data(), out.K.data(),
+                                                out.f.data(), execution);
+  return out;
+}
+
+TEST(EnrichedRotationClusters, AgreeWithTheReferenceAndIgnoreTheThreadCount) {
+  const CutQuad8Element one(1, 3, /*per_texel_rule=*/false, /*extra_slots=*/3);
+  const double I[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
+  const std::vector<double> current = deformed_state(one, 0.4, I, 0.02);
+  const kernels::EnrichedRotationClusters clusters = kernels::enriched_rotation_clusters(one.batch, one.quadrature(), 16);
+  ASSERT_GT(clusters.count(), 16);  // 16 blocks, some split by the cuts
+  const int W = one.batch.width;
+  std::vector<double> Kref(static_cast<std::size_t>(W) * W * 9), fref(3 * W), Rref(9 * clusters.count());
+  kernels::enriched_element_clustered_stiffness_reference(one.batch, one.quadrature(), clusters, current.data(),
+                                                          Kref.data(), fref.data(), Rref.data());
+  const Clustered serial = clustered(one, clusters, current, kernels::Execution::serial);
+  EXPECT_LE(max_difference(serial.R, Rref), 1e-12);
+  // The fast rest sums treat textures flat below enriched_flat_tolerance (1e-10 relative).
+  EXPECT_LE(max_difference(serial.K, Kref), 1e-9 * max_abs(Kref));
+  ASSERT_GT(max_abs(fref), 0.0);
+  EXPECT_LE(max_difference(serial.f, fref), 1e-9 * max_abs(fref));
+  for (int a = 0; a < W; ++a)  // exactly symmetric, padding slots 0
+    for (int c = 0; c < W; ++c)
+      for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j) {
+          const double v = serial.K[(a * W + c) * 9 + i * 3 + j];
+          ASSERT_EQ(v, serial.K[(c * W + a) * 9 + j * 3 + i]);
+          if (a >= one.n || c >= one.n) {
+            ASSERT_EQ(v, 0.0);
+          }
+        }
+  for (int threads : {1, 2, 3}) {
+    omp_set_num_threads(threads);
+    const Clustered parallel = clustered(one, clusters, current, kernels::Execution::parallel);
+    EXPECT_EQ(parallel.K, serial.K) << threads << " threads";
+    EXPECT_EQ(parallel.f, serial.f) << threads << " threads";
+    EXPECT_EQ(parallel.R, serial.R) << threads << " threads";
+  }
+}
+
+TEST(EnrichedRotationClusters, RigidRotationGivesThePerPointCorotation) {
+  // Every point turns by the same R, so any clustering gives the per-point K and forces.
+  const CutQuad8Element one(1, 2);
+  const std::vector<double> R = testing_support::small_random_rotations(1, 1.2, 5);
+  const std::vector<double> current = deformed_state(one, 0.0, R.data(), 0.0);
+  const int W = one.batch.width;
+  std::vector<double> K(static_cast<std::size_t>(W) * W * 9), f(3 * W);
+  kernels::enriched_element_corotated_stiffness(one.batch, one.quadrature(), current.data(), K.data(), f.data());
+  ASSERT_GT(max_abs(f), 0.0);
+  for (int block : {4, 64}) {
+    const Clustered c =
+        clustered(one, kernels::enriched_rotation_clusters(one.batch, one.quadrature(), block), current,
+                  kernels::Execution::parallel);
+    for (std::int64_t k = 0; k < static_cast<std::int64_t>(c.R.size()); ++k) ASSERT_NEAR(c.R[k], R[k % 9], 1e-12);
+    EXPECT_LE(max_difference(c.K, K), 1e-11 * max_abs(K)) << block;
+    EXPECT_LE(max_difference(c.f, f), 1e-9 * max_abs(f)) << block;
+  }
+}
+
+TEST(EnrichedRotationClusters, ApproachThePerPointCorotationAsBlocksShrink) {
+  // Bent (rotations vary by ~0.6 rad across the element) and the cuts opened: the clustered
+  // K differs from the per-point one by about the rotations' spread within a cluster.
+  const CutQuad8Element one(0, 2);
+  const double I[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
+  const std::vector<double> current = deformed_state(one, 0.6, I, 0.01);
+  const int W = one.batch.width;
+  std::vector<double> K(static_cast<std::size_t>(W) * W * 9), f(3 * W);
+  kernels::enriched_element_corotated_stiffness(one.batch, one.quadrature(), current.data(), K.data(), f.data());
+  double previous = 1;
+  for (int block : {64, 16, 4, 1}) {
+    const Clustered c =
+        clustered(one, kernels::enriched_rotation_clusters(one.batch, one.quadrature(), block), current,
+                  kernels::Execution::parallel);
+    const double error = max_difference(c.K, K) / max_abs(K);
+    EXPECT_LT(error, 0.6 * previous) << block << " texels";
+    std::printf("blocks of %d texels: %lld clusters, K off by %.3g relative\n", block,
+                static_cast<long long>(kernels::enriched_rotation_clusters(one.batch, one.quadrature(), block).count()), error);
+    previous = error;
+  }
+  EXPECT_LT(previous, 0.02);  // per texel (1/64 of the element)
+}
+
+TEST(EnrichedRotationClusters, NeverSpanACutAndHoldEveryPointOnce) {
+  // One complete cut across the tile (H = +-1 on its two sides).
+  const CutQuad8Element one(1, 0, /*per_texel_rule=*/true);
+  for (int block : {kT, 16, 5}) {
+    const kernels::EnrichedRotationClusters clusters =
+        kernels::enriched_rotation_clusters(one.batch, one.quadrature(), block);
+    if (block == kT) {
+      EXPECT_EQ(clusters.count(), 2);
+    }
+    std::vector<std::int64_t> all = clusters.points;
+    std::sort(all.begin(), all.end());
+    ASSERT_EQ(static_cast<std::int64_t>(all.size()), one.points());
+    for (std::int64_t k = 0; k < one.points(); ++k) ASSERT_EQ(all[k], k);
+    for (std::int64_t c = 0; c < clusters.count(); ++c) {
+      double side = 0;
+      for (std::int64_t k = clusters.point_start[c]; k < clusters.point_start[c + 1]; ++k) {
+        const double* pt = one.qp.data() + 3 * clusters.points[k];
+        kernels::TextureSample s;
+        kernels::sample_texture(ElementType::quad8, kT, one.views[0], pt[0], pt[1], s);
+        if (side == 0) side = s.value;
+        ASSERT_EQ(s.value, side) << "cluster " << c << " of blocks of " << block;
+      }
+    }
+  }
+  EXPECT_THROW(kernels::enriched_rotation_clusters(one.batch, one.quadrature(), 0), std::invalid_argument);
+}
+
+TEST(EnrichedRotationClusters, ModelRebuildsThemWhenTheEnrichmentChanges) {
+  // A model with clusters of 4 texels against one per point, both turned rigidly: the same
+  // K and corrective forces, before and after the cut moves (stale rest sums would differ).
+  const Mesh mesh = make_rectangle(1, 0.5, 4, 2, ElementType::quad8);
+  const Topology topology = build_topology(mesh);
+  const std::vector<kernels::ShellSection> sections(mesh.num_elements(), {1e6, 0.3, 0.01, 1000});
+  ShellModelOptions per_point, clustered_options;
+  clustered_options.rotation_cluster_texels = 4;
+  ShellModel reference(mesh, topology, sections, {}, per_point), model(mesh, topology, sections, {}, clustered_options);
+  const std::vector<double> R = testing_support::small_random_rotations(1, 0.9, 3);
+  // Cuts along texel edges, at different places within their elements.
+  for (double cut_at : {0.578125, 0.34375}) {
+    const auto level = [cut_at](const double* x) { return x[0] - cut_at; };
+    for (ShellModel* m : {&reference, &model})
+      m->set_enrichments({testing_support::straight_cut_enrichment(mesh, 16, level)});
+    std::vector<double> current = model.rest_state();
+    for (std::size_t n = 0; n < current.size() / 3; ++n) {
+      const double x[3] = {current[3 * n], current[3 * n + 1], current[3 * n + 2]};
+      for (int i = 0; i < 3; ++i) current[3 * n + i] = R[i * 3] * x[0] + R[i * 3 + 1] * x[1] + R[i * 3 + 2] * x[2];
+    }
+    std::vector<double> K, Kref, f, fref;
+    reference.assemble_stiffness(current.data(), Kref, &fref);
+    model.assemble_stiffness(current.data(), K, &f);
+    EXPECT_EQ(reference.num_rotation_clusters(), 0);
+    EXPECT_GT(model.num_rotation_clusters(), 2 * 16);  // 2 enriched elements of 16 blocks
+    EXPECT_GT(model.rotation_cluster_bytes(), 0);
+    ASSERT_EQ(K.size(), Kref.size());
+    EXPECT_LE(max_difference(K, Kref), 1e-11 * max_abs(Kref)) << "cut at x = " << cut_at;
+    ASSERT_GT(max_abs(fref), 0.0);
+    EXPECT_LE(max_difference(f, fref), 1e-9 * max_abs(fref)) << "cut at x = " << cut_at;
+  }
+}
+
+}  // namespace
