@@ -23,10 +23,54 @@ std::int64_t packed_row_start(int W, int a) {
   return static_cast<std::int64_t>(a) * W - static_cast<std::int64_t>(a) * (a - 1) / 2;
 }
 
+// Cut tips of one element: texel corners (x, y) inside the tile where exactly one wall edge
+// ends (corners on the tile border or next to an inactive texel are not tips: cuts end
+// there on the border, not inside the shell).
+std::vector<std::pair<int, int>> cut_tips(ElementType type, int T, const std::uint8_t* flags) {
+  auto flag = [&](int i, int j, std::uint8_t bit) {
+    return i >= 0 && j >= 0 && i < T && j < T && (flags[j * T + i] & bit);
+  };
+  std::vector<std::pair<int, int>> tips;
+  for (int y = 1; y < T; ++y)
+    for (int x = 1; x < T; ++x) {
+      bool inside = true;
+      for (int dj = -1; dj <= 0; ++dj)
+        for (int di = -1; di <= 0; ++di) inside = inside && texel_in_domain(type, T, flags, x + di, y + dj);
+      if (!inside) continue;
+      // Edges at the corner: up and down (east walls of the texels left of it), left and
+      // right (north walls of the texels below it).
+      const int degree = flag(x - 1, y, wall_east) + flag(x - 1, y - 1, wall_east) + flag(x - 1, y - 1, wall_north) +
+                         flag(x, y - 1, wall_north);
+      if (degree == 1) tips.emplace_back(x, y);
+    }
+  return tips;
+}
+
+// The block of each texel: blocks of B x B texels, and where one holds a cut tip (on its
+// closed outline) it is split in four, again while a quarter holds the tip and is larger
+// than tip_B. Returned as one id per texel (the block's size and position).
+std::vector<std::int64_t> texel_blocks(ElementType type, int T, const std::uint8_t* flags, int B, int tip_B) {
+  const std::vector<std::pair<int, int>> tips = cut_tips(type, T, flags);
+  auto holds_tip = [&](int s, int bi, int bj) {
+    for (const auto& [x, y] : tips)
+      if (x >= bi * s && x <= (bi + 1) * s && y >= bj * s && y <= (bj + 1) * s) return true;
+    return false;
+  };
+  std::vector<std::int64_t> block(static_cast<std::size_t>(T) * T);
+  for (int j = 0; j < T; ++j)
+    for (int i = 0; i < T; ++i) {
+      int s = B;
+      while (s > tip_B && holds_tip(s, i / s, j / s)) s = std::max(s / 2, tip_B);
+      block[j * T + i] = (static_cast<std::int64_t>(s) * T + j / s) * T + i / s;
+    }
+  return block;
+}
+
 // Labels the texels of one element: texels of one block connected without crossing a wall
 // share a label; labels are numbered in row-major order of their first texel. Texels outside
 // the domain are labelled among themselves the same way.
-std::vector<int> block_components(ElementType type, int T, const std::uint8_t* flags, int B) {
+std::vector<int> block_components(ElementType type, int T, const std::uint8_t* flags, int B, int tip_B) {
+  const std::vector<std::int64_t> block = texel_blocks(type, T, flags, B, tip_B);
   std::vector<int> label(static_cast<std::size_t>(T) * T, -1);
   std::vector<int> stack;
   int next = 0;
@@ -34,11 +78,11 @@ std::vector<int> block_components(ElementType type, int T, const std::uint8_t* f
     for (int i0 = 0; i0 < T; ++i0) {
       if (label[j0 * T + i0] >= 0) continue;
       const bool inside = texel_in_domain(type, T, flags, i0, j0);
-      const int bi = i0 / B, bj = j0 / B;
+      const std::int64_t own = block[j0 * T + i0];
       label[j0 * T + i0] = next;
       stack.assign(1, j0 * T + i0);
       auto visit = [&](int i, int j) {
-        if (i < 0 || j < 0 || i >= T || j >= T || i / B != bi || j / B != bj) return;
+        if (i < 0 || j < 0 || i >= T || j >= T || block[j * T + i] != own) return;
         if (label[j * T + i] >= 0 || texel_in_domain(type, T, flags, i, j) != inside) return;
         label[j * T + i] = next;
         stack.push_back(j * T + i);
@@ -134,17 +178,21 @@ std::int64_t enriched_cluster_rest_stride(int width) {
 }
 
 EnrichedRotationClusters enriched_rotation_clusters(const EnrichedElementBatch& batch,
-                                                    const EnrichedQuadrature& quadrature, int block_texels) {
+                                                    const EnrichedQuadrature& quadrature, int block_texels,
+                                                    int tip_block_texels) {
   if (block_texels < 1)
     throw std::invalid_argument("enriched_rotation_clusters: block_texels is " + std::to_string(block_texels) +
                                 "; it must be >= 1");
+  if (tip_block_texels < 1)
+    throw std::invalid_argument("enriched_rotation_clusters: tip_block_texels is " +
+                                std::to_string(tip_block_texels) + "; it must be >= 1");
   const int T = batch.resolution;
   EnrichedRotationClusters out;
   out.element_start.push_back(0);
   out.point_start.push_back(0);
   for (std::int64_t e = 0; e < batch.count; ++e) {
     const std::uint8_t* flags = batch.textures[batch.enrichment_start[e]].flags;
-    const std::vector<int> label = block_components(batch.type, T, flags, block_texels);
+    const std::vector<int> label = block_components(batch.type, T, flags, block_texels, tip_block_texels);
     // Points bucketed by label (stable), empty labels dropped.
     const std::int64_t first = quadrature.start[e], last = quadrature.start[e + 1];
     std::vector<int> point_label(static_cast<std::size_t>(last - first));

@@ -77,7 +77,7 @@ TEST(EnrichedRotationClusters, AgreeWithTheReferenceAndIgnoreTheThreadCount) {
   const CutQuad8Element one(1, 3, /*per_texel_rule=*/false, /*extra_slots=*/3);
   const double I[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
   const std::vector<double> current = deformed_state(one, 0.4, I, 0.02);
-  const kernels::EnrichedRotationClusters clusters = kernels::enriched_rotation_clusters(one.batch, one.quadrature(), 16);
+  const kernels::EnrichedRotationClusters clusters = kernels::enriched_rotation_clusters(one.batch, one.quadrature(), 16, 16);
   ASSERT_GT(clusters.count(), 16);  // 16 blocks, some split by the cuts
   const int W = one.batch.width;
   std::vector<double> Kref(static_cast<std::size_t>(W) * W * 9), fref(3 * W), Rref(9 * clusters.count());
@@ -119,7 +119,7 @@ TEST(EnrichedRotationClusters, RigidRotationGivesThePerPointCorotation) {
   ASSERT_GT(max_abs(f), 0.0);
   for (int block : {4, 64}) {
     const Clustered c =
-        clustered(one, kernels::enriched_rotation_clusters(one.batch, one.quadrature(), block), current,
+        clustered(one, kernels::enriched_rotation_clusters(one.batch, one.quadrature(), block, block), current,
                   kernels::Execution::parallel);
     for (std::int64_t k = 0; k < static_cast<std::int64_t>(c.R.size()); ++k) ASSERT_NEAR(c.R[k], R[k % 9], 1e-12);
     EXPECT_LE(max_difference(c.K, K), 1e-11 * max_abs(K)) << block;
@@ -139,12 +139,12 @@ TEST(EnrichedRotationClusters, ApproachThePerPointCorotationAsBlocksShrink) {
   double previous = 1;
   for (int block : {64, 16, 4, 1}) {
     const Clustered c =
-        clustered(one, kernels::enriched_rotation_clusters(one.batch, one.quadrature(), block), current,
+        clustered(one, kernels::enriched_rotation_clusters(one.batch, one.quadrature(), block, block), current,
                   kernels::Execution::parallel);
     const double error = max_difference(c.K, K) / max_abs(K);
     EXPECT_LT(error, 0.6 * previous) << block << " texels";
     std::printf("blocks of %d texels: %lld clusters, K off by %.3g relative\n", block,
-                static_cast<long long>(kernels::enriched_rotation_clusters(one.batch, one.quadrature(), block).count()), error);
+                static_cast<long long>(kernels::enriched_rotation_clusters(one.batch, one.quadrature(), block, block).count()), error);
     previous = error;
   }
   EXPECT_LT(previous, 0.02);  // per texel (1/64 of the element)
@@ -155,7 +155,7 @@ TEST(EnrichedRotationClusters, NeverSpanACutAndHoldEveryPointOnce) {
   const CutQuad8Element one(1, 0, /*per_texel_rule=*/true);
   for (int block : {kT, 16, 5}) {
     const kernels::EnrichedRotationClusters clusters =
-        kernels::enriched_rotation_clusters(one.batch, one.quadrature(), block);
+        kernels::enriched_rotation_clusters(one.batch, one.quadrature(), block, block);
     if (block == kT) {
       EXPECT_EQ(clusters.count(), 2);
     }
@@ -174,7 +174,38 @@ TEST(EnrichedRotationClusters, NeverSpanACutAndHoldEveryPointOnce) {
       }
     }
   }
-  EXPECT_THROW(kernels::enriched_rotation_clusters(one.batch, one.quadrature(), 0), std::invalid_argument);
+  EXPECT_THROW(kernels::enriched_rotation_clusters(one.batch, one.quadrature(), 0, 1), std::invalid_argument);
+}
+
+TEST(EnrichedRotationClusters, RefineTowardCutTips) {
+  // One partial cut from the left border to its tip at (0.6 T, T/2 + 0.3) texels: the one
+  // block of 64 is quartered toward the tip down to blocks of 16; points near the tip lie in
+  // clusters at most 16 texels across, points far from it in larger ones.
+  const CutQuad8Element one(0, 1);
+  const auto texel = [](double xi) { return (xi + 1) / 2 * kT; };
+  const double tip[2] = {0.6 * kT, kT * 0.5 + 0.3};
+  const kernels::EnrichedRotationClusters coarse = kernels::enriched_rotation_clusters(one.batch, one.quadrature(), 64, 64);
+  const kernels::EnrichedRotationClusters refined = kernels::enriched_rotation_clusters(one.batch, one.quadrature(), 64, 16);
+  EXPECT_EQ(coarse.count(), 1);
+  EXPECT_GT(refined.count(), 4);
+  bool far_in_large = false;
+  for (std::int64_t c = 0; c < refined.count(); ++c) {
+    double lo[2] = {1e9, 1e9}, hi[2] = {-1e9, -1e9}, nearest = 1e9, farthest = 0;
+    for (std::int64_t k = refined.point_start[c]; k < refined.point_start[c + 1]; ++k) {
+      const double* pt = one.qp.data() + 3 * refined.points[k];
+      const double t[2] = {texel(pt[0]), texel(pt[1])};
+      for (int d = 0; d < 2; ++d) lo[d] = std::min(lo[d], t[d]), hi[d] = std::max(hi[d], t[d]);
+      const double distance = std::hypot(t[0] - tip[0], t[1] - tip[1]);
+      nearest = std::min(nearest, distance), farthest = std::max(farthest, distance);
+    }
+    const double extent = std::max(hi[0] - lo[0], hi[1] - lo[1]);
+    if (nearest < 3) {
+      EXPECT_LE(extent, 16.0) << "cluster " << c << " at the tip";
+    }
+    if (farthest > 40 && extent > 16) far_in_large = true;
+  }
+  EXPECT_TRUE(far_in_large);
+  EXPECT_THROW(kernels::enriched_rotation_clusters(one.batch, one.quadrature(), 64, 0), std::invalid_argument);
 }
 
 TEST(EnrichedRotationClusters, ModelRebuildsThemWhenTheEnrichmentChanges) {

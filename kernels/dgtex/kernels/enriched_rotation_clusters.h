@@ -13,7 +13,9 @@
 //
 // Clusters: the texels of one block of B x B texels that are connected without crossing a
 // wall (so a cluster never straddles a cut: the two sides of a cut turn apart), holding the
-// points whose texel (containing_texel) is among them. R_c is the polar rotation of the
+// points whose texel (containing_texel) is among them. Blocks that hold a cut tip (a texel
+// corner inside the tile where one wall edge ends) are quartered toward it down to a
+// smaller size: the shell turns fastest around the tips (the hinges of an accordion). R_c is the polar rotation of the
 // cluster's mean deformation gradient: the current tangents are linear in the DOFs, so their
 // weighted means over the cluster are sum_f D_f x_f with D_f = sum_q w_q dN_f(q) (stored
 // with K0_c); the rest ones likewise from the rest positions. The error against per-point
@@ -41,10 +43,13 @@ struct EnrichedRotationClusters {
   std::int64_t count() const { return static_cast<std::int64_t>(point_start.size()) - 1; }
 };
 
-// The clusters of blocks of block_texels x block_texels texels (>= 1). Clusters of an
-// element are ordered by their first texel (row-major); points keep their order.
+// The clusters of blocks of block_texels x block_texels texels (>= 1); a block holding a
+// cut tip is quartered toward the tip down to tip_block_texels (>= 1; >= block_texels: no
+// refinement). Clusters of an element are ordered by their first texel (row-major); points
+// keep their order.
 EnrichedRotationClusters enriched_rotation_clusters(const EnrichedElementBatch& batch,
-                                                    const EnrichedQuadrature& quadrature, int block_texels);
+                                                    const EnrichedQuadrature& quadrature, int block_texels,
+                                                    int tip_block_texels);
 
 std::int64_t enriched_cluster_packed_blocks(int width);
 std::int64_t enriched_cluster_rest_stride(int width);
