@@ -10,6 +10,7 @@
 #include "dgtex/kernels/polar_decomposition.h"
 #include "dgtex/kernels/shell_point.h"
 #include "dgtex/mesh_validation.h"
+#include "multigrid_buffer.h"
 
 namespace dgtex {
 
@@ -139,7 +140,7 @@ void ShellModel::rebuild() {
   assembly_ = BlockAssembly(mesh_.num_nodes() + num_enriched_nodes(), families);
   workspace_.element_rest_rows.clear();  // the plain elements and edges may have changed
   workspace_.edge_rest_rows.clear();
-  workspace_.cluster_rest.clear();  // the enriched quadrature may have changed
+  workspace_.cluster_rest.reset();  // the enriched quadrature may have changed
 
   // Mass and load weights depend on the rest geometry only.
   std::vector<double> element_mass(static_cast<size_t>(num_plain) * npe * npe);
@@ -683,7 +684,7 @@ void ShellModel::assemble_stiffness(const double* current, std::vector<double>& 
     // Corotated: each point's F and rotation are formed in the stiffness pass (one texture
     // sampling per point; bitwise the separate gradient, polar and stiffness kernels).
     if (current && options_.rotation_cluster_texels > 0) {
-      if (w.cluster_rest.empty()) {
+      if (!w.cluster_rest) {
         // Blocks holding a cut tip are refined to a quarter: the rotation turns fastest at the
         // tips (accordion, 60 steps: B = 64 alone 1.1e-2 off at the probe with 70 clusters,
         // with tips at 16 4.5e-3 with 193, B = 16 alone 3.6e-3 with 472).
@@ -696,13 +697,16 @@ void ShellModel::assemble_stiffness(const double* current, std::vector<double>& 
                                    std::to_string(size * 8 >> 20) + " MiB of rest sums (limit " +
                                    std::to_string(max_rotation_cluster_doubles * 8 >> 20) +
                                    " MiB); use larger blocks (enrichment.rotation_cluster_texels) or 0 (per point)");
-        w.cluster_rest.resize(static_cast<size_t>(size));
-        kernels::enriched_cluster_rest_stiffness(xb, element_quad, w.clusters, w.cluster_rest.data(), execution);
+        const std::size_t bytes = static_cast<std::size_t>(size) * sizeof(double);
+        w.cluster_rest.reset(static_cast<double*>(detail::acquire_zeroed_block(bytes)),
+                             [bytes](double* block) { detail::release_block(block, bytes); });
+        w.cluster_rest_size = size;
+        kernels::enriched_cluster_rest_stiffness(xb, element_quad, w.clusters, w.cluster_rest.get(), execution);
       }
       w.cluster_rotations.resize(static_cast<size_t>(w.clusters.count()) * 9);
-      kernels::enriched_cluster_rotations(xb, w.clusters, w.cluster_rest.data(), current, w.cluster_rotations.data(),
+      kernels::enriched_cluster_rotations(xb, w.clusters, w.cluster_rest.get(), current, w.cluster_rotations.data(),
                                           execution);
-      kernels::enriched_element_clustered_stiffness(xb, w.clusters, w.cluster_rest.data(), w.cluster_rotations.data(),
+      kernels::enriched_element_clustered_stiffness(xb, w.clusters, w.cluster_rest.get(), w.cluster_rotations.data(),
                                                     w.enriched_blocks.data(),
                                                     forces ? w.enriched_forces.data() : nullptr, execution);
     } else if (current)

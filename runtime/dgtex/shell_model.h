@@ -122,10 +122,10 @@ class ShellModel {
   // Rotation clusters of the enriched elements (options().rotation_cluster_texels > 0) as of
   // the last corotated assembly, 0 before one or per point; their rest sums' size in bytes.
   std::int64_t num_rotation_clusters() const {
-    return workspace_.cluster_rest.empty() ? 0 : workspace_.clusters.count();
+    return workspace_.cluster_rest ? workspace_.clusters.count() : 0;
   }
   std::int64_t rotation_cluster_bytes() const {
-    return static_cast<std::int64_t>(workspace_.cluster_rest.size() * sizeof(double));
+    return workspace_.cluster_rest ? workspace_.cluster_rest_size * static_cast<std::int64_t>(sizeof(double)) : 0;
   }
   std::int64_t num_enriched_element_quadrature_points() const { return element_qp_start_.empty() ? 0 : element_qp_start_.back(); }
   std::int64_t num_enriched_edge_quadrature_points() const { return edge_qp_start_.empty() ? 0 : edge_qp_start_.back(); }
@@ -242,8 +242,13 @@ class ShellModel {
     std::vector<double> enriched_blocks, enriched_edge_blocks, enriched_forces, enriched_edge_forces;
     // Rotation clusters (options.rotation_cluster_texels > 0) and their rest sums: built at
     // the first corotated assembly after the enrichment changed (rebuild clears them).
+    // The rest sums take up to GBs: zeroed pages straight from the kernel, marked for huge
+    // pages (runtime/multigrid_buffer.h), not a vector's memset and 4 KiB page faults
+    // (17 % of the accordion's first step).
     kernels::EnrichedRotationClusters clusters;
-    std::vector<double> cluster_rest, cluster_rotations;
+    std::shared_ptr<double> cluster_rest;
+    std::int64_t cluster_rest_size = 0;
+    std::vector<double> cluster_rotations;
     AssemblyWorkspace() = default;
     AssemblyWorkspace(const AssemblyWorkspace&) {}
     AssemblyWorkspace& operator=(const AssemblyWorkspace&) { return *this; }
