@@ -224,27 +224,33 @@ void enriched_cluster_rest_stiffness(const EnrichedElementBatch& batch, const En
   std::vector<std::int64_t> element_of(static_cast<std::size_t>(clusters.count()));
   for (std::int64_t e = 0; e < batch.count; ++e)
     for (std::int64_t c = clusters.element_start[e]; c < clusters.element_start[e + 1]; ++c) element_of[c] = e;
-  forall(
-      clusters.count(),
-      [&](std::int64_t c) {
-        const std::int64_t e = element_of[c];
-        const int n = enriched_basis_count(batch, e);
-        const std::int64_t* points = clusters.points.data() + clusters.point_start[c];
-        const std::int64_t count = clusters.point_start[c + 1] - clusters.point_start[c];
-        static thread_local std::vector<double> K;
-        enriched_element_point_set_stiffness(batch, quadrature, e, points, count, K);
-        double* out = rest + c * stride;
-        std::fill(out, out + 9 * plane, 0.0);
-        const std::size_t N3 = 3 * static_cast<std::size_t>(n);
-        for (int a = 0; a < n; ++a)
-          for (int b = a; b < n; ++b) {
-            const std::int64_t p = packed_row_start(W, a) + (b - a);
-            for (int i = 0; i < 3; ++i)
-              for (int j = 0; j < 3; ++j) out[(i * 3 + j) * plane + p] = K[(3 * a + i) * N3 + 3 * b + j];
-          }
-        tangent_weights(batch, quadrature, e, points, count, out + 9 * plane);
-      },
-      execution);
+  // Clusters differ much in cost (tip blocks hold few points): handed out dynamically;
+  // each writes only its own rest data, so the result does not depend on the threads.
+  auto cluster = [&](std::int64_t c) {
+    const std::int64_t e = element_of[c];
+    const int n = enriched_basis_count(batch, e);
+    const std::int64_t* points = clusters.points.data() + clusters.point_start[c];
+    const std::int64_t count = clusters.point_start[c + 1] - clusters.point_start[c];
+    static thread_local std::vector<double> K;
+    enriched_element_point_set_stiffness(batch, quadrature, e, points, count, K);
+    double* out = rest + c * stride;
+    std::fill(out, out + 9 * plane, 0.0);
+    const std::size_t N3 = 3 * static_cast<std::size_t>(n);
+    for (int a = 0; a < n; ++a)
+      for (int b = a; b < n; ++b) {
+        const std::int64_t p = packed_row_start(W, a) + (b - a);
+        for (int i = 0; i < 3; ++i)
+          for (int j = 0; j < 3; ++j) out[(i * 3 + j) * plane + p] = K[(3 * a + i) * N3 + 3 * b + j];
+      }
+    tangent_weights(batch, quadrature, e, points, count, out + 9 * plane);
+  };
+  const std::int64_t total = clusters.count();
+  if (execution == Execution::parallel) {
+#pragma omp parallel for schedule(dynamic, 1)
+    for (std::int64_t c = 0; c < total; ++c) cluster(c);
+  } else {
+    for (std::int64_t c = 0; c < total; ++c) cluster(c);
+  }
 }
 
 void enriched_cluster_rotations(const EnrichedElementBatch& batch, const EnrichedRotationClusters& clusters,
