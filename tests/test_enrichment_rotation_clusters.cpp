@@ -10,6 +10,7 @@
 #include <cmath>
 #include <cstdio>
 #include <random>
+#include <string>
 #include <vector>
 
 #include "dgtex/kernels/enriched_rotation_clusters.h"
@@ -211,33 +212,39 @@ TEST(EnrichedRotationClusters, RefineTowardCutTips) {
 TEST(EnrichedRotationClusters, ModelRebuildsThemWhenTheEnrichmentChanges) {
   // A model with clusters of 4 texels against one per point, both turned rigidly: the same
   // K and corrective forces, before and after the cut moves (stale rest sums would differ).
-  const Mesh mesh = make_rectangle(1, 0.5, 4, 2, ElementType::quad8);
-  const Topology topology = build_topology(mesh);
-  const std::vector<kernels::ShellSection> sections(mesh.num_elements(), {1e6, 0.3, 0.01, 1000});
-  ShellModelOptions per_point, clustered_options;
-  clustered_options.rotation_cluster_texels = 4;
-  ShellModel reference(mesh, topology, sections, {}, per_point), model(mesh, topology, sections, {}, clustered_options);
-  const std::vector<double> R = testing_support::small_random_rotations(1, 0.9, 3);
-  // Cuts along texel edges, at different places within their elements.
-  for (double cut_at : {0.578125, 0.34375}) {
-    const auto level = [cut_at](const double* x) { return x[0] - cut_at; };
-    for (ShellModel* m : {&reference, &model})
-      m->set_enrichments({testing_support::straight_cut_enrichment(mesh, 16, level)});
-    std::vector<double> current = model.rest_state();
-    for (std::size_t n = 0; n < current.size() / 3; ++n) {
-      const double x[3] = {current[3 * n], current[3 * n + 1], current[3 * n + 2]};
-      for (int i = 0; i < 3; ++i) current[3 * n + i] = R[i * 3] * x[0] + R[i * 3 + 1] * x[1] + R[i * 3 + 2] * x[2];
+  for (ElementType type : {ElementType::quad8, ElementType::tri6}) {
+    const bool tri = type == ElementType::tri6;
+    const Mesh mesh = make_rectangle(1, 0.5, 4, 2, type);
+    const Topology topology = build_topology(mesh);
+    const std::vector<kernels::ShellSection> sections(mesh.num_elements(), {1e6, 0.3, 0.01, 1000});
+    ShellModelOptions per_point, clustered_options;
+    clustered_options.rotation_cluster_texels = 4;
+    ShellModel reference(mesh, topology, sections, {}, per_point), model(mesh, topology, sections, {}, clustered_options);
+    const std::vector<double> R = testing_support::small_random_rotations(1, 0.9, 3);
+    // Cuts along texel edges (tri6: parallel to the cell diagonals), at different places
+    // within their elements.
+    for (double cut_at : {0.578125, 0.34375}) {
+      const auto level = [cut_at, tri](const double* x) { return x[0] - (tri ? x[1] : 0.0) - cut_at; };
+      for (ShellModel* m : {&reference, &model})
+        m->set_enrichments({testing_support::straight_cut_enrichment(mesh, 16, level)});
+      std::vector<double> current = model.rest_state();
+      for (std::size_t n = 0; n < current.size() / 3; ++n) {
+        const double x[3] = {current[3 * n], current[3 * n + 1], current[3 * n + 2]};
+        for (int i = 0; i < 3; ++i) current[3 * n + i] = R[i * 3] * x[0] + R[i * 3 + 1] * x[1] + R[i * 3 + 2] * x[2];
+      }
+      std::vector<double> K, Kref, f, fref;
+      reference.assemble_stiffness(current.data(), Kref, &fref);
+      model.assemble_stiffness(current.data(), K, &f);
+      const std::string where = std::string(tri ? "tri6" : "quad8") + ", cut at " + std::to_string(cut_at);
+      EXPECT_EQ(reference.num_rotation_clusters(), 0);
+      ASSERT_GT(model.num_enriched_elements(), 0) << where;
+      EXPECT_GT(model.num_rotation_clusters(), 4 * model.num_enriched_elements()) << where;
+      EXPECT_GT(model.rotation_cluster_bytes(), 0);
+      ASSERT_EQ(K.size(), Kref.size());
+      EXPECT_LE(max_difference(K, Kref), 1e-11 * max_abs(Kref)) << where;
+      ASSERT_GT(max_abs(fref), 0.0);
+      EXPECT_LE(max_difference(f, fref), 1e-9 * max_abs(fref)) << where;
     }
-    std::vector<double> K, Kref, f, fref;
-    reference.assemble_stiffness(current.data(), Kref, &fref);
-    model.assemble_stiffness(current.data(), K, &f);
-    EXPECT_EQ(reference.num_rotation_clusters(), 0);
-    EXPECT_GT(model.num_rotation_clusters(), 2 * 16);  // 2 enriched elements of 16 blocks
-    EXPECT_GT(model.rotation_cluster_bytes(), 0);
-    ASSERT_EQ(K.size(), Kref.size());
-    EXPECT_LE(max_difference(K, Kref), 1e-11 * max_abs(Kref)) << "cut at x = " << cut_at;
-    ASSERT_GT(max_abs(fref), 0.0);
-    EXPECT_LE(max_difference(f, fref), 1e-9 * max_abs(fref)) << "cut at x = " << cut_at;
   }
 }
 
