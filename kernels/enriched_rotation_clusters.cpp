@@ -51,16 +51,28 @@ std::vector<std::pair<int, int>> cut_tips(ElementType type, int T, const std::ui
 // than tip_B. Returned as one id per texel (the block's size and position).
 std::vector<std::int64_t> texel_blocks(ElementType type, int T, const std::uint8_t* flags, int B, int tip_B) {
   const std::vector<std::pair<int, int>> tips = cut_tips(type, T, flags);
-  auto holds_tip = [&](int s, int bi, int bj) {
-    for (const auto& [x, y] : tips)
-      if (x >= bi * s && x <= (bi + 1) * s && y >= bj * s && y <= (bj + 1) * s) return true;
-    return false;
+  // Per block size B, B/2, ... above tip_B: which blocks hold a tip.
+  struct Level {
+    int size, count;  // block size, blocks per row
+    std::vector<char> holds_tip;
   };
+  std::vector<Level> levels;
+  for (int s = B; s > tip_B; s = std::max(s / 2, tip_B)) {
+    Level level{s, (T + s - 1) / s, {}};
+    level.holds_tip.assign(static_cast<std::size_t>(level.count) * level.count, 0);
+    for (const auto& [x, y] : tips)  // x, y >= 1: a corner on a block border is in both
+      for (int bj = (y - 1) / s; bj <= std::min(y / s, level.count - 1); ++bj)
+        for (int bi = (x - 1) / s; bi <= std::min(x / s, level.count - 1); ++bi) level.holds_tip[bj * level.count + bi] = 1;
+    levels.push_back(std::move(level));
+  }
   std::vector<std::int64_t> block(static_cast<std::size_t>(T) * T);
   for (int j = 0; j < T; ++j)
     for (int i = 0; i < T; ++i) {
       int s = B;
-      while (s > tip_B && holds_tip(s, i / s, j / s)) s = std::max(s / 2, tip_B);
+      for (const Level& level : levels) {  // sizes in order: s is level.size here
+        if (!level.holds_tip[(j / s) * level.count + i / s]) break;
+        s = std::max(s / 2, tip_B);
+      }
       block[j * T + i] = (static_cast<std::int64_t>(s) * T + j / s) * T + i / s;
     }
   return block;

@@ -10,6 +10,7 @@
 #include "dgtex/kernels/polar_decomposition.h"
 #include "dgtex/kernels/shell_point.h"
 #include "dgtex/mesh_validation.h"
+#include "dgtex/model_error.h"
 #include "multigrid_buffer.h"
 
 namespace dgtex {
@@ -681,7 +682,8 @@ void ShellModel::assemble_stiffness(const double* current, std::vector<double>& 
       w.enriched_forces.resize(static_cast<size_t>(num_enriched_elements()) * W * 3);
       w.enriched_edge_forces.resize(static_cast<size_t>(num_enriched_edges()) * 2 * W * 3);
     }
-    // Corotated: each point's F and rotation are formed in the stiffness pass (one texture
+    // Corotated per cluster of points (rest sums built once per enrichment), or per point:
+    // then each point's F and rotation are formed in the stiffness pass (one texture
     // sampling per point; bitwise the separate gradient, polar and stiffness kernels).
     if (current && options_.rotation_cluster_texels > 0) {
       if (!w.cluster_rest) {
@@ -692,7 +694,7 @@ void ShellModel::assemble_stiffness(const double* current, std::vector<double>& 
         w.clusters = kernels::enriched_rotation_clusters(xb, element_quad, options_.rotation_cluster_texels, tip_block);
         const std::int64_t size = w.clusters.count() * kernels::enriched_cluster_rest_stride(W);
         if (size > max_rotation_cluster_doubles)
-          throw std::runtime_error("rotation clusters of " + std::to_string(options_.rotation_cluster_texels) +
+          throw ModelError("rotation clusters of " + std::to_string(options_.rotation_cluster_texels) +
                                    " texels: " + std::to_string(w.clusters.count()) + " clusters would take " +
                                    std::to_string(size * 8 >> 20) + " MiB of rest sums (limit " +
                                    std::to_string(max_rotation_cluster_doubles * 8 >> 20) +

@@ -96,6 +96,14 @@ TEST(CliRun, BadInputExitsWithCodeTwoAndOneLine) {
   expect_rejected("selection",
                   scene("0.3", "1", R"("boundary": [{"select": {"plane": {"normal": [1, 0, 0], "offset": 5}}, "fix": ["z"]}],)"),
                   "boundary[0].select");
+  // Rotation clusters of one texel on the accordion (35k points, 150 functions) would need
+  // ~20 GB of rest sums: refused before anything is allocated, naming the key.
+  nlohmann::json accordion;
+  std::ifstream(std::string(DGTEX_SOURCE_DIR) + "/examples/scenes/accordion.json") >> accordion;
+  accordion["enrichment"]["rotation_cluster_texels"] = 1;
+  accordion["analysis"]["steps"] = 1;
+  accordion.erase("render");
+  expect_rejected("clusters", accordion.dump(), "enrichment.rotation_cluster_texels");
 }
 
 }  // namespace

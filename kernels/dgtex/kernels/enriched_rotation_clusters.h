@@ -15,10 +15,11 @@
 // wall (so a cluster never straddles a cut: the two sides of a cut turn apart), holding the
 // points whose texel (containing_texel) is among them. Blocks that hold a cut tip (a texel
 // corner inside the tile where one wall edge ends) are quartered toward it down to a
-// smaller size: the shell turns fastest around the tips (the hinges of an accordion). R_c is the polar rotation of the
-// cluster's mean deformation gradient: the current tangents are linear in the DOFs, so their
-// weighted means over the cluster are sum_f D_f x_f with D_f = sum_q w_q dN_f(q) (stored
-// with K0_c); the rest ones likewise from the rest positions. The error against per-point
+// smaller size: the shell turns fastest around the tips (the hinges of an accordion).
+// R_c is the polar rotation of the cluster's mean deformation gradient: the current
+// tangents are linear in the DOFs, so their weighted means over the cluster are
+// sum_f D_f x_f with D_f = sum_q w_q dN_f(q) (stored with K0_c); the rest ones likewise
+// from the rest positions. The error against per-point
 // rotations is of the order of the rotation's spread inside a cluster (B = 1: per texel).
 //
 // Shapes (W = batch.width): rest data per cluster, enriched_cluster_rest_stride(W) doubles:
