@@ -14,6 +14,18 @@
 
 namespace dgtex::testing_support {
 
+// Largest |v_i|, and largest |a_i - b_i| (a and b of one size).
+inline double max_abs(const std::vector<double>& v) {
+  double m = 0;
+  for (double x : v) m = std::max(m, std::abs(x));
+  return m;
+}
+inline double max_difference(const std::vector<double>& a, const std::vector<double>& b) {
+  double m = 0;
+  for (std::size_t i = 0; i < a.size(); ++i) m = std::max(m, std::abs(a[i] - b[i]));
+  return m;
+}
+
 using NodePredicate = std::function<bool(const double* x)>;
 
 struct Material {

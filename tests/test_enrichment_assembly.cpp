@@ -21,12 +21,6 @@ using namespace dgtex::testing_support;
 
 namespace {
 
-double max_abs(const std::vector<double>& v) {
-  double m = 0;
-  for (double x : v) m = std::max(m, std::abs(x));
-  return m;
-}
-
 std::vector<double> multiply(const ShellModel& model, const std::vector<double>& A, const std::vector<double>& u) {
   std::vector<double> r(u.size());
   block_multiply(model.pattern(), A.data(), u.data(), r.data());

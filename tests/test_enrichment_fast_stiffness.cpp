@@ -24,22 +24,14 @@ using namespace dgtex;
 
 namespace {
 
+using testing_support::max_abs;
+using testing_support::max_difference;
+
 using testing_support::CutQuad8Element;
 constexpr int kT = CutQuad8Element::T;
 
 // A rotation of up to 0.3 rad about a random axis per point.
 std::vector<double> random_rotations(std::int64_t count) { return testing_support::small_random_rotations(count, 0.3, 7); }
-
-double max_abs(const std::vector<double>& v) {
-  double m = 0;
-  for (double x : v) m = std::max(m, std::abs(x));
-  return m;
-}
-double max_difference(const std::vector<double>& a, const std::vector<double>& b) {
-  double m = 0;
-  for (std::size_t i = 0; i < a.size(); ++i) m = std::max(m, std::abs(a[i] - b[i]));
-  return m;
-}
 
 void compare_with_reference(const CutQuad8Element& one, double tolerance) {
   const int W = one.batch.width;

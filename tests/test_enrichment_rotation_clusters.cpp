@@ -23,19 +23,11 @@ using namespace dgtex;
 
 namespace {
 
+using testing_support::max_abs;
+using testing_support::max_difference;
+
 using testing_support::CutQuad8Element;
 constexpr int kT = CutQuad8Element::T;
-
-double max_abs(const std::vector<double>& v) {
-  double m = 0;
-  for (double x : v) m = std::max(m, std::abs(x));
-  return m;
-}
-double max_difference(const std::vector<double>& a, const std::vector<double>& b) {
-  double m = 0;
-  for (std::size_t i = 0; i < a.size(); ++i) m = std::max(m, std::abs(a[i] - b[i]));
-  return m;
-}
 
 // Current positions of the nodes, then the enriched DOFs: the element bent about its xi2
 // axis (z = bend x^2) and turned by R, the enriched DOFs `opening` times random numbers.

@@ -19,12 +19,6 @@ namespace {
 
 const char* name_of(ElementType t) { return t == ElementType::quad8 ? "quad8" : "tri6"; }
 
-double max_abs(const std::vector<double>& v) {
-  double m = 0;
-  for (double x : v) m = std::max(m, std::abs(x));
-  return m;
-}
-
 std::vector<double> multiply(const ShellModel& model, const std::vector<double>& K, const std::vector<double>& u) {
   std::vector<double> r(u.size());
   block_multiply(model.pattern(), K.data(), u.data(), r.data());

@@ -13,6 +13,7 @@
 #include "dgtex/kernels/shell_element_kernel.h"
 #include "dgtex/mesh_generators.h"
 #include "dgtex/topology.h"
+#include "shell_test_support.h"
 
 using namespace dgtex;
 using kernels::ElementType;
@@ -20,17 +21,8 @@ using kernels::Execution;
 
 namespace {
 
-double max_abs(const std::vector<double>& v) {
-  double m = 0;
-  for (double x : v) m = std::max(m, std::abs(x));
-  return m;
-}
-
-double max_difference(const std::vector<double>& a, const std::vector<double>& b) {
-  double m = 0;
-  for (size_t i = 0; i < a.size(); ++i) m = std::max(m, std::abs(a[i] - b[i]));
-  return m;
-}
+using testing_support::max_abs;
+using testing_support::max_difference;
 
 struct DeformedCylinder {
   Mesh mesh;
