@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "dgtex/kernels/flood_fill.h"
 #include "dgtex/kernels/polar_decomposition.h"
 #include "dgtex/kernels/shell_point.h"
 #include "dgtex/kernels/texel_grid.h"
@@ -78,38 +79,24 @@ std::vector<std::int64_t> texel_blocks(ElementType type, int T, const std::uint8
   return block;
 }
 
-// Labels the texels of one element: texels of one block connected without crossing a wall
-// share a label; labels are numbered in row-major order of their first texel. Texels outside
-// the domain are labelled among themselves the same way.
-std::vector<int> block_components(ElementType type, int T, const std::uint8_t* flags, int B, int tip_B) {
+// Labels the texels of one element by the wall-connected part of their block (canonical
+// labels of label_components, flood_fill.h: numbered in row-major order of their first
+// texel; texels outside the domain -1): the element's walls plus walls between blocks.
+// `count` receives the number of labels.
+std::vector<int> block_components(ElementType type, int T, const std::uint8_t* flags, int B, int tip_B, int& count) {
   const std::vector<std::int64_t> block = texel_blocks(type, T, flags, B, tip_B);
-  std::vector<int> label(static_cast<std::size_t>(T) * T, -1);
-  std::vector<int> stack;
-  int next = 0;
-  for (int j0 = 0; j0 < T; ++j0)
-    for (int i0 = 0; i0 < T; ++i0) {
-      if (label[j0 * T + i0] >= 0) continue;
-      const bool inside = texel_in_domain(type, T, flags, i0, j0);
-      const std::int64_t own = block[j0 * T + i0];
-      label[j0 * T + i0] = next;
-      stack.assign(1, j0 * T + i0);
-      auto visit = [&](int i, int j) {
-        if (i < 0 || j < 0 || i >= T || j >= T || block[j * T + i] != own) return;
-        if (label[j * T + i] >= 0 || texel_in_domain(type, T, flags, i, j) != inside) return;
-        label[j * T + i] = next;
-        stack.push_back(j * T + i);
-      };
-      while (!stack.empty()) {
-        const int t = stack.back();
-        stack.pop_back();
-        const int i = t % T, j = t / T;
-        if (!(flags[t] & wall_east)) visit(i + 1, j);
-        if (!(flags[t] & wall_north)) visit(i, j + 1);
-        if (i > 0 && !(flags[t - 1] & wall_east)) visit(i - 1, j);
-        if (j > 0 && !(flags[t - T] & wall_north)) visit(i, j - 1);
-      }
-      ++next;
+  TexelTile tile(T, T);
+  for (int j = 0; j < T; ++j)
+    for (int i = 0; i < T; ++i) {
+      const int t = j * T + i;
+      std::uint8_t f = flags[t];
+      if (!texel_in_domain(type, T, flags, i, j)) f |= inactive;
+      if (i + 1 < T && block[t] != block[t + 1]) f |= wall_east;
+      if (j + 1 < T && block[t] != block[t + T]) f |= wall_north;
+      tile.flags[t] = f;
     }
+  std::vector<int> label;
+  count = label_components(tile, label);
   return label;
 }
 
@@ -204,17 +191,20 @@ EnrichedRotationClusters enriched_rotation_clusters(const EnrichedElementBatch& 
   out.point_start.push_back(0);
   for (std::int64_t e = 0; e < batch.count; ++e) {
     const std::uint8_t* flags = batch.textures[batch.enrichment_start[e]].flags;
-    const std::vector<int> label = block_components(batch.type, T, flags, block_texels, tip_block_texels);
+    int labels = 0;
+    const std::vector<int> label = block_components(batch.type, T, flags, block_texels, tip_block_texels, labels);
     // Points bucketed by label (stable), empty labels dropped.
     const std::int64_t first = quadrature.start[e], last = quadrature.start[e + 1];
     std::vector<int> point_label(static_cast<std::size_t>(last - first));
-    int labels = 0;
-    for (int l : label) labels = std::max(labels, l + 1);
     std::vector<std::int64_t> bucket(static_cast<std::size_t>(labels) + 1, 0);
     for (std::int64_t q = first; q < last; ++q) {
       int i, j;
       containing_texel(batch.type, T, quadrature.points[3 * q], quadrature.points[3 * q + 1], i, j);
       point_label[q - first] = label[j * T + i];
+      if (point_label[q - first] < 0)  // containing_texel keeps points inside the domain
+        throw std::logic_error("enriched_rotation_clusters: quadrature point " + std::to_string(q) +
+                               " lies in texel (" + std::to_string(i) + ", " + std::to_string(j) +
+                               "), outside the domain");
       ++bucket[point_label[q - first] + 1];
     }
     const std::size_t base = out.points.size();
