@@ -224,6 +224,41 @@ std::vector<std::array<double, 2>> sample_points(ElementType type) {
   return s;
 }
 
+// How far the element's surface can leave the box of its corners: x(xi) is the (bi)linear
+// interpolation of the corners (inside their box) plus sum_m N_m(xi) d_m, d_m the offset of
+// midside node m from its edge's midpoint, and sum_m |N_m| <= 4/3 (tri6), 2 (quad8). Flat
+// straight-sided elements get (nearly) 0, so only elements whose box lies near the query
+// are refined; the slack covers rounding in the distances compared against it.
+double corner_box_bulge(const Mesh& mesh, int e) {
+  const int* en = mesh.element_nodes(e);
+  const int corners = mesh.type == ElementType::quad8 ? 4 : 3;
+  double offset = 0, size = 0;
+  for (int m = 0; m < corners; ++m) {
+    const double* a = mesh.node(en[m]);
+    const double* b = mesh.node(en[(m + 1) % corners]);
+    const double* mid = mesh.node(en[corners + m]);
+    double d2 = 0;
+    for (int d = 0; d < 3; ++d) {
+      const double g = mid[d] - 0.5 * (a[d] + b[d]);
+      d2 += g * g;
+      size = std::max({size, std::fabs(a[d]), std::fabs(mid[d])});
+    }
+    offset = std::max(offset, std::sqrt(d2));
+  }
+  const double bound = mesh.type == ElementType::quad8 ? 2.0 : 4.0 / 3.0;
+  return bound * offset * (1 + 1e-9) + 1e-12 * size;
+}
+
+// Distance from p to an axis-aligned box lo[3], hi[3] (0 inside).
+double box_distance(const double* lo, const double* hi, const double p[3]) {
+  double s = 0;
+  for (int d = 0; d < 3; ++d) {
+    const double gap = p[d] - std::clamp(p[d], lo[d], hi[d]);
+    s += gap * gap;
+  }
+  return std::sqrt(s);
+}
+
 // A refined candidate of the closest-point searches. (A private struct: a
 // std::vector<SurfacePoint> here would instantiate templates that clash with scene.h's
 // different dgtex::SurfacePoint.)
@@ -262,20 +297,23 @@ SurfacePoint closest_surface_point(const Mesh& mesh, const double p[3]) {
   const double tie_tolerance = 1e-12 * std::sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) +
                                                  (hi[2] - lo[2]) * (hi[2] - lo[2]));
 
-  // Sampled distance per element, with its best sample and a margin (half the diameter)
-  // below which the element's true distance cannot fall.
+  // Sampled distance per element, with its best sample and a lower bound of its true
+  // distance: the sampled distance less half the diameter, or the distance to the box of
+  // its samples less its bulge beyond its corners' box, whichever is larger.
   const auto samples = sample_points(mesh.type);
   std::vector<kernels::ShapeValues> shapes(samples.size());
   for (size_t s = 0; s < samples.size(); ++s) kernels::evaluate_shape(mesh.type, samples[s][0], samples[s][1], shapes[s]);
   struct Seed {
-    double distance, margin;
+    double distance, margin, lower_bound;
     int element, sample;
   };
   std::vector<Seed> seeds(elements);
   const int npe = mesh.nodes_per_element();
   for (int e = 0; e < elements; ++e) {
     const int* en = mesh.element_nodes(e);
-    Seed seed{std::numeric_limits<double>::infinity(), 0, e, 0};
+    Seed seed{std::numeric_limits<double>::infinity(), 0, 0, e, 0};
+    double lo[3], hi[3];
+    for (int d = 0; d < 3; ++d) lo[d] = std::numeric_limits<double>::infinity(), hi[d] = -lo[d];
     for (int a = 0; a < npe; ++a)
       for (int b = a + 1; b < npe; ++b) {
         const double* u = mesh.node(en[a]);
@@ -290,7 +328,9 @@ SurfacePoint closest_surface_point(const Mesh& mesh, const double p[3]) {
       const double dist = std::sqrt((x[0] - p[0]) * (x[0] - p[0]) + (x[1] - p[1]) * (x[1] - p[1]) +
                                     (x[2] - p[2]) * (x[2] - p[2]));
       if (dist < seed.distance) seed.distance = dist, seed.sample = static_cast<int>(s);
+      for (int d = 0; d < 3; ++d) lo[d] = std::min(lo[d], x[d]), hi[d] = std::max(hi[d], x[d]);
     }
+    seed.lower_bound = std::max(seed.distance - seed.margin, box_distance(lo, hi, p) - corner_box_bulge(mesh, e));
     seeds[e] = seed;
   }
   std::sort(seeds.begin(), seeds.end(), [](const Seed& a, const Seed& b) {
@@ -300,7 +340,7 @@ SurfacePoint closest_surface_point(const Mesh& mesh, const double p[3]) {
   std::vector<Candidate> candidates;
   double best = std::numeric_limits<double>::infinity();
   for (const Seed& seed : seeds) {
-    if (seed.distance - seed.margin > best + tie_tolerance) continue;
+    if (seed.lower_bound > best + tie_tolerance) continue;
     const ElementDistance f(mesh, seed.element, p);
     Candidate c;
     c.element = seed.element;
@@ -334,6 +374,7 @@ SurfacePointSearch::SurfacePointSearch(const Mesh& mesh) : mesh_(mesh) {
   const int npe = mesh.nodes_per_element();
   sample_positions_.resize(static_cast<size_t>(elements) * samples_ * 3);
   margins_.assign(elements, 0.0);
+  bulges_.resize(elements);
   sample_boxes_.resize(static_cast<size_t>(elements) * 6);
   node_boxes_.resize(static_cast<size_t>(elements) * 6);
   all_.resize(elements);
@@ -349,6 +390,7 @@ SurfacePointSearch::SurfacePointSearch(const Mesh& mesh) : mesh_(mesh) {
                                                   (u[2] - v[2]) * (u[2] - v[2])));
       }
     margins_[e] = margin;
+    bulges_[e] = corner_box_bulge(mesh, e);
     double* box = &sample_boxes_[6 * static_cast<size_t>(e)];
     double* nodes = &node_boxes_[6 * static_cast<size_t>(e)];
     for (int d = 0; d < 3; ++d) {
@@ -398,13 +440,13 @@ SurfacePoint SurfacePointSearch::search(const int* elements, int count, const do
   std::vector<int> seed_sample(count, 0);
   for (int k = 0; k < count; ++k) {
     const double* box = &sample_boxes_[6 * static_cast<size_t>(elements[k])];
-    double s = 0;
-    for (int d = 0; d < 3; ++d) {
-      const double gap = p[d] - std::clamp(p[d], box[d], box[3 + d]);
-      s += gap * gap;
-    }
-    lower[k] = std::sqrt(s);
+    lower[k] = box_distance(box, box + 3, p);
   }
+  // closest_surface_point's lower bound of element k's true distance (once seeded).
+  auto lower_bound = [&](int k) {
+    const int e = elements[k];
+    return std::max(seed_distance[k] - margins_[e], lower[k] - bulges_[e]);
+  };
   auto seed = [&](int k) {
     if (seed_distance[k] != unknown) return;
     const double* x = &sample_positions_[static_cast<size_t>(elements[k]) * samples_ * 3];
@@ -442,13 +484,16 @@ SurfacePoint SurfacePointSearch::search(const int* elements, int count, const do
   double best = candidates.front().distance;
   // Everything the full search could still refine after the first, in its order.
   std::vector<int> rest;
+  // (The box distance is at most the seeded distance, so a box too far for both terms of
+  // lower_bound needs no seed.)
   for (int k = 0; k < count; ++k)
-    if (k != first && !(lower[k] - margins_[elements[k]] > best + tie_tolerance)) seed(k), rest.push_back(k);
+    if (k != first && !(lower[k] - std::min(margins_[elements[k]], bulges_[elements[k]]) > best + tie_tolerance))
+      seed(k), rest.push_back(k);
   std::sort(rest.begin(), rest.end(), [&](int a, int b) {
     return seed_distance[a] != seed_distance[b] ? seed_distance[a] < seed_distance[b] : elements[a] < elements[b];
   });
   for (int k : rest) {
-    if (seed_distance[k] - margins_[elements[k]] > best + tie_tolerance) continue;
+    if (lower_bound(k) > best + tie_tolerance) continue;
     candidates.push_back(refine_seed(k));
     best = std::min(best, candidates.back().distance);
   }

@@ -94,6 +94,73 @@ TEST(SurfacePointSearch, SubsetMatchesTheSubMeshSearchBitwise) {
   }
 }
 
+// Refines every element from its best sample (a one-element search) and takes the nearest,
+// ties within 1e-12 x the bounding-box diagonal to the lowest element: what the pruned
+// searches must return bit for bit, since their lower bounds only skip elements that
+// could not come within the tie tolerance of the answer.
+SurfacePoint refine_every_element(const Mesh& mesh, const double p[3]) {
+  double lo[3], hi[3];
+  for (int d = 0; d < 3; ++d) lo[d] = hi[d] = mesh.positions[d];
+  for (int n = 0; n < mesh.num_nodes(); ++n)
+    for (int d = 0; d < 3; ++d) lo[d] = std::min(lo[d], mesh.node(n)[d]), hi[d] = std::max(hi[d], mesh.node(n)[d]);
+  const double tie = 1e-12 * std::hypot(hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]);
+  std::vector<SurfacePoint> each;
+  double best = 1e300;
+  for (int e = 0; e < mesh.num_elements(); ++e) {
+    SurfacePoint sp = closest_surface_point(sub_mesh(mesh, {e}), p);
+    sp.element = e;
+    best = std::min(best, sp.distance);
+    each.push_back(sp);
+  }
+  for (const SurfacePoint& sp : each)
+    if (sp.distance <= best + tie) return sp;  // the lowest element within the tie
+  return {};
+}
+
+TEST(SurfacePointSearch, PruningKeepsTheAnswerOfRefiningEveryElement) {
+  // Flat straight-sided elements (no bulge: only elements whose box is near the query are
+  // refined), a slightly warped plate and curved cylinders (bulge bounds from the midside
+  // offsets).
+  Mesh warped = make_rectangle(1.0, 1.0, 4, 4, ElementType::tri6);
+  for (int n = 0; n < warped.num_nodes(); ++n)
+    warped.positions[3 * n + 2] = 0.05 * std::sin(3 * warped.node(n)[0]) * std::cos(2 * warped.node(n)[1]);
+  const std::vector<Mesh> meshes = {make_rectangle(1.0, 1.0, 5, 4, ElementType::tri6),
+                                    make_rectangle(2.0, 1.0, 4, 3, ElementType::quad8), warped,
+                                    make_cylinder(0.5, 2.0, -25, 335, 6, 3, ElementType::quad8),
+                                    make_cylinder(0.5, 2.0, -65, 150, 5, 3, ElementType::tri6)};
+  unsigned seed = 21;
+  for (const Mesh& mesh : meshes) {
+    const SurfacePointSearch search(mesh);
+    std::vector<std::array<double, 3>> points = queries(mesh, seed++);
+    // Points on the surface, where the pruning skips the most.
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<double> u(0.0, 1.0);
+    for (int k = 0; k < 60; ++k) {
+      const int e = static_cast<int>(rng() % mesh.num_elements());
+      double r = u(rng), s = u(rng);
+      if (mesh.type == ElementType::tri6 && r + s > 1) r = 1 - r, s = 1 - s;
+      if (mesh.type == ElementType::quad8) r = 2 * r - 1, s = 2 * s - 1;
+      kernels::ShapeValues shape;
+      kernels::evaluate_shape(mesh.type, r, s, shape);
+      std::array<double, 3> x = {0, 0, 0};
+      for (int a = 0; a < mesh.nodes_per_element(); ++a)
+        for (int d = 0; d < 3; ++d) x[d] += shape.N[a] * mesh.node(mesh.element_nodes(e)[a])[d];
+      points.push_back(x);
+    }
+    // Radial points around the axis (y) at every degree: where an element's extreme in x
+    // or z lies between its samples, its surface leaves the box of its samples.
+    for (int degree = 0; degree < 360; ++degree) {
+      const double t = degree * M_PI / 180;
+      points.push_back({0.8 * std::sin(t), 0.37, 0.8 * std::cos(t)});
+    }
+    for (const auto& p : points) {
+      const SurfacePoint expected = refine_every_element(mesh, p.data());
+      expect_same(closest_surface_point(mesh, p.data()), expected, p.data());
+      expect_same(search.closest(p.data()), expected, p.data());
+    }
+  }
+}
+
 TEST(SurfacePointSearch, Errors) {
   const Mesh mesh = make_rectangle(1.0, 1.0, 2, 2, ElementType::quad8);
   const SurfacePointSearch search(mesh);
