@@ -1,6 +1,8 @@
 #pragma once
 // Internal: one process-wide lock held around every CHOLMOD analysis, factorisation and
-// solve in dgtex (SparseCholesky and Eigen's CholmodSupernodalLLT alike).
+// solve in dgtex (SparseCholesky and Eigen's CholmodSupernodalLLT alike), except the texel
+// Laplacians of mesh_texel_laplace.cpp: simplicial with AMD, they call neither BLAS nor
+// METIS, so the two hazards below cannot arise there.
 // Why: independent simulations may run on several threads of one process (one SceneRun
 // per thread), but (1) Debian's libopenblas0-serial, the BLAS that CHOLMOD calls, is built
 // without locking and collided under concurrent calls (a spurious "not positive definite"

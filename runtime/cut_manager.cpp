@@ -361,9 +361,8 @@ bool CutManager::update(double time) {
   // The solves of different segments are independent (each reads only the walls and its
   // own settled values): one per thread when there are several (fewer synchronisations
   // than a parallel multigrid per tile). Each solve runs the same operations whatever
-  // thread takes it, so the results do not depend on the thread count; the regions that
-  // need CHOLMOD are solved afterwards, serially in segment order (METIS's global random
-  // state makes its orderings depend on the order of the calls).
+  // thread takes it, the regions that need CHOLMOD included (solve_mesh_texel_laplace's
+  // direct solve is lock-free), so the results do not depend on the thread count.
   const LaplaceSolver solver =
       options_.solver == EnrichmentOptions::Solver::multigrid ? LaplaceSolver::multigrid : LaplaceSolver::cholmod;
   std::vector<MeshLaplaceStats> job_stats(jobs.size());
@@ -377,7 +376,7 @@ bool CutManager::update(double time) {
   auto solve_job = [&](std::size_t k) {
     try {
       job_stats[k] = solve_mesh_texel_laplace(jobs[k].region, mesh_.type, adjacency_, edge_walls_, solver,
-                                              multigrid_options, /*direct_fallback=*/jobs.size() == 1);
+                                              multigrid_options);
     } catch (...) {
       failures[k] = std::current_exception();
     }
@@ -391,9 +390,6 @@ bool CutManager::update(double time) {
   }
   for (const std::exception_ptr& failure : failures)
     if (failure) std::rethrow_exception(failure);
-  for (std::size_t k = 0; k < jobs.size(); ++k)
-    if (job_stats[k].needs_direct)
-      job_stats[k] = solve_mesh_texel_laplace(jobs[k].region, mesh_.type, adjacency_, edge_walls_, LaplaceSolver::cholmod);
   last_.solve_ms = ms_since(solve_start);
 
   for (std::size_t k = 0; k < jobs.size(); ++k) {

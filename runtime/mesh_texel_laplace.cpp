@@ -11,7 +11,6 @@
 
 #include "dgtex/kernels/forall.h"
 #include "dgtex/kernels/multigrid_unknowns.h"
-#include "cholmod_lock.h"
 #include "seamed_patch_laplace.h"
 
 namespace dgtex {
@@ -231,8 +230,7 @@ int find_root(std::vector<int>& parent, int x) {
 
 MeshLaplaceStats solve_mesh_texel_laplace(std::vector<RegionTile>& tiles, ElementType type,
                                           const ElementAdjacency& adjacency, const MeshEdgeWalls& edge_walls,
-                                          LaplaceSolver solver, const LaplaceMultigridOptions& options,
-                                          bool direct_fallback) {
+                                          LaplaceSolver solver, const LaplaceMultigridOptions& options) {
   const auto start = std::chrono::steady_clock::now();
   MeshLaplaceStats stats;
   if (tiles.empty()) return stats;
@@ -474,9 +472,7 @@ MeshLaplaceStats solve_mesh_texel_laplace(std::vector<RegionTile>& tiles, Elemen
         stats.multigrid = false;
       }
     }
-    if (!stats.multigrid && !direct_fallback) {
-      stats.needs_direct = true;
-    } else if (!stats.multigrid) {
+    if (!stats.multigrid) {
       // Lower triangle, column by column (rows in increasing order: cheap inserts).
       const int m = stats.unknowns;
       Eigen::SparseMatrix<double> a(m, m);
@@ -498,11 +494,15 @@ MeshLaplaceStats solve_mesh_texel_laplace(std::vector<RegionTile>& tiles, Elemen
       }
       a.makeCompressed();
       Eigen::CholmodSupernodalLLT<Eigen::SparseMatrix<double>, Eigen::Lower> cholesky;
-      // CHOLMOD's own choice between simplicial and supernodal (by flops per factor entry):
-      // the texel graphs of a few tri6 elements (fracture: 6k-20k unknowns) factor twice
-      // as fast simplicial, a 65k-unknown ring (slinky) stays supernodal.
-      cholesky.cholmod().supernodal = CHOLMOD_AUTO;
-      const auto lock = detail::lock_cholmod();  // held through the solve below
+      // Simplicial (no BLAS: Debian's serial OpenBLAS is not safe for concurrent calls) with
+      // AMD alone (METIS draws from a global random generator): lock-free and the same bits
+      // on any thread. The texel graphs of a few tri6 elements (fracture: 6k-20k unknowns)
+      // factor 2-4x faster simplicial than supernodal here, and AMD was CHOLMOD's own pick.
+      cholmod_common& common = cholesky.cholmod();
+      common.supernodal = CHOLMOD_SIMPLICIAL;
+      common.nmethods = 1;
+      common.method[0].ordering = CHOLMOD_AMD;
+      common.postorder = 1;
       cholesky.compute(a);
       if (cholesky.info() != Eigen::Success)
         throw std::runtime_error("enrichment Laplace solve: CHOLMOD could not factor the " + std::to_string(m) +

@@ -233,6 +233,7 @@ void check_rigid_motions(const Scene& scene, const Mesh& mesh) {
 void check_cut_points(const Scene& scene, const Mesh& mesh) {
   if (mesh.num_elements() == 0) return;
   const double tolerance = cut_point_tolerance(mesh);
+  const SurfacePointSearch search(mesh);  // closest_surface_point, pruned per query
   for (size_t c = 0; c < scene.cuts.size(); ++c) {
     const Cut& cut = scene.cuts[c];
     if (cut.kind != Cut::Kind::points) continue;
@@ -240,7 +241,7 @@ void check_cut_points(const Scene& scene, const Mesh& mesh) {
     double total = 0;
     Eigen::Vector3d previous = Eigen::Vector3d::Zero();
     for (size_t k = 0; k < cut.points.size(); ++k) {
-      const SurfacePoint sp = closest_surface_point(mesh, cut.points[k].data());
+      const SurfacePoint sp = search.closest(cut.points[k].data());
       const Eigen::Vector3d x(sp.position[0], sp.position[1], sp.position[2]);
       if (sp.distance > tolerance)
         throw SceneError(scene.source_name, path + "[" + std::to_string(k) + "]", "off the surface",

@@ -1,9 +1,7 @@
 // CutManager solves the Laplace problems of different segments concurrently
 // (cut_manager.cpp): the functions must be bitwise the same for 1, 2 and 4 threads, with
-// multigrid regions (a quad8 rectangle) and regions that need CHOLMOD (tri6, solved after
-// the concurrent part in segment order), static and progressive. And the deferred direct
-// solve of solve_mesh_texel_laplace (direct_fallback = false, then CHOLMOD) equals the
-// one call with the fallback, bitwise.
+// multigrid regions (a quad8 rectangle) and regions that need CHOLMOD (tri6, solved
+// concurrently too: the direct solve is lock-free), static and progressive.
 #include <gtest/gtest.h>
 
 #include <omp.h>
@@ -11,8 +9,6 @@
 #include <vector>
 
 #include "cut_test_support.h"
-#include "dgtex/kernels/cut_rasterization.h"
-#include "region_test_support.h"
 #include "dgtex/cut_manager.h"
 #include "dgtex/mesh_generators.h"
 #include "dgtex/topology.h"
@@ -93,30 +89,4 @@ TEST(CutsConcurrentSolves, ProgressiveMixedRegionsAreThreadCountIndependent) {
                            points_cut({{-0.5, 1.5, 0.0}, {0.0, 1.8, 0.5}})};
   for (Cut& cut : cuts) cut.has_schedule = true, cut.speed = 1.5;
   expect_thread_count_independent(mesh, cuts, multigrid_enrichment(16), {0.2, 0.6, 1.0, 1.4, 2.0}, 6);
-}
-
-TEST(CutsConcurrentSolves, DeferredDirectSolveEqualsTheFallback) {
-  // tri6 regions have no patch tile (a quad8 ring is a seamed patch now, see
-  // test_laplace_mesh_multigrid.cpp).
-  for (ElementType type : {ElementType::tri6}) {
-    const Mesh mesh = make_rectangle(2, 1, 2, 1, type);
-    const Topology topology = build_topology(mesh);
-    const ElementAdjacency adjacency(mesh, topology);
-    std::vector<int> elements;
-    for (int e = 0; e < mesh.num_elements(); ++e) elements.push_back(e);
-    std::vector<RegionTile> once = make_test_region(mesh, elements, 16), twice = once;
-    const MeshEdgeWalls walls(16);
-    const MeshLaplaceStats a = solve_mesh_texel_laplace(once, type, adjacency, walls, LaplaceSolver::multigrid);
-    const MeshLaplaceStats deferred =
-        solve_mesh_texel_laplace(twice, type, adjacency, walls, LaplaceSolver::multigrid, {}, false);
-    EXPECT_FALSE(a.multigrid);
-    EXPECT_GT(a.unknowns, 100);
-    EXPECT_TRUE(deferred.needs_direct);
-    EXPECT_FALSE(a.needs_direct);
-    const MeshLaplaceStats b = solve_mesh_texel_laplace(twice, type, adjacency, walls, LaplaceSolver::cholmod);
-    EXPECT_EQ(a.unknowns, b.unknowns);
-    for (std::size_t l = 0; l < once.size(); ++l)
-      for (std::size_t k = 0; k < once[l].tile.values.size(); ++k)
-        ASSERT_EQ(once[l].tile.values[k], twice[l].tile.values[k]) << "tile " << l << " texel " << k;
-  }
 }

@@ -76,22 +76,18 @@ struct MeshLaplaceStats {
   int solved_tiles = 0, frozen_tiles = 0;
   double relative_residual = 0;
   bool multigrid = false;  // solved by the tile multigrid (else CHOLMOD, or nothing to solve)
-  bool needs_direct = false;  // direct_fallback was false and the region needs CHOLMOD: not solved
   double ms = 0;  // wall time of the whole call
 };
 
 // Solves in place: free texels of non-frozen tiles get H; data texels keep their values.
 // All tiles must be T x T of the same T, elements distinct (std::invalid_argument
-// otherwise); std::runtime_error if CHOLMOD fails. direct_fallback = false: where the
-// multigrid does not apply (or does not converge) nothing is solved and needs_direct is
-// set; the texels without data keep their values then except in components with one or
-// no datum, so a second call with LaplaceSolver::cholmod gives what one call with the
-// fallback gives. (Concurrent callers use it to run every CHOLMOD solve in their own
-// serial order: METIS, CHOLMOD's ordering, draws from one global random generator.)
+// otherwise); std::runtime_error if CHOLMOD fails. Where the multigrid does not apply (tri6
+// regions, regions that do not lie flat) or does not converge, CHOLMOD solves the region:
+// simplicial with the AMD ordering, which call neither BLAS nor METIS, so concurrent calls
+// (one segment per thread in CutManager) need no lock and give the bits of a serial call.
 MeshLaplaceStats solve_mesh_texel_laplace(std::vector<RegionTile>& tiles, ElementType type,
                                           const ElementAdjacency& adjacency, const MeshEdgeWalls& edge_walls,
                                           LaplaceSolver solver = LaplaceSolver::cholmod,
-                                          const LaplaceMultigridOptions& options = {},
-                                          bool direct_fallback = true);
+                                          const LaplaceMultigridOptions& options = {});
 
 }  // namespace dgtex
