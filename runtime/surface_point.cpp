@@ -249,6 +249,75 @@ double corner_box_bulge(const Mesh& mesh, int e) {
   return bound * offset * (1 + 1e-9) + 1e-12 * size;
 }
 
+// Distance from p to the triangle a, b, c: the closest point by Voronoi regions (vertex,
+// edge or face). A degenerate triangle may give NaN: callers treat that as no bound.
+double triangle_distance(const double* a, const double* b, const double* c, const double p[3]) {
+  const auto sub = [](const double* u, const double* v, double* out) {
+    for (int d = 0; d < 3; ++d) out[d] = u[d] - v[d];
+  };
+  const auto dot = [](const double* u, const double* v) { return u[0] * v[0] + u[1] * v[1] + u[2] * v[2]; };
+  double ab[3], ac[3], ap[3], bp[3], cp[3];
+  sub(b, a, ab), sub(c, a, ac), sub(p, a, ap), sub(p, b, bp), sub(p, c, cp);
+  const double d1 = dot(ab, ap), d2 = dot(ac, ap), d3 = dot(ab, bp), d4 = dot(ac, bp), d5 = dot(ab, cp),
+               d6 = dot(ac, cp);
+  double v = 0, w = 0;  // closest point a + v ab + w ac
+  const double vc = d1 * d4 - d3 * d2, vb = d5 * d2 - d1 * d6, va = d3 * d6 - d5 * d4;
+  if (d1 <= 0 && d2 <= 0) {
+  } else if (d3 >= 0 && d4 <= d3) {
+    v = 1;
+  } else if (vc <= 0 && d1 >= 0 && d3 <= 0) {
+    v = d1 / (d1 - d3);
+  } else if (d6 >= 0 && d5 <= d6) {
+    w = 1;
+  } else if (vb <= 0 && d2 >= 0 && d6 <= 0) {
+    w = d2 / (d2 - d6);
+  } else if (va <= 0 && d4 - d3 >= 0 && d5 - d6 >= 0) {
+    w = (d4 - d3) / ((d4 - d3) + (d5 - d6));
+    v = 1 - w;
+  } else {
+    const double denominator = 1 / (va + vb + vc);
+    v = vb * denominator, w = vc * denominator;
+  }
+  double gap2 = 0;
+  for (int d = 0; d < 3; ++d) {
+    const double g = p[d] - (a[d] + v * ab[d] + w * ac[d]);
+    gap2 += g * g;
+  }
+  return std::sqrt(gap2);
+}
+
+// Distance from p to the element's corner facets: the triangle of a tri6's corners, the
+// triangles 0-1-2 and 0-2-3 of a quad8's.
+double corner_facet_distance(const Mesh& mesh, int e, const double p[3]) {
+  const int* en = mesh.element_nodes(e);
+  const double* x0 = mesh.node(en[0]);
+  const double distance = triangle_distance(x0, mesh.node(en[1]), mesh.node(en[2]), p);
+  if (mesh.type != ElementType::quad8) return distance;
+  return std::min(distance, triangle_distance(x0, mesh.node(en[2]), mesh.node(en[3]), p));
+}
+
+// How far the surface can lie from its corner facets: the bulge, plus for a quad8 how far
+// its bilinear interpolation of the corners leaves the two facets, at most 2 |d| with
+// d = (x0 - x1 + x2 - x3) / 4 the coefficient of r s (|r s - its linear interpolation on
+// either triangle| <= 2).
+double corner_facet_slack(const Mesh& mesh, int e, double bulge) {
+  if (mesh.type != ElementType::quad8) return bulge;
+  const int* en = mesh.element_nodes(e);
+  double twist2 = 0;
+  for (int d = 0; d < 3; ++d) {
+    const double t = 0.25 * (mesh.node(en[0])[d] - mesh.node(en[1])[d] + mesh.node(en[2])[d] - mesh.node(en[3])[d]);
+    twist2 += t * t;
+  }
+  return bulge + 2 * std::sqrt(twist2) * (1 + 1e-9);
+}
+
+// Lower bound of element e's distance to p from its corner facets (0 where they are
+// degenerate: no bound).
+double corner_facet_bound(const Mesh& mesh, int e, const double p[3], double slack) {
+  const double bound = corner_facet_distance(mesh, e, p) - slack;
+  return std::isfinite(bound) ? bound : 0.0;
+}
+
 // Distance from p to an axis-aligned box lo[3], hi[3] (0 inside).
 double box_distance(const double* lo, const double* hi, const double p[3]) {
   double s = 0;
@@ -330,7 +399,9 @@ SurfacePoint closest_surface_point(const Mesh& mesh, const double p[3]) {
       if (dist < seed.distance) seed.distance = dist, seed.sample = static_cast<int>(s);
       for (int d = 0; d < 3; ++d) lo[d] = std::min(lo[d], x[d]), hi[d] = std::max(hi[d], x[d]);
     }
-    seed.lower_bound = std::max(seed.distance - seed.margin, box_distance(lo, hi, p) - corner_box_bulge(mesh, e));
+    const double bulge = corner_box_bulge(mesh, e);
+    seed.lower_bound = std::max({seed.distance - seed.margin, box_distance(lo, hi, p) - bulge,
+                                 corner_facet_bound(mesh, e, p, corner_facet_slack(mesh, e, bulge))});
     seeds[e] = seed;
   }
   std::sort(seeds.begin(), seeds.end(), [](const Seed& a, const Seed& b) {
@@ -375,6 +446,7 @@ SurfacePointSearch::SurfacePointSearch(const Mesh& mesh) : mesh_(mesh) {
   sample_positions_.resize(static_cast<size_t>(elements) * samples_ * 3);
   margins_.assign(elements, 0.0);
   bulges_.resize(elements);
+  facet_slacks_.resize(elements);
   sample_boxes_.resize(static_cast<size_t>(elements) * 6);
   node_boxes_.resize(static_cast<size_t>(elements) * 6);
   all_.resize(elements);
@@ -391,6 +463,7 @@ SurfacePointSearch::SurfacePointSearch(const Mesh& mesh) : mesh_(mesh) {
       }
     margins_[e] = margin;
     bulges_[e] = corner_box_bulge(mesh, e);
+    facet_slacks_[e] = corner_facet_slack(mesh, e, bulges_[e]);
     double* box = &sample_boxes_[6 * static_cast<size_t>(e)];
     double* nodes = &node_boxes_[6 * static_cast<size_t>(e)];
     for (int d = 0; d < 3; ++d) {
@@ -445,7 +518,8 @@ SurfacePoint SurfacePointSearch::search(const int* elements, int count, const do
   // closest_surface_point's lower bound of element k's true distance (once seeded).
   auto lower_bound = [&](int k) {
     const int e = elements[k];
-    return std::max(seed_distance[k] - margins_[e], lower[k] - bulges_[e]);
+    return std::max({seed_distance[k] - margins_[e], lower[k] - bulges_[e],
+                     corner_facet_bound(mesh_, e, p, facet_slacks_[e])});
   };
   auto seed = [&](int k) {
     if (seed_distance[k] != unknown) return;

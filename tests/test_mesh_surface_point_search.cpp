@@ -121,11 +121,21 @@ TEST(SurfacePointSearch, PruningKeepsTheAnswerOfRefiningEveryElement) {
   // Flat straight-sided elements (no bulge: only elements whose box is near the query are
   // refined), a slightly warped plate and curved cylinders (bulge bounds from the midside
   // offsets).
-  Mesh warped = make_rectangle(1.0, 1.0, 4, 4, ElementType::tri6);
-  for (int n = 0; n < warped.num_nodes(); ++n)
-    warped.positions[3 * n + 2] = 0.05 * std::sin(3 * warped.node(n)[0]) * std::cos(2 * warped.node(n)[1]);
-  const std::vector<Mesh> meshes = {make_rectangle(1.0, 1.0, 5, 4, ElementType::tri6),
-                                    make_rectangle(2.0, 1.0, 4, 3, ElementType::quad8), warped,
+  // Warped plates: curved elements, and quad8 corners out of plane (a bilinear twist).
+  const auto warp = [](Mesh mesh) {
+    for (int n = 0; n < mesh.num_nodes(); ++n)
+      mesh.positions[3 * n + 2] = 0.08 * std::sin(3 * mesh.node(n)[0]) * std::cos(4 * mesh.node(n)[1]);
+    return mesh;
+  };
+  // A hyperbolic paraboloid z = c x y: quad8 elements with straight edges (midside nodes at
+  // the midpoints: no bulge), twisted bilinear patches between their corner facets.
+  Mesh hypar = make_rectangle(1.0, 1.0, 2, 2, ElementType::quad8);
+  for (int n = 0; n < hypar.num_nodes(); ++n)
+    hypar.positions[3 * n + 2] = 6.0 * (hypar.node(n)[0] - 0.5) * (hypar.node(n)[1] - 0.5);
+  const std::vector<Mesh> meshes = {hypar, make_rectangle(1.0, 1.0, 5, 4, ElementType::tri6),
+                                    make_rectangle(2.0, 1.0, 4, 3, ElementType::quad8),
+                                    warp(make_rectangle(1.0, 1.0, 4, 4, ElementType::tri6)),
+                                    warp(make_rectangle(1.0, 1.0, 3, 3, ElementType::quad8)),
                                     make_cylinder(0.5, 2.0, -25, 335, 6, 3, ElementType::quad8),
                                     make_cylinder(0.5, 2.0, -65, 150, 5, 3, ElementType::tri6)};
   unsigned seed = 21;
@@ -135,7 +145,7 @@ TEST(SurfacePointSearch, PruningKeepsTheAnswerOfRefiningEveryElement) {
     // Points on the surface, where the pruning skips the most.
     std::mt19937 rng(seed);
     std::uniform_real_distribution<double> u(0.0, 1.0);
-    for (int k = 0; k < 60; ++k) {
+    for (int k = 0; k < 400; ++k) {
       const int e = static_cast<int>(rng() % mesh.num_elements());
       double r = u(rng), s = u(rng);
       if (mesh.type == ElementType::tri6 && r + s > 1) r = 1 - r, s = 1 - s;
@@ -145,6 +155,9 @@ TEST(SurfacePointSearch, PruningKeepsTheAnswerOfRefiningEveryElement) {
       std::array<double, 3> x = {0, 0, 0};
       for (int a = 0; a < mesh.nodes_per_element(); ++a)
         for (int d = 0; d < 3; ++d) x[d] += shape.N[a] * mesh.node(mesh.element_nodes(e)[a])[d];
+      points.push_back(x);
+      // and just off it, where a neighbour's nearer sample may seed the search first
+      x[2] += 0.05 * (u(rng) - 0.5);
       points.push_back(x);
     }
     // Radial points around the axis (y) at every degree: where an element's extreme in x

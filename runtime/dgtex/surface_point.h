@@ -21,8 +21,10 @@ struct SurfacePoint {
 // tri6 15), elements are refined in order of their sampled distance and skipped once a
 // lower bound of their distance exceeds the best refined distance (the sampled distance
 // less half the element's diameter, or the distance to the box of its samples less how far
-// its midside nodes let it bulge beyond its corners' box: ~0 for flat straight-sided
-// elements, so a query on a flat mesh refines only the elements whose box holds it);
+// its midside nodes let it bulge beyond its corners' box, or the distance to its corner
+// facets less that bulge (and a quad8's twist), whichever is largest: for flat
+// straight-sided elements the last is the exact distance, so a query on a flat mesh
+// refines little more than the element that holds it);
 // refinement is Newton (Gauss-Newton where the Hessian is indefinite) on |x(xi) - p|^2
 // with an active set on the reference element's bounds and a projected backtracking line
 // search, so points on edges and corners come out exactly. Ties (distances within
@@ -54,6 +56,7 @@ class SurfacePointSearch {
   std::vector<double> sample_positions_;  // per element and sample: x, y, z
   std::vector<double> margins_;           // per element: half its diameter over node pairs
   std::vector<double> bulges_;            // per element: how far it can leave its corners' box
+  std::vector<double> facet_slacks_;      // per element: how far it can lie from its corner facets
   std::vector<double> sample_boxes_;      // per element: lo[3], hi[3] of its samples
   std::vector<double> node_boxes_;        // per element: lo[3], hi[3] of its nodes
   std::vector<int> all_;                  // 0..elements-1
