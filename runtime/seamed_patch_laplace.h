@@ -6,6 +6,9 @@
 // A = A_chain + S with S the seams' rank-one terms, so M^-1 A >= 1 with at most one outlier
 // per seam coupling, and CG removes those in a few extra iterations. Replaces CHOLMOD for
 // such regions (slinky: 4 x 128^2 texels, see README "Several elements on one patch tile").
+// A poor initial guess (relative residual > 0.1: a new function, x = 0) is first replaced by
+// the open chain's solution (the hierarchy's own multigrid solve): nearly-Neumann rings
+// (a short new cut on a closed cylinder) took 34 CG iterations from 0, 6 cycles + 21 from it.
 #include <vector>
 
 #include "dgtex/kernels/texel_grid.h"
