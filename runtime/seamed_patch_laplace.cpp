@@ -1,11 +1,13 @@
 #include "seamed_patch_laplace.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <stdexcept>
 #include <string>
 
 #include "dgtex/kernels/forall.h"
+#include "dgtex/kernels/multigrid_residual.h"
 #include "dgtex/kernels/multigrid_unknowns.h"
 #include "dgtex/stage_timer.h"
 
@@ -37,85 +39,127 @@ LaplaceSolveStats solve_seamed_patch_laplace(kernels::TexelTile& tile, const std
       throw std::runtime_error("seamed patch Laplace: texel " + std::to_string(t) +
                                " has Dirichlet data only across a seam");
   }
-  std::vector<std::uint8_t> bits;
-  kernels::classify_laplace_texels(tile, bits);
-  // Seam partners in compressed rows (few texels have any: one edge of the patch).
-  std::vector<int> partner_start(static_cast<std::size_t>(n) + 1, 0), partner;
-  for (const SeamCoupling& s : seams) ++partner_start[s.a + 1], ++partner_start[s.b + 1];
-  for (int t = 0; t < n; ++t) partner_start[t + 1] += partner_start[t];
-  partner.resize(partner_start[n]);
+  // The CG runs on the multigrid's padded level-0 layout, so the grid part of y = A x and
+  // p . A p come from its vector kernels (kernels::apply_texels and the fused direction
+  // update); the seam couplings are added after, texel by texel (few: one patch edge).
+  const kernels::GridShape g{w, h};
+  const std::size_t padded = g.padded_size();
+  const auto at = [&](int t) { return g.at(t % w, t / w); };
+  std::vector<std::uint8_t> bits(padded);
+  kernels::classify_laplace_texels_padded(tile, bits.data());
+  // Seam partners per seam texel (padded indices), each unknown seam texel listed once.
+  std::vector<std::int64_t> seam_texel;
+  std::vector<int> partner_start = {0};
+  std::vector<std::int64_t> partner;
   {
-    std::vector<int> next(partner_start.begin(), partner_start.end() - 1);
-    for (const SeamCoupling& s : seams) partner[next[s.a]++] = s.b, partner[next[s.b]++] = s.a;
+    std::vector<std::vector<std::int64_t>> partners_of(n);
+    for (const SeamCoupling& c : seams) partners_of[c.a].push_back(at(c.b)), partners_of[c.b].push_back(at(c.a));
+    for (int t = 0; t < n; ++t) {
+      if (partners_of[t].empty() || !unknown[t]) continue;
+      seam_texel.push_back(at(t));
+      partner.insert(partner.end(), partners_of[t].begin(), partners_of[t].end());
+      partner_start.push_back(static_cast<int>(partner.size()));
+    }
   }
-
-  // The CG's passes over the patch, one row per work item with per-row partial sums added
-  // in row order (deterministic for any thread count): y = A x at the unknowns (the grid
-  // couplings, the degree counting Dirichlet neighbours too, then one coupling per seam
-  // partner) with sum p . (A p) fused in.
+  const auto is_unknown = [&](std::int64_t k) { return (bits[k] & kernels::is_unknown) != 0; };
+  // y += S x at the seam texels; returns the seam share of x . y.
+  const auto add_seams = [&](const std::vector<double>& x, std::vector<double>& y) {
+    double dot = 0;
+    for (std::size_t s = 0; s < seam_texel.size(); ++s) {
+      const std::int64_t k = seam_texel[s];
+      double v = static_cast<double>(partner_start[s + 1] - partner_start[s]) * x[k];
+      for (int m = partner_start[s]; m < partner_start[s + 1]; ++m)
+        if (is_unknown(partner[m])) v -= x[partner[m]];
+      y[k] += v;
+      dot += x[k] * v;
+    }
+    return dot;
+  };
   std::vector<double> rows(h);
   const auto sum_rows = [&] {
     double sum = 0;
     for (double v : rows) sum += v;
     return sum;
   };
+  const kernels::Execution execution = options.execution;
+  // y = A x (0 off the unknowns) and x . y.
   const auto apply_and_dot = [&](const std::vector<double>& x, std::vector<double>& y) {
-    kernels::forall(h, [&](std::int64_t j) {
-      double dot = 0;
-      for (int t = static_cast<int>(j) * w; t < (static_cast<int>(j) + 1) * w; ++t) {
-        if (!unknown[t]) {
-          y[t] = 0;
-          continue;
-        }
-        const std::uint8_t m = bits[t];
-        const int first = partner_start[t], last = partner_start[t + 1];
-        double v = (kernels::laplace_degree(m) + static_cast<double>(last - first)) * x[t];
-        if (m & kernels::couples_west_unknown) v -= x[t - 1];
-        if (m & kernels::couples_east_unknown) v -= x[t + 1];
-        if (m & kernels::couples_south_unknown) v -= x[t - w];
-        if (m & kernels::couples_north_unknown) v -= x[t + w];
-        for (int k = first; k < last; ++k)
-          if (unknown[partner[k]]) v -= x[partner[k]];
-        y[t] = v;
-        dot += x[t] * v;
-      }
-      rows[j] = dot;
-    });
-    return sum_rows();
+    kernels::apply_texels(g, bits.data(), x.data(), y.data(), rows.data(), execution);
+    const double grid = sum_rows();
+    return grid + add_seams(x, y);
   };
-  // Sum over the patch of f(t), by rows.
+  // Sum over the padded rows of f(k) for the texels k of row j.
   const auto row_sum = [&](auto f) {
-    kernels::forall(h, [&](std::int64_t j) {
-      double sum = 0;
-      for (int t = static_cast<int>(j) * w; t < (static_cast<int>(j) + 1) * w; ++t) sum += f(t);
-      rows[j] = sum;
-    });
+    kernels::forall(
+        h,
+        [&](std::int64_t j) {
+          double sum = 0;
+          const std::int64_t first = g.at(0, static_cast<int>(j));
+          for (std::int64_t k = first; k < first + w; ++k) sum += f(k);
+          rows[j] = sum;
+        },
+        execution);
     return sum_rows();
   };
   // b: values of coupled Dirichlet texels, grid neighbours and seam partners.
-  std::vector<double> b(n, 0.0), x(n, 0.0), r(n), z, p, q(n);
+  std::vector<double> b(padded, 0.0), x(padded, 0.0), r(padded, 0.0), z(padded, 0.0), p(padded, 0.0),
+      q(padded, 0.0);
   for (int j = 0; j < h; ++j)
     for (int i = 0; i < w; ++i) {
       const int t = tile.index(i, j);
       if (!unknown[t]) continue;
+      const std::int64_t k = g.at(i, j);
       auto data = [&](bool coupled, int o) {
         if (coupled && (tile.flags[o] & (kernels::dirichlet | kernels::inactive)) == kernels::dirichlet)
-          b[t] += tile.values[o];
+          b[k] += tile.values[o];
       };
       data(i > 0 && kernels::texels_coupled_east(tile, i - 1, j), t - 1);
       data(i + 1 < w && kernels::texels_coupled_east(tile, i, j), t + 1);
       data(j > 0 && kernels::texels_coupled_north(tile, i, j - 1), t - w);
       data(j + 1 < h && kernels::texels_coupled_north(tile, i, j), t + w);
-      for (int k = partner_start[t]; k < partner_start[t + 1]; ++k) data(true, partner[k]);
-      if (options.warm_start && std::isfinite(tile.values[t])) x[t] = tile.values[t];
+      if (options.warm_start && std::isfinite(tile.values[t])) x[k] = tile.values[t];
     }
+  for (const SeamCoupling& c : seams) {
+    auto data = [&](int t, int o) {
+      if (unknown[t] && (tile.flags[o] & (kernels::dirichlet | kernels::inactive)) == kernels::dirichlet)
+        b[at(t)] += tile.values[o];
+    };
+    data(c.a, c.b), data(c.b, c.a);
+  }
+  // The multigrid's preconditioner reads and writes per tile texel (unpadded).
+  std::vector<double> r_tile(n), z_tile(n);
+  const auto precondition = [&] {
+    kernels::forall(
+        h,
+        [&](std::int64_t j) {
+          std::copy_n(r.data() + g.at(0, static_cast<int>(j)), w, r_tile.data() + j * w);
+        },
+        execution);
+    chain.precondition(r_tile, z_tile);
+    // z back into the padded layout, with r . z by rows.
+    kernels::forall(
+        h,
+        [&](std::int64_t j) {
+          const std::int64_t first = g.at(0, static_cast<int>(j));
+          const double* from = z_tile.data() + j * w;
+          double sum = 0;
+          for (int i = 0; i < w; ++i) {
+            z[first + i] = from[i];
+            sum += r[first + i] * from[i];
+          }
+          rows[j] = sum;
+        },
+        execution);
+    return sum_rows();
+  };
+
   LaplaceSolveStats stats;
-  const double b_norm = std::sqrt(row_sum([&](int t) { return b[t] * b[t]; }));
+  const double b_norm = std::sqrt(row_sum([&](std::int64_t k) { return b[k] * b[k]; }));
   const auto residual = [&] {
     apply_and_dot(x, q);
-    const double r0 = row_sum([&](int t) {
-      r[t] = b[t] - q[t];
-      return r[t] * r[t];
+    const double r0 = row_sum([&](std::int64_t k) {
+      r[k] = b[k] - q[k];
+      return r[k] * r[k];
     });
     return b_norm > 0 ? std::sqrt(r0) / b_norm : 0.0;
   };
@@ -128,50 +172,49 @@ LaplaceSolveStats solve_seamed_patch_laplace(kernels::TexelTile& tile, const std
   if (relative > fresh_start_residual) {
     kernels::TexelTile open = tile;
     for (int t = 0; t < n; ++t)
-      if (unknown[t]) open.values[t] = x[t];
+      if (unknown[t]) open.values[t] = x[at(t)];
     try {
       chain.solve(open);
       for (int t = 0; t < n; ++t)
-        if (unknown[t]) x[t] = open.values[t];
+        if (unknown[t]) x[at(t)] = open.values[t];
       relative = residual();
     } catch (const std::runtime_error&) {
       // the chain did not converge: CG goes on from its own start
     }
   }
   if (relative > options.tolerance) {
-    chain.precondition(r, z);
+    double rz = precondition();
     p = z;
-    double rz = row_sum([&](int t) { return r[t] * z[t]; });
-    while (relative > options.tolerance && stats.iterations < options.max_cycles) {
-      const double pq = apply_and_dot(p, q);
+    double pq = apply_and_dot(p, q);
+    while (stats.iterations < options.max_cycles) {
       if (!(pq > 0)) break;
       const double alpha = rz / pq;
       // x += alpha p, r -= alpha q, and r . r in one pass.
-      const double rr = row_sum([&](int t) {
-        x[t] += alpha * p[t];
-        r[t] -= alpha * q[t];
-        return r[t] * r[t];
+      const double rr = row_sum([&](std::int64_t k) {
+        x[k] += alpha * p[k];
+        r[k] -= alpha * q[k];
+        return r[k] * r[k];
       });
       ++stats.iterations;
       relative = std::sqrt(rr) / b_norm;
       if (relative <= options.tolerance) break;
-      chain.precondition(r, z);
-      const double rz_next = row_sum([&](int t) { return r[t] * z[t]; });
+      const double rz_next = precondition();
       const double beta = rz_next / rz;
       rz = rz_next;
-      kernels::forall(h, [&](std::int64_t j) {
-        for (int t = static_cast<int>(j) * w; t < (static_cast<int>(j) + 1) * w; ++t) p[t] = z[t] + beta * p[t];
-      });
+      // p = z + beta p and q = A p (grid part) in one pass, then the seams.
+      kernels::update_direction_and_apply_texels(g, bits.data(), z.data(), beta, p.data(), q.data(), rows.data(),
+                                                 execution);
+      pq = sum_rows();
+      pq += add_seams(p, q);
     }
     // The true residual, not the recursive one.
-    apply_and_dot(x, q);
-    relative = std::sqrt(row_sum([&](int t) { return (b[t] - q[t]) * (b[t] - q[t]); })) / b_norm;
+    relative = residual();
   }
   if (!(relative <= options.tolerance))
     throw std::runtime_error("seamed patch Laplace: relative residual " + std::to_string(relative) + " after " +
                              std::to_string(stats.iterations) + " iterations");
   for (int t = 0; t < n; ++t)
-    if (free_texel(t)) tile.values[t] = x[t];
+    if (free_texel(t)) tile.values[t] = x[at(t)];
   stats.relative_residual = relative;
   stats.ms = ms_since(start);
   return stats;
