@@ -1,14 +1,16 @@
 #pragma once
 // Internal (used by solve_mesh_texel_laplace): the texel Laplace problem of a patch tile
 // plus "seam" couplings between texels that are not grid neighbours there, as when a ring of
-// elements (around a cylinder) is cut open into a chain to lie in a plane. The tile
-// multigrid of the open chain preconditions conjugate gradients on the closed operator:
-// A = A_chain + S with S the seams' rank-one terms, so M^-1 A >= 1 with at most one outlier
-// per seam coupling, and CG removes those in a few extra iterations. Replaces CHOLMOD for
-// such regions (slinky: 4 x 128^2 texels, see README "Several elements on one patch tile").
-// A poor initial guess (relative residual > 0.1: a new function, x = 0) is first replaced by
-// the open chain's solution (the hierarchy's own multigrid solve): nearly-Neumann rings
-// (a short new cut on a closed cylinder) took 34 CG iterations from 0, 6 cycles + 21 from it.
+// elements (around a cylinder) is cut open into a chain to lie in a plane. Conjugate
+// gradients on the closed operator A = A_chain + S (S: the seams' rank-one terms),
+// preconditioned by the open chain's V-cycle between two exact solves on the seam strip
+// (the unknowns within 3 texels of a seam texel; banded Cholesky), symmetric
+// multiplicative Schwarz. The V-cycle alone leaves up to one outlier per seam coupling (34
+// iterations on slinky's step-17 ring from 0); with the strip solves 14. Replaces CHOLMOD
+// for such regions (slinky: 4 x 128^2 texels, see README "Several elements on one patch
+// tile"). A poor initial guess (relative residual > 0.1: a new function, x = 0) is first
+// replaced by the open chain's solution (the hierarchy's own multigrid solve): 7 iterations
+// from there on that ring.
 #include <vector>
 
 #include "dgtex/kernels/texel_grid.h"
