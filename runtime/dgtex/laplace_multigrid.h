@@ -43,7 +43,10 @@ struct LaplaceMultigridOptions {
   int coarsest_nodes = 64;        // coarsen until a level has at most this many nodes ...
   int max_orphans = 0;            // ... or until coarsening would leave more active nodes
                                   // without interpolation (channels narrower than the coarse
-                                  // spacing); the last level is solved by sparse Cholesky
+                                  // spacing), where the level is small enough to factor in
+                                  // band form (~2e7 multiply-adds; larger levels coarsen on
+                                  // and leave such nodes to the smoother); the last level is
+                                  // solved by sparse Cholesky
 };
 
 // One point of a convergence history: time since the solve started and relative residual.
