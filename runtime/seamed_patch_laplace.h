@@ -26,10 +26,11 @@ struct SeamCoupling {
 };
 
 // Solves in place (tile.values of the free texels; the initial guess is their finite values)
-// to options.tolerance, relative residual of the closed operator. Throws std::runtime_error
-// (the caller falls back to a direct solve) if a free texel is not an unknown of the chain's
-// hierarchy (a component whose only Dirichlet data lies across a seam) or CG does not
-// converge in options.max_cycles iterations; std::invalid_argument for bad seams.
+// to options.tolerance, relative residual of the closed operator. A part of the ring whose
+// only Dirichlet data lie across a seam is solved too (the chain then pins its seam texels
+// for the preconditioner). Throws std::runtime_error (the caller falls back to a direct
+// solve) if a free texel has no data even on the ring or CG does not converge in
+// options.max_cycles iterations; std::invalid_argument for bad seams.
 LaplaceSolveStats solve_seamed_patch_laplace(kernels::TexelTile& tile, const std::vector<SeamCoupling>& seams,
                                              const LaplaceMultigridOptions& options = {});
 
