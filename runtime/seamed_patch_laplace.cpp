@@ -302,10 +302,10 @@ LaplaceSolveStats solve_seamed_patch_laplace(kernels::TexelTile& tile, const std
   };
   double relative = residual();
   // A poor start (a new enrichment: x = 0) goes to the open chain's solution first, by the
-  // same hierarchy's own solver (~0.5x the cost of a CG iteration per cycle). Near-Neumann
-  // rings (slinky: a short new cut segment on a closed cylinder) took 34 iterations from
-  // x = 0 and take 6 chain cycles + 21 iterations from there; the chain's solution is wrong
-  // only near the seam. A warm start (the previous H) is kept as it is.
+  // same hierarchy's own solver (~0.5x the cost of a CG iteration per cycle). Slinky's
+  // step-17 ring (a short new cut segment on a closed cylinder) takes 14 iterations from
+  // x = 0 and 6 chain cycles + 7 iterations from there; the chain's solution is wrong only
+  // near the seam. A warm start (the previous H) is kept as it is.
   if (relative > fresh_start_residual) {
     kernels::TexelTile open = pinned;  // the seam texels keep their current values as data
     for (int t = 0; t < n; ++t)

@@ -367,8 +367,9 @@ SurfacePoint closest_surface_point(const Mesh& mesh, const double p[3]) {
                                                  (hi[2] - lo[2]) * (hi[2] - lo[2]));
 
   // Sampled distance per element, with its best sample and a lower bound of its true
-  // distance: the sampled distance less half the diameter, or the distance to the box of
-  // its samples less its bulge beyond its corners' box, whichever is larger.
+  // distance, the largest of: the sampled distance less half the diameter; the distance to
+  // the box of its samples less its bulge beyond its corners' box; the distance to its
+  // corner facets less the bulge (and a quad8's twist).
   const auto samples = sample_points(mesh.type);
   std::vector<kernels::ShapeValues> shapes(samples.size());
   for (size_t s = 0; s < samples.size(); ++s) kernels::evaluate_shape(mesh.type, samples[s][0], samples[s][1], shapes[s]);
@@ -558,8 +559,8 @@ SurfacePoint SurfacePointSearch::search(const int* elements, int count, const do
   double best = candidates.front().distance;
   // Everything the full search could still refine after the first, in its order.
   std::vector<int> rest;
-  // (The box distance is at most the seeded distance, so a box too far for both terms of
-  // lower_bound needs no seed.)
+  // (The box distance is at most the seeded distance, so a box too far for the first two
+  // terms of lower_bound is skipped without a seed.)
   for (int k = 0; k < count; ++k)
     if (k != first && !(lower[k] - std::min(margins_[elements[k]], bulges_[elements[k]]) > best + tie_tolerance))
       seed(k), rest.push_back(k);
