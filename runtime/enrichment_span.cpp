@@ -7,6 +7,8 @@
 #include <string>
 #include <utility>
 
+#include "dgtex/kernels/forall.h"
+
 namespace dgtex {
 namespace {
 
@@ -72,8 +74,28 @@ std::vector<std::vector<int>> independent_enriched_nodes(const std::vector<std::
   std::vector<double> column;
   // Per (function, element) moments, for nodes that only one function enriches: there the
   // Gram-Schmidt residual of H against 1 is H minus its mean, whose norm is sqrt(m2) of the
-  // pooled moments, so each tile is read once instead of once per incident node.
+  // pooled moments, so each tile is read once instead of once per incident node. Computed
+  // up front, one tile per work item (chad: 4 tiles of 65k texels, 1.9 ms a step on one
+  // thread); each tile is summed in texel order, so the result does not depend on threads.
   std::map<std::pair<int, int>, TexelMoments> moments;
+  {
+    std::vector<std::pair<int, int>> needed;
+    std::vector<const kernels::TexelTile*> needed_tiles;
+    for (const auto& [a, list] : by_node) {
+      if (list.size() != 1 || a < 0 || a >= static_cast<int>(node_elements.size())) continue;
+      for (int e : node_elements[a]) {
+        const kernels::TexelTile* tile = texture_of(functions[list[0]], e);
+        if (tile && moments.emplace(std::make_pair(list[0], e), TexelMoments{}).second) {
+          needed.emplace_back(list[0], e);
+          needed_tiles.push_back(tile);
+        }
+      }
+    }
+    std::vector<TexelMoments> computed(needed.size());
+    kernels::forall(static_cast<std::int64_t>(needed.size()),
+                    [&](std::int64_t k) { computed[k] = active_moments(*needed_tiles[k]); });
+    for (std::size_t k = 0; k < needed.size(); ++k) moments[needed[k]] = computed[k];
+  }
   std::vector<const TexelMoments*> parts;
   std::map<std::pair<std::vector<int>, std::vector<int>>, std::vector<char>> memo;  // (support, functions) -> kept
   for (const auto& [a, list] : by_node) {
@@ -85,9 +107,7 @@ std::vector<std::vector<int>> independent_enriched_nodes(const std::vector<std::
           throw std::invalid_argument("enrichment function " + std::to_string(list[0]) + ": element " +
                                       std::to_string(e) + " is incident to enriched node " + std::to_string(a) +
                                       " but has no texture");
-        auto it = moments.find({list[0], e});
-        if (it == moments.end()) it = moments.emplace(std::make_pair(list[0], e), active_moments(*tile)).first;
-        parts.push_back(&it->second);
+        parts.push_back(&moments.at({list[0], e}));
       }
       const TexelMoments all = pool(parts);
       if (all.count == 0) continue;

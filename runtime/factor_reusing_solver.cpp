@@ -22,12 +22,6 @@ constexpr std::int64_t parallel_vector_length = 1 << 15;
 kernels::Execution vector_execution(std::size_t n) {
   return static_cast<std::int64_t>(n) >= parallel_vector_length ? kernels::Execution::parallel : kernels::Execution::serial;
 }
-// Block products over fewer 3x3 blocks than this run serially for the same reason (a cut
-// single element has ~64 blocks: each product is ~1 us, and PCG calls it every iteration).
-constexpr std::int64_t parallel_block_count = 4096;
-kernels::Execution block_execution(const BlockAssembly& pattern) {
-  return pattern.num_blocks() >= parallel_block_count ? kernels::Execution::parallel : kernels::Execution::serial;
-}
 }  // namespace
 
 std::vector<char> element_local_blocks(const std::vector<double>& mass) {
@@ -175,7 +169,7 @@ void FactorReusingSolver::multiply_mass(const std::vector<double>& x, std::vecto
         }
         for (int i = 0; i < 3; ++i) y[3 * r + i] = sum[i];
       },
-      block_execution(pattern_));
+      block_product_execution(pattern_));
 }
 
 void FactorReusingSolver::multiply(const ScaledBlockSum& A, const std::vector<double>& x, std::vector<double>& y) const {
@@ -201,7 +195,7 @@ void FactorReusingSolver::multiply(const ScaledBlockSum& A, const std::vector<do
     }
     for (int i = 0; i < 3; ++i) y[3 * r + i] = free_[3 * r + i] ? ms * m_sum[i] + ks * k_sum[i] : 0.0;
   };
-  kernels::forall(pattern_.num_nodes(), row, block_execution(pattern_));
+  kernels::forall(pattern_.num_nodes(), row, block_product_execution(pattern_));
 }
 
 int FactorReusingSolver::pcg(const ScaledBlockSum& A, const std::vector<double>& b, std::vector<double>& x,

@@ -1011,7 +1011,7 @@ void block_multiply(const BlockAssembly& pattern, const double* blocks, const do
       for (int i = 0; i < 3; ++i) sum[i] += b[i * 3] * xv[0] + b[i * 3 + 1] * xv[1] + b[i * 3 + 2] * xv[2];
     }
     for (int i = 0; i < 3; ++i) y[3 * r + i] = sum[i];
-  });
+  }, block_product_execution(pattern));
 }
 
 void block_multiply_pair(const BlockAssembly& pattern, const double* blocks, const double* x1, const double* x2,
@@ -1030,7 +1030,7 @@ void block_multiply_pair(const BlockAssembly& pattern, const double* blocks, con
       }
     }
     for (int i = 0; i < 3; ++i) y1[3 * r + i] = sum1[i], y2[3 * r + i] = sum2[i];
-  });
+  }, block_product_execution(pattern));
 }
 
 }  // namespace dgtex

@@ -4,6 +4,7 @@
 #include <cstddef>
 #include <vector>
 
+#include "dgtex/kernels/cut_rasterization.h"
 #include "dgtex/kernels/texel_grid.h"
 #include "dgtex/mesh.h"
 #include "dgtex/mesh_texel_laplace.h"

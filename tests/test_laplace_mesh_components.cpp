@@ -1,0 +1,127 @@
+// The component search of solve_mesh_texel_laplace (mesh_texel_laplace.cpp): free texels
+// walled off from everything else form their own components. At T = 128 over two tiles, a
+// walled box with no data gets 0, a box touching one data value gets exactly that value
+// (neither is solved), and the rest (+1 and -1 data in the two tiles) is the one solved
+// component; the answer is bitwise the same for 1, 2 and 4 threads, with the multigrid and
+// with CHOLMOD, and the two solvers agree on the solved component.
+#include <gtest/gtest.h>
+
+#include <omp.h>
+
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+#include "dgtex/kernels/texel_grid.h"
+#include "dgtex/mesh_generators.h"
+#include "dgtex/mesh_texel_laplace.h"
+#include "dgtex/topology.h"
+#include "region_test_support.h"
+
+using namespace dgtex;
+
+namespace {
+
+constexpr int T = 128;
+
+struct Box {
+  int x0, x1, y0, y1;  // texels [x0, x1] x [y0, y1]
+  bool contains(int i, int j) const { return i >= x0 && i <= x1 && j >= y0 && j <= y1; }
+};
+constexpr Box empty_box{10, 30, 20, 50};       // tile 0
+constexpr Box constant_box{40, 100, 25, 100};  // tile 1
+constexpr double constant_value = 0.75;
+
+// Walls all around the box (texel flags hold the walls on their east and north sides).
+void wall_in(kernels::TexelTile& tile, const Box& b) {
+  for (int j = b.y0; j <= b.y1; ++j) {
+    tile.flags[j * T + b.x0 - 1] |= kernels::wall_east;
+    tile.flags[j * T + b.x1] |= kernels::wall_east;
+  }
+  for (int i = b.x0; i <= b.x1; ++i) {
+    tile.flags[(b.y0 - 1) * T + i] |= kernels::wall_north;
+    tile.flags[b.y1 * T + i] |= kernels::wall_north;
+  }
+}
+
+std::vector<RegionTile> boxed_region(const Mesh& mesh) {
+  std::vector<RegionTile> region = testing_support::make_test_region(mesh, {0, 1}, T);
+  wall_in(region[0].tile, empty_box);
+  wall_in(region[1].tile, constant_box);
+  const int k = 40 * T + 50;  // one data texel inside the constant box
+  region[1].tile.flags[k] |= kernels::dirichlet;
+  region[1].tile.values[k] = constant_value;
+  return region;
+}
+
+struct Solved {
+  std::vector<RegionTile> region;
+  MeshLaplaceStats stats;
+};
+
+Solved solve(LaplaceSolver solver, int threads) {
+  const Mesh mesh = make_rectangle(2, 1, 2, 1, ElementType::quad8);
+  const ElementAdjacency adjacency(mesh, build_topology(mesh));
+  Solved out{boxed_region(mesh), {}};
+  const int saved = omp_get_max_threads();
+  omp_set_num_threads(threads);
+  LaplaceMultigridOptions options;
+  options.tolerance = 1e-12;
+  out.stats = solve_mesh_texel_laplace(out.region, mesh.type, adjacency, MeshEdgeWalls(T), solver, options);
+  omp_set_num_threads(saved);
+  return out;
+}
+
+void expect_boxes_settled_without_a_solve(const Solved& s) {
+  EXPECT_EQ(s.stats.solved_components, 1);
+  EXPECT_EQ(s.stats.constant_components, 1);
+  // Every texel of the region is free except the +-1 runs (6 each) and the box's data texel.
+  const int boxed = (empty_box.x1 - empty_box.x0 + 1) * (empty_box.y1 - empty_box.y0 + 1) +
+                    (constant_box.x1 - constant_box.x0 + 1) * (constant_box.y1 - constant_box.y0 + 1) - 1;
+  EXPECT_EQ(s.stats.unknowns, 2 * T * T - 2 * 6 - 1 - boxed);
+  for (int j = 0; j < T; ++j)
+    for (int i = 0; i < T; ++i) {
+      if (empty_box.contains(i, j)) {
+        EXPECT_EQ(s.region[0].tile.values[j * T + i], 0.0) << i << ", " << j;
+      }
+      if (constant_box.contains(i, j)) {
+        EXPECT_EQ(s.region[1].tile.values[j * T + i], constant_value) << i << ", " << j;
+      }
+    }
+}
+
+void expect_bitwise_equal(const Solved& a, const Solved& b) {
+  EXPECT_EQ(a.stats.unknowns, b.stats.unknowns);
+  EXPECT_EQ(a.stats.solved_components, b.stats.solved_components);
+  EXPECT_EQ(a.stats.constant_components, b.stats.constant_components);
+  std::size_t differ = 0;
+  for (std::size_t l = 0; l < a.region.size(); ++l)
+    for (std::size_t k = 0; k < a.region[l].tile.values.size(); ++k)
+      differ += a.region[l].tile.values[k] != b.region[l].tile.values[k];
+  EXPECT_EQ(differ, 0u);
+}
+
+}  // namespace
+
+TEST(LaplaceMeshComponents, BoxesAcrossRowBandsAreSettledAlikeForAnyThreadCount) {
+  for (LaplaceSolver solver : {LaplaceSolver::multigrid, LaplaceSolver::cholmod}) {
+    SCOPED_TRACE(solver == LaplaceSolver::multigrid ? "multigrid" : "cholmod");
+    const Solved one = solve(solver, 1);
+    expect_boxes_settled_without_a_solve(one);
+    EXPECT_EQ(one.stats.multigrid, solver == LaplaceSolver::multigrid);
+    expect_bitwise_equal(one, solve(solver, 2));
+    expect_bitwise_equal(one, solve(solver, 4));
+  }
+}
+
+TEST(LaplaceMeshComponents, TheSolvedComponentMatchesAcrossSolvers) {
+  const Solved multigrid = solve(LaplaceSolver::multigrid, 2), direct = solve(LaplaceSolver::cholmod, 2);
+  double worst = 0, spread = 0;
+  for (std::size_t l = 0; l < direct.region.size(); ++l)
+    for (std::size_t k = 0; k < direct.region[l].tile.values.size(); ++k) {
+      worst = std::max(worst, std::abs(direct.region[l].tile.values[k] - multigrid.region[l].tile.values[k]));
+      spread = std::max(spread, std::abs(direct.region[l].tile.values[k] - 0.5));
+    }
+  EXPECT_LT(worst, 1e-8);
+  EXPECT_GT(spread, 0.4);  // not the warm start: the comparison is not vacuous
+}
