@@ -110,7 +110,7 @@ double SceneBenchResult::steps_per_second() const {
 double SceneBenchResult::peak_step_ms() const { return series_max(times.step); }
 
 SceneBenchResult run_scene_benchmark(const Scene& scene, const std::string& name, int steps,
-                                     const std::function<void(int, int)>& progress) {
+                                     const std::function<void(int, int)>& progress, const SceneRunOptions& options) {
   if (!scene.analysis.is_dynamic())
     throw std::invalid_argument("scene '" + scene.source_name +
                                 "' is a static analysis; the scene benchmark steps \"analysis\": {\"type\": \"dynamic\", ...}");
@@ -121,10 +121,11 @@ SceneBenchResult run_scene_benchmark(const Scene& scene, const std::string& name
   result.name = name;
   result.path = scene.source_name;
   result.threads = omp_get_max_threads();
+  result.overlap_cut_updates = options.overlap_cut_updates;
 
   const Clock::time_point setup_start = Clock::now();
   const double setup_cpu_start = process_cpu_ms();
-  SceneRun run(scene);
+  SceneRun run(scene, options);
   const double setup_ms = ms_since(setup_start), setup_cpu_ms = process_cpu_ms() - setup_cpu_start;
   // The time-0 enrichment update belongs to the first step (see the header).
   const double initial_enrichment_ms = stage_total(run.timings(), "enrichment");

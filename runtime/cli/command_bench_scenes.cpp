@@ -90,6 +90,7 @@ nlohmann::json scene_json(const SceneBenchResult& r) {
                       {"path", r.path},
                       {"steps", r.steps},
                       {"threads", r.threads},
+                      {"overlap_cut_updates", r.overlap_cut_updates},
                       {"steps_per_second", r.steps_per_second()},
                       {"steps_per_second_at_peak", r.peak_step_ms() > 0 ? 1e3 / r.peak_step_ms() : 0.0},
                       {"peak_step_ms", r.peak_step_ms()},
@@ -196,7 +197,7 @@ int bench_scenes_command(int argc, char** argv) {
   std::vector<std::string> scenes = bench_scene_names();
   std::string scene_dir = "examples/scenes", json_path, markdown_path;
   int steps = 30, threads = 0;
-  bool quiet = false;
+  bool quiet = false, inline_cut_updates = false;
   app.add_option("--scenes", scenes,
                  "scenes to run: names in --scene-dir (chad, spiral1, spiral6, accordion, slinky, fracture, "
                  "cylinder_buckling) or paths to .json files")
@@ -209,6 +210,9 @@ int bench_scenes_command(int argc, char** argv) {
   app.add_option("--threads", threads, "OpenMP threads (default: all cores)")->check(CLI::Range(1, 1024));
   app.add_option("--json", json_path, "write the results as JSON (rewritten after every scene)");
   app.add_option("--markdown", markdown_path, "write the Markdown tables to FILE too");
+  app.add_flag("--inline-cut-updates", inline_cut_updates,
+               "update the cuts at the start of each step instead of beside the previous step's projection and "
+               "shell step (SceneRunOptions::overlap_cut_updates)");
   app.add_flag("--quiet", quiet, "no progress on stderr");
   try {
     app.parse(argc, argv);
@@ -232,6 +236,7 @@ int bench_scenes_command(int argc, char** argv) {
   std::vector<SceneBenchResult> results;
   nlohmann::json all = {{"steps", steps},
                         {"threads", omp_get_max_threads()},
+                        {"overlap_cut_updates", !inline_cut_updates},
                         {"omp_wait_policy", std::getenv("OMP_WAIT_POLICY") ? std::getenv("OMP_WAIT_POLICY") : "default"},
                         {"targets", {{"steps_per_second", kTargetStepsPerSecond}, {"stage_ratio", kTargetStageRatio}}},
                         {"scenes", nlohmann::json::array()}};
@@ -241,10 +246,15 @@ int bench_scenes_command(int argc, char** argv) {
       const Scene scene = load_scene(entry.path);
       if (!quiet) std::fprintf(stderr, "bench scenes: %s (%s) ...%s", entry.name.c_str(), entry.path.c_str(), tty ? "" : "\n");
       double elapsed_ms = 0;
-      SceneBenchResult r = run_scene_benchmark(scene, entry.name, steps, [&](int step, int total) {
-        if (quiet || !tty) return;
-        std::fprintf(stderr, "\rbench scenes: %s step %d/%d   ", entry.name.c_str(), step, total);
-      });
+      SceneRunOptions run_options;
+      run_options.overlap_cut_updates = !inline_cut_updates;
+      SceneBenchResult r = run_scene_benchmark(
+          scene, entry.name, steps,
+          [&](int step, int total) {
+            if (quiet || !tty) return;
+            std::fprintf(stderr, "\rbench scenes: %s step %d/%d   ", entry.name.c_str(), step, total);
+          },
+          run_options);
       for (double ms : r.times.step) elapsed_ms += ms;
       if (!quiet)
         std::fprintf(stderr, "%sbench scenes: %s: %d steps, %.1f steps/s, peak step %.1f ms, %.1f s\n", tty ? "\r" : "",
@@ -270,8 +280,9 @@ int bench_scenes_command(int argc, char** argv) {
     }
   }
   const std::string tables = markdown_tables(results);
-  std::printf("dgtex bench scenes: %d OpenMP threads, %d steps per scene (ms per step; ratio = Table 5.1 / ours)\n\n%s",
-              omp_get_max_threads(), steps, tables.c_str());
+  std::printf("dgtex bench scenes: %d OpenMP threads, %d steps per scene, cut updates %s (ms per step; ratio = "
+              "Table 5.1 / ours)\n\n%s",
+              omp_get_max_threads(), steps, inline_cut_updates ? "inline" : "overlapped", tables.c_str());
   try {
     if (!markdown_path.empty()) write_text(markdown_path, tables, "--markdown");
   } catch (const std::exception& e) {

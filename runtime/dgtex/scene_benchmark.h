@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "dgtex/scene.h"
+#include "dgtex/scene_run.h"
 
 namespace dgtex {
 
@@ -56,6 +57,7 @@ struct SceneBenchResult {
   std::string name;      // bench name (file stem)
   std::string path;      // scene file
   int threads = 1;       // OpenMP threads it ran with
+  bool overlap_cut_updates = true;  // SceneRunOptions it ran with (dgtex/scene_run.h)
   int steps = 0;         // steps taken
   double setup_ms = 0;   // building mesh, model and simulation, without the time-0 enrichment
   SceneStepTimes times;  // per step (step 1 includes the time-0 enrichment update)
@@ -76,7 +78,9 @@ double series_median(std::vector<double> v);
 // after every step. Throws std::invalid_argument for a static scene or steps < 0, and
 // what SceneRun throws (SceneError, MeshError, ModelError) for a scene that does not build;
 // ModelError when the solution stops being finite (naming the step).
+// `options`: how SceneRun orders each step (overlapped cut updates by default).
 SceneBenchResult run_scene_benchmark(const Scene& scene, const std::string& name, int steps,
-                                     const std::function<void(int step, int steps)>& progress = {});
+                                     const std::function<void(int step, int steps)>& progress = {},
+                                     const SceneRunOptions& options = {});
 
 }  // namespace dgtex

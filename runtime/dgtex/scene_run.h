@@ -9,9 +9,24 @@
 // projected onto it (dgtex/basis_projection.h), then the shell steps. Stages timed per
 // step: "enrichment" (cut update and Laplace solves), "projection" (only steps where the
 // basis changed), "assembly" and "solve" (dgtex/shell_simulation.h).
+//
+// Overlapped cut updates (SceneRunOptions::overlap_cut_updates, the default): the cuts
+// follow their schedule, not the shell, so the next step's cut update can run while this
+// step projects and steps the shell. It runs on a thread of its own with serial kernels,
+// beside this step's OpenMP work, and step() returns once both are done. Why: much of a
+// cut scene's step runs on one thread (the multigrid's small levels, the texel Laplace's
+// set-up, the model rebuild), so the other core was idle (chad, 30 steps on 2 cores:
+// 27-29 -> 33-36 steps/s; README, session 13). Only where the calling thread has more than
+// one OpenMP thread, from the second step on, while another step of the scene
+// (analysis.steps) follows, and where a thread can be started (else the plain order). The
+// results are bitwise those of the plain order (every kernel's result is independent of
+// the thread count). Stage times then overlap: "enrichment" is the update's own wall time,
+// counted in the step that uses it, and the other stages include the slowdown of sharing
+// the cores.
 // Not thread-safe; each call uses all OpenMP threads itself.
 // SceneRun owns the mesh, topology, model, cut manager and simulation; it keeps a reference
 // to the Scene (which must outlive it). Units: those of the scene (SI: m, kg, s, N).
+#include <future>
 #include <memory>
 #include <vector>
 
@@ -26,12 +41,16 @@
 
 namespace dgtex {
 
+struct SceneRunOptions {
+  bool overlap_cut_updates = true;  // the next step's cut update beside this step (above)
+};
+
 class SceneRun {
  public:
   // Builds everything and brings the cuts to time 0; `scene` must outlive the run.
   // Throws MeshError / SceneError (bad mesh or scene), std::invalid_argument (a cut the
   // mesh cannot take, naming cuts[i]), ModelError (statically unconstrained model).
-  explicit SceneRun(const Scene& scene);
+  explicit SceneRun(const Scene& scene, SceneRunOptions options = {});
   ~SceneRun();
 
   // Static analysis: solve K u = f with the cuts present at time 0.
@@ -42,7 +61,9 @@ class SceneRun {
   const Mesh& mesh() const { return mesh_; }
   const ShellModel& model() const { return *model_; }
   const ShellSimulation& simulation() const { return *simulation_; }
-  const CutManager* cuts() const { return cuts_.get(); }  // null without cuts
+  // Null without cuts. With overlapped cut updates it may already be at the next step's
+  // end time (not after the scene's last step).
+  const CutManager* cuts() const { return cuts_.get(); }
   double time() const { return time_; }
   int steps_taken() const { return steps_; }
   int basis_changes() const { return basis_changes_; }
@@ -55,7 +76,19 @@ class SceneRun {
   const std::vector<double>& displacement() const { return simulation_->displacement(); }
 
  private:
-  void change_basis();
+  // The result of one cut update.
+  struct CutUpdate {
+    bool changed = false;
+    double ms = 0;  // its wall time
+  };
+  // The cut manager at `time`: the overlapped update started by the previous step, or now.
+  bool bring_cuts_to(double time);
+  // Starts the update to `time` beside the caller, where options_ and the scene allow.
+  void start_next_cut_update(double time);
+  // Waits for an update in flight and forgets it (the next step updates afresh).
+  void discard_next_cut_update() noexcept;
+  // The model takes the given functions and cut mesh-edge texels; the state is projected.
+  void change_basis(std::vector<EnrichmentFunction> functions, int edge_resolution, std::vector<char> edge_flags);
   // The cuts' current functions followed by the creases' (fixed) ones.
   std::vector<EnrichmentFunction> enrichment_functions() const;
 
@@ -71,6 +104,11 @@ class SceneRun {
   double time_ = 0;
   int steps_ = 0;
   int basis_changes_ = 0;
+  SceneRunOptions options_;
+  // The next step's cut update while it runs beside a step (after cuts_: it refers to it,
+  // so it is destroyed, i.e. waited for, first).
+  std::future<CutUpdate> next_cut_update_;
+  double next_cut_update_time_ = 0;
 };
 
 }  // namespace dgtex
