@@ -135,8 +135,9 @@ TEST(BenchScenes, TimingDoesNotChangeTheSimulationAndStagesFitInTheStep) {
 }
 
 TEST(BenchScenes, OverlappedCutUpdatesGiveTheSameStateAndRunBesideTheStepBefore) {
-  // The default: each step's cut update runs beside the step before (dgtex/scene_run.h),
-  // so it is counted in the step that uses it but fits in the wall time of the one before.
+  // The default (dgtex/scene_run.h): steps 1 and 2 update their cuts themselves (nothing
+  // runs beside the first step); from step 3 on, a step's update ran beside the step
+  // before, so it is counted in the step that uses it and fits in the one before.
   const Scene scene = load_scene(kScenes + "/spiral1.json");
   const SceneBenchResult r = run_scene_benchmark(scene, "spiral1", 4);
   SceneRunOptions inline_updates;
@@ -149,9 +150,12 @@ TEST(BenchScenes, OverlappedCutUpdatesGiveTheSameStateAndRunBesideTheStepBefore)
   const SceneStepTimes& t = r.times;
   ASSERT_EQ(t.step.size(), 4u);
   for (std::size_t s = 0; s < 4; ++s) {
-    EXPECT_LE(t.projection[s] + t.assembly[s] + t.solve[s], t.step[s] + 1e-6) << "step " << s + 1;
+    const double own = t.projection[s] + t.assembly[s] + t.solve[s];
     EXPECT_GT(t.enrichment[s], 0) << "step " << s + 1;
-    if (s > 0 && omp_get_max_threads() > 1) {
+    if (s < 2 || omp_get_max_threads() < 2) {
+      EXPECT_LE(t.enrichment[s] + own, t.step[s] + 1e-6) << "step " << s + 1;
+    } else {
+      EXPECT_LE(own, t.step[s] + 1e-6) << "step " << s + 1;
       EXPECT_LE(t.enrichment[s], t.step[s - 1] + 1e-6) << "step " << s + 1;
     }
   }
