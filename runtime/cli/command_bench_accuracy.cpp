@@ -21,20 +21,6 @@
 namespace dgtex::cli {
 namespace {
 
-// A gnuplot double-quoted string (newlines become line breaks there).
-std::string gnuplot_quoted(const std::string& text) {
-  std::string out = "\"";
-  for (char c : text) {
-    if (c == '\n') {
-      out += "\\n";
-      continue;
-    }
-    if (c == '"' || c == '\\') out += '\\';
-    out += c;
-  }
-  return out + "\"";
-}
-
 // Error against time per series; reference points (error 0) become dashed vertical lines.
 bool write_chart(const std::string& path, const AccuracyChart& chart, const std::string& machine,
                  const std::string& command) {

@@ -18,6 +18,7 @@
 
 #include "commands.h"
 #include "gnuplot_chart.h"
+#include "dgtex/accuracy_benchmark.h"
 #include "dgtex/mesh_error.h"
 #include "dgtex/model_error.h"
 #include "dgtex/scaling_benchmark.h"
@@ -92,8 +93,9 @@ std::string markdown_tables(const std::vector<int>& threads, const std::vector<K
 
 // Left: speed-up over the first thread count per family (and the ideal); right: scenes
 // per second, solo against batch.
+// Speed-up per family and batch throughput; `about` (machine, command) heads the chart.
 bool write_chart(const std::string& path, const std::vector<KernelScaling>& kernels,
-                 const std::vector<BatchThroughput>& batches) {
+                 const std::vector<BatchThroughput>& batches, const std::string& about) {
   std::ostringstream data;
   for (const KernelScaling& k : kernels) {
     data << "# " << k.family << "\n";
@@ -108,7 +110,7 @@ bool write_chart(const std::string& path, const std::vector<KernelScaling>& kern
   return draw_gnuplot_chart(path, two ? 1200 : 700, 500, data.str(), [&](const std::string& file) {
     std::ostringstream s;
     s << "set termoption noenhanced\n";  // names with underscores stay as they are
-    if (two) s << "set multiplot layout 1,2\n";
+    s << "set multiplot layout 1," << (two ? 2 : 1) << " title " << gnuplot_quoted(about) << " font ',10'\n";
     if (!kernels.empty()) {
       int max_threads = 1;
       for (const KernelScaling& k : kernels) max_threads = std::max(max_threads, k.threads.back());
@@ -132,7 +134,7 @@ bool write_chart(const std::string& path, const std::vector<KernelScaling>& kern
         << " threads each', '' index " << kernels.size() << " using 3 title 'batch, " << batches.front().runs
         << " at once, 1 thread each'\n";
     }
-    if (two) s << "unset multiplot\n";
+    s << "unset multiplot\n";
     return s.str();
   });
 }
@@ -191,6 +193,11 @@ int bench_scaling_command(int argc, char** argv) {
       return 2;
     }
   const std::set<std::string> chosen(families.begin(), families.end());
+  // The chart's heading: the machine (before any run changes the thread count) and command.
+  std::string command = "dgtex bench";
+  for (int k = 0; k < argc; ++k) command += std::string(" ") + argv[k];
+  const std::string about = describe_machine() + ", OMP_WAIT_POLICY=" +
+                            (std::getenv("OMP_WAIT_POLICY") ? std::getenv("OMP_WAIT_POLICY") : "default") + "\n" + command;
   if (batch_scenes.empty()) batch_scenes = {cut_scene_path, scene_path};
   const int max_threads = *std::max_element(threads.begin(), threads.end());
   if (batch_runs == 0) batch_runs = max_threads;
@@ -285,7 +292,7 @@ int bench_scaling_command(int argc, char** argv) {
     std::fprintf(stderr, "dgtex bench scaling: %s\n", e.what());
     return 1;
   }
-  if (!chart_path.empty() && !write_chart(chart_path, kernels, batches)) {
+  if (!chart_path.empty() && !write_chart(chart_path, kernels, batches, about)) {
     std::fprintf(stderr, "dgtex bench scaling: gnuplot failed to write '%s' (is gnuplot installed?)\n", chart_path.c_str());
     return 1;
   }

@@ -23,4 +23,17 @@ bool draw_gnuplot_chart(const std::string& path, int width, int height, const st
   return ok;
 }
 
+std::string gnuplot_quoted(const std::string& text) {
+  std::string out = "\"";
+  for (char c : text) {
+    if (c == '\n') {
+      out += "\\n";
+      continue;
+    }
+    if (c == '"' || c == '\\') out += '\\';
+    out += c;
+  }
+  return out + "\"";
+}
+
 }  // namespace dgtex::cli

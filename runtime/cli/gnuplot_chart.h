@@ -12,4 +12,7 @@ namespace dgtex::cli {
 bool draw_gnuplot_chart(const std::string& path, int width, int height, const std::string& data,
                         const std::function<std::string(const std::string& data_file)>& commands);
 
+// A gnuplot double-quoted string (newlines become line breaks there).
+std::string gnuplot_quoted(const std::string& text);
+
 }  // namespace dgtex::cli
