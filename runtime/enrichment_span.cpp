@@ -79,22 +79,18 @@ std::vector<std::vector<int>> independent_enriched_nodes(const std::vector<std::
   // thread); each tile is summed in texel order, so the result does not depend on threads.
   std::map<std::pair<int, int>, TexelMoments> moments;
   {
-    std::vector<std::pair<int, int>> needed;
-    std::vector<const kernels::TexelTile*> needed_tiles;
+    std::vector<std::pair<const kernels::TexelTile*, TexelMoments*>> work;  // map nodes stay put
     for (const auto& [a, list] : by_node) {
       if (list.size() != 1 || a < 0 || a >= static_cast<int>(node_elements.size())) continue;
       for (int e : node_elements[a]) {
         const kernels::TexelTile* tile = texture_of(functions[list[0]], e);
-        if (tile && moments.emplace(std::make_pair(list[0], e), TexelMoments{}).second) {
-          needed.emplace_back(list[0], e);
-          needed_tiles.push_back(tile);
-        }
+        if (!tile) continue;  // reported below
+        const auto [it, fresh] = moments.emplace(std::make_pair(list[0], e), TexelMoments{});
+        if (fresh) work.emplace_back(tile, &it->second);
       }
     }
-    std::vector<TexelMoments> computed(needed.size());
-    kernels::forall(static_cast<std::int64_t>(needed.size()),
-                    [&](std::int64_t k) { computed[k] = active_moments(*needed_tiles[k]); });
-    for (std::size_t k = 0; k < needed.size(); ++k) moments[needed[k]] = computed[k];
+    kernels::forall(static_cast<std::int64_t>(work.size()),
+                    [&](std::int64_t k) { *work[k].second = active_moments(*work[k].first); });
   }
   std::vector<const TexelMoments*> parts;
   std::map<std::pair<std::vector<int>, std::vector<int>>, std::vector<char>> memo;  // (support, functions) -> kept
