@@ -249,23 +249,51 @@ struct PointRows {
     for (int r = 0; r < 3; ++r) beta[r] = bend[r][0] * rho[0] + bend[r][1] * rho[1] + bend[r][2] * rho[2];
   }
 
-  // The six scaled, rotated rows of one function (3 columns each) at column `col` of the
-  // rows row[0..5]: L^T [Bm sqrt(w D_m); Bb sqrt(w D_b)] as scaled_strain_rows.
-  void write(const double dN[2], const double d2N[3], double* const row[6], int col) const {
+  // A function's scaled rows as frame coefficients: membrane row 0 = m[0] e1 + m[1] e2,
+  // row 1 = m[2] e2, row 2 = m[3] e1 + m[4] e2; bending row r = b[r] t0.
+  void coefficients(const double dN[2], const double d2N[3], double m[5], double b[3]) const {
     double g[2], beta[3];
     strains(dN, d2N, g, beta);
     const double u0 = sm * g[0], u1 = sm * g[1];
-    const double m0a = u0, m0b = nu * u1, m1 = k1 * u1, m2a = k2 * u1, m2b = k2 * u0;
-    const double b0 = sb * (beta[0] + nu * beta[1]), b1 = sb * k1 * beta[1], b2 = sb * k2 * beta[2];
+    m[0] = u0, m[1] = nu * u1, m[2] = k1 * u1, m[3] = k2 * u1, m[4] = k2 * u0;
+    b[0] = sb * (beta[0] + nu * beta[1]), b[1] = sb * k1 * beta[1], b[2] = sb * k2 * beta[2];
+  }
+
+  // The six scaled, rotated rows of one function (3 columns each) at column `col` of the
+  // rows row[0..5]: L^T [Bm sqrt(w D_m); Bb sqrt(w D_b)] as scaled_strain_rows.
+  void write(const double dN[2], const double d2N[3], double* const row[6], int col) const {
+    double m[5], b[3];
+    coefficients(dN, d2N, m, b);
     for (int k = 0; k < 3; ++k) {
-      row[0][col + k] = m0a * q[0][k] + m0b * q[1][k];
-      row[1][col + k] = m1 * q[1][k];
-      row[2][col + k] = m2a * q[0][k] + m2b * q[1][k];
-      row[3][col + k] = b0 * q[2][k];
-      row[4][col + k] = b1 * q[2][k];
-      row[5][col + k] = b2 * q[2][k];
+      row[0][col + k] = m[0] * q[0][k] + m[1] * q[1][k];
+      row[1][col + k] = m[2] * q[1][k];
+      row[2][col + k] = m[3] * q[0][k] + m[4] * q[1][k];
+      row[3][col + k] = b[0] * q[2][k];
+      row[4][col + k] = b[1] * q[2][k];
+      row[5][col + k] = b[2] * q[2][k];
     }
   }
+
+  // The same rows in a planar element's fixed frame (E1, E2, T; see PlanarFrame): the
+  // membrane rows have only E1, E2 components (2 columns per function, at 2 col of
+  // membrane[0..2]), the bending rows only a T component (1 column, at col of bending[0..2]).
+  // in_plane[f][a] = e_f . E_a, normal = t0 . T (+-1).
+  void write_planar(const double dN[2], const double d2N[3], const double in_plane[2][2], double normal,
+                    double* const membrane[3], double* const bending[3], int col) const {
+    double m[5], b[3];
+    coefficients(dN, d2N, m, b);
+    for (int a = 0; a < 2; ++a) {
+      membrane[0][2 * col + a] = m[0] * in_plane[0][a] + m[1] * in_plane[1][a];
+      membrane[1][2 * col + a] = m[2] * in_plane[1][a];
+      membrane[2][2 * col + a] = m[3] * in_plane[0][a] + m[4] * in_plane[1][a];
+    }
+    for (int r = 0; r < 3; ++r) bending[r][col] = b[r] * normal;
+  }
+};
+
+// A planar element's fixed frame (enriched_element_planar_frame): E1, E2, T.
+struct PlanarFrame {
+  double E[3][3];
 };
 
 // Points with the same varying textures (mask) and the same constant values: G = sum of
@@ -285,6 +313,10 @@ struct Group {
   int pending = 0;              // points stacked in rows, not yet in G
   bool written = false;         // G holds a first block
   std::vector<double> g, s;     // g: stride; s: the stacked points' scaled rest strains
+  // Planar elements (PlanarFrame): the membrane and bending sums, each from 3 rows a point
+  // (padded lengths >= 2 m and >= m), expanded into G after the last flush.
+  int membrane_stride = 0, bending_stride = 0;
+  double *Gm = nullptr, *Gb = nullptr, *membrane_rows = nullptr, *bending_rows = nullptr;
 
   bool matches(std::uint32_t mask, const double* values, int count) const {
     if (mask != varying) return false;
@@ -311,6 +343,14 @@ struct GroupStorage {
 // Adds the group's stacked points to G (and g), in point order.
 void flush(Group& group, bool want_forces) {
   if (group.pending == 0) return;
+  if (group.Gm) {  // planar: no forces (unrotated)
+    const int rows = 3 * group.pending;
+    accumulate_gram_upper(rows, group.membrane_stride, group.membrane_rows, group.Gm, !group.written);
+    accumulate_gram_upper(rows, group.bending_stride, group.bending_rows, group.Gb, !group.written);
+    group.written = true;
+    group.pending = 0;
+    return;
+  }
   const int rows = 6 * group.pending, S = group.stride;
   const double* A = group.rows;
   accumulate_gram_upper(rows, S, A, group.G, !group.written);
@@ -319,6 +359,52 @@ void flush(Group& group, bool want_forces) {
     for (int k = 0; k < rows; ++k) add_scaled(S, group.s[k], A + static_cast<std::size_t>(k) * S, group.g.data());
   group.pending = 0;
 }
+
+// Zeroes block rows a <= c (each w x w block whole) of an (w n) x (w n) row-major matrix:
+// the part the group maps write and the readers read (Kc persists between calls).
+void zero_upper_block_rows(double* K, int n, int w) {
+  const std::size_t N = static_cast<std::size_t>(w) * n;
+  for (std::size_t x = 0; x < N; ++x) std::fill(K + x * N + x / w * w, K + (x + 1) * N, 0.0);
+}
+
+// K += T^T G T for one group, w columns per function (3: x, y, z; planar 2: E1, E2, or 1: T):
+// element function i is reduced function red[i] times scale[i]. Element functions with
+// consecutive reduced functions form runs, so each K row takes contiguous stretches of a G
+// row. K: (w n) x (w n) row-major, block rows a <= c. Entries of G below the diagonal are
+// read only in the standard functions' columns (red < npe) and in diagonal w x w blocks:
+// those are mirrored first (G is the group's, scratch below the diagonal).
+struct GroupMap {
+  int n, npe, m;
+  const int* red;
+  const double* scale;
+  const std::vector<int>& run_start;
+  const std::vector<int>& run_of;
+
+  void add(double* G, std::size_t S, int w, double* K) const {
+    const std::size_t M = static_cast<std::size_t>(w) * m, standard_columns = static_cast<std::size_t>(w) * npe;
+    for (std::size_t x = 1; x < M; ++x) {
+      for (std::size_t y = 0; y < std::min(x, standard_columns); ++y) G[x * S + y] = G[y * S + x];
+      for (std::size_t y = std::max(x / w * w, standard_columns); y < x; ++y) G[x * S + y] = G[y * S + x];
+    }
+    const std::size_t N = static_cast<std::size_t>(w) * n;
+    double column_scale[3 * max_enriched_basis];
+    for (int j = 0; j < n; ++j)
+      for (int d = 0; d < w; ++d) column_scale[w * j + d] = scale[j];
+    for (int i = 0; i < n; ++i) {
+      if (scale[i] == 0) continue;
+      for (int c = 0; c < w; ++c) {
+        const double* Grow = G + (static_cast<std::size_t>(w) * red[i] + c) * S;
+        double* Krow = K + (static_cast<std::size_t>(w) * i + c) * N;
+        for (int run = run_of[i]; run + 1 < static_cast<int>(run_start.size()); ++run) {
+          const int j0 = std::max(run_start[run], i), j1 = run_start[run + 1];
+          const std::size_t J0 = static_cast<std::size_t>(w) * j0, J1 = static_cast<std::size_t>(w) * j1;
+          add_scaled_row(static_cast<int>(J1 - J0), scale[i], column_scale + J0,
+                         Grow + static_cast<std::size_t>(w) * red[j0], Krow + J0);
+        }
+      }
+    }
+  }
+};
 
 // F at one point from the whole basis (the rest tangents have no enriched share), the
 // textures sampled at the point: the arithmetic of enriched_element_deformation_gradients.
@@ -375,6 +461,9 @@ void chunk_stiffness(const EnrichedElementBatch& b, const EnrichedQuadrature& qu
   PointRows pr;
   double values[max_enrichments_per_element];
   TextureSample samples[max_enrichments_per_element];  // constructed once: it zero-fills
+  // Unrotated rows of a planar element take the split membrane / bending sums.
+  PlanarFrame frame;
+  const bool planar = !rotations && !current && enriched_element_planar_frame(b, e, &frame.E[0][0]);
   for (std::int64_t k = chunk.begin; k < chunk.end; ++k) {
     const std::int64_t q = chunk.point(k);
     const double* pt = quad.points + 3 * q;
@@ -401,15 +490,33 @@ void chunk_stiffness(const EnrichedElementBatch& b, const EnrichedQuadrature& qu
       for (int k = 0; k < L.count; ++k)
         if (mask >> k & 1u)
           for (int a = 0; a < npe; ++a) fresh.m += L.slot[k][a] >= 0;
-      const int S = (3 * fresh.m + gram_column_multiple - 1) / gram_column_multiple * gram_column_multiple;
+      const auto padded = [](int columns) {
+        return (columns + gram_column_multiple - 1) / gram_column_multiple * gram_column_multiple;
+      };
+      const int S = padded(3 * fresh.m);
       fresh.stride = S;
       if (storage.size() <= groups.size()) storage.emplace_back();
-      double* space = storage[groups.size()].take(static_cast<std::size_t>(S) * (S + group_block_rows));
-      fresh.G = space;
-      fresh.rows = space + static_cast<std::size_t>(S) * S;
+      GroupStorage& space = storage[groups.size()];
       // Padding columns of the stacked rows stay 0.
-      for (int k = 0; k < group_block_rows; ++k)
-        for (int i = 3 * fresh.m; i < S; ++i) fresh.rows[static_cast<std::size_t>(k) * S + i] = 0;
+      const auto zero_padding = [](double* rows, int count, int used, int stride) {
+        for (int k = 0; k < count; ++k)
+          for (int i = used; i < stride; ++i) rows[static_cast<std::size_t>(k) * stride + i] = 0;
+      };
+      if (planar) {
+        const std::size_t Sm = padded(2 * fresh.m), Sb = padded(fresh.m), block_rows = group_block_rows / 2;
+        fresh.membrane_stride = static_cast<int>(Sm), fresh.bending_stride = static_cast<int>(Sb);
+        fresh.G = space.take(static_cast<std::size_t>(S) * S + Sm * Sm + Sb * Sb + block_rows * (Sm + Sb));
+        fresh.Gm = fresh.G + static_cast<std::size_t>(S) * S;
+        fresh.Gb = fresh.Gm + Sm * Sm;
+        fresh.membrane_rows = fresh.Gb + Sb * Sb;
+        fresh.bending_rows = fresh.membrane_rows + block_rows * Sm;
+        zero_padding(fresh.membrane_rows, block_rows, 2 * fresh.m, fresh.membrane_stride);
+        zero_padding(fresh.bending_rows, block_rows, fresh.m, fresh.bending_stride);
+      } else {
+        fresh.G = space.take(static_cast<std::size_t>(S) * (S + group_block_rows));
+        fresh.rows = fresh.G + static_cast<std::size_t>(S) * S;
+        zero_padding(fresh.rows, group_block_rows, 3 * fresh.m, S);
+      }
       if (want_forces) fresh.g.assign(S, 0.0), fresh.s.assign(group_block_rows, 0.0);
       groups.push_back(std::move(fresh));
       g = static_cast<int>(groups.size()) - 1;
@@ -428,6 +535,30 @@ void chunk_stiffness(const EnrichedElementBatch& b, const EnrichedQuadrature& qu
       R = fused_rotation;
     }
     pr.set(rest, R, weight, dn, dm, nu);
+    if (planar) {
+      double in_plane[2][2];
+      for (int f = 0; f < 2; ++f)
+        for (int a = 0; a < 2; ++a) in_plane[f][a] = dot3(pr.e[f], frame.E[a]);
+      const double normal = dot3(pr.e[2], frame.E[2]);
+      const std::size_t Sm = group.membrane_stride, Sb = group.bending_stride;
+      double* mb = group.membrane_rows + 3 * group.pending * Sm;
+      double* bb = group.bending_rows + 3 * group.pending * Sb;
+      double* const membrane[3] = {mb, mb + Sm, mb + 2 * Sm};
+      double* const bending[3] = {bb, bb + Sb, bb + 2 * Sb};
+      for (int a = 0; a < npe; ++a) pr.write_planar(s.dN[a], s.d2N[a], in_plane, normal, membrane, bending, a);
+      int r = npe;
+      for (int k = 0; k < L.count; ++k) {
+        if (!(mask >> k & 1u)) continue;
+        for (int a = 0; a < npe; ++a) {
+          if (L.slot[k][a] < 0) continue;
+          double dN[2], d2N[3];
+          product_rule(samples[k], L.shift[k][a], s, a, dN, d2N);
+          pr.write_planar(dN, d2N, in_plane, normal, membrane, bending, r++);
+        }
+      }
+      if (++group.pending == group_block_points) flush(group, false);
+      continue;
+    }
     double* block = group.rows + static_cast<std::size_t>(6 * group.pending) * S;
     double* const row[6] = {block, block + S, block + 2 * S, block + 3 * S, block + 4 * S, block + 5 * S};
     for (int a = 0; a < npe; ++a) pr.write(s.dN[a], s.d2N[a], row, 3 * a);
@@ -467,20 +598,21 @@ void chunk_stiffness(const EnrichedElementBatch& b, const EnrichedQuadrature& qu
 
   // K += T^T G T per group: basis function i of the element is reduced function red[i]
   // times scale[i] (1, or H_k - H_k(xi^a) for a constant texture k: a multiple of N^a).
-  // Kc is row-major over the element's 3n DOFs (upper part, from each diagonal block's
-  // first column). Element functions with consecutive reduced functions form runs, so each
-  // K row takes contiguous stretches of a G row. Entries of G below the diagonal are read
-  // only in the standard functions' columns (red < npe) and in diagonal 3x3 blocks: those
-  // are mirrored first.
-  const std::size_t N3 = 3 * static_cast<std::size_t>(n);
-  // Only the upper block rows are written and read: zero those (Kc persists between calls).
-  Kc.resize(N3 * N3);
-  for (std::size_t x = 0; x < N3; ++x) std::fill(Kc.begin() + x * N3 + x / 3 * 3, Kc.begin() + (x + 1) * N3, 0.0);
-  fc.assign(want_forces ? N3 : 0, 0.0);
+  // Planar elements map their membrane sums (2 columns per function) and bending sums
+  // (1 column) alike into Kc = [Km (2n x 2n) | Kb (n x n)]; the others G (3 columns).
   int red[max_enriched_basis];
   double scale[max_enriched_basis];
-  std::vector<double> column_scale(N3);
   std::vector<int> run_start, run_of(n);  // runs: first element function; run of each function
+  const std::size_t N3 = 3 * static_cast<std::size_t>(n), n2 = static_cast<std::size_t>(n) * n;
+  if (planar) {
+    Kc.resize(5 * n2);
+    zero_upper_block_rows(Kc.data(), n, 2);
+    zero_upper_block_rows(Kc.data() + 4 * n2, n, 1);
+  } else {
+    Kc.resize(N3 * N3);
+    zero_upper_block_rows(Kc.data(), n, 3);
+  }
+  fc.assign(want_forces ? N3 : 0, 0.0);
   for (Group& group : groups) {
     for (int a = 0; a < npe; ++a) red[a] = a, scale[a] = 1;
     int r = npe;
@@ -495,36 +627,43 @@ void chunk_stiffness(const EnrichedElementBatch& b, const EnrichedQuadrature& qu
     for (int j = 0; j < n; ++j) {
       if (j == 0 || red[j] != red[j - 1] + 1) run_start.push_back(j);
       run_of[j] = static_cast<int>(run_start.size()) - 1;
-      for (int d = 0; d < 3; ++d) column_scale[3 * j + d] = scale[j];
     }
     run_start.push_back(n);
-    const std::size_t S = group.stride, M = 3 * static_cast<std::size_t>(group.m);
-    double* G = group.G;
-    const std::size_t standard_columns = 3 * static_cast<std::size_t>(npe);
-    for (std::size_t x = 1; x < M; ++x) {
-      for (std::size_t y = 0; y < std::min(x, standard_columns); ++y) G[x * S + y] = G[y * S + x];
-      for (std::size_t y = std::max(x / 3 * 3, standard_columns); y < x; ++y) G[x * S + y] = G[y * S + x];
+    const GroupMap map{n, npe, group.m, red, scale, run_start, run_of};
+    if (planar) {
+      map.add(group.Gm, group.membrane_stride, 2, Kc.data());
+      map.add(group.Gb, group.bending_stride, 1, Kc.data() + 4 * n2);
+      continue;
     }
-    for (int i = 0; i < n; ++i) {
-      if (scale[i] == 0) continue;
-      const double si = scale[i];
-      for (int c = 0; c < 3; ++c) {
-        const double* Grow = G + (3 * static_cast<std::size_t>(red[i]) + c) * S;
-        double* Krow = Kc.data() + (3 * static_cast<std::size_t>(i) + c) * N3;
-        for (int run = run_of[i]; run + 1 < static_cast<int>(run_start.size()); ++run) {
-          const int j0 = std::max(run_start[run], i), j1 = run_start[run + 1];
-          const std::size_t J0 = 3 * static_cast<std::size_t>(j0), J1 = 3 * static_cast<std::size_t>(j1);
-          add_scaled_row(static_cast<int>(J1 - J0), si, column_scale.data() + J0,
-                         Grow + 3 * static_cast<std::size_t>(red[j0]), Krow + J0);
-        }
-      }
-      if (want_forces)
+    map.add(group.G, group.stride, 3, Kc.data());
+    if (want_forces)
+      for (int i = 0; i < n; ++i)
         for (int c = 0; c < 3; ++c) fc[3 * i + c] += scale[i] * group.g[3 * red[i] + c];
-    }
   }
 }
 
 }  // namespace
+
+bool enriched_element_planar_frame(const EnrichedElementBatch& batch, std::int64_t e, double frame[9]) {
+  const int npe = nodes_per_element(batch.type);
+  const int* nodes = batch.connectivity + static_cast<std::int64_t>(batch.element[e]) * npe;
+  const double centre = batch.type == ElementType::quad8 ? 0.0 : 1.0 / 3.0;
+  ShapeValues s;
+  RestPoint p;
+  evaluate_shape(batch.type, centre, centre, s);
+  evaluate_rest_point(s, nodes, batch.positions, p);
+  frame_along(p, p.a1, frame, frame + 3);
+  for (int k = 0; k < 3; ++k) frame[6 + k] = p.t0[k];
+  const double* x0 = batch.positions + 3 * static_cast<std::int64_t>(nodes[0]);
+  double size = 0, off = 0;
+  for (int a = 1; a < npe; ++a) {
+    const double* x = batch.positions + 3 * static_cast<std::int64_t>(nodes[a]);
+    const double d[3] = {x[0] - x0[0], x[1] - x0[1], x[2] - x0[2]};
+    size = std::max(size, std::sqrt(dot3(d, d)));
+    off = std::max(off, std::abs(dot3(d, frame + 6)));
+  }
+  return off <= enriched_planar_tolerance * size;
+}
 
 void enriched_element_stiffness_reference(const EnrichedElementBatch& batch, const EnrichedQuadrature& quadrature,
                                           const double* rotations, double* blocks, double* forces) {
@@ -532,6 +671,32 @@ void enriched_element_stiffness_reference(const EnrichedElementBatch& batch, con
 }
 
 namespace {
+
+// The frame products of a planar element (rows E1, E2, T of E), in the order of the sums
+// g of planar_block: E1 E1^T, E1 E2^T, E2 E1^T, E2 E2^T, T T^T (row-major 3 x 3 each).
+void planar_frame_products(const double E[9], double O[45]) {
+  const int pair[5][2] = {{0, 0}, {0, 1}, {1, 0}, {1, 1}, {2, 2}};
+  for (int k = 0; k < 5; ++k)
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j) O[9 * k + i * 3 + j] = E[3 * pair[k][0] + i] * E[3 * pair[k][1] + j];
+}
+
+// Block (lo, hi), lo <= hi, of a planar element from its chunks' membrane and bending sums
+// (Kc = [Km | Kb], chunk_stiffness), summed over the chunks in order, then
+// sum_ab Km(2 lo + a, 2 hi + b) E_a E_b^T + Kb(lo, hi) T T^T (O: planar_frame_products).
+void planar_block(const std::vector<std::vector<double>>& Kc, std::int64_t c0, std::int64_t c1, int n, std::size_t lo,
+                  std::size_t hi, const double O[45], double block[9]) {
+  const std::size_t N2 = 2 * static_cast<std::size_t>(n), bending = N2 * N2;
+  const std::size_t at[5] = {2 * lo * N2 + 2 * hi, 2 * lo * N2 + 2 * hi + 1, (2 * lo + 1) * N2 + 2 * hi,
+                             (2 * lo + 1) * N2 + 2 * hi + 1, bending + lo * n + hi};
+  double g[5];
+  for (int k = 0; k < 5; ++k) {
+    g[k] = Kc[c0][at[k]];
+    for (std::int64_t ch = c0 + 1; ch < c1; ++ch) g[k] += Kc[ch][at[k]];
+  }
+  for (int ij = 0; ij < 9; ++ij)
+    block[ij] = g[0] * O[ij] + g[1] * O[9 + ij] + g[2] * O[18 + ij] + g[3] * O[27 + ij] + g[4] * O[36 + ij];
+}
 
 // The fast form with rotations given per point, computed from `current`, or none.
 void stiffness_by_chunks(const EnrichedElementBatch& batch, const EnrichedQuadrature& quadrature,
@@ -564,6 +729,14 @@ void stiffness_by_chunks(const EnrichedElementBatch& batch, const EnrichedQuadra
   for (const Chunk& c : chunks) ++first_chunk[c.element + 1];
   for (std::int64_t e = 0; e < batch.count; ++e) first_chunk[e + 1] += first_chunk[e];
   const int W = batch.width;
+  // Unrotated planar elements' chunks hold membrane and bending sums (chunk_stiffness).
+  std::vector<char> planar(static_cast<std::size_t>(batch.count), 0);
+  std::vector<double> products(45 * static_cast<std::size_t>(batch.count));
+  for (std::int64_t e = 0; !rotations && !current && e < batch.count; ++e) {
+    double frame[9];
+    planar[e] = enriched_element_planar_frame(batch, e, frame);
+    planar_frame_products(frame, &products[45 * e]);
+  }
   forall(
       batch.count * W,
       [&](std::int64_t item) {
@@ -572,22 +745,34 @@ void stiffness_by_chunks(const EnrichedElementBatch& batch, const EnrichedQuadra
         const int n = enriched_basis_count(batch, e);
         const std::int64_t c0 = first_chunk[e], c1 = first_chunk[e + 1];
         double* out = blocks + (e * W + a) * W * 9;
-        for (int c = 0; c < W; ++c) {
+        // A planar element's item a expands blocks (a, c >= a) once and writes their mirrors
+        // (c, a) too (the expansion is the costly part there); the others read both from Kc.
+        for (int c = planar[e] ? a : 0; c < W; ++c) {
           double* blk = out + c * 9;
+          double* mirror = blocks + ((e * W + c) * W + a) * 9;
           if (a >= n || c >= n) {
             for (int i = 0; i < 9; ++i) blk[i] = 0;
+            if (planar[e])
+              for (int i = 0; i < 9; ++i) mirror[i] = 0;
             continue;
           }
-          // Kc holds block (min, max) row-major over DOFs: (3 min + i) * 3n + 3 max + j.
           const bool upper = a <= c;
-          const std::size_t N3 = 3 * static_cast<std::size_t>(n);
-          const std::size_t at = 3 * static_cast<std::size_t>(upper ? a : c) * N3 + 3 * (upper ? c : a);
-          double sum[9];
-          for (int i = 0; i < 3; ++i)
-            for (int j = 0; j < 3; ++j) sum[i * 3 + j] = Kc[c0][at + i * N3 + j];
-          for (std::int64_t ch = c0 + 1; ch < c1; ++ch)
+          const std::size_t lo = upper ? a : c, hi = upper ? c : a;
+          double sum[9];  // block (lo, hi)
+          if (planar[e]) {
+            planar_block(Kc, c0, c1, n, lo, hi, &products[45 * e], sum);
             for (int i = 0; i < 3; ++i)
-              for (int j = 0; j < 3; ++j) sum[i * 3 + j] += Kc[ch][at + i * N3 + j];
+              for (int j = 0; j < 3; ++j) mirror[i * 3 + j] = sum[j * 3 + i];
+          } else {
+            // Kc holds block (lo, hi) row-major over DOFs: (3 lo + i) * 3n + 3 hi + j.
+            const std::size_t N3 = 3 * static_cast<std::size_t>(n);
+            const std::size_t at = 3 * lo * N3 + 3 * hi;
+            for (int i = 0; i < 3; ++i)
+              for (int j = 0; j < 3; ++j) sum[i * 3 + j] = Kc[c0][at + i * N3 + j];
+            for (std::int64_t ch = c0 + 1; ch < c1; ++ch)
+              for (int i = 0; i < 3; ++i)
+                for (int j = 0; j < 3; ++j) sum[i * 3 + j] += Kc[ch][at + i * N3 + j];
+          }
           for (int i = 0; i < 3; ++i)
             for (int j = 0; j < 3; ++j) blk[i * 3 + j] = upper ? sum[i * 3 + j] : sum[j * 3 + i];
         }

@@ -165,6 +165,35 @@ void add_rotated_blocks(int count, const double* B, std::int64_t plane, const do
   }
 }
 
+// The same for planar rest data: acc[ij][p] += sum_k P_k[p] O[k][ij] over the five planes
+// P_k (E1 B E1, E1 B E2, E2 B E1, E2 B E2, T B T) and the rotated frame products O[k]
+// ((R E1)(R E1)^T, (R E1)(R E2)^T, (R E2)(R E1)^T, (R E2)(R E2)^T, (R T)(R T)^T).
+__attribute__((target_clones("avx512f", "avx2", "default")))
+void add_rotated_planar_blocks(int count, const double* B, std::int64_t plane, const double O[5][9], double* acc,
+                               int acc_plane) {
+  for (int ij = 0; ij < 9; ++ij) {
+    const double o0 = O[0][ij], o1 = O[1][ij], o2 = O[2][ij], o3 = O[3][ij], o4 = O[4][ij];
+    double* a = acc + ij * acc_plane;
+    for (int p = 0; p < count; ++p)
+      a[p] += B[p] * o0 + B[plane + p] * o1 + B[2 * plane + p] * o2 + B[3 * plane + p] * o3 + B[4 * plane + p] * o4;
+  }
+}
+
+// The five frame products of a planar element's frame E (rows E1, E2, T) turned by R
+// (R null: unturned), in the order of the planes.
+void planar_frame_products(const double E[9], const double* R, double O[5][9]) {
+  double r[3][3];
+  for (int f = 0; f < 3; ++f)
+    for (int i = 0; i < 3; ++i)
+      r[f][i] = R ? R[i * 3] * E[3 * f] + R[i * 3 + 1] * E[3 * f + 1] + R[i * 3 + 2] * E[3 * f + 2] : E[3 * f + i];
+  const int pair[5][2] = {{0, 0}, {0, 1}, {1, 0}, {1, 1}, {2, 2}};
+  for (int k = 0; k < 5; ++k)
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j) O[k][i * 3 + j] = r[pair[k][0]][i] * r[pair[k][1]][j];
+}
+
+int rest_planes(bool planar) { return planar ? 5 : 9; }
+
 }  // namespace
 
 std::int64_t enriched_cluster_packed_blocks(int width) {
@@ -172,8 +201,16 @@ std::int64_t enriched_cluster_packed_blocks(int width) {
   return (blocks + 7) / 8 * 8;
 }
 
-std::int64_t enriched_cluster_rest_stride(int width) {
-  return 9 * enriched_cluster_packed_blocks(width) + 2 * static_cast<std::int64_t>(width);
+bool enriched_clusters_planar(const EnrichedElementBatch& batch) {
+  double frame[9];
+  for (std::int64_t e = 0; e < batch.count; ++e)
+    if (!enriched_element_planar_frame(batch, e, frame)) return false;
+  return true;
+}
+
+std::int64_t enriched_cluster_rest_stride(const EnrichedElementBatch& batch) {
+  return rest_planes(enriched_clusters_planar(batch)) * enriched_cluster_packed_blocks(batch.width) +
+         2 * static_cast<std::int64_t>(batch.width);
 }
 
 EnrichedRotationClusters enriched_rotation_clusters(const EnrichedElementBatch& batch,
@@ -222,7 +259,9 @@ EnrichedRotationClusters enriched_rotation_clusters(const EnrichedElementBatch& 
 void enriched_cluster_rest_stiffness(const EnrichedElementBatch& batch, const EnrichedQuadrature& quadrature,
                                      const EnrichedRotationClusters& clusters, double* rest, Execution execution) {
   const int W = batch.width;
-  const std::int64_t stride = enriched_cluster_rest_stride(W), plane = enriched_cluster_packed_blocks(W);
+  const bool planar = enriched_clusters_planar(batch);
+  const int planes = rest_planes(planar);
+  const std::int64_t stride = enriched_cluster_rest_stride(batch), plane = enriched_cluster_packed_blocks(W);
   std::vector<std::int64_t> element_of(static_cast<std::size_t>(clusters.count()));
   for (std::int64_t e = 0; e < batch.count; ++e)
     for (std::int64_t c = clusters.element_start[e]; c < clusters.element_start[e + 1]; ++c) element_of[c] = e;
@@ -236,15 +275,23 @@ void enriched_cluster_rest_stiffness(const EnrichedElementBatch& batch, const En
     static thread_local std::vector<double> K;
     enriched_element_point_set_stiffness(batch, quadrature, e, points, count, K);
     double* out = rest + c * stride;
-    std::fill(out, out + 9 * plane, 0.0);
-    const std::size_t N3 = 3 * static_cast<std::size_t>(n);
-    for (int a = 0; a < n; ++a)
-      for (int b = a; b < n; ++b) {
-        const std::int64_t p = packed_row_start(W, a) + (b - a);
-        for (int i = 0; i < 3; ++i)
-          for (int j = 0; j < 3; ++j) out[(i * 3 + j) * plane + p] = K[(3 * a + i) * N3 + 3 * b + j];
+    std::fill(out, out + planes * plane, 0.0);
+    const std::size_t N3 = 3 * static_cast<std::size_t>(n), N2 = 2 * static_cast<std::size_t>(n);
+    for (std::size_t a = 0; a < static_cast<std::size_t>(n); ++a)
+      for (std::size_t b = a; b < static_cast<std::size_t>(n); ++b) {
+        const std::int64_t p = packed_row_start(W, static_cast<int>(a)) + static_cast<std::int64_t>(b - a);
+        if (planar) {  // K = [Km | Kb] (enriched_element_point_set_stiffness)
+          out[0 * plane + p] = K[2 * a * N2 + 2 * b];
+          out[1 * plane + p] = K[2 * a * N2 + 2 * b + 1];
+          out[2 * plane + p] = K[(2 * a + 1) * N2 + 2 * b];
+          out[3 * plane + p] = K[(2 * a + 1) * N2 + 2 * b + 1];
+          out[4 * plane + p] = K[N2 * N2 + a * n + b];
+          continue;
+        }
+        for (std::size_t i = 0; i < 3; ++i)
+          for (std::size_t j = 0; j < 3; ++j) out[(i * 3 + j) * plane + p] = K[(3 * a + i) * N3 + 3 * b + j];
       }
-    tangent_weights(batch, quadrature, e, points, count, out + 9 * plane);
+    tangent_weights(batch, quadrature, e, points, count, out + planes * plane);
   };
   const std::int64_t total = clusters.count();
   if (execution == Execution::parallel) {
@@ -258,12 +305,13 @@ void enriched_cluster_rest_stiffness(const EnrichedElementBatch& batch, const En
 void enriched_cluster_rotations(const EnrichedElementBatch& batch, const EnrichedRotationClusters& clusters,
                                 const double* rest, const double* current, double* rotations, Execution execution) {
   const int W = batch.width;
-  const std::int64_t stride = enriched_cluster_rest_stride(W), plane = enriched_cluster_packed_blocks(W);
+  const std::int64_t stride = enriched_cluster_rest_stride(batch), plane = enriched_cluster_packed_blocks(W);
+  const std::int64_t weights = rest_planes(enriched_clusters_planar(batch)) * plane;
   forall(
       batch.count,
       [&](std::int64_t e) {
         for (std::int64_t c = clusters.element_start[e]; c < clusters.element_start[e + 1]; ++c)
-          cluster_rotation(batch, e, rest + c * stride + 9 * plane, current, rotations + 9 * c);
+          cluster_rotation(batch, e, rest + c * stride + weights, current, rotations + 9 * c);
       },
       execution);
 }
@@ -273,7 +321,10 @@ void enriched_element_clustered_stiffness(const EnrichedElementBatch& batch, con
                                           double* forces, Execution execution) {
   const int W = batch.width;
   const int npe = nodes_per_element(batch.type);
-  const std::int64_t stride = enriched_cluster_rest_stride(W), plane = enriched_cluster_packed_blocks(W);
+  const bool planar = enriched_clusters_planar(batch);
+  const std::int64_t stride = enriched_cluster_rest_stride(batch), plane = enriched_cluster_packed_blocks(W);
+  std::vector<double> frames(9 * static_cast<std::size_t>(batch.count));
+  for (std::int64_t e = 0; planar && e < batch.count; ++e) enriched_element_planar_frame(batch, e, &frames[9 * e]);
   const std::int64_t packed = static_cast<std::int64_t>(W) * (W + 1) / 2;
   const std::int64_t tiles = (packed + cluster_tile_blocks - 1) / cluster_tile_blocks;
   // Blocks: one work item per tile of an element's packed upper blocks; every cluster adds
@@ -288,8 +339,15 @@ void enriched_element_clustered_stiffness(const EnrichedElementBatch& batch, con
         const int length = static_cast<int>(std::min(packed - p0, cluster_tile_blocks));
         static thread_local std::vector<double> acc;
         acc.assign(static_cast<std::size_t>(9) * length, 0.0);
-        for (std::int64_t c = clusters.element_start[e]; c < clusters.element_start[e + 1]; ++c)
-          add_rotated_blocks(length, rest + c * stride + p0, plane, rotations + 9 * c, acc.data(), length);
+        for (std::int64_t c = clusters.element_start[e]; c < clusters.element_start[e + 1]; ++c) {
+          if (planar) {
+            double O[5][9];
+            planar_frame_products(&frames[9 * e], rotations + 9 * c, O);
+            add_rotated_planar_blocks(length, rest + c * stride + p0, plane, O, acc.data(), length);
+          } else {
+            add_rotated_blocks(length, rest + c * stride + p0, plane, rotations + 9 * c, acc.data(), length);
+          }
+        }
         int a = 0;
         while (packed_row_start(W, a + 1) <= p0) ++a;
         for (std::int64_t p = p0; p < p0 + length; ++p) {
@@ -313,6 +371,8 @@ void enriched_element_clustered_stiffness(const EnrichedElementBatch& batch, con
         double* fa = forces + (e * W + a) * 3;
         fa[0] = fa[1] = fa[2] = 0;
         if (a >= enriched_basis_count(batch, e)) return;
+        double O[5][9];  // a planar element's unturned frame products
+        if (planar) planar_frame_products(&frames[9 * e], nullptr, O);
         for (std::int64_t c = clusters.element_start[e]; c < clusters.element_start[e + 1]; ++c) {
           const double* B = rest + c * stride;
           const double* R = rotations + 9 * c;
@@ -323,8 +383,17 @@ void enriched_element_clustered_stiffness(const EnrichedElementBatch& batch, con
             for (int k = 0; k < 3; ++k) z[k] = X[k] - (R[0 * 3 + k] * X[0] + R[1 * 3 + k] * X[1] + R[2 * 3 + k] * X[2]);
             const bool upper = b >= a;  // block (a, b), or the transpose of the stored (b, a)
             const std::int64_t p = upper ? packed_row_start(W, a) + (b - a) : packed_row_start(W, b) + (a - b);
+            double block[9];  // stored block (min, max), row-major
+            for (int ij = 0; ij < 9; ++ij) {
+              if (!planar) {
+                block[ij] = B[ij * plane + p];
+                continue;
+              }
+              block[ij] = 0;
+              for (int k = 0; k < 5; ++k) block[ij] += B[k * plane + p] * O[k][ij];
+            }
             for (int i = 0; i < 3; ++i)
-              for (int j = 0; j < 3; ++j) g[i] += B[(upper ? i * 3 + j : j * 3 + i) * plane + p] * z[j];
+              for (int j = 0; j < 3; ++j) g[i] += block[upper ? i * 3 + j : j * 3 + i] * z[j];
           }
           for (int i = 0; i < 3; ++i) fa[i] += R[i * 3 + 0] * g[0] + R[i * 3 + 1] * g[1] + R[i * 3 + 2] * g[2];
         }
