@@ -436,9 +436,11 @@ void point_deformation_gradient(const ElementLayout& L, const ShapeValues& s, co
 // basis: Kc (3n x 3n, row-major over DOFs, block rows a <= c filled) and fc (3n).
 // Rotations: given per point (`rotations`), or computed here from `current` exactly as
 // enriched_element_deformation_gradients and polar_rotation would (the fused form), or none.
+// tangent_weights (may be null): receives D_f = sum_q w_q dN_f(q) over the chunk's points
+// for every element function f (2 W slots; the arithmetic of evaluate_enriched_shape).
 void chunk_stiffness(const EnrichedElementBatch& b, const EnrichedQuadrature& quad, const Chunk& chunk,
                      const double* rotations, const double* current, bool want_forces, std::vector<double>& Kc,
-                     std::vector<double>& fc) {
+                     std::vector<double>& fc, double* tangent_weights = nullptr) {
   const std::int64_t e = chunk.element;
   const ElementLayout L(b, e);
   int global[max_enriched_basis];
@@ -464,6 +466,7 @@ void chunk_stiffness(const EnrichedElementBatch& b, const EnrichedQuadrature& qu
   // Unrotated rows of a planar element take the split membrane / bending sums.
   PlanarFrame frame;
   const bool planar = !rotations && !current && enriched_element_planar_frame(b, e, &frame.E[0][0]);
+  if (tangent_weights) std::fill(tangent_weights, tangent_weights + 2 * b.width, 0.0);
   for (std::int64_t k = chunk.begin; k < chunk.end; ++k) {
     const std::int64_t q = chunk.point(k);
     const double* pt = quad.points + 3 * q;
@@ -477,6 +480,18 @@ void chunk_stiffness(const EnrichedElementBatch& b, const EnrichedQuadrature& qu
       sample_texel_polynomial(b.type, b.resolution, cache.fd[k], ti, tj, pt[0], pt[1], samples[k]);
       values[k] = samples[k].value;
       if (!cache.flat[k]) mask |= 1u << k;
+    }
+    if (tangent_weights) {
+      double* D = tangent_weights;
+      for (int a = 0; a < npe; ++a) D[2 * a] += weight * s.dN[a][0], D[2 * a + 1] += weight * s.dN[a][1];
+      for (int k = 0; k < L.count; ++k)
+        for (int a = 0; a < npe; ++a) {
+          const int f = L.slot[k][a];
+          if (f < 0) continue;
+          double dN[2], d2N[3];
+          product_rule(samples[k], L.shift[k][a], s, a, dN, d2N);
+          D[2 * f] += weight * dN[0], D[2 * f + 1] += weight * dN[1];
+        }
     }
     int g = -1;
     if (last >= 0 && groups[last].matches(mask, values, L.count)) g = last;
@@ -806,9 +821,10 @@ void enriched_element_corotated_stiffness(const EnrichedElementBatch& batch, con
 
 void enriched_element_point_set_stiffness(const EnrichedElementBatch& batch, const EnrichedQuadrature& quadrature,
                                           std::int64_t e, const std::int64_t* points, std::int64_t count,
-                                          std::vector<double>& K) {
+                                          std::vector<double>& K, double* tangent_weights) {
   std::vector<double> unused_forces;
-  chunk_stiffness(batch, quadrature, Chunk{e, 0, count, points}, nullptr, nullptr, false, K, unused_forces);
+  chunk_stiffness(batch, quadrature, Chunk{e, 0, count, points}, nullptr, nullptr, false, K, unused_forces,
+                  tangent_weights);
 }
 
 void enriched_element_deformation_gradients(const EnrichedElementBatch& b, const EnrichedQuadrature& quad,

@@ -273,8 +273,8 @@ void enriched_cluster_rest_stiffness(const EnrichedElementBatch& batch, const En
     const std::int64_t* points = clusters.points.data() + clusters.point_start[c];
     const std::int64_t count = clusters.point_start[c + 1] - clusters.point_start[c];
     static thread_local std::vector<double> K;
-    enriched_element_point_set_stiffness(batch, quadrature, e, points, count, K);
     double* out = rest + c * stride;
+    enriched_element_point_set_stiffness(batch, quadrature, e, points, count, K, out + planes * plane);
     std::fill(out, out + planes * plane, 0.0);
     const std::size_t N3 = 3 * static_cast<std::size_t>(n), N2 = 2 * static_cast<std::size_t>(n);
     for (std::size_t a = 0; a < static_cast<std::size_t>(n); ++a)
@@ -291,7 +291,6 @@ void enriched_cluster_rest_stiffness(const EnrichedElementBatch& batch, const En
         for (std::size_t i = 0; i < 3; ++i)
           for (std::size_t j = 0; j < 3; ++j) out[(i * 3 + j) * plane + p] = K[(3 * a + i) * N3 + 3 * b + j];
       }
-    tangent_weights(batch, quadrature, e, points, count, out + planes * plane);
   };
   const std::int64_t total = clusters.count();
   if (execution == Execution::parallel) {
