@@ -361,38 +361,59 @@ void enriched_element_clustered_stiffness(const EnrichedElementBatch& batch, con
       execution);
   if (!forces) return;
   // Forces: f_a = sum_c R_c sum_b K0_c(a, b) z_b, z = X0 - R_c^T X0 on the standard functions.
+  // z per cluster first (planar: its frame components E_y . z, the rest sums' own basis).
+  std::vector<double> z(static_cast<std::size_t>(clusters.count()) * npe * 3);
+  forall(
+      batch.count,
+      [&](std::int64_t e) {
+        const int* nodes = batch.connectivity + static_cast<std::int64_t>(batch.element[e]) * npe;
+        const double* E = &frames[9 * e];
+        for (std::int64_t c = clusters.element_start[e]; c < clusters.element_start[e + 1]; ++c) {
+          const double* R = rotations + 9 * c;
+          for (int b = 0; b < npe; ++b) {
+            const double* X = batch.positions + 3 * static_cast<std::int64_t>(nodes[b]);
+            double d[3];
+            for (int k = 0; k < 3; ++k) d[k] = X[k] - (R[0 * 3 + k] * X[0] + R[1 * 3 + k] * X[1] + R[2 * 3 + k] * X[2]);
+            double* out = &z[(c * npe + b) * 3];
+            for (int y = 0; y < 3; ++y) out[y] = planar ? E[3 * y] * d[0] + E[3 * y + 1] * d[1] + E[3 * y + 2] * d[2] : d[y];
+          }
+        }
+      },
+      execution);
+  // Planes k = (x, y) of the frame pairs; a stored block (b, a) read as (a, b) swaps them.
+  const int pair[5][2] = {{0, 0}, {0, 1}, {1, 0}, {1, 1}, {2, 2}};
+  const int transposed[5] = {0, 2, 1, 3, 4};
   forall(
       batch.count * W,
       [&](std::int64_t item) {
         const std::int64_t e = item / W;
         const int a = static_cast<int>(item % W);
-        const int* nodes = batch.connectivity + static_cast<std::int64_t>(batch.element[e]) * npe;
         double* fa = forces + (e * W + a) * 3;
         fa[0] = fa[1] = fa[2] = 0;
         if (a >= enriched_basis_count(batch, e)) return;
-        double O[5][9];  // a planar element's unturned frame products
-        if (planar) planar_frame_products(&frames[9 * e], nullptr, O);
+        const double* E = &frames[9 * e];
         for (std::int64_t c = clusters.element_start[e]; c < clusters.element_start[e + 1]; ++c) {
           const double* B = rest + c * stride;
           const double* R = rotations + 9 * c;
-          double g[3] = {0, 0, 0};
-          for (int b = 0; b < npe; ++b) {
-            const double* X = batch.positions + 3 * static_cast<std::int64_t>(nodes[b]);
-            double z[3];
-            for (int k = 0; k < 3; ++k) z[k] = X[k] - (R[0 * 3 + k] * X[0] + R[1 * 3 + k] * X[1] + R[2 * 3 + k] * X[2]);
-            const bool upper = b >= a;  // block (a, b), or the transpose of the stored (b, a)
-            const std::int64_t p = upper ? packed_row_start(W, a) + (b - a) : packed_row_start(W, b) + (a - b);
-            double block[9];  // stored block (min, max), row-major
-            for (int ij = 0; ij < 9; ++ij) {
-              if (!planar) {
-                block[ij] = B[ij * plane + p];
-                continue;
-              }
-              block[ij] = 0;
-              for (int k = 0; k < 5; ++k) block[ij] += B[k * plane + p] * O[k][ij];
+          double g[3] = {0, 0, 0};  // sum_b K0_c(a, b) z_b
+          if (planar) {
+            double h[5] = {0, 0, 0, 0, 0};  // sum_b g_k(a, b) (E_y . z_b)
+            for (int b = 0; b < npe; ++b) {
+              const double* zb = &z[(c * npe + b) * 3];
+              const bool upper = b >= a;
+              const std::int64_t p = upper ? packed_row_start(W, a) + (b - a) : packed_row_start(W, b) + (a - b);
+              for (int k = 0; k < 5; ++k) h[k] += B[(upper ? k : transposed[k]) * plane + p] * zb[pair[k][1]];
             }
-            for (int i = 0; i < 3; ++i)
-              for (int j = 0; j < 3; ++j) g[i] += block[upper ? i * 3 + j : j * 3 + i] * z[j];
+            for (int k = 0; k < 5; ++k)
+              for (int i = 0; i < 3; ++i) g[i] += E[3 * pair[k][0] + i] * h[k];
+          } else {
+            for (int b = 0; b < npe; ++b) {
+              const double* zb = &z[(c * npe + b) * 3];
+              const bool upper = b >= a;  // block (a, b), or the transpose of the stored (b, a)
+              const std::int64_t p = upper ? packed_row_start(W, a) + (b - a) : packed_row_start(W, b) + (a - b);
+              for (int i = 0; i < 3; ++i)
+                for (int j = 0; j < 3; ++j) g[i] += B[(upper ? i * 3 + j : j * 3 + i) * plane + p] * zb[j];
+            }
           }
           for (int i = 0; i < 3; ++i) fa[i] += R[i * 3 + 0] * g[0] + R[i * 3 + 1] * g[1] + R[i * 3 + 2] * g[2];
         }

@@ -62,7 +62,8 @@ std::int64_t enriched_cluster_packed_blocks(int width);
 bool enriched_clusters_planar(const EnrichedElementBatch& batch);
 std::int64_t enriched_cluster_rest_stride(const EnrichedElementBatch& batch);
 
-// K0_c and D_f of every cluster (rest data, #clusters x enriched_cluster_rest_stride(W)).
+// K0_c and D_f of every cluster (rest data, #clusters x enriched_cluster_rest_stride(batch));
+// every entry is written (padding 0), so `rest` need not be zeroed.
 void enriched_cluster_rest_stiffness(const EnrichedElementBatch& batch, const EnrichedQuadrature& quadrature,
                                      const EnrichedRotationClusters& clusters, double* rest,
                                      Execution execution = Execution::parallel);
