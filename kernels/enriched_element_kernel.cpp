@@ -274,22 +274,32 @@ struct PointRows {
     }
   }
 
-  // The same rows in a planar element's fixed frame (E1, E2, T; see PlanarFrame): the
-  // membrane rows have only E1, E2 components (2 columns per function, at 2 col of
-  // membrane[0..2]), the bending rows only a T component (1 column, at col of bending[0..2]).
+  // A planar element's rows in its fixed frame (E1, E2, T; see PlanarFrame). Membrane:
+  // one row, sqrt(w D_m) times the function's gradient along E1 and E2 (2 columns per
+  // function, at 2 col of `membrane`); its Gram sums are the gradient products S_ab, from
+  // which membrane_from_gradient_products forms the plane-stress stiffness. Bending: the
+  // three rows along T (1 column per function, at col of bending[0..2]).
   // in_plane[f][a] = e_f . E_a, normal = t0 . T (+-1).
   void write_planar(const double dN[2], const double d2N[3], const double in_plane[2][2], double normal,
-                    double* const membrane[3], double* const bending[3], int col) const {
-    double m[5], b[3];
-    coefficients(dN, d2N, m, b);
-    for (int a = 0; a < 2; ++a) {
-      membrane[0][2 * col + a] = m[0] * in_plane[0][a] + m[1] * in_plane[1][a];
-      membrane[1][2 * col + a] = m[2] * in_plane[1][a];
-      membrane[2][2 * col + a] = m[3] * in_plane[0][a] + m[4] * in_plane[1][a];
-    }
+                    double* membrane, double* const bending[3], int col) const {
+    double g[2], beta[3];
+    strains(dN, d2N, g, beta);
+    for (int a = 0; a < 2; ++a) membrane[2 * col + a] = sm * (g[0] * in_plane[0][a] + g[1] * in_plane[1][a]);
+    const double b[3] = {sb * (beta[0] + nu * beta[1]), sb * k1 * beta[1], sb * k2 * beta[2]};
     for (int r = 0; r < 3; ++r) bending[r][col] = b[r] * normal;
   }
 };
+
+// Plane-stress membrane stiffness of function pair (i, j) along (E_a, E_b) from the sums of
+// gradient products S_ab(i, j) = sum_q w D_m G_ia G_jb (s = S_11, S_12, S_21, S_22), in place:
+// with c = (1 - nu) / 2, K_11 = S_11 + c S_22, K_12 = nu S_12 + c S_21, K_21 = nu S_21 + c S_12,
+// K_22 = S_22 + c S_11 (eps = (G_1, 0, G_2) for a displacement along E1, (0, G_2, G_1) along
+// E2, against C = [[1, nu, 0], [nu, 1, 0], [0, 0, c]]).
+inline void membrane_from_gradient_products(double nu, double s[4]) {
+  const double c = 0.5 * (1 - nu);
+  const double k11 = s[0] + c * s[3], k12 = nu * s[1] + c * s[2], k21 = nu * s[2] + c * s[1], k22 = s[3] + c * s[0];
+  s[0] = k11, s[1] = k12, s[2] = k21, s[3] = k22;
+}
 
 // A planar element's fixed frame (enriched_element_planar_frame): E1, E2, T.
 struct PlanarFrame {
@@ -303,6 +313,8 @@ struct PlanarFrame {
 // blocks: the points of the group in order, so the sums do not depend on threads).
 constexpr int group_block_points = 16;
 constexpr int group_block_rows = 6 * group_block_points;
+// Planar groups stack 32 points: 32 membrane rows and 96 bending rows a block.
+constexpr int planar_block_points = 32;
 
 struct Group {
   std::uint32_t varying = 0;
@@ -344,9 +356,8 @@ struct GroupStorage {
 void flush(Group& group, bool want_forces) {
   if (group.pending == 0) return;
   if (group.Gm) {  // planar: no forces (unrotated)
-    const int rows = 3 * group.pending;
-    accumulate_gram_upper(rows, group.membrane_stride, group.membrane_rows, group.Gm, !group.written);
-    accumulate_gram_upper(rows, group.bending_stride, group.bending_rows, group.Gb, !group.written);
+    accumulate_gram_upper(group.pending, group.membrane_stride, group.membrane_rows, group.Gm, !group.written);
+    accumulate_gram_upper(3 * group.pending, group.bending_stride, group.bending_rows, group.Gb, !group.written);
     group.written = true;
     group.pending = 0;
     return;
@@ -518,15 +529,14 @@ void chunk_stiffness(const EnrichedElementBatch& b, const EnrichedQuadrature& qu
           for (int i = used; i < stride; ++i) rows[static_cast<std::size_t>(k) * stride + i] = 0;
       };
       if (planar) {
-        const std::size_t Sm = padded(2 * fresh.m), Sb = padded(fresh.m), block_rows = group_block_rows / 2;
+        const std::size_t Sm = padded(2 * fresh.m), Sb = padded(fresh.m), points = planar_block_points;
         fresh.membrane_stride = static_cast<int>(Sm), fresh.bending_stride = static_cast<int>(Sb);
-        fresh.G = space.take(static_cast<std::size_t>(S) * S + Sm * Sm + Sb * Sb + block_rows * (Sm + Sb));
-        fresh.Gm = fresh.G + static_cast<std::size_t>(S) * S;
+        fresh.Gm = space.take(Sm * Sm + Sb * Sb + points * Sm + 3 * points * Sb);
         fresh.Gb = fresh.Gm + Sm * Sm;
         fresh.membrane_rows = fresh.Gb + Sb * Sb;
-        fresh.bending_rows = fresh.membrane_rows + block_rows * Sm;
-        zero_padding(fresh.membrane_rows, block_rows, 2 * fresh.m, fresh.membrane_stride);
-        zero_padding(fresh.bending_rows, block_rows, fresh.m, fresh.bending_stride);
+        fresh.bending_rows = fresh.membrane_rows + points * Sm;
+        zero_padding(fresh.membrane_rows, static_cast<int>(points), 2 * fresh.m, fresh.membrane_stride);
+        zero_padding(fresh.bending_rows, static_cast<int>(3 * points), fresh.m, fresh.bending_stride);
       } else {
         fresh.G = space.take(static_cast<std::size_t>(S) * (S + group_block_rows));
         fresh.rows = fresh.G + static_cast<std::size_t>(S) * S;
@@ -556,9 +566,8 @@ void chunk_stiffness(const EnrichedElementBatch& b, const EnrichedQuadrature& qu
         for (int a = 0; a < 2; ++a) in_plane[f][a] = dot3(pr.e[f], frame.E[a]);
       const double normal = dot3(pr.e[2], frame.E[2]);
       const std::size_t Sm = group.membrane_stride, Sb = group.bending_stride;
-      double* mb = group.membrane_rows + 3 * group.pending * Sm;
+      double* membrane = group.membrane_rows + group.pending * Sm;
       double* bb = group.bending_rows + 3 * group.pending * Sb;
-      double* const membrane[3] = {mb, mb + Sm, mb + 2 * Sm};
       double* const bending[3] = {bb, bb + Sb, bb + 2 * Sb};
       for (int a = 0; a < npe; ++a) pr.write_planar(s.dN[a], s.d2N[a], in_plane, normal, membrane, bending, a);
       int r = npe;
@@ -571,7 +580,7 @@ void chunk_stiffness(const EnrichedElementBatch& b, const EnrichedQuadrature& qu
           pr.write_planar(dN, d2N, in_plane, normal, membrane, bending, r++);
         }
       }
-      if (++group.pending == group_block_points) flush(group, false);
+      if (++group.pending == planar_block_points) flush(group, false);
       continue;
     }
     double* block = group.rows + static_cast<std::size_t>(6 * group.pending) * S;
@@ -655,6 +664,16 @@ void chunk_stiffness(const EnrichedElementBatch& b, const EnrichedQuadrature& qu
       for (int i = 0; i < n; ++i)
         for (int c = 0; c < 3; ++c) fc[3 * i + c] += scale[i] * group.g[3 * red[i] + c];
   }
+  if (!planar) return;
+  // The membrane sums are gradient products so far: the stiffness of each upper 2 x 2 block.
+  const std::size_t N2 = 2 * static_cast<std::size_t>(n);
+  for (std::size_t i = 0; i < static_cast<std::size_t>(n); ++i)
+    for (std::size_t j = i; j < static_cast<std::size_t>(n); ++j) {
+      double* top = Kc.data() + 2 * i * N2 + 2 * j;
+      double block[4] = {top[0], top[1], top[N2], top[N2 + 1]};
+      membrane_from_gradient_products(nu, block);
+      top[0] = block[0], top[1] = block[1], top[N2] = block[2], top[N2 + 1] = block[3];
+    }
 }
 
 }  // namespace
