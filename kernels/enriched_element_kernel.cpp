@@ -325,8 +325,8 @@ struct Group {
   int pending = 0;              // points stacked in rows, not yet in G
   bool written = false;         // G holds a first block
   std::vector<double> g, s;     // g: stride; s: the stacked points' scaled rest strains
-  // Planar elements (PlanarFrame): the membrane and bending sums, each from 3 rows a point
-  // (padded lengths >= 2 m and >= m), expanded into G after the last flush.
+  // Planar elements (PlanarFrame): the membrane sums from 1 row a point (gradient products,
+  // padded length >= 2 m) and the bending sums from 3 rows (>= m), in place of G and rows.
   int membrane_stride = 0, bending_stride = 0;
   double *Gm = nullptr, *Gb = nullptr, *membrane_rows = nullptr, *bending_rows = nullptr;
 
@@ -699,6 +699,18 @@ bool enriched_element_planar_frame(const EnrichedElementBatch& batch, std::int64
   return off <= enriched_planar_tolerance * size;
 }
 
+void enriched_planar_frame_products(const double frame[9], const double* R, double products[45]) {
+  double r[3][3];  // R E1, R E2, R T
+  for (int f = 0; f < 3; ++f)
+    for (int i = 0; i < 3; ++i)
+      r[f][i] = R ? R[i * 3] * frame[3 * f] + R[i * 3 + 1] * frame[3 * f + 1] + R[i * 3 + 2] * frame[3 * f + 2]
+                  : frame[3 * f + i];
+  for (int k = 0; k < 5; ++k)
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j)
+        products[9 * k + i * 3 + j] = r[enriched_planar_pairs[k][0]][i] * r[enriched_planar_pairs[k][1]][j];
+}
+
 void enriched_element_stiffness_reference(const EnrichedElementBatch& batch, const EnrichedQuadrature& quadrature,
                                           const double* rotations, double* blocks, double* forces) {
   for (std::int64_t e = 0; e < batch.count; ++e) element_stiffness(batch, quadrature, e, rotations, blocks, forces);
@@ -706,18 +718,9 @@ void enriched_element_stiffness_reference(const EnrichedElementBatch& batch, con
 
 namespace {
 
-// The frame products of a planar element (rows E1, E2, T of E), in the order of the sums
-// g of planar_block: E1 E1^T, E1 E2^T, E2 E1^T, E2 E2^T, T T^T (row-major 3 x 3 each).
-void planar_frame_products(const double E[9], double O[45]) {
-  const int pair[5][2] = {{0, 0}, {0, 1}, {1, 0}, {1, 1}, {2, 2}};
-  for (int k = 0; k < 5; ++k)
-    for (int i = 0; i < 3; ++i)
-      for (int j = 0; j < 3; ++j) O[9 * k + i * 3 + j] = E[3 * pair[k][0] + i] * E[3 * pair[k][1] + j];
-}
-
 // Block (lo, hi), lo <= hi, of a planar element from its chunks' membrane and bending sums
 // (Kc = [Km | Kb], chunk_stiffness), summed over the chunks in order, then
-// sum_ab Km(2 lo + a, 2 hi + b) E_a E_b^T + Kb(lo, hi) T T^T (O: planar_frame_products).
+// sum_ab Km(2 lo + a, 2 hi + b) E_a E_b^T + Kb(lo, hi) T T^T (O: enriched_planar_frame_products).
 void planar_block(const std::vector<std::vector<double>>& Kc, std::int64_t c0, std::int64_t c1, int n, std::size_t lo,
                   std::size_t hi, const double O[45], double block[9]) {
   const std::size_t N2 = 2 * static_cast<std::size_t>(n), bending = N2 * N2;
@@ -769,7 +772,7 @@ void stiffness_by_chunks(const EnrichedElementBatch& batch, const EnrichedQuadra
   for (std::int64_t e = 0; !rotations && !current && e < batch.count; ++e) {
     double frame[9];
     planar[e] = enriched_element_planar_frame(batch, e, frame);
-    planar_frame_products(frame, &products[45 * e]);
+    enriched_planar_frame_products(frame, nullptr, &products[45 * e]);
   }
   forall(
       batch.count * W,

@@ -181,19 +181,6 @@ void add_rotated_planar_blocks(int count, const double* B, std::int64_t plane, c
   }
 }
 
-// The five frame products of a planar element's frame E (rows E1, E2, T) turned by R
-// (R null: unturned), in the order of the planes.
-void planar_frame_products(const double E[9], const double* R, double O[5][9]) {
-  double r[3][3];
-  for (int f = 0; f < 3; ++f)
-    for (int i = 0; i < 3; ++i)
-      r[f][i] = R ? R[i * 3] * E[3 * f] + R[i * 3 + 1] * E[3 * f + 1] + R[i * 3 + 2] * E[3 * f + 2] : E[3 * f + i];
-  const int pair[5][2] = {{0, 0}, {0, 1}, {1, 0}, {1, 1}, {2, 2}};
-  for (int k = 0; k < 5; ++k)
-    for (int i = 0; i < 3; ++i)
-      for (int j = 0; j < 3; ++j) O[k][i * 3 + j] = r[pair[k][0]][i] * r[pair[k][1]][j];
-}
-
 int rest_planes(bool planar) { return planar ? 5 : 9; }
 
 }  // namespace
@@ -343,7 +330,7 @@ void enriched_element_clustered_stiffness(const EnrichedElementBatch& batch, con
         for (std::int64_t c = clusters.element_start[e]; c < clusters.element_start[e + 1]; ++c) {
           if (planar) {
             double O[5][9];
-            planar_frame_products(&frames[9 * e], rotations + 9 * c, O);
+            enriched_planar_frame_products(&frames[9 * e], rotations + 9 * c, &O[0][0]);
             add_rotated_planar_blocks(length, rest + c * stride + p0, plane, O, acc.data(), length);
           } else {
             add_rotated_blocks(length, rest + c * stride + p0, plane, rotations + 9 * c, acc.data(), length);
@@ -383,7 +370,7 @@ void enriched_element_clustered_stiffness(const EnrichedElementBatch& batch, con
       },
       execution);
   // Planes k = (x, y) of the frame pairs; a stored block (b, a) read as (a, b) swaps them.
-  const int pair[5][2] = {{0, 0}, {0, 1}, {1, 0}, {1, 1}, {2, 2}};
+  const auto& pair = enriched_planar_pairs;
   const int transposed[5] = {0, 2, 1, 3, 4};
   // Work items: tiles of functions a of one element. Cluster by cluster and b by b, the
   // tile reads blocks (a, b < npe), which for a >= b lie contiguously in row b of every

@@ -57,17 +57,22 @@ void enriched_element_corotated_stiffness(const EnrichedElementBatch& batch, con
                                           Execution execution = Execution::parallel);
 // Planar elements. Where an element's rest nodes lie in one plane (each within
 // enriched_planar_tolerance times the element's size of it), every point has the same
-// tangent plane and normal, so the unrotated strain rows need no 3 columns per function:
-// membrane rows are combinations of two fixed in-plane directions E1, E2, bending rows
-// multiples of the normal T. The unrotated forms (enriched_element_stiffness without
-// rotations, enriched_element_point_set_stiffness) then sum a 2n x 2n membrane and an
-// n x n bending matrix from 3 rows each (7.5 n^2 instead of 27 n^2 multiply-adds per
-// point) and expand the 3 x 3 blocks from them once per group of points: the same K to
-// round-off. enriched_element_planar_frame tells whether element e is planar and gives its
-// frame (rows E1, E2, T; E1 along the rest tangent a1 and T the rest normal t0 at the
-// element's centre; row-major 3 x 3), the same for every call.
+// tangent plane and normal, so the unrotated strain rows need no 3 columns per function.
+// The unrotated forms (enriched_element_stiffness without rotations,
+// enriched_element_point_set_stiffness) then sum one membrane row a point, the function
+// gradients along two fixed in-plane directions E1, E2 (2n columns: their products, from
+// which the plane-stress stiffness is formed per block afterwards), and three bending rows
+// along the normal T (n columns): 3.5 n^2 instead of 27 n^2 multiply-adds per point, the
+// same K to round-off. A 3 x 3 block (a, c) is then sum_k g_k x_k y_k^T over the five frame
+// pairs (x, y) = (E1, E1), (E1, E2), (E2, E1), (E2, E2), (T, T) (enriched_planar_pairs).
+// enriched_element_planar_frame tells whether element e is planar and gives its frame
+// (rows E1, E2, T; E1 along the rest tangent a1 and T the rest normal t0 at the element's
+// centre; row-major 3 x 3), the same for every call. enriched_planar_frame_products gives
+// the five products (R x)(R y)^T (R null: x y^T), 3 x 3 row-major each.
 constexpr double enriched_planar_tolerance = 1e-12;
+constexpr int enriched_planar_pairs[5][2] = {{0, 0}, {0, 1}, {1, 0}, {1, 1}, {2, 2}};
 bool enriched_element_planar_frame(const EnrichedElementBatch& batch, std::int64_t e, double frame[9]);
+void enriched_planar_frame_products(const double frame[9], const double* R, double products[45]);
 
 // Plain per-point form (every basis function at every point; serial): the reference.
 void enriched_element_stiffness_reference(const EnrichedElementBatch& batch, const EnrichedQuadrature& quadrature,
