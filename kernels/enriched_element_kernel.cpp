@@ -417,6 +417,24 @@ struct GroupMap {
   }
 };
 
+// Calls write(dN, d2N, r) for the reduced basis of a point, r = 0, 1, ...: the standard
+// functions, then the enriched ones of the textures that vary there (mask).
+template <class Write>
+void for_reduced_functions(const ElementLayout& L, std::uint32_t mask, const ShapeValues& s,
+                           const TextureSample* samples, Write&& write) {
+  for (int a = 0; a < L.npe; ++a) write(s.dN[a], s.d2N[a], a);
+  int r = L.npe;
+  for (int k = 0; k < L.count; ++k) {
+    if (!(mask >> k & 1u)) continue;
+    for (int a = 0; a < L.npe; ++a) {
+      if (L.slot[k][a] < 0) continue;
+      double dN[2], d2N[3];
+      product_rule(samples[k], L.shift[k][a], s, a, dN, d2N);
+      write(dN, d2N, r++);
+    }
+  }
+}
+
 // F at one point from the whole basis (the rest tangents have no enriched share), the
 // textures sampled at the point: the arithmetic of enriched_element_deformation_gradients.
 void point_deformation_gradient(const ElementLayout& L, const ShapeValues& s, const RestPoint& rest,
@@ -569,34 +587,16 @@ void chunk_stiffness(const EnrichedElementBatch& b, const EnrichedQuadrature& qu
       double* membrane = group.membrane_rows + group.pending * Sm;
       double* bb = group.bending_rows + 3 * group.pending * Sb;
       double* const bending[3] = {bb, bb + Sb, bb + 2 * Sb};
-      for (int a = 0; a < npe; ++a) pr.write_planar(s.dN[a], s.d2N[a], in_plane, normal, membrane, bending, a);
-      int r = npe;
-      for (int k = 0; k < L.count; ++k) {
-        if (!(mask >> k & 1u)) continue;
-        for (int a = 0; a < npe; ++a) {
-          if (L.slot[k][a] < 0) continue;
-          double dN[2], d2N[3];
-          product_rule(samples[k], L.shift[k][a], s, a, dN, d2N);
-          pr.write_planar(dN, d2N, in_plane, normal, membrane, bending, r++);
-        }
-      }
+      for_reduced_functions(L, mask, s, samples, [&](const double* dN, const double* d2N, int r) {
+        pr.write_planar(dN, d2N, in_plane, normal, membrane, bending, r);
+      });
       if (++group.pending == planar_block_points) flush(group, false);
       continue;
     }
     double* block = group.rows + static_cast<std::size_t>(6 * group.pending) * S;
     double* const row[6] = {block, block + S, block + 2 * S, block + 3 * S, block + 4 * S, block + 5 * S};
-    for (int a = 0; a < npe; ++a) pr.write(s.dN[a], s.d2N[a], row, 3 * a);
-    int r = npe;
-    for (int k = 0; k < L.count; ++k) {
-      if (!(mask >> k & 1u)) continue;
-      for (int a = 0; a < npe; ++a) {
-        if (L.slot[k][a] < 0) continue;
-        double dN[2], d2N[3];
-        product_rule(samples[k], L.shift[k][a], s, a, dN, d2N);
-        pr.write(dN, d2N, row, 3 * r);
-        ++r;
-      }
-    }
+    for_reduced_functions(L, mask, s, samples,
+                          [&](const double* dN, const double* d2N, int r) { pr.write(dN, d2N, row, 3 * r); });
     if (R && want_forces) {
       // Rest corotation strain B (X0 - R^T X0) over the standard functions (enriched X0 = 0).
       double strain[6] = {0, 0, 0, 0, 0, 0};
