@@ -32,6 +32,11 @@ bool mapped(std::size_t bytes) {
 
 std::size_t mapped_bytes(std::size_t bytes) { return (bytes + huge_page - 1) / huge_page * huge_page; }
 
+// The size a block is cached under: what it really holds. A mapped block is whole huge
+// pages, so a request a little larger or smaller than the one it was made for can take it
+// (a progressive cut's models ask for slightly different sizes from step to step).
+std::size_t block_capacity(std::size_t bytes) { return mapped(bytes) ? mapped_bytes(bytes) : bytes; }
+
 void* fresh_block(std::size_t bytes) {
 #if defined(__linux__) && defined(MADV_HUGEPAGE)
   if (mapped(bytes)) {
@@ -121,13 +126,14 @@ FloatMultigridBuffer frame_zeroed_float_buffer(std::size_t nx_padded, std::size_
 void* acquire_zeroed_block(std::size_t bytes) {
   if (bytes >= min_cached_bytes) {
     BlockCache& c = cache();
+    const std::size_t capacity = block_capacity(bytes);
     void* block = nullptr;
     {
       const std::lock_guard<std::mutex> lock(c.mutex);
       for (int k = c.count - 1; k >= 0; --k)
-        if (c.entries[k].bytes == bytes) {
+        if (c.entries[k].bytes == capacity) {
           block = c.entries[k].block;
-          c.total -= bytes;
+          c.total -= capacity;
           c.entries[k] = c.entries[--c.count];
           break;
         }
@@ -147,10 +153,11 @@ void release_block(void* block, std::size_t bytes) noexcept {
   if (!block) return;
   if (bytes >= min_cached_bytes) {
     BlockCache& c = cache();
+    const std::size_t capacity = block_capacity(bytes);
     const std::lock_guard<std::mutex> lock(c.mutex);
-    if (c.count < max_cached_blocks && c.total + bytes <= max_cached_total) {
-      c.entries[c.count++] = {block, bytes};
-      c.total += bytes;
+    if (c.count < max_cached_blocks && c.total + capacity <= max_cached_total) {
+      c.entries[c.count++] = {block, capacity};
+      c.total += capacity;
       return;
     }
   }

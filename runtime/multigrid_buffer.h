@@ -22,9 +22,10 @@ namespace dgtex::detail {
 
 // Zeroed memory for multigrid arrays: bytes >= 1 MiB mapped for huge pages, smaller blocks
 // from calloc. Released blocks of 64 KiB and more are kept (at most 64 blocks and 128 MiB per
-// process; thread-safe) and handed out again, zero-filled, for the same size: solves on tiles
-// of one size (bench repeats, the elements of one enrichment) then pay no page faults,
-// munmap/mmap or huge-page compaction after the first setup.
+// process; thread-safe) and handed out again, zero-filled, for the same size (mapped blocks:
+// the same number of huge pages): solves on tiles of one size (bench repeats, the elements of
+// one enrichment) then pay no page faults, munmap/mmap or huge-page compaction after the
+// first setup.
 void* acquire_zeroed_block(std::size_t bytes);
 void release_block(void* block, std::size_t bytes) noexcept;
 

@@ -699,13 +699,11 @@ void ShellModel::assemble_stiffness(const double* current, std::vector<double>& 
                                    std::to_string(size * 8 >> 20) + " MiB of rest sums (limit " +
                                    std::to_string(max_rotation_cluster_doubles * 8 >> 20) +
                                    " MiB); use larger blocks (enrichment.rotation_cluster_texels) or 0 (per point)");
-        // Whole huge pages: a progressive cut's next model needs a slightly different size,
-        // and a rounded one finds the block of the model before last in the block cache
+        // A progressive cut's next model needs a slightly different size; the block cache
+        // hands it the block of the model before last if it spans as many huge pages
         // (spiral6 at B = 16: ~23 MB a step, otherwise fresh pages faulted in every step).
         // The kernel writes every entry, so a cached block needs no zeroing.
-        constexpr std::size_t huge_page = std::size_t{2} << 20;
-        const std::size_t bytes =
-            (static_cast<std::size_t>(size) * sizeof(double) + huge_page - 1) / huge_page * huge_page;
+        const std::size_t bytes = static_cast<std::size_t>(size) * sizeof(double);
         {
           const detail::SkipCachedBlockZeroing written_by_the_kernel;
           w.cluster_rest.reset(static_cast<double*>(detail::acquire_zeroed_block(bytes)),

@@ -1,6 +1,7 @@
 // The multigrid's array allocator (runtime/multigrid_buffer.h): every MultigridBuffer(n)
 // holds n zeros, also when its block comes back from the cache with old values in it, for
-// heap-sized, cached and huge-page-mapped sizes; blocks are reused for the same size.
+// heap-sized, cached and huge-page-mapped sizes; blocks are reused for the same size, mapped
+// ones for any size of as many huge pages.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -44,6 +45,28 @@ TEST(MultigridBuffer, ReleasedBlocksAreReusedForTheSameSize) {
 #if defined(__linux__)
   // A huge-page mapped block is 2 MiB aligned.
   EXPECT_EQ(reinterpret_cast<std::uintptr_t>(again.data()) % (std::uintptr_t{2} << 20), 0u);
+#endif
+}
+
+TEST(MultigridBuffer, MappedBlocksAreReusedForSizesOfAsManyHugePages) {
+#if defined(__linux__)
+  // 1.6 MB and 1.9 MB both take one 2 MiB page; 2.4 MB takes two.
+  const double* first = nullptr;
+  {
+    MultigridBuffer v(200000);
+    first = v.data();
+    std::fill(v.begin(), v.end(), -1.0);
+  }
+  {
+    MultigridBuffer larger(237500);
+    EXPECT_EQ(larger.data(), first);
+    EXPECT_TRUE(all_zero(larger));
+  }
+  MultigridBuffer two_pages(300000);
+  EXPECT_NE(two_pages.data(), first);
+  EXPECT_TRUE(all_zero(two_pages));
+#else
+  GTEST_SKIP() << "huge-page mapping is Linux only";
 #endif
 }
 
