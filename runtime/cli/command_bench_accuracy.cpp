@@ -124,8 +124,7 @@ int bench_accuracy_command(int argc, char** argv) {
   } catch (const CLI::ParseError& e) {
     return app.exit(e) == 0 ? 0 : 2;
   }
-  std::string command = "dgtex bench";
-  for (int k = 0; k < argc; ++k) command += std::string(" ") + argv[k];
+  const std::string command = bench_command_line(argc, argv);
   try {
     split_names(charts);
     plate.repeat = quadrature.repeat = texture.repeat = tolerance.repeat = repeat;

@@ -194,10 +194,9 @@ int bench_scaling_command(int argc, char** argv) {
     }
   const std::set<std::string> chosen(families.begin(), families.end());
   // The chart's heading: the machine (before any run changes the thread count) and command.
-  std::string command = "dgtex bench";
-  for (int k = 0; k < argc; ++k) command += std::string(" ") + argv[k];
   const std::string about = describe_machine() + ", OMP_WAIT_POLICY=" +
-                            (std::getenv("OMP_WAIT_POLICY") ? std::getenv("OMP_WAIT_POLICY") : "default") + "\n" + command;
+                            (std::getenv("OMP_WAIT_POLICY") ? std::getenv("OMP_WAIT_POLICY") : "default") + "\n" +
+                            bench_command_line(argc, argv);
   if (batch_scenes.empty()) batch_scenes = {cut_scene_path, scene_path};
   const int max_threads = *std::max_element(threads.begin(), threads.end());
   if (batch_runs == 0) batch_runs = max_threads;

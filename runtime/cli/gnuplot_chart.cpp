@@ -36,4 +36,10 @@ std::string gnuplot_quoted(const std::string& text) {
   return out + "\"";
 }
 
+std::string bench_command_line(int argc, char** argv) {
+  std::string command = "dgtex bench";
+  for (int k = 0; k < argc; ++k) command += std::string(" ") + argv[k];
+  return command;
+}
+
 }  // namespace dgtex::cli

@@ -15,4 +15,8 @@ bool draw_gnuplot_chart(const std::string& path, int width, int height, const st
 // A gnuplot double-quoted string (newlines become line breaks there).
 std::string gnuplot_quoted(const std::string& text);
 
+// The command a bench chart states: "dgtex bench" and the subcommand's own arguments
+// (argv[0] is the subcommand's name).
+std::string bench_command_line(int argc, char** argv);
+
 }  // namespace dgtex::cli
