@@ -84,12 +84,14 @@ class BlockAssembly {
 };
 
 // How a product of a block matrix in this pattern with vectors should run: serially below
-// 4096 blocks. Waking the OpenMP team costs more than such a product (a cut single element
-// has 64-2500 blocks: spiral1's K u took 40 us on 2 threads against 3 us serially, and the
-// solver's PCG multiplies every iteration). Rows are independent, so either way gives the
-// same bits.
+// 32768 blocks. Waking the OpenMP team costs more than such a product (a cut single element
+// has 64-21609 blocks: spiral1's K u took 40 us on 2 threads against 3 us serially, and the
+// solver's PCG multiplies every iteration). The accordion's fully coupled 147 nodes (21609
+// blocks, 1.6 MB) still gain: its solve took 1.14-1.20 ms a step on 2 threads against
+// 0.77-0.86 ms serially (200 steps, 3 runs each). Fracture (41k blocks) and the cylinder
+// (120k) were the same either way. Rows are independent, so either way gives the same bits.
 inline kernels::Execution block_product_execution(const BlockAssembly& pattern) {
-  constexpr std::int64_t min_parallel_blocks = 4096;
+  constexpr std::int64_t min_parallel_blocks = 1 << 15;
   return pattern.num_blocks() >= min_parallel_blocks ? kernels::Execution::parallel : kernels::Execution::serial;
 }
 
