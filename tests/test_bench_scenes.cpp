@@ -74,6 +74,18 @@ TEST(BenchScenes, JsonHasEveryRequestedSceneWithRequiredKeysAndThesisRatios) {
     EXPECT_NEAR(s["steps_per_second"].get<double>() * s["timings_ms"]["step"]["mean"].get<double>(), 1e3, 1e-6);
     for (const char* key : {"elements", "nodes", "dofs", "free_dofs", "nonzeros", "enrichments"})
       EXPECT_TRUE(s["counts"].contains(key)) << key;
+    // The solver's counts per step add up to the totals; the first step factorises, and
+    // under gravity every step iterates.
+    const nlohmann::json& solver = s["solver"]["per_step"];
+    ASSERT_EQ(solver["pcg_iterations"].size(), 2u);
+    ASSERT_EQ(solver["factorizations"].size(), 2u);
+    EXPECT_GE(solver["factorizations"][0].get<int>(), 1);
+    EXPECT_GE(solver["pcg_iterations"][0].get<int>(), 1);
+    EXPECT_GE(solver["pcg_iterations"][1].get<int>(), 1);
+    EXPECT_EQ(s["solver"]["pcg_iterations"].get<int>(),
+              solver["pcg_iterations"][0].get<int>() + solver["pcg_iterations"][1].get<int>());
+    EXPECT_EQ(s["solver"]["factorizations"].get<int>(),
+              solver["factorizations"][0].get<int>() + solver["factorizations"][1].get<int>());
   }
   // spiral1: Table 5.1 "Spiral 1" (274 / 1.8 / 0.1 ms); ratio = thesis / ours.
   const nlohmann::json& spiral = j["scenes"][0];

@@ -51,6 +51,10 @@ struct SceneStepTimes {
   std::vector<double> enrichment, projection, assembly, solve;
   std::vector<double> step;      // wall clock of the whole step
   std::vector<double> step_cpu;  // process CPU time of the whole step (all threads summed)
+  // Per step, the factor-reusing solver's PCG iterations (those of a stale factor that
+  // failed included) and numeric factorisations (corotational scenes; a linear scene
+  // factorises outside it and counts 0).
+  std::vector<std::int64_t> pcg_iterations, factorizations;
 };
 
 struct SceneBenchResult {
