@@ -16,8 +16,8 @@
 // function order, starting from the constant 1. A function whose residual after removing
 // 1 and the earlier kept functions has an RMS below `tolerance` (H is O(1): +-1 data) does
 // not keep the node. Exact dependencies (constant +-1 components, which the Laplace solve
-// sets exactly) leave round-off; near dependencies (fragments) are left to the mass test
-// of ShellModel::set_enrichments.
+// sets exactly) leave round-off; near dependencies (fragments, cut pieces running close
+// to each other) are left to the mass test of ShellModel::set_enrichments.
 #include <vector>
 
 #include "dgtex/enrichment_function.h"

@@ -43,8 +43,11 @@ struct ShellModelOptions {
   // enrichment is one quadratic (enriched_quadrature.h), or per-texel everywhere.
   kernels::EnrichedQuadratureOptions enrichment_quadrature;
   // Enriched DOFs whose basis function adds less independent mass than this fraction of
-  // its node's own, M_vv - M_av^2 / M_aa < ratio M_aa (fragments a few texels wide), are
-  // dropped (set_enrichments); 0 keeps all.
+  // its node's own are dropped (set_enrichments); 0 keeps all. Independent of N^a and of
+  // the node's enrichments by earlier functions that were kept: M_vv - m^T G^-1 m < ratio
+  // M_aa, with G their mass Gram matrix and m their couplings to v (M_vv - M_av^2 / M_aa
+  // with no other enrichment). Catches fragments a few texels wide and two cut pieces
+  // whose functions nearly coincide at the node.
   double min_enrichment_mass_ratio = 1e-3;
   // Corotation of enriched elements: 0, per quadrature point; B > 0, one rotation per cluster
   // of points (those of a block of B x B texels on one side of every cut), their rest
