@@ -108,15 +108,30 @@ void FactorReusingSolver::factorize_element_local_values() {
   if (options_.single_precision_preconditioner) element_local_factor_->copy_factor_to_single_precision();
 }
 
+void FactorReusingSolver::factorize_full_values(SparseCholesky& cholesky) {
+  if (!cholesky.analyzed()) cholesky.analyze(system_.size(), system_.column_start(), system_.row_index());
+  cholesky.factorize(values_);
+  if (options_.single_precision_preconditioner) cholesky.copy_factor_to_single_precision();
+}
+
 void FactorReusingSolver::factorize_pending() {
   if (!factorization_pending_) return;
   factorization_pending_ = false;
   const auto start = std::chrono::steady_clock::now();
-  factorize_element_local_values();
+  bool factored = true;
+  if (use_element_local_) {
+    factorize_element_local_values();
+    factored = use_element_local_;  // false: it fell back, the next solve factorises the whole pattern
+  } else {
+    try {
+      factorize_full_values(*pending_factor_);
+    } catch (const NotPositiveDefinite&) {
+      factored = false;  // the next solve factorises its own matrix, and reports it if that fails too
+    }
+  }
   stats_.factorize_ms += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
-  if (!use_element_local_) return;  // fell back: the next solve factorises the whole pattern
-  factor_current_ = true;
-  ++stats_.factorizations;
+  factor_current_ = factored;
+  if (factored) ++stats_.factorizations;
 }
 
 void FactorReusingSolver::factorize(const ScaledBlockSum& A, SparseCholesky& cholesky) {
@@ -127,9 +142,7 @@ void FactorReusingSolver::factorize(const ScaledBlockSum& A, SparseCholesky& cho
   }
   if (!use_element_local_) {
     system_.gather(mass_.data(), A.mass_scale, A.stiffness->data(), A.stiffness_scale, values_);
-    if (!cholesky.analyzed()) cholesky.analyze(system_.size(), system_.column_start(), system_.row_index());
-    cholesky.factorize(values_);
-    if (options_.single_precision_preconditioner) cholesky.copy_factor_to_single_precision();
+    factorize_full_values(cholesky);
   }
   stats_.factorize_ms += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   factor_current_ = true;
@@ -290,8 +303,14 @@ void FactorReusingSolver::solve(const ScaledBlockSum& A, const std::vector<doubl
                              std::to_string(residual) + "); the system is ill-conditioned");
   // Judged by the factor now held (a fresh one after a failed attempt).
   if (iterations > options_.refactor_after_iterations) {
-    if (use_element_local_ && options_.overlap_factorization) {
-      gather_element_local(A);  // A_k now: the caller overwrites its K before the next solve
+    if (options_.overlap_factorization) {
+      // A_k now: the caller overwrites its K before the next solve.
+      if (use_element_local_) {
+        gather_element_local(A);
+      } else {
+        system_.gather(mass_.data(), A.mass_scale, A.stiffness->data(), A.stiffness_scale, values_);
+        pending_factor_ = &cholesky;
+      }
       factorization_pending_ = true;
     } else {
       factor_current_ = false;

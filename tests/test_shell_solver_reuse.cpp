@@ -5,7 +5,9 @@
 #include <gtest/gtest.h>
 #include <omp.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <vector>
 
 #include "dgtex/factor_reusing_solver.h"
@@ -213,6 +215,44 @@ TEST(FactorReuse, OverlappedFactorisationMeetsTheBoundAndAgreesWithTheSynchronou
   EXPECT_EQ(o.element_local_fallbacks, 0);
   EXPECT_GT(scale, 1e-3);
   EXPECT_LE(diff, 1e-6 * scale);
+}
+
+TEST(FactorReuse, WholePatternFactorisationIsAlsoLeftForBesideTheAssembly) {
+  // With the whole pattern (chosen, or after a fallback, as in the fracture scene) a stale
+  // solve, too, leaves the factorisation of its own matrix pending instead of factorising
+  // the next one synchronously; factorize_pending() then refreshes the caller's factor.
+  CompressedCylinder c;
+  std::vector<double> K;
+  c.model->assemble_stiffness(nullptr, K, nullptr);
+  FreeDofSystem system(c.model->pattern(), c.fixed);
+  SparseCholesky cholesky;
+  FactorReuseOptions options;
+  options.preconditioner_pattern = PreconditionerPattern::full;
+  options.refactor_after_iterations = 2;
+  FactorReusingSolver solver(c.model->pattern(), system, c.model->mass_blocks(), options);
+  ASSERT_FALSE(solver.element_local());
+  std::vector<double> x(c.model->num_dofs(), 0.0);
+  solver.solve(ScaledBlockSum{1.0, &K, 4e-6}, c.load, x, cholesky);  // factorises A_1
+  EXPECT_FALSE(solver.factorization_pending());
+  const ScaledBlockSum stiffer{1.0, &K, 1e-4};  // far from A_1: the old factor is stale
+  std::fill(x.begin(), x.end(), 0.0);
+  solver.solve(stiffer, c.load, x, cholesky);
+  const int stale_iterations = solver.statistics().last_iterations;
+  EXPECT_GT(stale_iterations, options.refactor_after_iterations);
+  EXPECT_LE(solver.statistics().last_relative_residual, options.relative_tolerance);
+  EXPECT_EQ(solver.statistics().factorizations, 1);
+  ASSERT_TRUE(solver.factorization_pending());
+  solver.factorize_pending();
+  EXPECT_FALSE(solver.factorization_pending());
+  EXPECT_EQ(solver.statistics().factorizations, 2);
+  // The refreshed factor is that of `stiffer` itself (in float): a few iterations at most.
+  std::fill(x.begin(), x.end(), 0.0);
+  solver.solve(stiffer, c.load, x, cholesky);
+  std::printf("stale factor: %d iterations; after the pending factorisation: %d\n", stale_iterations,
+              solver.statistics().last_iterations);
+  EXPECT_LE(solver.statistics().last_iterations, 3);
+  EXPECT_LE(solver.statistics().last_relative_residual, options.relative_tolerance);
+  EXPECT_EQ(solver.statistics().factorizations, 2);
 }
 
 TEST(FactorReuse, FallsBackToTheWholePatternWhenElementLocalIsTooWeak) {

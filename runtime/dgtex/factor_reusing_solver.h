@@ -28,9 +28,10 @@
 // not suffice either, the whole pattern of A_k is.
 // Refactorisation happens when a solve took more than `refactor_after_iterations`
 // iterations or did not converge in `max_iterations` (then A_k at once). In the first case
-// the element-local matrix of A_k itself is factorised while the caller assembles A_k+1
-// (FactorReuseOptions::overlap_factorization, factorize_pending()): CHOLMOD factorises on
-// one core, and waiting for it cost ~4 ms of the cylinder scene's ~22 ms step (2 threads).
+// the matrix of A_k itself (element-local or whole pattern) is factorised while the caller
+// assembles A_k+1 (FactorReuseOptions::overlap_factorization, factorize_pending()): CHOLMOD
+// factorises on one core, and waiting for it cost ~4 ms of the cylinder scene's ~22 ms step
+// (2 threads). The whole pattern's pending factor is the one passed to that solve.
 //
 // Determinism: the factor (CHOLMOD with serial BLAS), the block matrix-vector product
 // and the dot products (fixed chunking, summed in a fixed order) do not depend on the
@@ -72,11 +73,11 @@ struct FactorReuseOptions {
   // arithmetic stays in double, only the preconditioner is approximated further).
   bool single_precision_preconditioner = true;
   PreconditionerPattern preconditioner_pattern = PreconditionerPattern::element_local;
-  // Element-local only: a solve slower than refactor_after_iterations gathers its own matrix
-  // A_k and leaves its factorisation pending, to be run by factorize_pending() while the
-  // caller assembles the next matrix (on a thread of its own: CHOLMOD runs on one core),
-  // or else at the start of the next solve. That solve then starts from a factor one step
-  // old, judged like any reused factor. false: the next solve factorises its own A_k+1.
+  // A solve slower than refactor_after_iterations gathers its own matrix A_k (element-local
+  // or whole pattern) and leaves its factorisation pending, to be run by factorize_pending()
+  // while the caller assembles the next matrix (on a thread of its own: CHOLMOD runs on one
+  // core), or else at the start of the next solve. That solve then starts from a factor one
+  // step old, judged like any reused factor. false: the next solve factorises its own A_k+1.
   bool overlap_factorization = true;
 };
 
@@ -131,7 +132,9 @@ class FactorReusingSolver {
   // Factorises the matrix gathered by the last solve, if one is pending. Needs no OpenMP
   // team (CHOLMOD with serial BLAS): safe to run beside code that touches neither this
   // solver nor CHOLMOD. An element-local matrix that is not positive definite switches to
-  // the whole pattern (then the next solve factorises its own matrix).
+  // the whole pattern (then the next solve factorises its own matrix); a whole-pattern one
+  // leaves the next solve to factorise its own matrix (and report it). The whole pattern is
+  // factorised into the `cholesky` of the solve that left it pending: it must still exist.
   void factorize_pending();
   // True while the preconditioner is the element-local factor (no fallback happened).
   bool element_local() const { return use_element_local_; }
@@ -155,6 +158,7 @@ class FactorReusingSolver {
   bool factorization_pending_ = false;  // values_ holds an element-local A to factorise
   std::vector<double> values_, r_, z_, p_, q_, reduced_in_, reduced_out_, b_free_, guess_;
   std::vector<char> free_;
+  SparseCholesky* pending_factor_ = nullptr;  // the caller's whole-pattern factor a pending factorisation refreshes
   // Element-local preconditioner: the blocks it keeps, its system and factor (built on
   // first use), and whether it is in use.
   std::vector<char> element_local_blocks_;
@@ -170,6 +174,8 @@ class FactorReusingSolver {
   void gather_element_local(const ScaledBlockSum& A);
   // Numeric factorisation of values_ into the element-local factor (+ float copy).
   void factorize_element_local_values();
+  // Numeric factorisation of values_ (the whole pattern) into `cholesky` (+ float copy).
+  void factorize_full_values(SparseCholesky& cholesky);
   void fall_back_to_full_pattern();
   void precondition(const SparseCholesky& cholesky, const std::vector<double>& r, std::vector<double>& z);
   // y = A x over free DOFs (fixed entries of y set to zero).
