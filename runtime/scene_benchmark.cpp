@@ -163,6 +163,7 @@ SceneBenchResult run_scene_benchmark(const Scene& scene, const std::string& name
     if (progress) progress(step, steps);
   }
   result.steps = steps;
+  result.scene_steps = scene.analysis.steps;
   result.counts = count(scene, run);
   result.displacement = run.displacement();
   return result;

@@ -98,6 +98,8 @@ TEST(BenchScenes, JsonHasEveryRequestedSceneWithRequiredKeysAndThesisRatios) {
               0.1, 1e-12);
   EXPECT_EQ(spiral["counts"]["elements"], 1);
   EXPECT_EQ(spiral["counts"]["nodes"], 8);
+  // 2 of the scene's 300 steps: the targets (whole-run means in Table 5.1) are not judged.
+  EXPECT_TRUE(spiral["targets_met"].is_null());
   EXPECT_TRUE(j["scenes"][1]["table_5_1"].is_null());
   EXPECT_TRUE(j["scenes"][1]["ratio_to_table_5_1"].is_null());
   EXPECT_EQ(j["scenes"][1]["counts"]["enrichments"], 0);
@@ -119,6 +121,7 @@ TEST(BenchScenes, CountsMatchTheReportOfDgtexRun) {
   ASSERT_EQ(b["scenes"].size(), 1u);
   EXPECT_EQ(b["scenes"][0]["steps"], 3);
   EXPECT_EQ(b["scenes"][0]["counts"], report["counts"]);
+  EXPECT_TRUE(b["scenes"][0]["targets_met"].is_boolean());  // a whole run is judged
   EXPECT_GE(report["counts"]["enrichments"].get<int>(), 1);  // the cut is there after 3 steps
 }
 

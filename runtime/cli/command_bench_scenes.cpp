@@ -80,6 +80,18 @@ StageRatios ratios(const ThesisTable51Row& row, const SceneBenchResult& r) {
           ratio(row.solve_ms, series_mean(r.times.solve))};
 }
 
+// The targets are judged on whole runs only: Table 5.1's assembly and solve figures are
+// means over the whole simulation, and a progressive cut's later steps cost more than its
+// first ones (the slinky starts with one enrichment function and ends with 12).
+enum class TargetVerdict { met, missed, partial_run };
+TargetVerdict judge_targets(const ThesisTable51Row& row, const SceneBenchResult& r) {
+  if (r.steps < r.scene_steps) return TargetVerdict::partial_run;
+  const StageRatios q = ratios(row, r);
+  const bool met = r.steps_per_second() >= kTargetStepsPerSecond && 1e3 / r.peak_step_ms() >= kTargetStepsPerSecond &&
+                   q.enrichment >= kTargetStageRatio && q.assembly >= kTargetStageRatio && q.solve >= kTargetStageRatio;
+  return met ? TargetVerdict::met : TargetVerdict::missed;
+}
+
 // 1000 / mean process CPU ms per step: robust against other processes taking the cores;
 // with one thread it approximates the steps/s of an idle core, with more it is a lower bound.
 double cpu_steps_per_second(const SceneBenchResult& r) {
@@ -129,9 +141,9 @@ nlohmann::json scene_json(const SceneBenchResult& r) {
                       {"assembly_ms_mean", row->assembly_ms},
                       {"solve_ms_mean", row->solve_ms}};
     j["ratio_to_table_5_1"] = {{"enrichment", q.enrichment}, {"assembly", q.assembly}, {"solve", q.solve}};
-    j["targets_met"] = r.steps_per_second() >= kTargetStepsPerSecond &&
-                       1e3 / r.peak_step_ms() >= kTargetStepsPerSecond && q.enrichment >= kTargetStageRatio &&
-                       q.assembly >= kTargetStageRatio && q.solve >= kTargetStageRatio;
+    const TargetVerdict verdict = judge_targets(*row, r);
+    j["targets_met"] = verdict == TargetVerdict::partial_run ? nlohmann::json(nullptr)
+                                                             : nlohmann::json(verdict == TargetVerdict::met);
   } else {
     j["table_5_1"] = nullptr;
     j["ratio_to_table_5_1"] = nullptr;
@@ -178,11 +190,12 @@ std::string markdown_tables(const std::vector<SceneBenchResult>& results) {
         << c.dofs << " | ";
     if (row) {
       const StageRatios q = ratios(*row, r);
-      const bool met = r.steps_per_second() >= kTargetStepsPerSecond && 1e3 / r.peak_step_ms() >= kTargetStepsPerSecond &&
-                       q.enrichment >= kTargetStageRatio && q.assembly >= kTargetStageRatio && q.solve >= kTargetStageRatio;
+      const TargetVerdict verdict = judge_targets(*row, r);
       out << format("%g", row->enrichment_ms) << " / " << format("%g", row->assembly_ms) << " / "
           << format("%g", row->solve_ms) << " | " << format("%.3g", q.enrichment) << " / " << format("%.3g", q.assembly)
-          << " / " << format("%.3g", q.solve) << " | " << (met ? "yes" : "no") << " |\n";
+          << " / " << format("%.3g", q.solve) << " | "
+          << (verdict == TargetVerdict::met ? "yes" : verdict == TargetVerdict::missed ? "no" : "- (partial run)")
+          << " |\n";
     } else {
       out << "- | - | - |\n";
     }
@@ -204,7 +217,7 @@ int bench_scenes_command(int argc, char** argv) {
                "dgtex bench scenes"};
   std::vector<std::string> scenes = bench_scene_names();
   std::string scene_dir = "examples/scenes", json_path, markdown_path;
-  int steps = 30, threads = 0;
+  int steps = 0, threads = 0;
   bool quiet = false, inline_cut_updates = false;
   app.add_option("--scenes", scenes,
                  "scenes to run: names in --scene-dir (chad, spiral1, spiral6, accordion, slinky, fracture, "
@@ -212,7 +225,9 @@ int bench_scenes_command(int argc, char** argv) {
       ->delimiter(',')
       ->capture_default_str();
   app.add_option("--scene-dir", scene_dir, "folder of the named scenes")->capture_default_str();
-  app.add_option("--steps", steps, "time steps per scene from rest (0: the scene's own analysis.steps)")
+  app.add_option("--steps", steps,
+                 "time steps per scene from rest (0: the scene's own analysis.steps, the whole run; Table 5.1 "
+                 "averages over whole runs, so the targets are judged only then)")
       ->capture_default_str()
       ->check(CLI::NonNegativeNumber);
   app.add_option("--threads", threads, "OpenMP threads (default: all cores)")->check(CLI::Range(1, 1024));

@@ -63,6 +63,7 @@ struct SceneBenchResult {
   int threads = 1;       // OpenMP threads it ran with
   bool overlap_cut_updates = true;  // SceneRunOptions it ran with (dgtex/scene_run.h)
   int steps = 0;         // steps taken
+  int scene_steps = 0;   // the scene's own analysis.steps (fewer taken: a partial run)
   double setup_ms = 0;   // building mesh, model and simulation, without the time-0 enrichment
   SceneStepTimes times;  // per step (step 1 includes the time-0 enrichment update)
   SceneCounts counts;
