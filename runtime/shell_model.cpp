@@ -809,9 +809,8 @@ void ShellModel::set_enrichments(std::vector<EnrichmentFunction> functions) {
     for (std::int64_t k = pattern().row_start()[r]; k < pattern().row_start()[r + 1]; ++k)
       if (pattern().column()[k] == r) diagonal[r] = mass_blocks_[9 * k];
   auto coupling = [&](int row, int column) {
-    for (std::int64_t k = pattern().row_start()[row]; k < pattern().row_start()[row + 1]; ++k)
-      if (pattern().column()[k] == column) return mass_blocks_[9 * k];
-    return 0.0;
+    const std::int64_t k = pattern().find(row, column);
+    return k < 0 ? 0.0 : mass_blocks_[9 * k];
   };
   // The nodes kept per function first; the textures are moved (not copied) only if any go.
   std::vector<std::vector<int>> kept_nodes(enrichments_.size());
@@ -826,7 +825,7 @@ void ShellModel::set_enrichments(std::vector<EnrichmentFunction> functions) {
     Eigen::VectorXd cross(k);
     for (int i = 0; i < k; ++i) {
       cross[i] = coupling(v, earlier[i]);
-      for (int j = 0; j < k; ++j) gram(i, j) = coupling(earlier[i], earlier[j]);
+      for (int j = 0; j <= i; ++j) gram(i, j) = gram(j, i) = coupling(earlier[i], earlier[j]);
     }
     const double independent = diagonal[v] - cross.dot(gram.ldlt().solve(cross));
     if (independent < options_.min_enrichment_mass_ratio * diagonal[node]) {
