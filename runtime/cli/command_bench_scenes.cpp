@@ -172,7 +172,8 @@ std::string markdown_tables(const std::vector<SceneBenchResult>& results) {
     out << "| " << r.name << " | " << r.steps << " | " << format("%.1f", r.steps_per_second()) << " | "
         << format("%.1f", r.peak_step_ms() > 0 ? 1e3 / r.peak_step_ms() : 0.0) << " | " << pair(t.enrichment) << " | "
         << pair(t.projection) << " | " << pair(t.assembly) << " | " << pair(t.solve) << " | "
-        << total(t.pcg_iterations) << " / " << total(t.factorizations) << " | " << format("%.3g", series_mean(t.step_cpu)) << " | " << format("%.1f", cpu_steps_per_second(r)) << " |\n";
+        << total(t.pcg_iterations) << " / " << total(t.factorizations) << " | "
+        << format("%.3g", series_mean(t.step_cpu)) << " | " << format("%.1f", cpu_steps_per_second(r)) << " |\n";
   }
   out << "\n| scene | Table 5.1 row: els / nodes / enr / T | ours: els / nodes / enr / T / DOFs "
          "| Table 5.1 enr peak / asm / sol | ratio enr / asm / sol | targets met |\n"

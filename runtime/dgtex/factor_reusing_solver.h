@@ -155,10 +155,10 @@ class FactorReusingSolver {
   FactorReuseOptions options_;
   FactorReuseStatistics stats_;
   bool factor_current_ = false;  // cholesky holds a factor of some earlier A
-  bool factorization_pending_ = false;  // values_ holds an element-local A to factorise
+  bool factorization_pending_ = false;  // values_ holds an A_k (element-local or whole pattern) to factorise
   std::vector<double> values_, r_, z_, p_, q_, reduced_in_, reduced_out_, b_free_, guess_;
   std::vector<char> free_;
-  SparseCholesky* pending_factor_ = nullptr;  // the caller's whole-pattern factor a pending factorisation refreshes
+  SparseCholesky* pending_factor_ = nullptr;  // whole pattern: the caller's factor that factorize_pending() refreshes
   // Element-local preconditioner: the blocks it keeps, its system and factor (built on
   // first use), and whether it is in use.
   std::vector<char> element_local_blocks_;
