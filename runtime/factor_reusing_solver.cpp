@@ -31,6 +31,18 @@ std::vector<char> element_local_blocks(const std::vector<double>& mass) {
   return kept;
 }
 
+FactorReuseStatistics operator+(const FactorReuseStatistics& a, const FactorReuseStatistics& b) {
+  FactorReuseStatistics sum = b;
+  sum.solves += a.solves;
+  sum.factorizations += a.factorizations;
+  sum.iterations += a.iterations;
+  sum.factorize_ms += a.factorize_ms;
+  sum.precondition_ms += a.precondition_ms;
+  sum.element_local_fallbacks += a.element_local_fallbacks;
+  sum.stale_factor_failures += a.stale_factor_failures;
+  return sum;
+}
+
 double deterministic_dot(const std::vector<double>& x, const std::vector<double>& y) {
   const std::int64_t n = static_cast<std::int64_t>(x.size());
   double partial[dot_chunks];
@@ -284,6 +296,7 @@ void FactorReusingSolver::solve(const ScaledBlockSum& A, const std::vector<doubl
   int wasted = 0;
   if (iterations < 0 && !fresh) {
     // The old factor no longer preconditions well enough: factorise this matrix.
+    ++stats_.stale_factor_failures;
     wasted += options_.max_iterations;
     factorize(A, cholesky);
     x = guess_;

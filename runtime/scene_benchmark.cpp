@@ -134,9 +134,7 @@ SceneBenchResult run_scene_benchmark(const Scene& scene, const std::string& name
   const double initial_enrichment_cpu_ms = setup_ms > 0 ? setup_cpu_ms * initial_enrichment_ms / setup_ms : 0.0;
 
   SceneStepTimes& t = result.times;
-  // Each basis change starts a new simulation, whose solver counts from zero.
-  int counted_basis_changes = run.basis_changes();
-  FactorReuseStatistics counted = run.simulation().solver_statistics();
+  FactorReuseStatistics counted = run.solver_statistics();
   StageTimings before = run.timings();
   before["enrichment"].total_ms -= initial_enrichment_ms;
   for (int step = 1; step <= steps; ++step) {
@@ -155,8 +153,7 @@ SceneBenchResult run_scene_benchmark(const Scene& scene, const std::string& name
     t.step.push_back(wall + (step == 1 ? initial_enrichment_ms : 0.0));
     t.step_cpu.push_back(cpu + (step == 1 ? initial_enrichment_cpu_ms : 0.0));
     before = after;
-    if (run.basis_changes() != counted_basis_changes) counted_basis_changes = run.basis_changes(), counted = {};
-    const FactorReuseStatistics& solver = run.simulation().solver_statistics();
+    const FactorReuseStatistics solver = run.solver_statistics();
     t.pcg_iterations.push_back(solver.iterations - counted.iterations);
     t.factorizations.push_back(solver.factorizations - counted.factorizations);
     counted = solver;

@@ -150,6 +150,7 @@ void SceneRun::change_basis(std::vector<EnrichmentFunction> functions, int edge_
   auto simulation = std::make_unique<ShellSimulation>(*next, std::move(fixed), std::move(force));
   simulation->set_state(std::move(projected.displacement), std::move(projected.velocity));
   merge(timings_, simulation_->timings());
+  replaced_solver_statistics_ = replaced_solver_statistics_ + simulation_->solver_statistics();
   simulation_ = std::move(simulation);  // before model_: the old simulation refers to it
   model_ = std::move(next);
   ++basis_changes_;
@@ -159,6 +160,10 @@ StageTimings SceneRun::timings() const {
   StageTimings all = timings_;
   merge(all, simulation_->timings());
   return all;
+}
+
+FactorReuseStatistics SceneRun::solver_statistics() const {
+  return replaced_solver_statistics_ + simulation_->solver_statistics();
 }
 
 ShellState SceneRun::state() const {

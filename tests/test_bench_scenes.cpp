@@ -122,6 +122,11 @@ TEST(BenchScenes, CountsMatchTheReportOfDgtexRun) {
   EXPECT_EQ(b["scenes"][0]["steps"], 3);
   EXPECT_EQ(b["scenes"][0]["counts"], report["counts"]);
   EXPECT_TRUE(b["scenes"][0]["targets_met"].is_boolean());  // a whole run is judged
+  // The solver's totals over the run's three bases (a basis change every step) agree too.
+  EXPECT_EQ(report["solver"]["solves"], 3);
+  EXPECT_EQ(report["solver"]["pcg_iterations"], b["scenes"][0]["solver"]["pcg_iterations"]);
+  EXPECT_EQ(report["solver"]["factorizations"], b["scenes"][0]["solver"]["factorizations"]);
+  EXPECT_EQ(report["solver"]["stale_factor_failures"], 0);
   EXPECT_GE(report["counts"]["enrichments"].get<int>(), 1);  // the cut is there after 3 steps
 }
 

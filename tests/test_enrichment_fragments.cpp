@@ -166,4 +166,5 @@ TEST(EnrichmentFragments, FractureSceneStaysStableWithNearCopiesDropped) {
   EXPECT_LT(max_enriched, 2 * max_standard);
   // Fewer than max_iterations: the reused factor never failed.
   EXPECT_LT(max_iterations, FactorReuseOptions{}.max_iterations);
+  EXPECT_EQ(run.solver_statistics().stale_factor_failures, 0);
 }

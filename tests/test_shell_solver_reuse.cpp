@@ -152,6 +152,7 @@ TEST(FactorReuse, StalePreconditionerIsReplacedAndTheBoundStillHolds) {
   }
   EXPECT_EQ(solver.statistics().solves, 3);
   EXPECT_EQ(solver.statistics().factorizations, 2);
+  EXPECT_EQ(solver.statistics().stale_factor_failures, 1);  // the third solve's old factor
 }
 
 TEST(FactorReuse, ElementLocalPreconditionerIsSparserAndGivesTheSameSteps) {

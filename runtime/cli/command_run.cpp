@@ -165,6 +165,20 @@ int run_command(int argc, char** argv) {
                           {"assembly", stage_json(timings, "assembly")},
                           {"solve", stage_json(timings, "solve")}};
   if (png_frames) report["timings_ms"]["render"] = stage_json(png_frames->timings(), "render");
+  const FactorReuseStatistics solver = run->solver_statistics();
+  report["solver"] = {{"solves", solver.solves},
+                      {"pcg_iterations", solver.iterations},
+                      {"factorizations", solver.factorizations},
+                      {"stale_factor_failures", solver.stale_factor_failures},
+                      {"element_local_fallbacks", solver.element_local_fallbacks}};
+  // A reused factor that keeps failing means the step matrix changes fast from step to step:
+  // worth a look at the result (fracture's unstable near-massless mode showed up this way).
+  if (solver.stale_factor_failures >= 5 && solver.stale_factor_failures * 20 > solver.solves)
+    std::fprintf(stderr,
+                 "dgtex run: warning: the step solver's reused factor failed in %ld of %ld solves (the system "
+                 "changes fast from step to step, e.g. a mode with almost no mass going unstable); check the "
+                 "result, see README \"Stability where methods fail\"\n",
+                 solver.stale_factor_failures, solver.solves);
   report["time"] = run->time();
   report["threads"] = omp_get_max_threads();
   nlohmann::json probes = nlohmann::json::object();

@@ -92,7 +92,14 @@ struct FactorReuseStatistics {
   // Element-local preconditioning given up for the whole pattern (0 or 1): its matrix was
   // not positive definite, or a fresh factor of it did not converge in max_iterations.
   int element_local_fallbacks = 0;
+  // Solves whose reused factor did not converge in max_iterations (those iterations wasted,
+  // then A_k factorised at once). Many in a row: A changes fast from step to step, e.g. a
+  // nearly massless mode that has gone unstable.
+  long stale_factor_failures = 0;
 };
+
+// a + b for the counters and times; the last_* fields are b's (the later run's).
+FactorReuseStatistics operator+(const FactorReuseStatistics& a, const FactorReuseStatistics& b);
 
 // The step matrix A = mass_scale M + stiffness_scale K (blocks in the solver's pattern). A is
 // never formed: a product reads K once and M through its scalar diagonal (the shell's

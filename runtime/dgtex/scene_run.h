@@ -69,6 +69,9 @@ class SceneRun {
   int basis_changes() const { return basis_changes_; }
   // All stages so far (those of replaced simulations included).
   StageTimings timings() const;
+  // The step solver's statistics so far, summed over the simulations of every basis (the
+  // last_* fields: the latest solve's).
+  FactorReuseStatistics solver_statistics() const;
   // The state for rendering and export: mesh, nodal displacement and, per enrichment
   // function and element of its Omega_i, the texture, node shifts and DOFs.
   ShellState state() const;
@@ -101,6 +104,7 @@ class SceneRun {
   std::unique_ptr<ShellSimulation> simulation_;
   DynamicsOptions dynamics_;
   StageTimings timings_;  // own stages and those of replaced simulations
+  FactorReuseStatistics replaced_solver_statistics_;  // summed over replaced simulations
   double time_ = 0;
   int steps_ = 0;
   int basis_changes_ = 0;
