@@ -39,7 +39,9 @@ std::pair<double, double> scaled_mass_spectrum(const ShellModel& model) {
   return {eig(0), eig(n - 1)};
 }
 
-std::unique_ptr<ShellModel> sliver_model(const Mesh& mesh, double min_mass_ratio) {
+// A model of the default material with these enrichment functions.
+std::unique_ptr<ShellModel> enriched_model(const Mesh& mesh, std::vector<EnrichmentFunction> functions,
+                                           double min_mass_ratio) {
   const Topology topology = build_topology(mesh);
   const testing_support::Material m;
   std::vector<kernels::ShellSection> sections(mesh.num_elements(), {m.E, m.nu, m.h, m.rho});
@@ -47,9 +49,14 @@ std::unique_ptr<ShellModel> sliver_model(const Mesh& mesh, double min_mass_ratio
   options.penalty = 1.0;
   options.min_enrichment_mass_ratio = min_mass_ratio;
   auto model = std::make_unique<ShellModel>(mesh, topology, sections, std::vector<int>{}, options);
-  // 1 texel from the left edge of a 2 x 1 plate of 0.5-wide elements at T = 64.
-  model->set_enrichments({straight_cut_enrichment(mesh, 64, [](const double* x) { return x[0] - 0.5 / 64; })});
+  model->set_enrichments(std::move(functions));
   return model;
+}
+
+std::unique_ptr<ShellModel> sliver_model(const Mesh& mesh, double min_mass_ratio) {
+  // 1 texel from the left edge of a 2 x 1 plate of 0.5-wide elements at T = 64.
+  return enriched_model(mesh, {straight_cut_enrichment(mesh, 64, [](const double* x) { return x[0] - 0.5 / 64; })},
+                        min_mass_ratio);
 }
 
 TEST(EnrichmentFragments, DroppingTinySupportsKeepsTheMassMatrixWellConditioned) {
@@ -92,18 +99,10 @@ EnrichmentFunction smooth_enrichment(const Mesh& mesh, int t, const LevelFunctio
 
 // The first function sin(8x) (and a second one, if given) on every node.
 std::unique_ptr<ShellModel> smooth_function_model(const Mesh& mesh, const LevelFunction* second, double min_mass_ratio) {
-  const Topology topology = build_topology(mesh);
-  const testing_support::Material m;
-  std::vector<kernels::ShellSection> sections(mesh.num_elements(), {m.E, m.nu, m.h, m.rho});
-  ShellModelOptions options;
-  options.penalty = 1.0;
-  options.min_enrichment_mass_ratio = min_mass_ratio;
-  auto model = std::make_unique<ShellModel>(mesh, topology, sections, std::vector<int>{}, options);
   std::vector<EnrichmentFunction> functions = {
       smooth_enrichment(mesh, 32, [](const double* x) { return std::sin(8 * x[0]); })};
   if (second) functions.push_back(smooth_enrichment(mesh, 32, *second));
-  model->set_enrichments(std::move(functions));
-  return model;
+  return enriched_model(mesh, std::move(functions), min_mass_ratio);
 }
 
 }  // namespace

@@ -42,6 +42,15 @@ struct CompressedCylinder {
   }
 };
 
+// The cylinder's rest stiffness K and free-DOF system, and a factor for the solver to fill.
+struct CylinderSystem {
+  CompressedCylinder c;
+  std::vector<double> K;
+  FreeDofSystem system;
+  SparseCholesky cholesky;
+  CylinderSystem() : system(c.model->pattern(), c.fixed) { c.model->assemble_stiffness(nullptr, K, nullptr); }
+};
+
 double norm_free(const std::vector<double>& v, const std::vector<char>& fixed) {
   double s = 0;
   for (size_t d = 0; d < v.size(); ++d)
@@ -120,16 +129,15 @@ TEST(FactorReuse, ResultIsBitwiseIndependentOfThreadCountAcrossRefactorisations)
 }
 
 TEST(FactorReuse, StalePreconditionerIsReplacedAndTheBoundStillHolds) {
-  CompressedCylinder c;
-  std::vector<double> K;
-  c.model->assemble_stiffness(nullptr, K, nullptr);
+  CylinderSystem cylinder;
+  CompressedCylinder& c = cylinder.c;
+  const std::vector<double>& K = cylinder.K;
+  SparseCholesky& cholesky = cylinder.cholesky;
   const std::vector<double>& M = c.model->mass_blocks();
   const int n = c.model->num_dofs();
-  FreeDofSystem system(c.model->pattern(), c.fixed);
-  SparseCholesky cholesky;
   FactorReuseOptions options;
   options.max_iterations = 3;
-  FactorReusingSolver solver(c.model->pattern(), system, M, options);
+  FactorReusingSolver solver(c.model->pattern(), cylinder.system, M, options);
   auto relative_residual = [&](const ScaledBlockSum& A, const std::vector<double>& b, const std::vector<double>& x) {
     std::vector<double> Mx(n), Kx(n), r(n);
     block_multiply(c.model->pattern(), M.data(), x.data(), Mx.data());
@@ -222,22 +230,19 @@ TEST(FactorReuse, WholePatternFactorisationIsAlsoLeftForBesideTheAssembly) {
   // With the whole pattern (chosen, or after a fallback, as in the fracture scene) a stale
   // solve, too, leaves the factorisation of its own matrix pending instead of factorising
   // the next one synchronously; factorize_pending() then refreshes the caller's factor.
-  CompressedCylinder c;
-  std::vector<double> K;
-  c.model->assemble_stiffness(nullptr, K, nullptr);
-  FreeDofSystem system(c.model->pattern(), c.fixed);
-  SparseCholesky cholesky;
+  CylinderSystem cylinder;
+  const CompressedCylinder& c = cylinder.c;
   FactorReuseOptions options;
   options.preconditioner_pattern = PreconditionerPattern::full;
   options.refactor_after_iterations = 2;
-  FactorReusingSolver solver(c.model->pattern(), system, c.model->mass_blocks(), options);
+  FactorReusingSolver solver(c.model->pattern(), cylinder.system, c.model->mass_blocks(), options);
   ASSERT_FALSE(solver.element_local());
   std::vector<double> x(c.model->num_dofs(), 0.0);
-  solver.solve(ScaledBlockSum{1.0, &K, 4e-6}, c.load, x, cholesky);  // factorises A_1
+  solver.solve(ScaledBlockSum{1.0, &cylinder.K, 4e-6}, c.load, x, cylinder.cholesky);  // factorises A_1
   EXPECT_FALSE(solver.factorization_pending());
-  const ScaledBlockSum stiffer{1.0, &K, 1e-4};  // far from A_1: the old factor is stale
+  const ScaledBlockSum stiffer{1.0, &cylinder.K, 1e-4};  // far from A_1: the old factor is stale
   std::fill(x.begin(), x.end(), 0.0);
-  solver.solve(stiffer, c.load, x, cholesky);
+  solver.solve(stiffer, c.load, x, cylinder.cholesky);
   const int stale_iterations = solver.statistics().last_iterations;
   EXPECT_GT(stale_iterations, options.refactor_after_iterations);
   EXPECT_LE(solver.statistics().last_relative_residual, options.relative_tolerance);
@@ -248,7 +253,7 @@ TEST(FactorReuse, WholePatternFactorisationIsAlsoLeftForBesideTheAssembly) {
   EXPECT_EQ(solver.statistics().factorizations, 2);
   // The refreshed factor is that of `stiffer` itself (in float): a few iterations at most.
   std::fill(x.begin(), x.end(), 0.0);
-  solver.solve(stiffer, c.load, x, cholesky);
+  solver.solve(stiffer, c.load, x, cylinder.cholesky);
   std::printf("stale factor: %d iterations; after the pending factorisation: %d\n", stale_iterations,
               solver.statistics().last_iterations);
   EXPECT_LE(solver.statistics().last_iterations, 3);
@@ -260,20 +265,17 @@ TEST(FactorReuse, FallsBackToTheWholePatternWhenElementLocalIsTooWeak) {
   // With one iteration allowed and an exact (double) preconditioner only a factor of A
   // itself converges: the element-local factor fails twice (stale, then fresh) and the
   // solver must switch to the whole pattern for good, still meeting the bound.
-  CompressedCylinder c;
-  std::vector<double> K;
-  c.model->assemble_stiffness(nullptr, K, nullptr);
-  FreeDofSystem system(c.model->pattern(), c.fixed);
-  SparseCholesky cholesky;
+  CylinderSystem cylinder;
+  const CompressedCylinder& c = cylinder.c;
   FactorReuseOptions options;
   options.max_iterations = 1;
   options.single_precision_preconditioner = false;
-  FactorReusingSolver solver(c.model->pattern(), system, c.model->mass_blocks(), options);
+  FactorReusingSolver solver(c.model->pattern(), cylinder.system, c.model->mass_blocks(), options);
   ASSERT_TRUE(solver.element_local());
-  const ScaledBlockSum A{1.0, &K, 4e-6};
+  const ScaledBlockSum A{1.0, &cylinder.K, 4e-6};
   for (int s = 0; s < 2; ++s) {
     std::vector<double> x(c.model->num_dofs(), 0.0);
-    solver.solve(A, c.load, x, cholesky);
+    solver.solve(A, c.load, x, cylinder.cholesky);
     EXPECT_LE(solver.statistics().last_relative_residual, options.relative_tolerance);
   }
   EXPECT_FALSE(solver.element_local());
