@@ -154,9 +154,10 @@ TEST(EnrichmentFragments, FractureSceneStaysStableWithNearCopiesDropped) {
   for (int step = 1; step <= 160; ++step) {
     run.step();
     const std::vector<double>& v = run.simulation().velocity();
-    for (int d = 0; d < static_cast<int>(v.size()); ++d)
-      (d < standard_dofs ? max_standard : max_enriched) = std::max(d < standard_dofs ? max_standard : max_enriched,
-                                                                    std::fabs(v[d]));
+    for (int d = 0; d < static_cast<int>(v.size()); ++d) {
+      double& largest = d < standard_dofs ? max_standard : max_enriched;
+      largest = std::max(largest, std::fabs(v[d]));
+    }
     max_iterations = std::max(max_iterations, run.simulation().solver_statistics().last_iterations);
   }
   std::printf("fracture, 160 steps: max |v| standard %.3g m/s, enriched %.3g m/s; most PCG iterations in a step %d; "
