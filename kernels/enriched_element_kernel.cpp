@@ -711,6 +711,13 @@ void enriched_planar_frame_products(const double frame[9], const double* R, doub
         products[9 * k + i * 3 + j] = r[enriched_planar_pairs[k][0]][i] * r[enriched_planar_pairs[k][1]][j];
 }
 
+void enriched_planar_sum_offsets(int n, std::size_t a, std::size_t c, std::size_t at[5]) {
+  const std::size_t N2 = 2 * static_cast<std::size_t>(n);
+  at[0] = 2 * a * N2 + 2 * c, at[1] = 2 * a * N2 + 2 * c + 1;
+  at[2] = (2 * a + 1) * N2 + 2 * c, at[3] = (2 * a + 1) * N2 + 2 * c + 1;
+  at[4] = N2 * N2 + a * n + c;
+}
+
 void enriched_element_stiffness_reference(const EnrichedElementBatch& batch, const EnrichedQuadrature& quadrature,
                                           const double* rotations, double* blocks, double* forces) {
   for (std::int64_t e = 0; e < batch.count; ++e) element_stiffness(batch, quadrature, e, rotations, blocks, forces);
@@ -723,9 +730,8 @@ namespace {
 // sum_ab Km(2 lo + a, 2 hi + b) E_a E_b^T + Kb(lo, hi) T T^T (O: enriched_planar_frame_products).
 void planar_block(const std::vector<std::vector<double>>& Kc, std::int64_t c0, std::int64_t c1, int n, std::size_t lo,
                   std::size_t hi, const double O[45], double block[9]) {
-  const std::size_t N2 = 2 * static_cast<std::size_t>(n), bending = N2 * N2;
-  const std::size_t at[5] = {2 * lo * N2 + 2 * hi, 2 * lo * N2 + 2 * hi + 1, (2 * lo + 1) * N2 + 2 * hi,
-                             (2 * lo + 1) * N2 + 2 * hi + 1, bending + lo * n + hi};
+  std::size_t at[5];
+  enriched_planar_sum_offsets(n, lo, hi, at);
   double g[5];
   for (int k = 0; k < 5; ++k) {
     g[k] = Kc[c0][at[k]];

@@ -265,16 +265,14 @@ void enriched_cluster_rest_stiffness(const EnrichedElementBatch& batch, const En
     double* out = rest + c * stride;
     enriched_element_point_set_stiffness(batch, quadrature, e, points, count, K, out + planes * plane);
     std::fill(out, out + planes * plane, 0.0);
-    const std::size_t N3 = 3 * static_cast<std::size_t>(n), N2 = 2 * static_cast<std::size_t>(n);
+    const std::size_t N3 = 3 * static_cast<std::size_t>(n);
     for (std::size_t a = 0; a < static_cast<std::size_t>(n); ++a)
       for (std::size_t b = a; b < static_cast<std::size_t>(n); ++b) {
         const std::int64_t p = packed_row_start(W, static_cast<int>(a)) + static_cast<std::int64_t>(b - a);
         if (planar) {  // K = [Km | Kb] (enriched_element_point_set_stiffness)
-          out[0 * plane + p] = K[2 * a * N2 + 2 * b];
-          out[1 * plane + p] = K[2 * a * N2 + 2 * b + 1];
-          out[2 * plane + p] = K[(2 * a + 1) * N2 + 2 * b];
-          out[3 * plane + p] = K[(2 * a + 1) * N2 + 2 * b + 1];
-          out[4 * plane + p] = K[N2 * N2 + a * n + b];
+          std::size_t at[5];
+          enriched_planar_sum_offsets(n, a, b, at);
+          for (int k = 0; k < 5; ++k) out[k * plane + p] = K[at[k]];
           continue;
         }
         for (std::size_t i = 0; i < 3; ++i)

@@ -16,6 +16,7 @@
 // Kernel conventions (dgtex/kernels/forall.h): arrays are the caller's, batch/view structs
 // only point into them, nothing is kept after a call; thread-safe on distinct outputs.
 // Units: consistent (SI: positions m, E Pa, h m, density kg/m^3; blocks N/m, forces N, mass kg).
+#include <cstddef>
 #include <cstdint>
 #include <vector>
 
@@ -73,6 +74,10 @@ constexpr double enriched_planar_tolerance = 1e-12;
 constexpr int enriched_planar_pairs[5][2] = {{0, 0}, {0, 1}, {1, 0}, {1, 1}, {2, 2}};
 bool enriched_element_planar_frame(const EnrichedElementBatch& batch, std::int64_t e, double frame[9]);
 void enriched_planar_frame_products(const double frame[9], const double* R, double products[45]);
+// Where block (a, c), a <= c, of a planar element's sums K = [Km | Kb] over n functions
+// (enriched_element_point_set_stiffness) keeps its five frame sums, in
+// enriched_planar_pairs order: Km(2a + x, 2c + y) for the four in-plane pairs, Kb(a, c).
+void enriched_planar_sum_offsets(int n, std::size_t a, std::size_t c, std::size_t at[5]);
 
 // Plain per-point form (every basis function at every point; serial): the reference.
 void enriched_element_stiffness_reference(const EnrichedElementBatch& batch, const EnrichedQuadrature& quadrature,
