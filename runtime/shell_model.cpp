@@ -804,10 +804,6 @@ void ShellModel::set_enrichments(std::vector<EnrichmentFunction> functions) {
   // Fracture had such pairs at three nodes: their difference, a mode with almost no mass,
   // went unstable under corotation after ~140 steps (90 m/s against the sheet's 2.5, and
   // 43 PCG iterations a step; tests/test_enrichment_fragments.cpp).
-  std::vector<double> diagonal(pattern().num_nodes(), 0.0);
-  for (int r = 0; r < pattern().num_nodes(); ++r)
-    for (std::int64_t k = pattern().row_start()[r]; k < pattern().row_start()[r + 1]; ++k)
-      if (pattern().column()[k] == r) diagonal[r] = mass_blocks_[9 * k];
   auto coupling = [&](int row, int column) {
     const std::int64_t k = pattern().find(row, column);
     return k < 0 ? 0.0 : mass_blocks_[9 * k];
@@ -827,8 +823,8 @@ void ShellModel::set_enrichments(std::vector<EnrichmentFunction> functions) {
       cross[i] = coupling(v, earlier[i]);
       for (int j = 0; j <= i; ++j) gram(i, j) = gram(j, i) = coupling(earlier[i], earlier[j]);
     }
-    const double independent = diagonal[v] - cross.dot(gram.ldlt().solve(cross));
-    if (independent < options_.min_enrichment_mass_ratio * diagonal[node]) {
+    const double independent = coupling(v, v) - cross.dot(gram.ldlt().solve(cross));
+    if (independent < options_.min_enrichment_mass_ratio * gram(0, 0)) {  // gram(0, 0) = M_aa
       ++pruned;
     } else {
       kept_nodes[virtual_node_function(v)].push_back(node);

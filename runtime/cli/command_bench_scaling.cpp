@@ -7,7 +7,6 @@
 
 #include <algorithm>
 #include <cstdio>
-#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -92,8 +91,7 @@ std::string markdown_tables(const std::vector<int>& threads, const std::vector<K
 }
 
 // Left: speed-up over the first thread count per family (and the ideal); right: scenes
-// per second, solo against batch.
-// Speed-up per family and batch throughput; `about` (machine, command) heads the chart.
+// per second, solo against batch. `about` (machine, command) heads the chart.
 bool write_chart(const std::string& path, const std::vector<KernelScaling>& kernels,
                  const std::vector<BatchThroughput>& batches, const std::string& about) {
   std::ostringstream data;
@@ -194,8 +192,7 @@ int bench_scaling_command(int argc, char** argv) {
     }
   const std::set<std::string> chosen(families.begin(), families.end());
   // The chart's heading: the machine (before any run changes the thread count) and command.
-  const std::string about = describe_machine() + ", OMP_WAIT_POLICY=" +
-                            (std::getenv("OMP_WAIT_POLICY") ? std::getenv("OMP_WAIT_POLICY") : "default") + "\n" +
+  const std::string about = describe_machine() + ", OMP_WAIT_POLICY=" + omp_wait_policy_name() + "\n" +
                             bench_command_line(argc, argv);
   if (batch_scenes.empty()) batch_scenes = {cut_scene_path, scene_path};
   const int max_threads = *std::max_element(threads.begin(), threads.end());
@@ -273,14 +270,14 @@ int bench_scaling_command(int argc, char** argv) {
 
   const std::string tables = markdown_tables(threads, kernels, batches);
   std::printf("dgtex bench scaling: %d cores, OMP_WAIT_POLICY=%s (kernels: best of %d, ms)\n\n%s", omp_get_num_procs(),
-              std::getenv("OMP_WAIT_POLICY") ? std::getenv("OMP_WAIT_POLICY") : "default", repeats, tables.c_str());
+              omp_wait_policy_name().c_str(), repeats, tables.c_str());
   try {
     if (!markdown_path.empty()) write_text(markdown_path, tables, "--markdown");
     if (!json_path.empty()) {
       nlohmann::json j = {{"cores", omp_get_num_procs()},
                           {"threads", threads},
                           {"repeats", repeats},
-                          {"omp_wait_policy", std::getenv("OMP_WAIT_POLICY") ? std::getenv("OMP_WAIT_POLICY") : "default"},
+                          {"omp_wait_policy", omp_wait_policy_name()},
                           {"kernels", nlohmann::json::array()},
                           {"batch", nlohmann::json::array()}};
       for (const KernelScaling& k : kernels) j["kernels"].push_back(kernel_json(k));

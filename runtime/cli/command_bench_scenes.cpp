@@ -6,7 +6,6 @@
 #include <unistd.h>
 
 #include <cstdio>
-#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -16,6 +15,7 @@
 #include <vector>
 
 #include "commands.h"
+#include "gnuplot_chart.h"
 #include "dgtex/mesh_error.h"
 #include "dgtex/model_error.h"
 #include "dgtex/scene_benchmark.h"
@@ -261,7 +261,7 @@ int bench_scenes_command(int argc, char** argv) {
   nlohmann::json all = {{"steps", steps},
                         {"threads", omp_get_max_threads()},
                         {"overlap_cut_updates", !inline_cut_updates},
-                        {"omp_wait_policy", std::getenv("OMP_WAIT_POLICY") ? std::getenv("OMP_WAIT_POLICY") : "default"},
+                        {"omp_wait_policy", omp_wait_policy_name()},
                         {"targets", {{"steps_per_second", kTargetStepsPerSecond}, {"stage_ratio", kTargetStageRatio}}},
                         {"scenes", nlohmann::json::array()}};
   const bool tty = isatty(fileno(stderr));

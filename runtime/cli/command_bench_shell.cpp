@@ -183,7 +183,7 @@ int bench_shell_command(int argc, char** argv) {
                             {"steps", steps},
                             {"solver", refactor_every_step ? "refactor_every_step" : "pcg_reused_factor"},
                             {"pcg_relative_tolerance", solver.relative_tolerance},
-                            {"omp_wait_policy", std::getenv("OMP_WAIT_POLICY") ? std::getenv("OMP_WAIT_POLICY") : "default"},
+                            {"omp_wait_policy", omp_wait_policy_name()},
                             {"refactor_after_iterations", solver.refactor_after_iterations},
                             {"preconditioner", preconditioner},
                             {"overlap_factorization", solver.overlap_factorization},

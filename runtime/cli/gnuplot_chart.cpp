@@ -42,4 +42,9 @@ std::string bench_command_line(int argc, char** argv) {
   return command;
 }
 
+std::string omp_wait_policy_name() {
+  const char* policy = std::getenv("OMP_WAIT_POLICY");
+  return policy ? policy : "default";
+}
+
 }  // namespace dgtex::cli

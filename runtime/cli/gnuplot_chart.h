@@ -1,5 +1,6 @@
 #pragma once
-// Charts of the bench commands, drawn by gnuplot (Debian gnuplot-nox).
+// Charts of the bench commands, drawn by gnuplot (Debian gnuplot-nox), and what a bench
+// report states about its run (command line, wait policy).
 #include <functional>
 #include <string>
 
@@ -18,5 +19,8 @@ std::string gnuplot_quoted(const std::string& text);
 // The command a bench chart states: "dgtex bench" and the subcommand's own arguments
 // (argv[0] is the subcommand's name).
 std::string bench_command_line(int argc, char** argv);
+
+// OMP_WAIT_POLICY as the bench reports state it: the variable's value, or "default".
+std::string omp_wait_policy_name();
 
 }  // namespace dgtex::cli
