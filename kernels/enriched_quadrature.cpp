@@ -190,16 +190,21 @@ struct CellBuilder {
     if (triangle) ri = i0 + w / 4, rj = j0 + h / 4;
     const double size = std::max(w, h);
     const double tol = options.merge_tolerance;
+    // The polynomials drift apart with the distance from the reference row, so the rows go
+    // outermost first (r = 0, h - 1, 1, h - 2, ...), every texture at each: a cell that is
+    // split usually fails at its first row instead of after all rows of the earlier textures.
+    TexelDerivatives refs[max_enrichments_per_element];
     for (int k = 0; k < in.texture_count; ++k) {
       const TexelDerivativePlanes at_ref = in.field_row(k, rj);
-      TexelDerivatives ref;
-      ref.value = at_ref.value[ri];
-      for (int c = 0; c < 2; ++c) ref.g[c] = at_ref.g[c][ri];
-      for (int c = 0; c < 3; ++c) ref.s[c] = at_ref.s[c][ri];
-      for (int r = 0; r < h; ++r) {
-        const int j = j0 + r, length = triangle ? w - r : w;
-        if (!row_agrees(ref, in.field_row(k, j), i0, length, ri, j - rj, size, tol)) return false;
-      }
+      refs[k].value = at_ref.value[ri];
+      for (int c = 0; c < 2; ++c) refs[k].g[c] = at_ref.g[c][ri];
+      for (int c = 0; c < 3; ++c) refs[k].s[c] = at_ref.s[c][ri];
+    }
+    for (int m = 0; m < h; ++m) {
+      const int r = m % 2 == 0 ? m / 2 : h - 1 - m / 2;
+      const int j = j0 + r, length = triangle ? w - r : w;
+      for (int k = 0; k < in.texture_count; ++k)
+        if (!row_agrees(refs[k], in.field_row(k, j), i0, length, ri, j - rj, size, tol)) return false;
     }
     return true;
   }
