@@ -10,6 +10,7 @@
 #include "dgtex/kernels/polar_decomposition.h"
 #include "dgtex/kernels/shell_point.h"
 #include "dgtex/kernels/symmetric_accumulator.h"
+#include "dgtex/kernels/texel_derivative_tile.h"
 #include "dgtex/kernels/vec3.h"
 
 namespace dgtex::kernels {
@@ -186,7 +187,10 @@ struct TexelCache {
     const double inv_h = 1.0 / texel_size(b.type, b.resolution);
     const double tol_g = enriched_flat_tolerance / inv_h, tol_s = tol_g / inv_h;
     for (int k = 0; k < L.count; ++k) {
-      texel_derivatives(b.type, b.resolution, b.textures[L.first + k], i, j, fd[k]);
+      const TextureView& texture = b.textures[L.first + k];
+      const TexelDerivativeTile* tile = b.derivatives ? b.derivatives[L.first + k] : nullptr;
+      if (tile && texel_in_domain(b.type, b.resolution, texture.flags, i, j)) tile->at(i, j, fd[k]);
+      else texel_derivatives(b.type, b.resolution, texture, i, j, fd[k]);
       const TexelDerivatives& d = fd[k];
       // |g| inv_h <= tol and |S| inv_h^2 <= tol over the texel (parametric units).
       flat[k] = std::abs(d.g[0]) <= tol_g && std::abs(d.g[1]) <= tol_g && std::abs(d.s[0]) <= tol_s &&

@@ -669,7 +669,10 @@ void ShellModel::assemble_stiffness(const double* current, std::vector<double>& 
   // edge) and only their used slots are written, so a fresh zero-filled vector per call
   // would cost more than the kernels.
   if (!enriched_elements_.empty()) {
-    const kernels::EnrichedElementBatch xb = enriched_element_batch();
+    kernels::EnrichedElementBatch xb = enriched_element_batch();
+    // The quadrature's texel derivatives: the stiffness kernels sample the textures at every
+    // point (per step under per-point corotation, per basis for the cluster rest sums).
+    if (texture_derivatives_.size() == textures_.size()) xb.derivatives = texture_derivatives_.data();
     const kernels::EnrichedEdgeBatch xg = enriched_edge_batch(xb);
     const kernels::EnrichedQuadrature element_quad{element_qp_start_.data(), element_qp_.data()};
     const kernels::EdgeQuadrature edge_quad{edge_qp_start_.data(), edge_qp_.data()};

@@ -82,6 +82,8 @@ void sample_texel_polynomial(ElementType type, int resolution, const TexelDeriva
 constexpr int max_enrichments_per_element = 31;
 constexpr int max_enriched_basis = max_element_nodes * (1 + max_enrichments_per_element);
 
+struct TexelDerivativeTile;
+
 struct EnrichedElementBatch {
   ElementType type;
   std::int64_t count;              // enriched elements
@@ -95,6 +97,11 @@ struct EnrichedElementBatch {
   const TextureView* textures;     // per element enrichment
   const int* enriched_node;        // per element enrichment x npe: global (virtual) node or -1
   const double* node_shift;        // per element enrichment x npe: H_j(xi^a)
+  // Optional, per element enrichment like textures: the texel derivatives of that texture
+  // (texel_derivative_tile.h) or null. Kernels that sample texel polynomials read a tile
+  // instead of recomputing texel_derivatives (the same bits in the domain; outside it they
+  // compute). The adaptive quadrature builds the tiles; ShellModel passes them on.
+  const TexelDerivativeTile* const* derivatives = nullptr;
 };
 
 // Number of local basis functions of enriched element e (npe + enriched ones).
