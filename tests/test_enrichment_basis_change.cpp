@@ -8,11 +8,13 @@
 //  - project_onto_basis equals the projection written out with those reference moments;
 //  - kernels::enriched_element_mass_and_load_weights (serial and parallel) equals
 //    enriched_element_mass and enriched_element_load_weights, and enriched_shape_values
-//    equals evaluate_enriched_shape's N.
+//    equals evaluate_enriched_shape's N;
+//  - the stiffness kernels given the quadrature's texel derivative tiles equal them without.
 // The cut advances across a 3x3 quad8 plate (and a 2x2 tri6 one) over several steps, so
 // elements far from the tip keep their textures while the others change.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstring>
 #include <memory>
 #include <random>
@@ -25,6 +27,7 @@
 #include "dgtex/kernels/cut_rasterization.h"
 #include "dgtex/kernels/enriched_element_rest_integrals.h"
 #include "dgtex/kernels/enriched_quadrature.h"
+#include "dgtex/kernels/enriched_rotation_clusters.h"
 #include "dgtex/mesh_generators.h"
 #include "dgtex/sparse_cholesky.h"
 #include "dgtex/topology.h"
@@ -154,34 +157,42 @@ TEST(BasisChange, ChainedTri6ModelAndProjectionEqualTheReferenceBitwise) {
 }
 
 // Two quad8 elements of one mesh, each with harmonic partial cuts (the second with two
-// enrichments), some nodes not enriched: the fused kernel against the two kernels.
-TEST(BasisChange, FusedMassAndLoadWeightsEqualTheTwoKernelsBitwise) {
-  const Mesh mesh = make_rectangle(2, 1, 2, 1, ElementType::quad8);
-  const int t = 32;
-  auto harmonic = [&](std::vector<kernels::TexelPoint> path) {
-    kernels::TexelTile walls = kernels::make_element_tile(ElementType::quad8, t);
-    const kernels::CutRaster raster = kernels::rasterize_cut(path, walls);
-    return harmonic_enrichment(walls, raster).tile;
-  };
-  const std::vector<kernels::TexelTile> tiles = {harmonic({{0, 15.5}, {20.3, 17.2}}), harmonic({{32, 9.2}, {12.1, 8.4}}),
-                                                 harmonic({{7.3, 32}, {9.8, 21.6}})};
+// enrichments), some nodes not enriched.
+struct TwoEnrichedElements {
+  static constexpr int t = 32, npe = 8;
+  Mesh mesh = make_rectangle(2, 1, 2, 1, ElementType::quad8);
+  std::vector<kernels::TexelTile> tiles;
   std::vector<kernels::TextureView> views;
-  for (const auto& tile : tiles) views.push_back({tile.values.data(), tile.flags.data()});
-  std::vector<kernels::ShellSection> sections(mesh.num_elements(), {1e6, 0.3, 0.01, 1000});
-  const int npe = 8;
-  const std::vector<int> element = {0, 1}, start = {0, 1, 3};
-  std::vector<int> node(3 * npe);
-  std::vector<double> shift(3 * npe);
-  for (int k = 0; k < 3; ++k)
-    for (int a = 0; a < npe; ++a) {
-      node[k * npe + a] = (k + a) % 3 == 0 ? -1 : 100 + k * npe + a;  // some nodes not enriched
-      shift[k * npe + a] = 0.1 * (a - 3) + 0.05 * k;
-    }
-  int width = 0;
-  kernels::EnrichedElementBatch batch{ElementType::quad8, 2, element.data(), mesh.elements.data(), mesh.positions.data(),
-                                      sections.data(), t, 0, start.data(), views.data(), node.data(), shift.data()};
-  for (int e = 0; e < 2; ++e) width = std::max(width, kernels::enriched_basis_count(batch, e));
-  batch.width = width;
+  std::vector<kernels::ShellSection> sections = std::vector<kernels::ShellSection>(2, {1e6, 0.3, 0.01, 1000});
+  std::vector<int> element = {0, 1}, start = {0, 1, 3}, node = std::vector<int>(3 * npe);
+  std::vector<double> shift = std::vector<double>(3 * npe);
+  kernels::EnrichedElementBatch batch{};
+
+  TwoEnrichedElements() {
+    auto harmonic = [&](std::vector<kernels::TexelPoint> path) {
+      kernels::TexelTile walls = kernels::make_element_tile(ElementType::quad8, t);
+      const kernels::CutRaster raster = kernels::rasterize_cut(path, walls);
+      return harmonic_enrichment(walls, raster).tile;
+    };
+    tiles = {harmonic({{0, 15.5}, {20.3, 17.2}}), harmonic({{32, 9.2}, {12.1, 8.4}}), harmonic({{7.3, 32}, {9.8, 21.6}})};
+    for (const auto& tile : tiles) views.push_back({tile.values.data(), tile.flags.data()});
+    for (int k = 0; k < 3; ++k)
+      for (int a = 0; a < npe; ++a) {
+        node[k * npe + a] = (k + a) % 3 == 0 ? -1 : 100 + k * npe + a;  // some nodes not enriched
+        shift[k * npe + a] = 0.1 * (a - 3) + 0.05 * k;
+      }
+    batch = {ElementType::quad8, 2,           element.data(), mesh.elements.data(), mesh.positions.data(),
+             sections.data(),    t,           0,              start.data(),         views.data(),
+             node.data(),        shift.data()};
+    for (int e = 0; e < 2; ++e) batch.width = std::max(batch.width, kernels::enriched_basis_count(batch, e));
+  }
+};
+
+// The fused kernel against the two kernels.
+TEST(BasisChange, FusedMassAndLoadWeightsEqualTheTwoKernelsBitwise) {
+  const TwoEnrichedElements setup;
+  const kernels::EnrichedElementBatch& batch = setup.batch;
+  const int width = batch.width;
   for (bool adaptive : {true, false}) {
     SCOPED_TRACE(adaptive ? "adaptive quadrature" : "per-texel quadrature");
     kernels::EnrichedQuadratureOptions options;
@@ -218,6 +229,56 @@ TEST(BasisChange, FusedMassAndLoadWeightsEqualTheTwoKernelsBitwise) {
     ASSERT_EQ(kernels::enriched_shape_values(batch, e, xi1, xi2, s, cache, values), full.count);
     ASSERT_EQ(std::memcmp(values, full.N, sizeof(double) * full.count), 0) << "point " << trial;
   }
+}
+
+// The stiffness kernels sample the textures at every point; given the quadrature's texel
+// derivative tiles (EnrichedElementBatch::derivatives) they read them instead of
+// recomputing each texel's derivatives, with the same bits: unrotated, corotated per point
+// and the rotation clusters' rest sums.
+TEST(BasisChange, StiffnessKernelsReadingTheTexelTilesAreBitwiseTheSame) {
+  const TwoEnrichedElements setup;
+  const kernels::EnrichedElementBatch plain = setup.batch;
+  std::vector<std::int64_t> qs;
+  std::vector<double> qp;
+  std::vector<std::shared_ptr<const kernels::TexelDerivativeTile>> owned;
+  kernels::enriched_element_quadrature(plain, kernels::EnrichedQuadratureOptions{}, qs, qp, &owned);
+  std::vector<const kernels::TexelDerivativeTile*> tiles;
+  for (const auto& tile : owned) tiles.push_back(tile.get());
+  ASSERT_EQ(tiles.size(), setup.views.size());
+  for (const auto* tile : tiles) ASSERT_NE(tile, nullptr);
+  kernels::EnrichedElementBatch with_tiles = plain;
+  with_tiles.derivatives = tiles.data();
+  const kernels::EnrichedQuadrature quad{qs.data(), qp.data()};
+
+  // A deformed state: rest positions plus a smooth displacement of every DOF.
+  const int dofs = 3 * (100 + 3 * TwoEnrichedElements::npe);
+  std::vector<double> current(dofs, 0.0);
+  for (int d = 0; d < dofs; ++d) current[d] = 0.01 * std::sin(0.7 * d);
+  for (size_t d = 0; d < setup.mesh.positions.size(); ++d) current[d] += setup.mesh.positions[d];
+
+  const int W = plain.width;
+  for (const double* state : {static_cast<const double*>(nullptr), static_cast<const double*>(current.data())}) {
+    SCOPED_TRACE(state ? "corotated per point" : "unrotated");
+    std::vector<double> blocks[2], forces[2];
+    for (int k = 0; k < 2; ++k) {
+      blocks[k].assign(2 * static_cast<size_t>(W) * W * 9, -1.0);
+      forces[k].assign(2 * static_cast<size_t>(W) * 3, -1.0);
+      const kernels::EnrichedElementBatch& batch = k == 0 ? plain : with_tiles;
+      if (state) kernels::enriched_element_corotated_stiffness(batch, quad, state, blocks[k].data(), forces[k].data());
+      else kernels::enriched_element_stiffness(batch, quad, nullptr, blocks[k].data(), nullptr);
+    }
+    EXPECT_TRUE(bitwise_equal(blocks[0], blocks[1]));
+    if (state) {
+      EXPECT_TRUE(bitwise_equal(forces[0], forces[1]));
+    }
+  }
+  const kernels::EnrichedRotationClusters clusters = kernels::enriched_rotation_clusters(plain, quad, 8, 2);
+  std::vector<double> rest[2];
+  for (int k = 0; k < 2; ++k) {
+    rest[k].assign(clusters.count() * kernels::enriched_cluster_rest_stride(plain), -1.0);
+    kernels::enriched_cluster_rest_stiffness(k == 0 ? plain : with_tiles, quad, clusters, rest[k].data());
+  }
+  EXPECT_TRUE(bitwise_equal(rest[0], rest[1]));
 }
 
 }  // namespace
