@@ -393,11 +393,43 @@ void ShellModel::integrate_enriched_elements(const kernels::EnrichedElementBatch
              std::equal(old->flags[k].begin(), old->flags[k].end(), textures_[first + k].flags);
     if (!same) continue;
     same_textures[x] = 1;
-    for (int i = 0; i < k_count * npe && same; ++i) {
-      const double shift = enriched_node_[first * npe + i] >= 0 ? enriched_shift_[first * npe + i] : std::nan("");
-      same = std::memcmp(&shift, &old->shifts[i], sizeof shift) == 0;
+    // Local function of the new basis -> the old one's; -1 where the new basis has a function
+    // the old one lacks or whose shift differs.
+    std::vector<int> old_function(npe);
+    for (int a = 0; a < npe; ++a) old_function[a] = a;
+    bool subset = true;
+    for (int i = 0, o = npe; i < k_count * npe && subset; ++i) {
+      const bool was = !std::isnan(old->shifts[i]);
+      if (enriched_node_[first * npe + i] >= 0) {
+        const double shift = enriched_shift_[first * npe + i];
+        subset = was && std::memcmp(&shift, &old->shifts[i], sizeof shift) == 0;
+        old_function.push_back(o);
+      }
+      o += was;
     }
-    if (same) reused[x] = element_integrals_[e];
+    if (!subset) continue;
+    if (static_cast<int>(old_function.size()) == old->count) {
+      reused[x] = element_integrals_[e];
+      continue;
+    }
+    // Nodes only dropped (set_enrichments' pruning rebuilds with fewer nodes): the mass and
+    // weights of the remaining functions are those entries of the old ones, the same bits,
+    // since each entry sums over the same points in the same order whatever other functions
+    // the element has.
+    auto kept = std::make_shared<ElementIntegrals>(*old);
+    const int n = static_cast<int>(old_function.size());
+    kept->count = n;
+    for (int k = 0; k < k_count * npe; ++k)
+      if (enriched_node_[first * npe + k] < 0) kept->shifts[k] = std::nan("");
+    kept->mass.resize(static_cast<size_t>(n) * n);
+    kept->area_weights.resize(n);
+    kept->mass_weights.resize(n);
+    for (int a = 0; a < n; ++a) {
+      for (int c = 0; c < n; ++c) kept->mass[a * n + c] = old->mass[old_function[a] * old->count + old_function[c]];
+      kept->area_weights[a] = old->area_weights[old_function[a]];
+      kept->mass_weights[a] = old->mass_weights[old_function[a]];
+    }
+    reused[x] = std::move(kept);
   }
   // Batches of the elements to compute: a sub-batch of eb (kernels work per element, so
   // each element's result does not depend on which others are in the batch).
