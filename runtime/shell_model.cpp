@@ -242,7 +242,7 @@ kernels::PointSectionBatch ShellModel::textured_batch() const {
           textured_qp_start_.data(), textured_qp_.data(), textured_qp_sections_.data()};
 }
 
-void ShellModel::install_enrichments(std::vector<EnrichmentFunction> functions) {
+void ShellModel::install_enrichments(std::vector<EnrichmentFunction> functions, bool build) {
   const int ne = mesh_.num_elements();
   const int nn = mesh_.num_nodes();
   const int npe = mesh_.nodes_per_element();
@@ -365,7 +365,7 @@ void ShellModel::install_enrichments(std::vector<EnrichmentFunction> functions) 
   enriched_global_nodes_.assign(static_cast<size_t>(num_enriched_elements()) * width_, -1);
   for (int e = 0; e < num_enriched_elements(); ++e)
     kernels::enriched_global_nodes(eb, e, enriched_global_nodes_.data() + static_cast<size_t>(e) * width_);
-  rebuild();
+  if (build) rebuild();
 }
 
 void ShellModel::integrate_enriched_elements(const kernels::EnrichedElementBatch& eb, std::vector<double>& mass) {
@@ -820,10 +820,14 @@ void ShellModel::add_area_force(const double q[3], std::vector<double>& f) const
 }
 
 void ShellModel::set_enrichments(std::vector<EnrichmentFunction> functions) {
-  install_enrichments(std::move(functions));
-
   pruned_enriched_nodes_ = 0;
-  if (options_.min_enrichment_mass_ratio <= 0 || num_enriched_nodes() == 0) return;
+  const bool test_masses = options_.min_enrichment_mass_ratio > 0;
+  install_enrichments(std::move(functions), !test_masses);
+  if (!test_masses) return;
+  if (num_enriched_nodes() == 0) {
+    rebuild();
+    return;
+  }
   // A cut that leaves a fragment a few texels wide makes enriched functions that are almost
   // dependent: (H - H(xi^a)) N^a either has almost no support (a node beyond the fragment)
   // or equals a multiple of N^a except on the fragment (a node on the fragment's side).
@@ -839,15 +843,45 @@ void ShellModel::set_enrichments(std::vector<EnrichmentFunction> functions) {
   // Fracture had such pairs at three nodes: their difference, a mode with almost no mass,
   // went unstable under corotation after ~140 steps (90 m/s against the sheet's 2.5, and
   // 43 PCG iterations a step; tests/test_enrichment_fragments.cpp).
+  // The masses come from the enriched elements' integrals before the block pattern is
+  // built (a pruned basis builds it once, for the kept nodes): every element incident to an
+  // enriched node is an enriched element, so the mass block of two functions of one node
+  // is the sum of their element entries in element order, as the assembly sums it.
+  std::vector<double> element_mass;
+  integrate_enriched_elements(enriched_element_batch(), element_mass);
+  const int nn = num_nodes(), W = width_;
+  std::vector<std::vector<int>> functions_at(nn);  // per mesh node: N^a, then its virtual nodes
+  std::vector<int> position(nn + num_enriched_nodes(), -1);  // of a basis node in its list
+  for (int v = nn; v < nn + num_enriched_nodes(); ++v) {
+    auto& list = functions_at[virtual_node_mesh_node(v)];
+    if (list.empty()) list.push_back(virtual_node_mesh_node(v)), position[virtual_node_mesh_node(v)] = 0;
+    position[v] = static_cast<int>(list.size());
+    list.push_back(v);
+  }
+  std::vector<std::vector<double>> node_mass(nn);  // per mesh node: Gram of its list, row-major
+  for (int a = 0; a < nn; ++a) node_mass[a].assign(functions_at[a].size() * functions_at[a].size(), 0.0);
+  auto mesh_node_of = [&](int g) { return g < nn ? g : virtual_node_mesh_node(g); };
+  for (int x = 0; x < num_enriched_elements(); ++x) {
+    const int* global = enriched_global_nodes_.data() + static_cast<size_t>(x) * W;
+    const double* mass = element_mass.data() + static_cast<size_t>(x) * W * W;
+    for (int p = 0; p < W; ++p) {
+      if (global[p] < 0 || position[global[p]] < 0) continue;
+      const int a = mesh_node_of(global[p]);
+      const size_t size = functions_at[a].size();
+      for (int q = 0; q < W; ++q)
+        if (global[q] >= 0 && position[global[q]] >= 0 && mesh_node_of(global[q]) == a)
+          node_mass[a][position[global[p]] * size + position[global[q]]] += mass[p * W + q];
+    }
+  }
   auto coupling = [&](int row, int column) {
-    const std::int64_t k = pattern().find(row, column);
-    return k < 0 ? 0.0 : mass_blocks_[9 * k];
+    const int a = mesh_node_of(row);
+    return node_mass[a][position[row] * functions_at[a].size() + position[column]];
   };
   // The nodes kept per function first; the textures are moved (not copied) only if any go.
   std::vector<std::vector<int>> kept_nodes(enrichments_.size());
   int pruned = 0;
   std::vector<std::vector<int>> kept_at(num_nodes());  // per mesh node: its kept virtual nodes so far
-  for (int v = num_nodes(); v < pattern().num_nodes(); ++v) {  // virtual nodes go function by function
+  for (int v = nn; v < nn + num_enriched_nodes(); ++v) {  // virtual nodes go function by function
     const int node = virtual_node_mesh_node(v);
     std::vector<int> earlier = {node};  // N^a, then its kept enrichments
     earlier.insert(earlier.end(), kept_at[node].begin(), kept_at[node].end());
@@ -866,7 +900,10 @@ void ShellModel::set_enrichments(std::vector<EnrichmentFunction> functions) {
       kept_at[node].push_back(v);
     }
   }
-  if (pruned == 0) return;
+  if (pruned == 0) {
+    rebuild();  // the element integrals just computed are reused
+    return;
+  }
   // install_enrichments below replaces every member derived from enrichments_.
   std::vector<EnrichmentFunction> kept = std::move(enrichments_);
   for (size_t i = 0; i < kept.size(); ++i) kept[i].enriched_nodes = std::move(kept_nodes[i]);

@@ -284,7 +284,9 @@ class ShellModel {
   void integrate_enriched_elements(const kernels::EnrichedElementBatch& eb, std::vector<double>& mass);
 
   int pruned_enriched_nodes_ = 0;
-  void install_enrichments(std::vector<EnrichmentFunction> functions);
+  // Takes the functions and sets up the per-element layout; `build`: then rebuild() (else
+  // the caller must, after reading the element integrals).
+  void install_enrichments(std::vector<EnrichmentFunction> functions, bool build = true);
   void rebuild();
   kernels::ElementBatch element_batch() const;
   kernels::EdgeBatch edge_batch() const;
