@@ -393,8 +393,8 @@ void ShellModel::integrate_enriched_elements(const kernels::EnrichedElementBatch
              std::equal(old->flags[k].begin(), old->flags[k].end(), textures_[first + k].flags);
     if (!same) continue;
     same_textures[x] = 1;
-    // Local function of the new basis -> the old one's; -1 where the new basis has a function
-    // the old one lacks or whose shift differs.
+    // Local function of the new basis -> the old one's: the reuse needs every new function
+    // among the old ones, with the same shift.
     std::vector<int> old_function(npe);
     for (int a = 0; a < npe; ++a) old_function[a] = a;
     bool subset = true;
