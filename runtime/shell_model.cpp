@@ -52,7 +52,7 @@ ShellModel::ShellModel(Mesh mesh, const Topology& topology, std::vector<kernels:
 // Splits elements and edges into plain and enriched ones, then builds the pattern, the
 // quadrature of the enriched ones, the mass and the load weights. Without enrichments
 // the plain arrays are the whole mesh and every result is that of the plain DG shell.
-void ShellModel::rebuild() {
+void ShellModel::rebuild(std::vector<double>* integrated_mass) {
   const int ne = mesh_.num_elements();
   const int npe = mesh_.nodes_per_element();
   const bool enriched = !enriched_elements_.empty();
@@ -124,7 +124,8 @@ void ShellModel::rebuild() {
   const kernels::EnrichedEdgeBatch gb = enriched_edge_batch(eb);
   std::vector<double> enriched_element_mass;  // #enriched elements x width^2
   if (enriched) {
-    integrate_enriched_elements(eb, enriched_element_mass);
+    if (integrated_mass) enriched_element_mass = std::move(*integrated_mass);
+    else integrate_enriched_elements(eb, enriched_element_mass);
     kernels::enriched_edge_quadrature(gb, options_.enrichment_quadrature, edge_qp_start_, edge_qp_);
     drop_cut_edge_points();
     families.push_back({num_enriched_elements(), width_, enriched_global_nodes_});
@@ -901,7 +902,7 @@ void ShellModel::set_enrichments(std::vector<EnrichmentFunction> functions) {
     }
   }
   if (pruned == 0) {
-    rebuild();  // the element integrals just computed are reused
+    rebuild(&element_mass);
     return;
   }
   // install_enrichments below replaces every member derived from enrichments_.

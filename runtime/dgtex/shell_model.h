@@ -287,7 +287,9 @@ class ShellModel {
   // Takes the functions and sets up the per-element layout; `build`: then rebuild() (else
   // the caller must, after reading the element integrals).
   void install_enrichments(std::vector<EnrichmentFunction> functions, bool build = true);
-  void rebuild();
+  // Everything derived from the mesh, sections and enrichments. `integrated_mass`: the
+  // mass integrate_enriched_elements just gave for the current enrichments (not run again).
+  void rebuild(std::vector<double>* integrated_mass = nullptr);
   kernels::ElementBatch element_batch() const;
   kernels::EdgeBatch edge_batch() const;
   kernels::EnrichedElementBatch enriched_element_batch() const;
