@@ -1031,11 +1031,13 @@ std::vector<std::vector<double>> ShellModel::moments_of_fields(const ShellModel&
   const int stride = std::max(mesh_.nodes_per_element(), width_);  // this model's local basis
   constexpr std::int64_t block = kernels::rest_integral_block_points;
   constexpr std::int64_t span = 16 * block;
-  // Per point of a span: w, this basis (global nodes, values) and every field's value there,
-  // evaluated in parallel (fixed blocks); then w N_A g_c added serially in point order:
-  // exactly the sums of mass_weighted_moments with g = source.interpolate.
+  // Per point of a span: w, this basis's values and every field's value there, evaluated in
+  // parallel (fixed blocks); then w N_A g_c added serially in point order: exactly the sums
+  // of mass_weighted_moments with g = source.interpolate. Every point of an element has the
+  // same basis (its element's global nodes), so the span's first point records them.
   const int per_point = 1 + stride + 3 * nf;
-  std::vector<int> counts(span), globals(static_cast<size_t>(span) * stride);
+  std::vector<int> global(stride);
+  int basis_count = 0;
   std::vector<double> data(static_cast<size_t>(span) * per_point);
   std::vector<double> local(3 * static_cast<size_t>(stride));
   for (int e = 0; e < mesh_.num_elements(); ++e) {
@@ -1057,7 +1059,7 @@ std::vector<std::vector<double>> ShellModel::moments_of_fields(const ShellModel&
       const std::int64_t count = std::min(span, total - begin);
       auto evaluate = [&](std::int64_t item) {
         TexelCache cache, source_cache;
-        int source_global[kernels::max_enriched_basis];
+        int source_global[kernels::max_enriched_basis], unused_global[kernels::max_enriched_basis];
         double source_values[kernels::max_enriched_basis];
         for (std::int64_t p = item * block; p < std::min(count, (item + 1) * block); ++p) {
           double xi[2], weight;
@@ -1068,7 +1070,8 @@ std::vector<std::vector<double>> ShellModel::moments_of_fields(const ShellModel&
           d[0] = weight * kernels::rest_area_factor(shape, mesh_.element_nodes(e), mesh_.positions.data()) *
                  section.density * section.thickness;
           const int m = source.basis_values_at(e, xi, shape, source_cache, source_global, source_values);
-          counts[p] = basis_values_at(e, xi, shape, cache, globals.data() + p * stride, d + 1);
+          const int n = basis_values_at(e, xi, shape, cache, p == 0 ? global.data() : unused_global, d + 1);
+          if (p == 0) basis_count = n;
           for (int f = 0; f < nf; ++f) {
             const double* u = fields[f]->data();
             double* value = d + 1 + stride + 3 * f;
@@ -1081,11 +1084,10 @@ std::vector<std::vector<double>> ShellModel::moments_of_fields(const ShellModel&
       // Plain elements have a handful of points: no parallel region for them.
       kernels::forall((count + block - 1) / block, evaluate,
                       count > block ? kernels::Execution::parallel : kernels::Execution::serial);
-      // Every point of an element has the same basis (its element's global nodes, distinct),
-      // so each field's sums run in a local copy, point after point: the same additions in
-      // the same order as adding into out directly, without the scattered stores (2x faster).
-      const int m = counts[0];
-      const int* global = globals.data();
+      // The element's global nodes are distinct, so each field's sums run in a local copy,
+      // point after point: the same additions in the same order as adding into out
+      // directly, without the scattered stores (2x faster).
+      const int m = basis_count;
       for (int f = 0; f < nf; ++f) {
         double* o = out[f].data();
         for (int a = 0; a < m; ++a)
