@@ -253,28 +253,23 @@ struct PointRows {
     for (int r = 0; r < 3; ++r) beta[r] = bend[r][0] * rho[0] + bend[r][1] * rho[1] + bend[r][2] * rho[2];
   }
 
-  // A function's scaled rows as frame coefficients: membrane row 0 = m[0] e1 + m[1] e2,
-  // row 1 = m[2] e2, row 2 = m[3] e1 + m[4] e2; bending row r = b[r] t0.
-  void coefficients(const double dN[2], const double d2N[3], double m[5], double b[3]) const {
-    double g[2], beta[3];
-    strains(dN, d2N, g, beta);
-    const double u0 = sm * g[0], u1 = sm * g[1];
-    m[0] = u0, m[1] = nu * u1, m[2] = k1 * u1, m[3] = k2 * u1, m[4] = k2 * u0;
-    b[0] = sb * (beta[0] + nu * beta[1]), b[1] = sb * k1 * beta[1], b[2] = sb * k2 * beta[2];
-  }
-
-  // The six scaled, rotated rows of one function (3 columns each) at column `col` of the
-  // rows row[0..5]: L^T [Bm sqrt(w D_m); Bb sqrt(w D_b)] as scaled_strain_rows.
-  void write(const double dN[2], const double d2N[3], double* const row[6], int col) const {
-    double m[5], b[3];
-    coefficients(dN, d2N, m, b);
-    for (int k = 0; k < 3; ++k) {
-      row[0][col + k] = m[0] * q[0][k] + m[1] * q[1][k];
-      row[1][col + k] = m[2] * q[1][k];
-      row[2][col + k] = m[3] * q[0][k] + m[4] * q[1][k];
-      row[3][col + k] = b[0] * q[2][k];
-      row[4][col + k] = b[1] * q[2][k];
-      row[5][col + k] = b[2] * q[2][k];
+  // A function's six scaled rows (L^T [Bm sqrt(w D_m); Bb sqrt(w D_b)], as
+  // scaled_strain_rows) in the frame q: membrane u0 q0 + nu u1 q1, k1 u1 q1 and
+  // k2 (u1 q0 + u0 q1); bending b_r q2. The factors are linear in the function's
+  // derivatives d = (dN_1, dN_2, d2N_11, d2N_22, d2N_12): u = A d with u_i = sm c_ia dN_a,
+  // and b = Bf d with b = diag(sb) [1 nu 0; 0 k1 0; 0 0 k2] bend rho, rho_r = -(d2N_r -
+  // gamma_r . dN) (strains()).
+  void split_factors(double A[2][2], double Bf[3][5]) const {
+    for (int i = 0; i < 2; ++i)
+      for (int a = 0; a < 2; ++a) A[i][a] = sm * c[i][a];
+    const double scale[3][3] = {{sb, sb * nu, 0}, {0, sb * k1, 0}, {0, 0, sb * k2}};
+    for (int t = 0; t < 3; ++t) {
+      double phi[3];  // b_t = phi . rho
+      for (int r = 0; r < 3; ++r)
+        phi[r] = scale[t][0] * bend[0][r] + scale[t][1] * bend[1][r] + scale[t][2] * bend[2][r];
+      Bf[t][0] = phi[0] * gamma[0][0] + phi[1] * gamma[1][0] + phi[2] * gamma[2][0];
+      Bf[t][1] = phi[0] * gamma[0][1] + phi[1] * gamma[1][1] + phi[2] * gamma[2][1];
+      for (int r = 0; r < 3; ++r) Bf[t][2 + r] = -phi[r];
     }
   }
 
@@ -291,6 +286,47 @@ struct PointRows {
     for (int a = 0; a < 2; ++a) membrane[2 * col + a] = sm * (g[0] * in_plane[0][a] + g[1] * in_plane[1][a]);
     const double b[3] = {sb * (beta[0] + nu * beta[1]), sb * k1 * beta[1], sb * k2 * beta[2]};
     for (int r = 0; r < 3; ++r) bending[r][col] = b[r] * normal;
+  }
+};
+
+// A point's rows split by global component k (x, y, z). Membrane row rho of function i,
+// component k, is c[rho][k] . (u0_i, u1_i) (PointRows::split_factors) with, in the rotated frame
+// q0, q1, q2: c[0][k] = (q0_k, nu q1_k), c[1][k] = (0, k1 q1_k), c[2][k] = (k2 q1_k,
+// k2 q0_k); bending row r is q2_k b_r,i. So the (k, l) block of sum_rows row^T row is, over
+// the functions, U^T W_kl U + q2_k q2_l B^T B with U the two membrane factors, B the three
+// bending factors and W_kl = sum_rho c[rho][k] c[rho][l]^T (2 x 2). The diagonal blocks
+// take W_kk = L_k L_k^T as two rows L_k^T U; the bending products are symmetric in every
+// block. Per point 18 m^2 multiply-adds over m functions instead of 27 m^2 for the six
+// rows of 3 m columns.
+constexpr int frame_split_pairs[3][2] = {{0, 1}, {0, 2}, {1, 2}};
+
+struct FrameSplit {
+  double L[3][3];  // per k: L00, L10, L11 (W_kk = L L^T, L lower)
+  double W[3][4];  // per pair (x, y), (x, z), (y, z): W00, W01, W10, W11
+  double t[3];     // q2
+  double c[3][3][2];
+
+  void set(const PointRows& pr) {
+    for (int k = 0; k < 3; ++k) {
+      const double q0 = pr.q[0][k], q1 = pr.q[1][k];
+      c[0][k][0] = q0, c[0][k][1] = pr.nu * q1;
+      c[1][k][0] = 0, c[1][k][1] = pr.k1 * q1;
+      c[2][k][0] = pr.k2 * q1, c[2][k][1] = pr.k2 * q0;
+      t[k] = pr.q[2][k];
+    }
+    const auto w = [&](int k, int l, int a, int b) {
+      return c[0][k][a] * c[0][l][b] + c[1][k][a] * c[1][l][b] + c[2][k][a] * c[2][l][b];
+    };
+    for (int k = 0; k < 3; ++k) {
+      // W_00 is 0 only with q0_k = q1_k = 0, and then W_kk = 0.
+      const double w00 = w(k, k, 0, 0), w10 = w(k, k, 1, 0), w11 = w(k, k, 1, 1);
+      const double l00 = std::sqrt(w00), l10 = l00 > 0 ? w10 / l00 : 0.0;
+      L[k][0] = l00, L[k][1] = l10, L[k][2] = std::sqrt(std::max(0.0, w11 - l10 * l10));
+    }
+    for (int p = 0; p < 3; ++p) {
+      const int k = frame_split_pairs[p][0], l = frame_split_pairs[p][1];
+      W[p][0] = w(k, l, 0, 0), W[p][1] = w(k, l, 0, 1), W[p][2] = w(k, l, 1, 0), W[p][3] = w(k, l, 1, 1);
+    }
   }
 };
 
@@ -312,27 +348,50 @@ struct PlanarFrame {
 
 // Points with the same varying textures (mask) and the same constant values: G = sum of
 // S^T S over the group's reduced basis (standard functions, then the varying textures'
-// enriched ones), upper triangle; g = sum of S^T s (corrective forces). The rows of up to
-// group_block_points points are stacked and added to G in one blocked product (fixed
-// blocks: the points of the group in order, so the sums do not depend on threads).
+// enriched ones), upper triangle; g = sum of S^T s (corrective forces). Curved or rotated
+// elements sum the frame-split products of FrameSplit: the rows of up to
+// group_block_points points are stacked and added in blocked products (fixed blocks: the
+// points of the group in order, so the sums do not depend on threads), and G is formed
+// from them once the chunk's points are in.
 constexpr int group_block_points = 16;
-constexpr int group_block_rows = 6 * group_block_points;
 // Planar groups stack 32 points: 32 membrane rows and 96 bending rows a block.
 constexpr int planar_block_points = 32;
+
+// Stacked rows of a block of P points (stride columns each), in units of P rows: U (the
+// membrane factors u0, u1 of each point), M_k = L_k^T U, WU_p = W_p U (2 P rows each), and
+// B_k = q2_k B (3 P rows each).
+constexpr int split_row_units = 2 + 3 * 2 + 3 * 2 + 3 * 3;
+constexpr int split_u = 0;
+inline int split_m(int k) { return 2 + 2 * k; }
+inline int split_wu(int p) { return 8 + 2 * p; }
+inline int split_b(int k) { return 14 + 3 * k; }
 
 struct Group {
   std::uint32_t varying = 0;
   double value[max_enrichments_per_element];
-  int m = 0, stride = 0;       // reduced basis functions; padded row length (>= 3 m)
-  double* G = nullptr;          // stride x stride (upper part used)
-  double* rows = nullptr;       // group_block_rows x stride
-  int pending = 0;              // points stacked in rows, not yet in G
-  bool written = false;         // G holds a first block
-  std::vector<double> g, s;     // g: stride; s: the stacked points' scaled rest strains
+  int m = 0;                    // reduced basis functions
+  double* G = nullptr;          // 3m x 3m, row stride 3m (filled by finish_split)
+  int pending = 0;              // points stacked, not yet summed
+  bool written = false;         // the sums hold a first block
+  // Frame-split sums, stride = m padded to product_column_multiple: D_k (sum of the
+  // (k, k) blocks, upper), O_p (membrane part of pair p, whole), Bs_p (bending part of pair
+  // p, upper), each stride x stride; the stacked rows; g_k, the forces per component.
+  int stride = 0;
+  double* sums = nullptr;       // D_0..2, O_0..2, Bs_0..2
+  double* rows = nullptr;       // split_row_units x group_block_points rows
+  std::vector<double> g;        // 3 x stride
   // Planar elements (PlanarFrame): the membrane sums from 1 row a point (gradient products,
-  // padded length >= 2 m) and the bending sums from 3 rows (>= m), in place of G and rows.
+  // padded length >= 2 m) and the bending sums from 3 rows (>= m).
   int membrane_stride = 0, bending_stride = 0;
   double *Gm = nullptr, *Gb = nullptr, *membrane_rows = nullptr, *bending_rows = nullptr;
+
+  std::size_t square() const { return static_cast<std::size_t>(stride) * stride; }
+  double* D(int k) const { return sums + k * square(); }
+  double* O(int p) const { return sums + (3 + p) * square(); }
+  double* Bs(int p) const { return sums + (6 + p) * square(); }
+  double* row_block(int unit) const {
+    return rows + static_cast<std::size_t>(unit) * group_block_points * stride;
+  }
 
   bool matches(std::uint32_t mask, const double* values, int count) const {
     if (mask != varying) return false;
@@ -356,8 +415,8 @@ struct GroupStorage {
   }
 };
 
-// Adds the group's stacked points to G (and g), in point order.
-void flush(Group& group, bool want_forces) {
+// Adds the group's stacked points to its sums, in point order.
+void flush(Group& group) {
   if (group.pending == 0) return;
   if (group.Gm) {  // planar: no forces (unrotated)
     accumulate_gram_upper(group.pending, group.membrane_stride, group.membrane_rows, group.Gm, !group.written);
@@ -366,13 +425,47 @@ void flush(Group& group, bool want_forces) {
     group.pending = 0;
     return;
   }
-  const int rows = 6 * group.pending, S = group.stride;
-  const double* A = group.rows;
-  accumulate_gram_upper(rows, S, A, group.G, !group.written);
+  const int S = group.stride, two = 2 * group.pending, three = 3 * group.pending;
+  const bool first = !group.written;
+  const double* U = group.row_block(split_u);
+  for (int k = 0; k < 3; ++k) {
+    const double* M = group.row_block(split_m(k));
+    const double* B = group.row_block(split_b(k));
+    accumulate_product(two, S, M, M, group.D(k), first, true);
+    accumulate_product(three, S, B, B, group.D(k), false, true);
+  }
+  for (int p = 0; p < 3; ++p) {
+    const int k = frame_split_pairs[p][0], l = frame_split_pairs[p][1];
+    accumulate_product(two, S, U, group.row_block(split_wu(p)), group.O(p), first, false);
+    accumulate_product(three, S, group.row_block(split_b(k)), group.row_block(split_b(l)), group.Bs(p), first, true);
+  }
   group.written = true;
-  if (want_forces)
-    for (int k = 0; k < rows; ++k) add_scaled(S, group.s[k], A + static_cast<std::size_t>(k) * S, group.g.data());
   group.pending = 0;
+}
+
+// G (3m x 3m, entry (3 i + k, 3 j + l)) of a frame-split group from its sums: D_k for
+// k = l, O_p + Bs_p for the pair p = (k, l), k < l, and their transposes for k > l.
+void finish_split(Group& group) {
+  const int m = group.m, S = group.stride;
+  const std::size_t N = 3 * static_cast<std::size_t>(m);
+  const auto at = [S](const double* X, int i, int j) { return X[static_cast<std::size_t>(i) * S + j]; };
+  int pair_of[3][3] = {};
+  for (int p = 0; p < 3; ++p) pair_of[frame_split_pairs[p][0]][frame_split_pairs[p][1]] = p;
+  for (int i = 0; i < m; ++i)
+    for (int j = 0; j < m; ++j) {
+      const int lo = std::min(i, j), hi = std::max(i, j);
+      double* out = group.G + 3 * i * N + 3 * j;
+      for (int k = 0; k < 3; ++k)
+        for (int l = 0; l < 3; ++l) {
+          double v = 0;
+          if (group.written) {
+            if (k == l) v = at(group.D(k), lo, hi);
+            else if (k < l) v = at(group.O(pair_of[k][l]), i, j) + at(group.Bs(pair_of[k][l]), lo, hi);
+            else v = at(group.O(pair_of[l][k]), j, i) + at(group.Bs(pair_of[l][k]), lo, hi);
+          }
+          out[k * N + l] = v;
+        }
+    }
 }
 
 // Zeroes block rows a <= c (each w x w block whole) of an (w n) x (w n) row-major matrix:
@@ -538,11 +631,7 @@ void chunk_stiffness(const EnrichedElementBatch& b, const EnrichedQuadrature& qu
       for (int k = 0; k < L.count; ++k)
         if (mask >> k & 1u)
           for (int a = 0; a < npe; ++a) fresh.m += L.slot[k][a] >= 0;
-      const auto padded = [](int columns) {
-        return (columns + gram_column_multiple - 1) / gram_column_multiple * gram_column_multiple;
-      };
-      const int S = padded(3 * fresh.m);
-      fresh.stride = S;
+      const auto padded = [](int columns, int multiple) { return (columns + multiple - 1) / multiple * multiple; };
       if (storage.size() <= groups.size()) storage.emplace_back();
       GroupStorage& space = storage[groups.size()];
       // Padding columns of the stacked rows stay 0.
@@ -551,7 +640,8 @@ void chunk_stiffness(const EnrichedElementBatch& b, const EnrichedQuadrature& qu
           for (int i = used; i < stride; ++i) rows[static_cast<std::size_t>(k) * stride + i] = 0;
       };
       if (planar) {
-        const std::size_t Sm = padded(2 * fresh.m), Sb = padded(fresh.m), points = planar_block_points;
+        const std::size_t Sm = padded(2 * fresh.m, gram_column_multiple), Sb = padded(fresh.m, gram_column_multiple),
+                          points = planar_block_points;
         fresh.membrane_stride = static_cast<int>(Sm), fresh.bending_stride = static_cast<int>(Sb);
         fresh.Gm = space.take(Sm * Sm + Sb * Sb + points * Sm + 3 * points * Sb);
         fresh.Gb = fresh.Gm + Sm * Sm;
@@ -560,17 +650,20 @@ void chunk_stiffness(const EnrichedElementBatch& b, const EnrichedQuadrature& qu
         zero_padding(fresh.membrane_rows, static_cast<int>(points), 2 * fresh.m, fresh.membrane_stride);
         zero_padding(fresh.bending_rows, static_cast<int>(3 * points), fresh.m, fresh.bending_stride);
       } else {
-        fresh.G = space.take(static_cast<std::size_t>(S) * (S + group_block_rows));
-        fresh.rows = fresh.G + static_cast<std::size_t>(S) * S;
-        zero_padding(fresh.rows, group_block_rows, 3 * fresh.m, S);
+        fresh.stride = padded(fresh.m, product_column_multiple);
+        const std::size_t N = 3 * static_cast<std::size_t>(fresh.m);
+        const int row_count = split_row_units * group_block_points;
+        fresh.sums = space.take(9 * fresh.square() + static_cast<std::size_t>(row_count) * fresh.stride + N * N);
+        fresh.rows = fresh.sums + 9 * fresh.square();
+        fresh.G = fresh.rows + static_cast<std::size_t>(row_count) * fresh.stride;
+        zero_padding(fresh.rows, row_count, fresh.m, fresh.stride);
+        if (want_forces) fresh.g.assign(3 * static_cast<std::size_t>(fresh.stride), 0.0);
       }
-      if (want_forces) fresh.g.assign(S, 0.0), fresh.s.assign(group_block_rows, 0.0);
       groups.push_back(std::move(fresh));
       g = static_cast<int>(groups.size()) - 1;
     }
     last = g;
     Group& group = groups[g];
-    const int S = group.stride;
 
     // This point's rows of the reduced basis, stacked under the group's pending ones.
     double fused_rotation[9];
@@ -594,15 +687,16 @@ void chunk_stiffness(const EnrichedElementBatch& b, const EnrichedQuadrature& qu
       for_reduced_functions(L, mask, s, samples, [&](const double* dN, const double* d2N, int r) {
         pr.write_planar(dN, d2N, in_plane, normal, membrane, bending, r);
       });
-      if (++group.pending == planar_block_points) flush(group, false);
+      if (++group.pending == planar_block_points) flush(group);
       continue;
     }
-    double* block = group.rows + static_cast<std::size_t>(6 * group.pending) * S;
-    double* const row[6] = {block, block + S, block + 2 * S, block + 3 * S, block + 4 * S, block + 5 * S};
-    for_reduced_functions(L, mask, s, samples,
-                          [&](const double* dN, const double* d2N, int r) { pr.write(dN, d2N, row, 3 * r); });
-    if (R && want_forces) {
-      // Rest corotation strain B (X0 - R^T X0) over the standard functions (enriched X0 = 0).
+    // Corrective forces g += S^T s: s, the scaled rest corotation strain B (X0 - R^T X0)
+    // over the standard functions (enriched X0 = 0); per component k of function i,
+    // alpha_k . (u0_i, u1_i) + q2_k beta_i with alpha_k = sum_rho s_rho c[rho][k] and
+    // beta_i = sum_r s_(3+r) b_r,i.
+    const bool point_forces = R && want_forces;
+    double sv[6];
+    if (point_forces) {
       double strain[6] = {0, 0, 0, 0, 0, 0};
       for (int a = 0; a < npe; ++a) {
         const double* x = b.positions + 3 * static_cast<std::int64_t>(nodes[a]);
@@ -616,13 +710,59 @@ void chunk_stiffness(const EnrichedElementBatch& b, const EnrichedQuadrature& qu
         strain[2] += gm[1] * xf[0] + gm[0] * xf[1];
         for (int k = 0; k < 3; ++k) strain[3 + k] += beta[k] * xf[2];
       }
-      double* sv = group.s.data() + 6 * group.pending;
       half_constitutive(nu, pr.sm, strain, sv);
       half_constitutive(nu, pr.sb, strain + 3, sv + 3);
     }
-    if (++group.pending == group_block_points) flush(group, want_forces);
+    FrameSplit fs;
+    fs.set(pr);
+    double alpha[3][2];
+    for (int k = 0; k < 3; ++k)
+      for (int a = 0; a < 2; ++a)
+        alpha[k][a] = point_forces ? sv[0] * fs.c[0][k][a] + sv[1] * fs.c[1][k][a] + sv[2] * fs.c[2][k][a] : 0.0;
+    // This point's rows, stacked under the group's pending ones: first the factors u0, u1
+    // (into U) and b (scratch) of every function, then the combinations row by row.
+    const std::size_t S = group.stride;
+    const int m = group.m;
+    double* const U0 = group.row_block(split_u) + 2 * group.pending * S;
+    double* const U1 = U0 + S;
+    double d[5][max_enriched_basis], bending[3][max_enriched_basis];
+    for_reduced_functions(L, mask, s, samples, [&](const double* dN, const double* d2N, int r) {
+      d[0][r] = dN[0], d[1][r] = dN[1], d[2][r] = d2N[0], d[3][r] = d2N[1], d[4][r] = d2N[2];
+    });
+    double A[2][2], Bf[3][5];
+    pr.split_factors(A, Bf);
+    for (int r = 0; r < m; ++r) U0[r] = A[0][0] * d[0][r] + A[0][1] * d[1][r];
+    for (int r = 0; r < m; ++r) U1[r] = A[1][0] * d[0][r] + A[1][1] * d[1][r];
+    for (int t = 0; t < 3; ++t) {
+      const double* f = Bf[t];
+      for (int r = 0; r < m; ++r)
+        bending[t][r] = f[0] * d[0][r] + f[1] * d[1][r] + f[2] * d[2][r] + f[3] * d[3][r] + f[4] * d[4][r];
+    }
+    for (int k = 0; k < 3; ++k) {
+      double* const M0 = group.row_block(split_m(k)) + 2 * group.pending * S;
+      double* const M1 = M0 + S;
+      const double* l = fs.L[k];
+      for (int r = 0; r < m; ++r) M0[r] = l[0] * U0[r] + l[1] * U1[r], M1[r] = l[2] * U1[r];
+      double* const W0 = group.row_block(split_wu(k)) + 2 * group.pending * S;
+      double* const W1 = W0 + S;
+      const double* w = fs.W[k];
+      for (int r = 0; r < m; ++r) W0[r] = w[0] * U0[r] + w[1] * U1[r], W1[r] = w[2] * U0[r] + w[3] * U1[r];
+      double* const B = group.row_block(split_b(k)) + 3 * group.pending * S;
+      for (int t = 0; t < 3; ++t)
+        for (int r = 0; r < m; ++r) B[t * S + r] = fs.t[k] * bending[t][r];
+    }
+    if (point_forces)
+      for (int r = 0; r < m; ++r) {
+        const double beta = sv[3] * bending[0][r] + sv[4] * bending[1][r] + sv[5] * bending[2][r];
+        for (int k = 0; k < 3; ++k)
+          group.g[k * S + r] += alpha[k][0] * U0[r] + alpha[k][1] * U1[r] + fs.t[k] * beta;
+      }
+    if (++group.pending == group_block_points) flush(group);
   }
-  for (Group& group : groups) flush(group, want_forces);
+  for (Group& group : groups) {
+    flush(group);
+    if (!planar) finish_split(group);
+  }
 
   // K += T^T G T per group: basis function i of the element is reduced function red[i]
   // times scale[i] (1, or H_k - H_k(xi^a) for a constant texture k: a multiple of N^a).
@@ -663,10 +803,11 @@ void chunk_stiffness(const EnrichedElementBatch& b, const EnrichedQuadrature& qu
       map.add(group.Gb, group.bending_stride, 1, Kc.data() + 4 * n2);
       continue;
     }
-    map.add(group.G, group.stride, 3, Kc.data());
+    map.add(group.G, 3 * static_cast<std::size_t>(group.m), 3, Kc.data());
     if (want_forces)
       for (int i = 0; i < n; ++i)
-        for (int c = 0; c < 3; ++c) fc[3 * i + c] += scale[i] * group.g[3 * red[i] + c];
+        for (int c = 0; c < 3; ++c)
+          fc[3 * i + c] += scale[i] * group.g[static_cast<std::size_t>(c) * group.stride + red[i]];
   }
   if (!planar) return;
   // The membrane sums are gradient products so far: the stiffness of each upper 2 x 2 block.

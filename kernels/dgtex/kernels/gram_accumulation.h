@@ -1,11 +1,12 @@
 #pragma once
 // For the enriched kernels: G += A^T A for a block of stacked rows A (the strain rows
-// of several quadrature points), upper part only, with register tiles and a code path per
-// instruction set (AVX-512, AVX2, baseline x86-64; chosen at run time). Every entry
-// (i, j >= i) is its own sum over the rows in order, started from 0 and then added to G
-// (or stored, `overwrite`), and the file is compiled without FMA contraction: every path
-// rounds exactly alike, so results depend neither on the machine's vector unit nor on the
-// tile shape. Entries below the diagonal are scratch (never read).
+// of several quadrature points), upper part only, and G += A^T B (accumulate_product),
+// with register tiles and a code path per instruction set (AVX-512, AVX2, baseline
+// x86-64; chosen at run time). Every entry (i, j >= i) is its own sum over the rows in
+// order, started from 0 and then added to G (or stored, `overwrite`), and the file is
+// compiled without FMA contraction: every path rounds exactly alike, so results depend
+// neither on the machine's vector unit nor on the tile shape. Entries below the diagonal
+// are scratch (never read).
 // Shapes: A is rows x cols, G cols x cols, both row-major with row stride cols; cols must
 // be a multiple of gram_column_multiple (pad A with zero columns). Thread-safe on distinct
 // outputs; keeps nothing. Units: those of the rows' products.
@@ -26,14 +27,22 @@ bool gram_path_supported(GramPath path);
 void accumulate_gram_upper(int rows, int cols, const double* A, double* G, bool overwrite,
                            GramPath path = GramPath::best);
 
+// G += A^T B for blocks of rows A and B (rows x cols each, row-major, cols a multiple of
+// product_column_multiple: pad with zero columns), G cols x cols with row stride cols.
+// upper: only the entries (i, j >= i) are summed (those below are scratch, as above; for
+// products known to be symmetric), else all. The same per-entry sums in row order as
+// accumulate_gram_upper, so every path rounds alike.
+constexpr int product_column_multiple = 8;
+void accumulate_product(int rows, int cols, const double* A, const double* B, double* G, bool overwrite,
+                        bool upper, GramPath path = GramPath::best);
+
 // out[j] += (s * scales[j]) * g[j] for j < count (the scaled gather of a G row into K).
 void add_scaled_row(int count, double s, const double* scales, const double* g, double* out);
 
-// out[j] += x[j] * s for j < count (corrective forces: g += S^T s row by row).
-void add_scaled(int count, double s, const double* x, double* out);
-
 // The same sums, one entry at a time (the reference of the tiled paths).
 void accumulate_gram_upper_reference(int rows, int cols, const double* A, double* G, bool overwrite);
+void accumulate_product_reference(int rows, int cols, const double* A, const double* B, double* G, bool overwrite,
+                                  bool upper);
 
 // A = sum_r v_r v_r^T over rows v_r of length n (the API of SymmetricAccumulator), summed
 // by accumulate_gram_upper in fixed blocks of `block_rows` rows (fewer when the caller knows
