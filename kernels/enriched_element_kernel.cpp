@@ -373,7 +373,7 @@ struct Group {
   double* G = nullptr;          // 3m x 3m, row stride 3m (filled by finish_split)
   int pending = 0;              // points stacked, not yet summed
   bool written = false;         // the sums hold a first block
-  // Frame-split sums, stride = m padded to product_column_multiple: D_k (sum of the
+  // Frame-split sums, stride = m padded to gram_column_multiple: D_k (sum of the
   // (k, k) blocks, upper), O_p (membrane part of pair p, whole), Bs_p (bending part of pair
   // p, upper), each stride x stride; the stacked rows; g_k, the forces per component.
   int stride = 0;
@@ -650,7 +650,7 @@ void chunk_stiffness(const EnrichedElementBatch& b, const EnrichedQuadrature& qu
         zero_padding(fresh.membrane_rows, static_cast<int>(points), 2 * fresh.m, fresh.membrane_stride);
         zero_padding(fresh.bending_rows, static_cast<int>(3 * points), fresh.m, fresh.bending_stride);
       } else {
-        fresh.stride = padded(fresh.m, product_column_multiple);
+        fresh.stride = padded(fresh.m, gram_column_multiple);
         const std::size_t N = 3 * static_cast<std::size_t>(fresh.m);
         const int row_count = split_row_units * group_block_points;
         fresh.sums = space.take(9 * fresh.square() + static_cast<std::size_t>(row_count) * fresh.stride + N * N);

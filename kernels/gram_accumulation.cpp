@@ -5,45 +5,9 @@
 namespace dgtex::kernels {
 namespace {
 
-// Tiles of TR rows of G by NV vectors of V (L doubles each) of columns; tiles start at the
-// tile-column boundary at or left of the diagonal, so every upper entry is covered exactly
-// once. GCC vector extensions keep the accumulators in registers; lanes never mix.
-template <class V, int L, int TR, int NV>
-__attribute__((always_inline)) inline void gram_tiles(int rows, int cols, const double* __restrict A,
-                                                      double* __restrict G, bool overwrite) {
-  constexpr int TC = L * NV;
-  static_assert(gram_column_multiple % TC == 0 && gram_column_multiple % TR == 0, "tiles divide the padding");
-  for (int i0 = 0; i0 < cols; i0 += TR)
-    for (int c0 = i0 / TC * TC; c0 < cols; c0 += TC) {
-      V acc[TR][NV];
-      for (int r = 0; r < TR; ++r)
-        for (int v = 0; v < NV; ++v) acc[r][v] = V{};
-      const double* row = A;
-      for (int k = 0; k < rows; ++k, row += cols) {
-        V b[NV];
-        for (int v = 0; v < NV; ++v) __builtin_memcpy(&b[v], row + c0 + v * L, sizeof(V));
-        for (int r = 0; r < TR; ++r) {
-          const double a = row[i0 + r];
-          for (int v = 0; v < NV; ++v) acc[r][v] += a * b[v];
-        }
-      }
-      for (int r = 0; r < TR; ++r) {
-        double* out = G + static_cast<std::size_t>(i0 + r) * cols + c0;
-        for (int v = 0; v < NV; ++v) {
-          V x = acc[r][v];
-          if (!overwrite) {
-            V old;
-            __builtin_memcpy(&old, out + v * L, sizeof(V));
-            x = old + x;
-          }
-          __builtin_memcpy(out + v * L, &x, sizeof(V));
-        }
-      }
-    }
-}
-
-// One tile of G += A^T B: output rows i0..i0+TR, columns c0..c0+L NV; the entries are
-// summed over the rows in order from 0, then stored or added (as gram_tiles).
+// One tile of G += A^T B: output rows i0..i0+TR, columns c0..c0+L NV; each entry is summed
+// over the rows in order from 0, then stored or added. GCC vector extensions keep the
+// accumulators in registers; lanes never mix.
 template <class V, int L, int TR, int NV>
 __attribute__((always_inline)) inline void product_tile(int rows, int cols, const double* __restrict A,
                                                         const double* __restrict B, double* __restrict G, int i0,
@@ -76,14 +40,16 @@ __attribute__((always_inline)) inline void product_tile(int rows, int cols, cons
 }
 
 // G += A^T B by tiles of TR rows and L NV columns, the last columns of a row by tiles of L;
-// upper: only tiles from the tile column at or left of the diagonal on.
+// upper: each row of tiles starts at its diagonal (TR x TR below it are scratch), so every
+// upper entry is covered exactly once.
 template <class V, int L, int TR, int NV>
 __attribute__((always_inline)) inline void product_tiles(int rows, int cols, const double* A, const double* B,
                                                          double* G, bool overwrite, bool upper) {
   constexpr int TC = L * NV;
-  static_assert(product_column_multiple % L == 0 && product_column_multiple % TR == 0, "tiles divide the padding");
+  static_assert(gram_column_multiple % L == 0 && gram_column_multiple % TR == 0 && TR % L == 0,
+                "tiles divide the padding");
   for (int i0 = 0; i0 < cols; i0 += TR) {
-    int c0 = upper ? i0 / TC * TC : 0;
+    int c0 = upper ? i0 : 0;
     for (; c0 + TC <= cols; c0 += TC) product_tile<V, L, TR, NV>(rows, cols, A, B, G, i0, c0, overwrite);
     for (; c0 < cols; c0 += L) product_tile<V, L, TR, 1>(rows, cols, A, B, G, i0, c0, overwrite);
   }
@@ -92,16 +58,6 @@ __attribute__((always_inline)) inline void product_tiles(int rows, int cols, con
 typedef double V8 __attribute__((vector_size(64)));
 typedef double V4 __attribute__((vector_size(32)));
 typedef double V2 __attribute__((vector_size(16)));
-
-__attribute__((target("avx512f"))) void gram_avx512(int rows, int cols, const double* A, double* G, bool overwrite) {
-  gram_tiles<V8, 8, 8, 2>(rows, cols, A, G, overwrite);
-}
-__attribute__((target("avx2"))) void gram_avx2(int rows, int cols, const double* A, double* G, bool overwrite) {
-  gram_tiles<V4, 4, 4, 2>(rows, cols, A, G, overwrite);
-}
-void gram_baseline(int rows, int cols, const double* A, double* G, bool overwrite) {
-  gram_tiles<V2, 2, 4, 2>(rows, cols, A, G, overwrite);
-}
 
 __attribute__((target("avx512f"))) void product_avx512(int rows, int cols, const double* A, const double* B,
                                                        double* G, bool overwrite, bool upper) {
@@ -143,8 +99,6 @@ void scaled_row_baseline(int count, double s, const double* scales, const double
   scaled_row<V2, 2>(count, s, scales, g, out);
 }
 
-using GramKernel = void (*)(int, int, const double*, double*, bool);
-
 bool supported(GramPath path) {
   __builtin_cpu_init();
   switch (path) {
@@ -154,25 +108,9 @@ bool supported(GramPath path) {
   }
 }
 
-GramKernel kernel_of(GramPath path) {
-  if (path == GramPath::best) path = supported(GramPath::avx512) ? GramPath::avx512
-                                    : supported(GramPath::avx2)  ? GramPath::avx2
-                                                                 : GramPath::baseline;
-  switch (path) {
-    case GramPath::avx512: return gram_avx512;
-    case GramPath::avx2: return gram_avx2;
-    default: return gram_baseline;
-  }
-}
-
 }  // namespace
 
 bool gram_path_supported(GramPath path) { return supported(path); }
-
-void accumulate_gram_upper(int rows, int cols, const double* A, double* G, bool overwrite, GramPath path) {
-  static const GramKernel best = kernel_of(GramPath::best);
-  (path == GramPath::best ? best : kernel_of(path))(rows, cols, A, G, overwrite);
-}
 
 void accumulate_product(int rows, int cols, const double* A, const double* B, double* G, bool overwrite,
                         bool upper, GramPath path) {
@@ -189,6 +127,10 @@ void accumulate_product(int rows, int cols, const double* A, const double* B, do
   };
   static const ProductKernel best = kernel_for(GramPath::best);
   (path == GramPath::best ? best : kernel_for(path))(rows, cols, A, B, G, overwrite, upper);
+}
+
+void accumulate_gram_upper(int rows, int cols, const double* A, double* G, bool overwrite, GramPath path) {
+  accumulate_product(rows, cols, A, A, G, overwrite, true, path);
 }
 
 void add_scaled_row(int count, double s, const double* scales, const double* g, double* out) {

@@ -18,7 +18,7 @@
 
 namespace dgtex::kernels {
 
-constexpr int gram_column_multiple = 16;
+constexpr int gram_column_multiple = 8;
 
 // best: the widest the machine supports (chosen once); the others for tests (must be
 // supported: gram_path_supported).
@@ -28,11 +28,9 @@ void accumulate_gram_upper(int rows, int cols, const double* A, double* G, bool 
                            GramPath path = GramPath::best);
 
 // G += A^T B for blocks of rows A and B (rows x cols each, row-major, cols a multiple of
-// product_column_multiple: pad with zero columns), G cols x cols with row stride cols.
+// gram_column_multiple: pad with zero columns), G cols x cols with row stride cols.
 // upper: only the entries (i, j >= i) are summed (those below are scratch, as above; for
-// products known to be symmetric), else all. The same per-entry sums in row order as
-// accumulate_gram_upper, so every path rounds alike.
-constexpr int product_column_multiple = 8;
+// products known to be symmetric), else all. accumulate_gram_upper is the upper A^T A.
 void accumulate_product(int rows, int cols, const double* A, const double* B, double* G, bool overwrite,
                         bool upper, GramPath path = GramPath::best);
 
