@@ -272,21 +272,6 @@ struct PointRows {
       for (int r = 0; r < 3; ++r) Bf[t][2 + r] = -phi[r];
     }
   }
-
-  // A planar element's rows in its fixed frame (E1, E2, T; see PlanarFrame). Membrane:
-  // one row, sqrt(w D_m) times the function's gradient along E1 and E2 (2 columns per
-  // function, at 2 col of `membrane`); its Gram sums are the gradient products S_ab, from
-  // which membrane_from_gradient_products forms the plane-stress stiffness. Bending: the
-  // three rows along T (1 column per function, at col of bending[0..2]).
-  // in_plane[f][a] = e_f . E_a, normal = t0 . T (+-1).
-  void write_planar(const double dN[2], const double d2N[3], const double in_plane[2][2], double normal,
-                    double* membrane, double* const bending[3], int col) const {
-    double g[2], beta[3];
-    strains(dN, d2N, g, beta);
-    for (int a = 0; a < 2; ++a) membrane[2 * col + a] = sm * (g[0] * in_plane[0][a] + g[1] * in_plane[1][a]);
-    const double b[3] = {sb * (beta[0] + nu * beta[1]), sb * k1 * beta[1], sb * k2 * beta[2]};
-    for (int r = 0; r < 3; ++r) bending[r][col] = b[r] * normal;
-  }
 };
 
 // A point's rows split by global component k (x, y, z). Membrane row rho of function i,
@@ -675,18 +660,43 @@ void chunk_stiffness(const EnrichedElementBatch& b, const EnrichedQuadrature& qu
       R = fused_rotation;
     }
     pr.set(rest, R, weight, dn, dm, nu);
+    // The derivatives d = (dN_1, dN_2, d2N_11, d2N_22, d2N_12) of the point's reduced
+    // basis, one array each: the rows are linear in them (PointRows::split_factors), and
+    // forming them by loops over the functions vectorises.
+    const int m = group.m;
+    double d[5][max_enriched_basis];
+    for_reduced_functions(L, mask, s, samples, [&](const double* dN, const double* d2N, int r) {
+      d[0][r] = dN[0], d[1][r] = dN[1], d[2][r] = d2N[0], d[3][r] = d2N[1], d[4][r] = d2N[2];
+    });
+    double A[2][2], Bf[3][5];
+    pr.split_factors(A, Bf);
     if (planar) {
+      // A planar element's rows in its fixed frame (E1, E2, T; see PlanarFrame). Membrane:
+      // one row, sqrt(w D_m) times the function's gradient along E1 and E2 (2 columns per
+      // function, at 2 r + a), u_1 (e1 . E_a) + u_2 (e2 . E_a); its Gram sums are the
+      // gradient products S_ab, from which membrane_from_gradient_products forms the
+      // plane-stress stiffness. Bending: the three rows b_t (t0 . T) along T (1 column per
+      // function).
       double in_plane[2][2];
       for (int f = 0; f < 2; ++f)
         for (int a = 0; a < 2; ++a) in_plane[f][a] = dot3(pr.e[f], frame.E[a]);
       const double normal = dot3(pr.e[2], frame.E[2]);
+      double Am[2][2];
+      for (int a = 0; a < 2; ++a)
+        for (int j = 0; j < 2; ++j) Am[a][j] = A[0][j] * in_plane[0][a] + A[1][j] * in_plane[1][a];
       const std::size_t Sm = group.membrane_stride, Sb = group.bending_stride;
       double* membrane = group.membrane_rows + group.pending * Sm;
-      double* bb = group.bending_rows + 3 * group.pending * Sb;
-      double* const bending[3] = {bb, bb + Sb, bb + 2 * Sb};
-      for_reduced_functions(L, mask, s, samples, [&](const double* dN, const double* d2N, int r) {
-        pr.write_planar(dN, d2N, in_plane, normal, membrane, bending, r);
-      });
+      for (int r = 0; r < m; ++r) {
+        membrane[2 * r] = Am[0][0] * d[0][r] + Am[0][1] * d[1][r];
+        membrane[2 * r + 1] = Am[1][0] * d[0][r] + Am[1][1] * d[1][r];
+      }
+      double* bending = group.bending_rows + 3 * group.pending * Sb;
+      for (int t = 0; t < 3; ++t) {
+        double f[5];
+        for (int j = 0; j < 5; ++j) f[j] = Bf[t][j] * normal;
+        for (int r = 0; r < m; ++r)
+          bending[t * Sb + r] = f[0] * d[0][r] + f[1] * d[1][r] + f[2] * d[2][r] + f[3] * d[3][r] + f[4] * d[4][r];
+      }
       if (++group.pending == planar_block_points) flush(group);
       continue;
     }
@@ -722,15 +732,9 @@ void chunk_stiffness(const EnrichedElementBatch& b, const EnrichedQuadrature& qu
     // This point's rows, stacked under the group's pending ones: first the factors u0, u1
     // (into U) and b (scratch) of every function, then the combinations row by row.
     const std::size_t S = group.stride;
-    const int m = group.m;
     double* const U0 = group.row_block(split_u) + 2 * group.pending * S;
     double* const U1 = U0 + S;
-    double d[5][max_enriched_basis], bending[3][max_enriched_basis];
-    for_reduced_functions(L, mask, s, samples, [&](const double* dN, const double* d2N, int r) {
-      d[0][r] = dN[0], d[1][r] = dN[1], d[2][r] = d2N[0], d[3][r] = d2N[1], d[4][r] = d2N[2];
-    });
-    double A[2][2], Bf[3][5];
-    pr.split_factors(A, Bf);
+    double bending[3][max_enriched_basis];
     for (int r = 0; r < m; ++r) U0[r] = A[0][0] * d[0][r] + A[0][1] * d[1][r];
     for (int r = 0; r < m; ++r) U1[r] = A[1][0] * d[0][r] + A[1][1] * d[1][r];
     for (int t = 0; t < 3; ++t) {
