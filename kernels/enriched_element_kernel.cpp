@@ -355,7 +355,7 @@ struct Group {
   std::uint32_t varying = 0;
   double value[max_enrichments_per_element];
   int m = 0;                    // reduced basis functions
-  double* G = nullptr;          // 3m x 3m, row stride 3m (filled by finish_split)
+  double* G = nullptr;          // 3m x 3m, row stride 3m (upper part filled by finish_split)
   int pending = 0;              // points stacked, not yet summed
   bool written = false;         // the sums hold a first block
   // Frame-split sums, stride = m padded to gram_column_multiple: D_k (sum of the
@@ -428,8 +428,9 @@ void flush(Group& group) {
   group.pending = 0;
 }
 
-// G (3m x 3m, entry (3 i + k, 3 j + l)) of a frame-split group from its sums: D_k for
-// k = l, O_p + Bs_p for the pair p = (k, l), k < l, and their transposes for k > l.
+// G (3m x 3m, entry (3 i + k, 3 j + l)) of a frame-split group from its sums, upper part
+// (GroupMap mirrors the lower entries it reads): D_k for k = l, O_p + Bs_p for the pair
+// p = (k, l), k < l, and for k > l (i < j) the transposed entries of pair (l, k).
 void finish_split(Group& group) {
   const int m = group.m, S = group.stride;
   const std::size_t N = 3 * static_cast<std::size_t>(m);
@@ -437,16 +438,15 @@ void finish_split(Group& group) {
   int pair_of[3][3] = {};
   for (int p = 0; p < 3; ++p) pair_of[frame_split_pairs[p][0]][frame_split_pairs[p][1]] = p;
   for (int i = 0; i < m; ++i)
-    for (int j = 0; j < m; ++j) {
-      const int lo = std::min(i, j), hi = std::max(i, j);
+    for (int j = i; j < m; ++j) {
       double* out = group.G + 3 * i * N + 3 * j;
       for (int k = 0; k < 3; ++k)
-        for (int l = 0; l < 3; ++l) {
+        for (int l = i == j ? k : 0; l < 3; ++l) {
           double v = 0;
           if (group.written) {
-            if (k == l) v = at(group.D(k), lo, hi);
-            else if (k < l) v = at(group.O(pair_of[k][l]), i, j) + at(group.Bs(pair_of[k][l]), lo, hi);
-            else v = at(group.O(pair_of[l][k]), j, i) + at(group.Bs(pair_of[l][k]), lo, hi);
+            if (k == l) v = at(group.D(k), i, j);
+            else if (k < l) v = at(group.O(pair_of[k][l]), i, j) + at(group.Bs(pair_of[k][l]), i, j);
+            else v = at(group.O(pair_of[l][k]), j, i) + at(group.Bs(pair_of[l][k]), i, j);
           }
           out[k * N + l] = v;
         }
