@@ -153,27 +153,29 @@ inline PolygonMoments half_rectangle_moments(double a, double b, const LevelFunc
   return m;
 }
 
+// Equal to the last bit (memcmp, so -0.0 differs from 0.0 and a NaN equals itself).
+inline bool bitwise_equal(const std::vector<double>& a, const std::vector<double>& b) {
+  return a.size() == b.size() && (a.empty() || std::memcmp(a.data(), b.data(), a.size() * sizeof(double)) == 0);
+}
+
 // Two models equal to the last bit in what a simulation reads of them: the block pattern,
 // the mass, gravity and area loads, and the unrotated stiffness.
 inline void expect_models_equal_bitwise(ShellModel& a, ShellModel& b) {
-  auto same = [](const std::vector<double>& x, const std::vector<double>& y) {
-    return x.size() == y.size() && (x.empty() || std::memcmp(x.data(), y.data(), x.size() * sizeof(double)) == 0);
-  };
   ASSERT_EQ(a.num_dofs(), b.num_dofs());
   EXPECT_EQ(a.pattern().column(), b.pattern().column());
   EXPECT_EQ(a.pattern().row_start(), b.pattern().row_start());
-  EXPECT_TRUE(same(a.mass_blocks(), b.mass_blocks()));
+  EXPECT_TRUE(bitwise_equal(a.mass_blocks(), b.mass_blocks()));
   const double g[3] = {0.1, -0.2, -9.81}, q[3] = {1, 2, 3};
   std::vector<double> fa(a.num_dofs(), 0.0), fb(b.num_dofs(), 0.0);
   a.add_gravity(g, fa);
   a.add_area_force(q, fa);
   b.add_gravity(g, fb);
   b.add_area_force(q, fb);
-  EXPECT_TRUE(same(fa, fb));
+  EXPECT_TRUE(bitwise_equal(fa, fb));
   std::vector<double> ka, kb;
   a.assemble_stiffness(nullptr, ka, nullptr);
   b.assemble_stiffness(nullptr, kb, nullptr);
-  EXPECT_TRUE(same(ka, kb));
+  EXPECT_TRUE(bitwise_equal(ka, kb));
 }
 
 }  // namespace dgtex::testing_support

@@ -2,8 +2,9 @@
 // (dgtex/kernels/gram_accumulation.h) are bitwise the one-entry-at-a-time references on
 // every instruction-set path the machine supports, and the fast stiffness (frame-split
 // sums of the strain rows, blocked products, runs-based group mapping, row-parallel
-// chunk reduction) agrees with the plain per-point reference to round-off for complete cuts (1e-13 relative to max |K|) and to the flat
-// tolerance for harmonic partial cuts (1e-9), writes exact zeros into padding slots, is
+// chunk reduction) agrees with the plain per-point reference to round-off for complete
+// cuts (1e-13 relative to max |K|) and to the flat tolerance for harmonic partial cuts
+// (1e-9), on flat and curved elements, writes exact zeros into padding slots, is
 // exactly symmetric, and is bitwise the same for 1, 2 and 4 threads; GramAccumulator (the
 // mass and edge sums) matches the plain sum to round-off. The fused corotated
 // form (F and rotation per point inside the stiffness pass) is bitwise the three kernels.

@@ -38,10 +38,6 @@ using namespace dgtex::testing_support;
 
 namespace {
 
-bool bitwise_equal(const std::vector<double>& a, const std::vector<double>& b) {
-  return a.size() == b.size() && (a.empty() || std::memcmp(a.data(), b.data(), a.size() * sizeof(double)) == 0);
-}
-
 std::vector<double> random_state(int dofs, unsigned seed) {
   std::mt19937 rng(seed);
   std::uniform_real_distribution<double> uniform(-1e-3, 1e-3);
