@@ -8,7 +8,9 @@
 // functions change, the model takes the new basis and displacement and velocity are
 // projected onto it (dgtex/basis_projection.h), then the shell steps. Stages timed per
 // step: "enrichment" (cut update and Laplace solves), "projection" (only steps where the
-// basis changed), "assembly" and "solve" (dgtex/shell_simulation.h).
+// basis changed), "assembly" and "solve" (dgtex/shell_simulation.h). Each basis gets its
+// own simulation; once one has given up its element-local preconditioner, the later ones
+// start with the whole pattern (dgtex/factor_reusing_solver.h).
 //
 // Overlapped cut updates (SceneRunOptions::overlap_cut_updates, the default): the cuts
 // follow their schedule, not the shell, so the next step's cut update can run while this
