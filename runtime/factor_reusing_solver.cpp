@@ -79,12 +79,14 @@ FactorReusingSolver::FactorReusingSolver(const BlockAssembly& pattern, const Fre
   for (size_t d = 0; d < mask.size(); ++d) free_[d] = mask[d] != 0;
   if (static_cast<std::int64_t>(mass.size()) == blocks * 9) element_local_blocks_ = element_local_blocks(mass);
   for (char kept : element_local_blocks_) element_local_differs_ |= !kept;
+  whole_pattern_dense_ =
+      SparseCholesky::factors_densely(system.size(), static_cast<std::int64_t>(system.row_index().size()));
   set_options(options);
 }
 
 void FactorReusingSolver::set_options(const FactorReuseOptions& options) {
   const bool element_local = options.preconditioner_pattern == PreconditionerPattern::element_local &&
-                             element_local_differs_ && stats_.element_local_fallbacks == 0;
+                             element_local_differs_ && !whole_pattern_dense_ && stats_.element_local_fallbacks == 0;
   if (element_local != use_element_local_) factor_current_ = false, factorization_pending_ = false;
   use_element_local_ = element_local;
   options_ = options;

@@ -100,6 +100,11 @@ SparseCholesky::SparseCholesky(int dense_max_unknowns)
     : impl_(std::make_unique<Impl>()), dense_max_unknowns_(dense_max_unknowns) {}
 SparseCholesky::~SparseCholesky() = default;
 
+bool SparseCholesky::factors_densely(int n, std::int64_t lower_nonzeros, int dense_max_unknowns) {
+  const double lower_entries = 0.5 * n * (n + 1.0);
+  return n <= dense_max_unknowns && (n <= 128 || static_cast<double>(lower_nonzeros) >= 0.25 * lower_entries);
+}
+
 bool SparseCholesky::analyzed() const { return impl_->factor != nullptr || impl_->dense != nullptr; }
 bool SparseCholesky::dense() const { return impl_->dense != nullptr; }
 
@@ -110,8 +115,7 @@ void SparseCholesky::analyze(int n, const std::vector<int>& column_start, const 
   m.dense.reset();
   n_ = n;
   const size_t nnz = row_index.size();
-  const double lower_entries = 0.5 * n * (n + 1.0);
-  if (n <= dense_max_unknowns_ && (n <= 128 || nnz >= 0.25 * lower_entries)) {
+  if (factors_densely(n, static_cast<std::int64_t>(nnz), dense_max_unknowns_)) {
     m.dense = std::make_unique<detail::DenseCholesky>();
     m.dense->set_pattern(n, column_start, row_index);
     return;

@@ -261,6 +261,30 @@ TEST(FactorReuse, WholePatternFactorisationIsAlsoLeftForBesideTheAssembly) {
   EXPECT_EQ(solver.statistics().factorizations, 2);
 }
 
+TEST(FactorReuse, ASystemFactoredDenselyUsesTheWholePattern) {
+  // A small cylinder (~100 free DOFs): its DG edge couplings make the element-local
+  // pattern differ, but SparseCholesky factors the whole pattern densely, so an
+  // element-local factor would be no smaller, only a weaker preconditioner. The coarser
+  // compressed cylinder above (sparse) keeps the element-local default.
+  Mesh mesh = make_cylinder(0.5, 2.0, 0, 360, 4, 2, ElementType::quad8);
+  auto bottom = [](const double* x) { return x[1] < 1e-9; };
+  auto model = make_model(mesh, Material{}, 1.0, bottom);
+  std::vector<char> fixed;
+  fix_nodes(mesh, bottom, true, true, true, fixed);
+  const FreeDofSystem system(model->pattern(), fixed);
+  ASSERT_TRUE(SparseCholesky::factors_densely(system.size(), static_cast<std::int64_t>(system.row_index().size())));
+  const std::vector<char> kept = element_local_blocks(model->mass_blocks());
+  ASSERT_NE(std::count(kept.begin(), kept.end(), 0), 0) << "the element-local pattern must differ";
+  const FactorReusingSolver small(model->pattern(), system, model->mass_blocks());
+  EXPECT_FALSE(small.element_local());
+
+  CylinderSystem cylinder;
+  ASSERT_FALSE(SparseCholesky::factors_densely(cylinder.system.size(),
+                                               static_cast<std::int64_t>(cylinder.system.row_index().size())));
+  const FactorReusingSolver large(cylinder.c.model->pattern(), cylinder.system, cylinder.c.model->mass_blocks());
+  EXPECT_TRUE(large.element_local());
+}
+
 TEST(FactorReuse, FallsBackToTheWholePatternWhenElementLocalIsTooWeak) {
   // With one iteration allowed and an exact (double) preconditioner only a factor of A
   // itself converges: the element-local factor fails twice (stale, then fresh) and the

@@ -29,7 +29,13 @@ class NotPositiveDefinite : public std::runtime_error {
 class SparseCholesky {
  public:
   // dense_max_unknowns: systems up to this size may be factored densely (0: always CHOLMOD).
-  explicit SparseCholesky(int dense_max_unknowns = 512);
+  static constexpr int default_dense_max_unknowns = 512;
+  explicit SparseCholesky(int dense_max_unknowns = default_dense_max_unknowns);
+  // Whether analyze() factors an n x n pattern with `lower_nonzeros` entries in its lower
+  // triangle (diagonal included) densely: small, and small enough or filled enough that
+  // CHOLMOD's bookkeeping would cost more than the arithmetic (dense_cholesky.h).
+  static bool factors_densely(int n, std::int64_t lower_nonzeros,
+                              int dense_max_unknowns = default_dense_max_unknowns);
   ~SparseCholesky();
   SparseCholesky(const SparseCholesky&) = delete;
   SparseCholesky& operator=(const SparseCholesky&) = delete;
