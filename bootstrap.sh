@@ -10,7 +10,7 @@ mode="${1:-build}"
 
 packages=(
   build-essential cmake ninja-build ccache pkg-config
-  libeigen3-dev libsuitesparse-dev libopenblas0-serial libopenvdb-dev libtbb-dev libboost-iostreams-dev
+  libeigen3-dev libsuitesparse-dev liblapack-dev libopenblas0-serial libopenvdb-dev libtbb-dev libboost-iostreams-dev
   libblosc-dev libimath-dev libopenexr-dev zlib1g-dev
   nlohmann-json3-dev libcli11-dev libgtest-dev libgmock-dev libbenchmark-dev libhypre-dev
   libegl-dev libegl-mesa0 libgl1-mesa-dri libgles-dev libepoxy-dev libpng-dev

@@ -4,7 +4,10 @@
 // supernodal bookkeeping and OpenMP regions cost more there than the arithmetic: n = 39,
 // analysis + factorisation 0.03-0.12 ms against 0.007 ms for Eigen's blocked LLT, and 0.2-2
 // ms inside a scene step with spinning OpenMP threads; n = 441 (fully dense) 2.9-3.4 ms
-// against 2.2 ms (one run of each, 2-core machine).
+// against 2.2 ms (one run of each, 2-core machine). Since session 18 systems of 128 unknowns
+// and more are factorised by LAPACK's dpotrf (OpenBLAS, serial; under the process-wide BLAS
+// lock, cholmod_lock.h): 1.5x Eigen's LLT at n = 126-168 and 2.2x at 441 in this baseline
+// x86-64 build. The solves stay Eigen's triangular solves (half the time of dpotrs there).
 #include <vector>
 
 #include <Eigen/Dense>
@@ -24,8 +27,8 @@ class DenseCholesky {
  private:
   int n_ = 0;
   std::vector<int> column_start_, row_index_;
-  Eigen::MatrixXd matrix_;  // the lower triangle of A, then (after a failure) scratch
-  Eigen::LLT<Eigen::MatrixXd, Eigen::Lower> factor_;
+  Eigen::MatrixXd factor_;  // the lower triangle of A, then its Cholesky factor L
+  void fill_lower(const std::vector<double>& values);  // factor_ = the lower triangle of A
 };
 
 }  // namespace dgtex::detail

@@ -78,8 +78,8 @@ TEST(DenseCholesky, SolvesLikeCholmodOnSmallSystems) {
 }
 
 TEST(DenseCholesky, DoesNotDependOnTheThreadCount) {
-  // Eigen may run the LLT's block products on the OpenMP threads; its blocking does not
-  // depend on their number, so neither may the factor.
+  // The factor (LAPACK's dpotrf at this size, serial OpenBLAS) must not depend on the
+  // OpenMP thread count.
   const LowerCsc m = lower_csc(random_spd(441, 441, 19u));
   std::vector<double> b(441);
   for (int i = 0; i < 441; ++i) b[i] = std::cos(0.7 * i);
@@ -119,31 +119,44 @@ TEST(DenseCholesky, SinglePrecisionSolveIsTheDoubleSolve) {
 }
 
 TEST(DenseCholesky, ReportsTheFirstNonPositivePivot) {
-  Eigen::MatrixXd a = random_spd(50, 50, 13u);
-  // Row and column 17 copy row and column 3 in the leading 18 x 18 block, with the diagonal
-  // one lower: the pivot at column 17 is -1 (the leading 17 x 17 block stays definite).
-  a.row(17).head(17) = a.row(3).head(17);
-  a.col(17).head(17) = a.col(3).head(17);
-  a(17, 17) = a(3, 3) - 1;
-  const LowerCsc m = lower_csc(a);
-  dgtex::SparseCholesky c;
-  c.analyze(m.n, m.column_start, m.row_index);
-  ASSERT_TRUE(c.dense());
-  try {
-    c.factorize(m.values);
-    FAIL() << "an indefinite matrix was factored";
-  } catch (const dgtex::NotPositiveDefinite& e) {
-    EXPECT_EQ(e.column(), 17);
-    EXPECT_NE(std::string(e.what()).find("column 17 of 50"), std::string::npos) << e.what();
+  // Both factorisations: Eigen's LLT (small systems) and LAPACK's dpotrf (128 unknowns on).
+  for (int n : {50, 200}) {
+    Eigen::MatrixXd a = random_spd(n, n, 13u);
+    // Row and column 17 copy row and column 3 in the leading 18 x 18 block, with the
+    // diagonal one lower: the pivot at column 17 is -1 (the leading 17 x 17 block stays
+    // definite).
+    a.row(17).head(17) = a.row(3).head(17);
+    a.col(17).head(17) = a.col(3).head(17);
+    a(17, 17) = a(3, 3) - 1;
+    const LowerCsc m = lower_csc(a);
+    dgtex::SparseCholesky c;
+    c.analyze(m.n, m.column_start, m.row_index);
+    ASSERT_TRUE(c.dense());
+    try {
+      c.factorize(m.values);
+      FAIL() << "an indefinite matrix was factored, n = " << n;
+    } catch (const dgtex::NotPositiveDefinite& e) {
+      EXPECT_EQ(e.column(), 17) << n;
+      const std::string where = "column 17 of " + std::to_string(n);
+      EXPECT_NE(std::string(e.what()).find(where), std::string::npos) << e.what();
+    }
   }
 }
 
 TEST(DenseCholesky, RejectsNonFiniteValuesAndWrongCounts) {
-  LowerCsc m = lower_csc(random_spd(20, 20, 17u));
-  dgtex::SparseCholesky c;
-  c.analyze(m.n, m.column_start, m.row_index);
-  m.values[m.column_start[5]] = std::numeric_limits<double>::quiet_NaN();  // diagonal of column 5
-  EXPECT_THROW(c.factorize(m.values), dgtex::NotPositiveDefinite);
-  m.values.pop_back();
-  EXPECT_THROW(c.factorize(m.values), std::invalid_argument);
+  for (int n : {20, 160}) {
+    LowerCsc m = lower_csc(random_spd(n, n, 17u));
+    dgtex::SparseCholesky c;
+    c.analyze(m.n, m.column_start, m.row_index);
+    ASSERT_TRUE(c.dense());
+    m.values[m.column_start[5]] = std::numeric_limits<double>::quiet_NaN();  // diagonal of column 5
+    try {
+      c.factorize(m.values);
+      FAIL() << "a NaN pivot was factored, n = " << n;
+    } catch (const dgtex::NotPositiveDefinite& e) {
+      EXPECT_EQ(e.column(), 5) << n;
+    }
+    m.values.pop_back();
+    EXPECT_THROW(c.factorize(m.values), std::invalid_argument);
+  }
 }
