@@ -149,10 +149,10 @@ void SceneRun::change_basis(std::vector<EnrichmentFunction> functions, int edge_
       project_onto_basis(*model_, simulation_->displacement(), simulation_->velocity(), *next, fixed);
   auto simulation = std::make_unique<ShellSimulation>(*next, std::move(fixed), std::move(force));
   // Once an element-local preconditioner has failed (its matrix not positive definite, or
-  // too weak), the next bases, much like this one, get the whole pattern from the start:
-  // chad and the slinky fell back after most of their basis changes, each time after an
-  // element-local factorisation wasted.
-  if (simulation_->solver_statistics().element_local_fallbacks > 0 || replaced_solver_statistics_.element_local_fallbacks > 0) {
+  // too weak), the next bases, much like this one, get the whole pattern from the start
+  // instead of wasting an element-local factorisation each (chad and the slinky fell back
+  // at most of their basis changes before they were found too small for it).
+  if (solver_statistics().element_local_fallbacks > 0) {
     FactorReuseOptions whole_pattern;
     whole_pattern.preconditioner_pattern = PreconditionerPattern::full;
     simulation->set_solver_options(whole_pattern);
