@@ -262,10 +262,11 @@ TEST(FactorReuse, WholePatternFactorisationIsAlsoLeftForBesideTheAssembly) {
 }
 
 TEST(FactorReuse, ASystemFactoredDenselyUsesTheWholePattern) {
-  // A small cylinder (~100 free DOFs): its DG edge couplings make the element-local
-  // pattern differ, but SparseCholesky factors the whole pattern densely, so an
-  // element-local factor would be no smaller, only a weaker preconditioner. The coarser
-  // compressed cylinder above (sparse) keeps the element-local default.
+  // A small cylinder (4 x 2 elements, 96 DOFs): its DG edge couplings make the
+  // element-local pattern differ, but SparseCholesky factors the whole pattern densely, so
+  // an element-local factor would be no smaller, only a weaker preconditioner. The
+  // compressed cylinder above (10 x 6 elements, factored sparse) keeps the element-local
+  // default.
   Mesh mesh = make_cylinder(0.5, 2.0, 0, 360, 4, 2, ElementType::quad8);
   auto bottom = [](const double* x) { return x[1] < 1e-9; };
   auto model = make_model(mesh, Material{}, 1.0, bottom);
