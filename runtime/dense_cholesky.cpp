@@ -23,9 +23,9 @@ void DenseCholesky::set_pattern(int n, const std::vector<int>& column_start, con
 
 namespace {
 
-// Below this size Eigen's LLT is as fast: dpotrf's per-call overhead (and the lock) cost
-// more than its faster kernels save (spiral1, n = 36-48: 21 us a factorisation with Eigen,
-// 31 us with dpotrf).
+// Below this size Eigen's LLT stays: in isolation dpotrf is as fast or faster there too
+// (examples/bench_dense_cholesky), but inside the scenes it was slower (spiral1, n = 36-48:
+// its factorisations 3.9-5.1 -> 5.2-8.6 ms over the run; chad, n <= 126: 5.4-5.6 -> 6.4-6.9).
 constexpr int lapack_min_unknowns = 128;
 
 }  // namespace
@@ -42,7 +42,7 @@ void DenseCholesky::factorize(const std::vector<double>& values) {
   fill_lower(values);
   int bad = -1;
   if (n_ >= lapack_min_unknowns) {
-    // LAPACK (OpenBLAS, serial): 1.5-2.3x Eigen's LLT at n = 126-441 in this baseline
+    // LAPACK (OpenBLAS, serial): 1.5-1.9x Eigen's LLT at n = 168-498 in this baseline
     // x86-64 build. info > 0 names the first leading minor that is not positive definite (a
     // non-positive or NaN pivot).
     int info = 0;

@@ -6,8 +6,9 @@
 // ms inside a scene step with spinning OpenMP threads; n = 441 (fully dense) 2.9-3.4 ms
 // against 2.2 ms (one run of each, 2-core machine). Since session 18 systems of 128 unknowns
 // and more are factorised by LAPACK's dpotrf (OpenBLAS, serial; under the process-wide BLAS
-// lock, cholmod_lock.h): 1.5x Eigen's LLT at n = 126-168 and 2.2x at 441 in this baseline
-// x86-64 build. The solves stay Eigen's triangular solves (half the time of dpotrs there).
+// lock, cholmod_lock.h): 1.5x Eigen's LLT at n = 168 and 1.8-1.9x at 441-498 in this
+// baseline x86-64 build (examples/bench_dense_cholesky). The solves stay Eigen's
+// triangular solves (half the time of dpotrs there).
 #include <vector>
 
 #include <Eigen/Dense>
