@@ -331,6 +331,12 @@ struct PlanarFrame {
   double E[3][3];
 };
 
+// out[r] = f . (d[0][r], ..., d[4][r]) for the m functions: a factor linear in each
+// function's derivatives (dN_1, dN_2, d2N_11, d2N_22, d2N_12), one loop over the functions.
+inline void combine_derivatives(const double f[5], const double (*d)[max_enriched_basis], int m, double* out) {
+  for (int r = 0; r < m; ++r) out[r] = f[0] * d[0][r] + f[1] * d[1][r] + f[2] * d[2][r] + f[3] * d[3][r] + f[4] * d[4][r];
+}
+
 // Points with the same varying textures (mask) and the same constant values: G = sum of
 // S^T S over the group's reduced basis (standard functions, then the varying textures'
 // enriched ones), upper triangle; g = sum of S^T s (corrective forces). Curved or rotated
@@ -616,7 +622,9 @@ void chunk_stiffness(const EnrichedElementBatch& b, const EnrichedQuadrature& qu
       for (int k = 0; k < L.count; ++k)
         if (mask >> k & 1u)
           for (int a = 0; a < npe; ++a) fresh.m += L.slot[k][a] >= 0;
-      const auto padded = [](int columns, int multiple) { return (columns + multiple - 1) / multiple * multiple; };
+      const auto padded = [](int columns) {
+        return (columns + gram_column_multiple - 1) / gram_column_multiple * gram_column_multiple;
+      };
       if (storage.size() <= groups.size()) storage.emplace_back();
       GroupStorage& space = storage[groups.size()];
       // Padding columns of the stacked rows stay 0.
@@ -625,8 +633,7 @@ void chunk_stiffness(const EnrichedElementBatch& b, const EnrichedQuadrature& qu
           for (int i = used; i < stride; ++i) rows[static_cast<std::size_t>(k) * stride + i] = 0;
       };
       if (planar) {
-        const std::size_t Sm = padded(2 * fresh.m, gram_column_multiple), Sb = padded(fresh.m, gram_column_multiple),
-                          points = planar_block_points;
+        const std::size_t Sm = padded(2 * fresh.m), Sb = padded(fresh.m), points = planar_block_points;
         fresh.membrane_stride = static_cast<int>(Sm), fresh.bending_stride = static_cast<int>(Sb);
         fresh.Gm = space.take(Sm * Sm + Sb * Sb + points * Sm + 3 * points * Sb);
         fresh.Gb = fresh.Gm + Sm * Sm;
@@ -635,7 +642,7 @@ void chunk_stiffness(const EnrichedElementBatch& b, const EnrichedQuadrature& qu
         zero_padding(fresh.membrane_rows, static_cast<int>(points), 2 * fresh.m, fresh.membrane_stride);
         zero_padding(fresh.bending_rows, static_cast<int>(3 * points), fresh.m, fresh.bending_stride);
       } else {
-        fresh.stride = padded(fresh.m, gram_column_multiple);
+        fresh.stride = padded(fresh.m);
         const std::size_t N = 3 * static_cast<std::size_t>(fresh.m);
         const int row_count = split_row_units * group_block_points;
         fresh.sums = space.take(9 * fresh.square() + static_cast<std::size_t>(row_count) * fresh.stride + N * N);
@@ -694,8 +701,7 @@ void chunk_stiffness(const EnrichedElementBatch& b, const EnrichedQuadrature& qu
       for (int t = 0; t < 3; ++t) {
         double f[5];
         for (int j = 0; j < 5; ++j) f[j] = Bf[t][j] * normal;
-        for (int r = 0; r < m; ++r)
-          bending[t * Sb + r] = f[0] * d[0][r] + f[1] * d[1][r] + f[2] * d[2][r] + f[3] * d[3][r] + f[4] * d[4][r];
+        combine_derivatives(f, d, m, bending + t * Sb);
       }
       if (++group.pending == planar_block_points) flush(group);
       continue;
@@ -737,11 +743,7 @@ void chunk_stiffness(const EnrichedElementBatch& b, const EnrichedQuadrature& qu
     double bending[3][max_enriched_basis];
     for (int r = 0; r < m; ++r) U0[r] = A[0][0] * d[0][r] + A[0][1] * d[1][r];
     for (int r = 0; r < m; ++r) U1[r] = A[1][0] * d[0][r] + A[1][1] * d[1][r];
-    for (int t = 0; t < 3; ++t) {
-      const double* f = Bf[t];
-      for (int r = 0; r < m; ++r)
-        bending[t][r] = f[0] * d[0][r] + f[1] * d[1][r] + f[2] * d[2][r] + f[3] * d[3][r] + f[4] * d[4][r];
-    }
+    for (int t = 0; t < 3; ++t) combine_derivatives(Bf[t], d, m, bending[t]);
     for (int k = 0; k < 3; ++k) {
       double* const M0 = group.row_block(split_m(k)) + 2 * group.pending * S;
       double* const M1 = M0 + S;

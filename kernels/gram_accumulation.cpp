@@ -141,17 +141,6 @@ void add_scaled_row(int count, double s, const double* scales, const double* g, 
   kernel(count, s, scales, g, out);
 }
 
-void accumulate_gram_upper_reference(int rows, int cols, const double* A, double* G, bool overwrite) {
-  for (int i = 0; i < cols; ++i)
-    for (int j = i; j < cols; ++j) {
-      double sum = 0;
-      for (int k = 0; k < rows; ++k)
-        sum += A[static_cast<std::size_t>(k) * cols + i] * A[static_cast<std::size_t>(k) * cols + j];
-      double& out = G[static_cast<std::size_t>(i) * cols + j];
-      out = overwrite ? sum : out + sum;
-    }
-}
-
 void accumulate_product_reference(int rows, int cols, const double* A, const double* B, double* G, bool overwrite,
                                   bool upper) {
   for (int i = 0; i < cols; ++i)
@@ -162,6 +151,10 @@ void accumulate_product_reference(int rows, int cols, const double* A, const dou
       double& out = G[static_cast<std::size_t>(i) * cols + j];
       out = overwrite ? sum : out + sum;
     }
+}
+
+void accumulate_gram_upper_reference(int rows, int cols, const double* A, double* G, bool overwrite) {
+  accumulate_product_reference(rows, cols, A, A, G, overwrite, true);
 }
 
 }  // namespace dgtex::kernels
