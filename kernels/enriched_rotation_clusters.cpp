@@ -49,11 +49,27 @@ std::vector<std::pair<int, int>> cut_tips(ElementType type, int T, const std::ui
   return tips;
 }
 
+// The same from a mask of the texels in the domain (texel_in_domain per texel), row by row
+// without a call per texel: the fast kernel's form.
+std::vector<std::pair<int, int>> cut_tips(int T, const std::uint8_t* flags, const std::uint8_t* inside) {
+  std::vector<std::pair<int, int>> tips;
+  for (int y = 1; y < T; ++y) {
+    const std::uint8_t *below = flags + (y - 1) * T, *above = flags + y * T;
+    const std::uint8_t *in_below = inside + (y - 1) * T, *in_above = inside + y * T;
+    for (int x = 1; x < T; ++x) {
+      if (!(in_below[x - 1] & in_below[x] & in_above[x - 1] & in_above[x])) continue;
+      const int degree = !!(above[x - 1] & wall_east) + !!(below[x - 1] & wall_east) + !!(below[x - 1] & wall_north) +
+                         !!(below[x] & wall_north);
+      if (degree == 1) tips.emplace_back(x, y);
+    }
+  }
+  return tips;
+}
+
 // The block of each texel: blocks of B x B texels, and where one holds a cut tip (on its
 // closed outline) it is split in four, again while a quarter holds the tip and is larger
 // than tip_B. Returned as one id per texel (the block's size and position).
-std::vector<std::int64_t> texel_blocks(ElementType type, int T, const std::uint8_t* flags, int B, int tip_B) {
-  const std::vector<std::pair<int, int>> tips = cut_tips(type, T, flags);
+std::vector<std::int64_t> texel_blocks(int T, const std::vector<std::pair<int, int>>& tips, int B, int tip_B) {
   // Per block size B, B/2, ... above tip_B: which blocks hold a tip.
   struct Level {
     int size, count;  // block size, blocks per row
@@ -86,7 +102,7 @@ std::vector<std::int64_t> texel_blocks(ElementType type, int T, const std::uint8
 // texel; texels outside the domain -1): the element's walls plus walls between blocks.
 // `count` receives the number of labels.
 std::vector<int> block_components(ElementType type, int T, const std::uint8_t* flags, int B, int tip_B, int& count) {
-  const std::vector<std::int64_t> block = texel_blocks(type, T, flags, B, tip_B);
+  const std::vector<std::int64_t> block = texel_blocks(T, cut_tips(type, T, flags), B, tip_B);
   TexelTile tile(T, T);
   for (int j = 0; j < T; ++j)
     for (int i = 0; i < T; ++i) {
@@ -100,6 +116,109 @@ std::vector<int> block_components(ElementType type, int T, const std::uint8_t* f
   std::vector<int> label;
   count = label_components(tile, label);
   return label;
+}
+
+// The same labels without a tile and label_components: one serial union-find over a mask of
+// the domain (several elements run side by side instead). Couplings are those of
+// label_components on block_components' tile: both texels in the domain, no wall between
+// them, the same block. Runs of east-coupled texels point to their first texel, and a
+// union hangs the larger root below the smaller, so each part's root is its first texel
+// and numbering roots in texel order gives the canonical labels.
+std::vector<int> block_components_fast(ElementType type, int T, const std::uint8_t* flags, int B, int tip_B,
+                                       int& count) {
+  const std::size_t n = static_cast<std::size_t>(T) * T;
+  std::vector<std::uint8_t> inside(n);
+  for (int j = 0; j < T; ++j)
+    for (int i = 0; i < T; ++i) {
+      const int t = j * T + i;
+      inside[t] = (type != ElementType::tri6 || i + j <= T - 1) && !(flags[t] & inactive);
+    }
+  const std::vector<std::int64_t> block = texel_blocks(T, cut_tips(T, flags, inside.data()), B, tip_B);
+  std::vector<int> parent(n);
+  for (int j = 0; j < T; ++j) {
+    int run_start = j * T;
+    for (int i = 0; i < T; ++i) {
+      const int t = j * T + i;
+      const bool joined = i > 0 && inside[t - 1] && inside[t] && !(flags[t - 1] & wall_east) && block[t - 1] == block[t];
+      if (!joined) run_start = t;
+      parent[t] = run_start;
+    }
+  }
+  const auto root = [&parent](int x) {
+    while (parent[x] != x) x = parent[x] = parent[parent[x]];  // path halving
+    return x;
+  };
+  for (int j = 0; j + 1 < T; ++j)
+    for (int i = 0; i < T; ++i) {
+      const int t = j * T + i;
+      if (!(inside[t] && inside[t + T] && !(flags[t] & wall_north) && block[t] == block[t + T])) continue;
+      const int a = root(t), b = root(t + T);
+      if (a != b) parent[std::max(a, b)] = std::min(a, b);
+    }
+  std::vector<int> label(n, -1);
+  count = 0;
+  for (std::size_t t = 0; t < n; ++t) {
+    if (!inside[t]) continue;
+    const int r = root(static_cast<int>(t));
+    label[t] = r == static_cast<int>(t) ? count++ : label[r];
+  }
+  return label;
+}
+
+// One element's clusters: its points bucketed by label (stable), empty labels dropped.
+struct ElementClusters {
+  std::vector<std::int64_t> sizes;   // points per cluster
+  std::vector<std::int64_t> points;  // by cluster
+  std::string error;                 // a point outside the domain (thrown by the caller)
+};
+
+ElementClusters bucket_points(const EnrichedElementBatch& batch, const EnrichedQuadrature& quadrature, std::int64_t e,
+                              const std::vector<int>& label, int labels) {
+  const int T = batch.resolution;
+  ElementClusters out;
+  const std::int64_t first = quadrature.start[e], last = quadrature.start[e + 1];
+  std::vector<int> point_label(static_cast<std::size_t>(last - first));
+  std::vector<std::int64_t> bucket(static_cast<std::size_t>(labels) + 1, 0);
+  for (std::int64_t q = first; q < last; ++q) {
+    int i, j;
+    containing_texel(batch.type, T, quadrature.points[3 * q], quadrature.points[3 * q + 1], i, j);
+    point_label[q - first] = label[j * T + i];
+    if (point_label[q - first] < 0) {  // containing_texel keeps points inside the domain
+      out.error = "enriched_rotation_clusters: quadrature point " + std::to_string(q) + " lies in texel (" +
+                  std::to_string(i) + ", " + std::to_string(j) + "), outside the domain";
+      return out;
+    }
+    ++bucket[point_label[q - first] + 1];
+  }
+  for (int l = 0; l < labels; ++l) {
+    if (bucket[l + 1] > 0) out.sizes.push_back(bucket[l + 1]);
+    bucket[l + 1] += bucket[l];
+  }
+  out.points.resize(static_cast<std::size_t>(last - first));
+  for (std::int64_t q = first; q < last; ++q) out.points[bucket[point_label[q - first]]++] = q;
+  return out;
+}
+
+void check_block_sizes(int block_texels, int tip_block_texels) {
+  if (block_texels < 1)
+    throw std::invalid_argument("enriched_rotation_clusters: block_texels is " + std::to_string(block_texels) +
+                                "; it must be >= 1");
+  if (tip_block_texels < 1)
+    throw std::invalid_argument("enriched_rotation_clusters: tip_block_texels is " +
+                                std::to_string(tip_block_texels) + "; it must be >= 1");
+}
+
+EnrichedRotationClusters concatenate(const std::vector<ElementClusters>& elements) {
+  EnrichedRotationClusters out;
+  out.element_start.push_back(0);
+  out.point_start.push_back(0);
+  for (const ElementClusters& element : elements) {
+    if (!element.error.empty()) throw std::logic_error(element.error);
+    for (std::int64_t size : element.sizes) out.point_start.push_back(out.point_start.back() + size);
+    out.points.insert(out.points.end(), element.points.begin(), element.points.end());
+    out.element_start.push_back(out.count());
+  }
+  return out;
 }
 
 // Mean-tangent weights D_f = sum_q w_q dN_f(q) of one cluster (2 per function, W slots).
@@ -204,45 +323,37 @@ std::int64_t enriched_cluster_rest_stride(const EnrichedElementBatch& batch) {
 
 EnrichedRotationClusters enriched_rotation_clusters(const EnrichedElementBatch& batch,
                                                     const EnrichedQuadrature& quadrature, int block_texels,
-                                                    int tip_block_texels) {
-  if (block_texels < 1)
-    throw std::invalid_argument("enriched_rotation_clusters: block_texels is " + std::to_string(block_texels) +
-                                "; it must be >= 1");
-  if (tip_block_texels < 1)
-    throw std::invalid_argument("enriched_rotation_clusters: tip_block_texels is " +
-                                std::to_string(tip_block_texels) + "; it must be >= 1");
-  const int T = batch.resolution;
-  EnrichedRotationClusters out;
-  out.element_start.push_back(0);
-  out.point_start.push_back(0);
+                                                    int tip_block_texels, Execution execution) {
+  check_block_sizes(block_texels, tip_block_texels);
+  // Elements side by side, each labelled serially (chad's 4 tiles of 256^2 texels: 9.5 -> 3.9
+  // ms a basis change against the reference form; spiral6's one: 2.3 -> 1.3 ms).
+  std::vector<ElementClusters> elements(static_cast<std::size_t>(batch.count));
+  forall(
+      batch.count,
+      [&](std::int64_t e) {
+        int labels = 0;
+        const std::vector<int> label = block_components_fast(batch.type, batch.resolution,
+                                                             batch.textures[batch.enrichment_start[e]].flags,
+                                                             block_texels, tip_block_texels, labels);
+        elements[e] = bucket_points(batch, quadrature, e, label, labels);
+      },
+      execution);
+  return concatenate(elements);
+}
+
+EnrichedRotationClusters enriched_rotation_clusters_reference(const EnrichedElementBatch& batch,
+                                                              const EnrichedQuadrature& quadrature, int block_texels,
+                                                              int tip_block_texels) {
+  check_block_sizes(block_texels, tip_block_texels);
+  std::vector<ElementClusters> elements;
   for (std::int64_t e = 0; e < batch.count; ++e) {
-    const std::uint8_t* flags = batch.textures[batch.enrichment_start[e]].flags;
     int labels = 0;
-    const std::vector<int> label = block_components(batch.type, T, flags, block_texels, tip_block_texels, labels);
-    // Points bucketed by label (stable), empty labels dropped.
-    const std::int64_t first = quadrature.start[e], last = quadrature.start[e + 1];
-    std::vector<int> point_label(static_cast<std::size_t>(last - first));
-    std::vector<std::int64_t> bucket(static_cast<std::size_t>(labels) + 1, 0);
-    for (std::int64_t q = first; q < last; ++q) {
-      int i, j;
-      containing_texel(batch.type, T, quadrature.points[3 * q], quadrature.points[3 * q + 1], i, j);
-      point_label[q - first] = label[j * T + i];
-      if (point_label[q - first] < 0)  // containing_texel keeps points inside the domain
-        throw std::logic_error("enriched_rotation_clusters: quadrature point " + std::to_string(q) +
-                               " lies in texel (" + std::to_string(i) + ", " + std::to_string(j) +
-                               "), outside the domain");
-      ++bucket[point_label[q - first] + 1];
-    }
-    const std::size_t base = out.points.size();
-    for (int l = 0; l < labels; ++l) {
-      if (bucket[l + 1] > 0) out.point_start.push_back(static_cast<std::int64_t>(base) + bucket[l] + bucket[l + 1]);
-      bucket[l + 1] += bucket[l];
-    }
-    out.points.resize(base + static_cast<std::size_t>(last - first));
-    for (std::int64_t q = first; q < last; ++q) out.points[base + bucket[point_label[q - first]]++] = q;
-    out.element_start.push_back(out.count());
+    const std::vector<int> label = block_components(batch.type, batch.resolution,
+                                                    batch.textures[batch.enrichment_start[e]].flags, block_texels,
+                                                    tip_block_texels, labels);
+    elements.push_back(bucket_points(batch, quadrature, e, label, labels));
   }
-  return out;
+  return concatenate(elements);
 }
 
 void enriched_cluster_rest_stiffness(const EnrichedElementBatch& batch, const EnrichedQuadrature& quadrature,

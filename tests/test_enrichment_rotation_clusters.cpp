@@ -13,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include "dgtex/kernels/cut_rasterization.h"
 #include "dgtex/kernels/enriched_rotation_clusters.h"
 #include "dgtex/topology.h"
 #include "cut_element_fixture.h"
@@ -168,6 +169,81 @@ TEST(EnrichedRotationClusters, NeverSpanACutAndHoldEveryPointOnce) {
     }
   }
   EXPECT_THROW(kernels::enriched_rotation_clusters(one.batch, one.quadrature(), 0, 1), std::invalid_argument);
+}
+
+// Tiles of several elements with partial cuts (tips inside, walls ending on the border,
+// tri6 diagonals), random points in every texel: the clusters equal the reference's (the
+// tile labelled by label_components, texel_in_domain per texel) for every block size and
+// thread count.
+TEST(EnrichedRotationClusters, BuildAsTheReferenceForAnyThreadCount) {
+  constexpr int T = 32, elements = 3;
+  for (ElementType type : {ElementType::quad8, ElementType::tri6}) {
+    const bool tri = type == ElementType::tri6;
+    std::mt19937 rng(tri ? 5 : 7);
+    std::uniform_real_distribution<double> u(0, 1);
+    std::vector<kernels::TexelTile> tiles;
+    std::vector<kernels::TextureView> views;
+    for (int e = 0; e < elements; ++e) {
+      tiles.push_back(kernels::make_element_tile(type, T));
+      for (int c = 0; c < 2 + e; ++c) {  // polylines of 3 points, from a border or inside
+        std::vector<kernels::TexelPoint> path;
+        for (int k = 0; k < 3; ++k) {
+          double x = T * u(rng), y = T * u(rng);
+          if (tri && x + y > T) x = T - x, y = T - y;
+          if (k == 0 && c % 2 == 0) x = 0;  // from the left border
+          path.push_back({x, y});
+        }
+        kernels::rasterize_cut(path, tiles.back());
+      }
+    }
+    for (const auto& tile : tiles) views.push_back({tile.values.data(), tile.flags.data()});
+    std::vector<int> element(elements), start(elements + 1);
+    for (int e = 0; e <= elements; ++e) start[e] = e;
+    for (int e = 0; e < elements; ++e) element[e] = e;
+    kernels::EnrichedElementBatch batch{};
+    batch.type = type;
+    batch.count = elements;
+    batch.element = element.data();
+    batch.resolution = T;
+    batch.enrichment_start = start.data();
+    batch.textures = views.data();
+    // Two points in every texel of the domain: its centre and a random one (tri6 diagonal
+    // texels: in their lower-left half).
+    std::vector<std::int64_t> qs = {0};
+    std::vector<double> qp;
+    for (int e = 0; e < elements; ++e) {
+      for (int j = 0; j < T; ++j)
+        for (int i = 0; i < T; ++i) {
+          if (!kernels::texel_in_domain(type, T, tiles[e].flags.data(), i, j)) continue;
+          for (int k = 0; k < 2; ++k) {
+            double a = k == 0 ? 0.5 : u(rng), b = k == 0 ? 0.25 : u(rng);
+            if (tri && i + j == T - 1 && a + b > 1) a = 1 - a, b = 1 - b;
+            const auto xi = kernels::parametric_from_texel_point(type, T, {i + a, j + b});
+            qp.insert(qp.end(), {xi[0], xi[1], 1.0});
+          }
+        }
+      qs.push_back(static_cast<std::int64_t>(qp.size() / 3));
+    }
+    const kernels::EnrichedQuadrature quad{qs.data(), qp.data()};
+    for (const auto& [block, tip] : std::vector<std::pair<int, int>>{{16, 4}, {8, 8}, {T, 5}, {1, 1}, {7, 2}}) {
+      const kernels::EnrichedRotationClusters reference =
+          kernels::enriched_rotation_clusters_reference(batch, quad, block, tip);
+      ASSERT_GT(reference.count(), elements * (block == T ? 1 : 4));
+      for (int threads : {1, 2, 3}) {
+        omp_set_num_threads(threads);
+        for (kernels::Execution execution : {kernels::Execution::serial, kernels::Execution::parallel}) {
+          const kernels::EnrichedRotationClusters fast =
+              kernels::enriched_rotation_clusters(batch, quad, block, tip, execution);
+          const std::string where = std::string(tri ? "tri6" : "quad8") + ", blocks " + std::to_string(block) + "/" +
+                                    std::to_string(tip) + ", " + std::to_string(threads) + " threads";
+          EXPECT_EQ(fast.element_start, reference.element_start) << where;
+          EXPECT_EQ(fast.point_start, reference.point_start) << where;
+          EXPECT_EQ(fast.points, reference.points) << where;
+        }
+      }
+      omp_set_num_threads(2);
+    }
+  }
 }
 
 TEST(EnrichedRotationClusters, RefineTowardCutTips) {

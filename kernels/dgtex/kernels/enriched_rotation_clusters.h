@@ -52,10 +52,16 @@ struct EnrichedRotationClusters {
 // The clusters of blocks of block_texels x block_texels texels (>= 1); a block holding a
 // cut tip is quartered toward the tip down to tip_block_texels (>= 1; >= block_texels: no
 // refinement). Clusters of an element are ordered by their first texel (row-major); points
-// keep their order.
+// keep their order. Elements are labelled side by side (one serial union-find each); the
+// result is the reference's for any thread count.
 EnrichedRotationClusters enriched_rotation_clusters(const EnrichedElementBatch& batch,
                                                     const EnrichedQuadrature& quadrature, int block_texels,
-                                                    int tip_block_texels);
+                                                    int tip_block_texels, Execution execution = Execution::parallel);
+// The serial reference twin: the rule written plainly (texel_in_domain per texel, a tile of
+// the block walls labelled by label_components). For tests.
+EnrichedRotationClusters enriched_rotation_clusters_reference(const EnrichedElementBatch& batch,
+                                                              const EnrichedQuadrature& quadrature, int block_texels,
+                                                              int tip_block_texels);
 
 std::int64_t enriched_cluster_packed_blocks(int width);
 // Whether every element of the batch is planar (the rest data then has 5 planes).
