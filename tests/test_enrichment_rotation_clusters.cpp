@@ -177,6 +177,7 @@ TEST(EnrichedRotationClusters, NeverSpanACutAndHoldEveryPointOnce) {
 // thread count.
 TEST(EnrichedRotationClusters, BuildAsTheReferenceForAnyThreadCount) {
   constexpr int T = 32, elements = 3;
+  const int threads_before = omp_get_max_threads();
   for (ElementType type : {ElementType::quad8, ElementType::tri6}) {
     const bool tri = type == ElementType::tri6;
     std::mt19937 rng(tri ? 5 : 7);
@@ -241,7 +242,7 @@ TEST(EnrichedRotationClusters, BuildAsTheReferenceForAnyThreadCount) {
           EXPECT_EQ(fast.points, reference.points) << where;
         }
       }
-      omp_set_num_threads(2);
+      omp_set_num_threads(threads_before);
     }
   }
 }
