@@ -128,8 +128,38 @@ void edge_points(const EnrichedEdgeBatch& b, std::int64_t e, const EnrichedQuadr
 
 // --- Stiffness -------------------------------------------------------------------------
 
+// Current unit normal of one side from its whole basis.
+void current_normal(const Side& s, const int* global, const double* current, double tangent[3], double normal[3]) {
+  double a1[3] = {0, 0, 0}, a2[3] = {0, 0, 0};
+  for (int a = 0; a < s.shape.count; ++a) {
+    const double* x = current + 3 * static_cast<std::int64_t>(global[a]);
+    for (int k = 0; k < 3; ++k) a1[k] += s.shape.dN[a][0] * x[k], a2[k] += s.shape.dN[a][1] * x[k];
+  }
+  for (int k = 0; k < 3; ++k) tangent[k] = a1[k] * s.dxi_dt[0] + a2[k] * s.dxi_dt[1];
+  cross3(a1, a2, normal);
+  normalize3(normal);
+}
+
+
+// R = Cur Rest^T of one point: the edge frame (tangent, averaged normal) from rest to
+// current, each side's current normal from its whole basis (global: the edge's 2W slots).
+void edge_point_rotation(const Side& plus, const Side* minus, const int* global, int W, const double* current,
+                         double* R) {
+  double rest[9], cur[9], tangent[3], n_plus[3], n_minus[3], unused[3];
+  edge_frame(plus.tangent, plus.point.t0, minus ? minus->point.t0 : nullptr, rest);
+  current_normal(plus, global, current, tangent, n_plus);
+  if (minus) current_normal(*minus, global + W, current, unused, n_minus);
+  edge_frame(tangent, n_plus, minus ? n_minus : nullptr, cur);
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j)
+      R[i * 3 + j] = cur[i * 3 + 0] * rest[j * 3 + 0] + cur[i * 3 + 1] * rest[j * 3 + 1] + cur[i * 3 + 2] * rest[j * 3 + 2];
+}
+
+
+// rotations: one per point, or null; current (with rotations null): each point's rotation
+// formed here from the sides this pass evaluates anyway (edge_point_rotation), or null: linear.
 void edge_stiffness(const EnrichedEdgeBatch& b, const EdgeQuadrature& quad, std::int64_t e, const double* rotations,
-                    double* blocks, double* forces) {
+                    const double* current, double* blocks, double* forces) {
   const int npe = nodes_per_element(b.type);
   const int W = b.elements->width;
   const int nb = 2 * W;
@@ -159,6 +189,11 @@ void edge_stiffness(const EnrichedEdgeBatch& b, const EdgeQuadrature& quad, std:
   std::unique_ptr<GramAccumulator> K;
   std::vector<double> G, f;
   int m = 0;
+  std::vector<int> global;
+  if (current) {
+    global.resize(static_cast<std::size_t>(nb));
+    enriched_edge_global_nodes(b, e, global.data());
+  }
   for (std::int64_t q = quad.start[e]; q < quad.start[e + 1]; ++q) {
     const double t = quad.points[2 * q], wt = quad.points[2 * q + 1];
     evaluate_side(b, ed[0], ed[1], t, side_data[0]);
@@ -187,7 +222,12 @@ void edge_stiffness(const EnrichedEdgeBatch& b, const EdgeQuadrature& quad, std:
           G[3 * i + c] = sign * (nu_vec[0] * T[0 * 3 + c] + nu_vec[1] * T[1 * 3 + c] + nu_vec[2] * T[2 * 3 + c]);
       }
     }
+    double fused_rotation[9];
     const double* R = rotations ? rotations + 9 * q : nullptr;
+    if (current) {
+      edge_point_rotation(side_data[0], interior ? &side_data[1] : nullptr, global.data(), W, current, fused_rotation);
+      R = fused_rotation;
+    }
     double gd = 0;  // over the standard functions; enriched X0 = 0
     if (R && forces) {
       for (int s = 0; s < sides; ++s) {
@@ -240,18 +280,6 @@ void edge_stiffness(const EnrichedEdgeBatch& b, const EdgeQuadrature& quad, std:
   }
 }
 
-// Current unit normal of one side from its whole basis.
-void current_normal(const Side& s, const int* global, const double* current, double tangent[3], double normal[3]) {
-  double a1[3] = {0, 0, 0}, a2[3] = {0, 0, 0};
-  for (int a = 0; a < s.shape.count; ++a) {
-    const double* x = current + 3 * static_cast<std::int64_t>(global[a]);
-    for (int k = 0; k < 3; ++k) a1[k] += s.shape.dN[a][0] * x[k], a2[k] += s.shape.dN[a][1] * x[k];
-  }
-  for (int k = 0; k < 3; ++k) tangent[k] = a1[k] * s.dxi_dt[0] + a2[k] * s.dxi_dt[1];
-  cross3(a1, a2, normal);
-  normalize3(normal);
-}
-
 }  // namespace
 
 void enriched_edge_quadrature(const EnrichedEdgeBatch& batch, const EnrichedQuadratureOptions& options,
@@ -274,7 +302,13 @@ void enriched_edge_global_nodes(const EnrichedEdgeBatch& b, std::int64_t e, int*
 
 void enriched_edge_stiffness(const EnrichedEdgeBatch& batch, const EdgeQuadrature& quadrature, const double* rotations,
                              double* blocks, double* forces, Execution execution) {
-  forall(batch.count, [&](std::int64_t e) { edge_stiffness(batch, quadrature, e, rotations, blocks, forces); },
+  forall(batch.count, [&](std::int64_t e) { edge_stiffness(batch, quadrature, e, rotations, nullptr, blocks, forces); },
+         execution);
+}
+
+void enriched_edge_corotated_stiffness(const EnrichedEdgeBatch& batch, const EdgeQuadrature& quadrature,
+                                       const double* current, double* blocks, double* forces, Execution execution) {
+  forall(batch.count, [&](std::int64_t e) { edge_stiffness(batch, quadrature, e, nullptr, current, blocks, forces); },
          execution);
 }
 
@@ -293,16 +327,7 @@ void enriched_edge_rotations(const EnrichedEdgeBatch& b, const EdgeQuadrature& q
           const double t = quad.points[2 * q];
           evaluate_side(b, ed[0], ed[1], t, plus);
           if (interior) evaluate_side(b, ed[2], ed[3], -t, minus);
-          double rest[9], cur[9], tangent[3], n_plus[3], n_minus[3], unused[3];
-          edge_frame(plus.tangent, plus.point.t0, interior ? minus.point.t0 : nullptr, rest);
-          current_normal(plus, global.data(), current, tangent, n_plus);
-          if (interior) current_normal(minus, global.data() + W, current, unused, n_minus);
-          edge_frame(tangent, n_plus, interior ? n_minus : nullptr, cur);
-          // R = Cur * Rest^T maps the rest frame onto the current one.
-          double* R = rotations + 9 * q;
-          for (int i = 0; i < 3; ++i)
-            for (int j = 0; j < 3; ++j)
-              R[i * 3 + j] = cur[i * 3 + 0] * rest[j * 3 + 0] + cur[i * 3 + 1] * rest[j * 3 + 1] + cur[i * 3 + 2] * rest[j * 3 + 2];
+          edge_point_rotation(plus, interior ? &minus : nullptr, global.data(), W, current, rotations + 9 * q);
         }
       },
       execution);

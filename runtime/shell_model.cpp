@@ -710,10 +710,6 @@ void ShellModel::assemble_stiffness(const double* current, std::vector<double>& 
     const kernels::EnrichedQuadrature element_quad{element_qp_start_.data(), element_qp_.data()};
     const kernels::EdgeQuadrature edge_quad{edge_qp_start_.data(), edge_qp_.data()};
     const int W = width_;
-    if (current) {
-      w.enriched_edge_rotations.resize(static_cast<size_t>(num_enriched_edge_quadrature_points()) * 9);
-      kernels::enriched_edge_rotations(xg, edge_quad, current, w.enriched_edge_rotations.data(), execution);
-    }
     w.enriched_blocks.resize(static_cast<size_t>(num_enriched_elements()) * W * W * 9);
     w.enriched_edge_blocks.resize(static_cast<size_t>(num_enriched_edges()) * 4 * W * W * 9);
     if (forces) {
@@ -761,9 +757,13 @@ void ShellModel::assemble_stiffness(const double* current, std::vector<double>& 
                                                     forces ? w.enriched_forces.data() : nullptr, execution);
     else
       kernels::enriched_element_stiffness(xb, element_quad, nullptr, w.enriched_blocks.data(), nullptr, execution);
-    kernels::enriched_edge_stiffness(xg, edge_quad, current ? w.enriched_edge_rotations.data() : nullptr,
-                                     w.enriched_edge_blocks.data(), forces ? w.enriched_edge_forces.data() : nullptr,
-                                     execution);
+    // Edges: each point's rotation formed in the stiffness pass (one side evaluation a point).
+    if (current)
+      kernels::enriched_edge_corotated_stiffness(xg, edge_quad, current, w.enriched_edge_blocks.data(),
+                                                 forces ? w.enriched_edge_forces.data() : nullptr, execution);
+    else
+      kernels::enriched_edge_stiffness(xg, edge_quad, nullptr, w.enriched_edge_blocks.data(),
+                                       forces ? w.enriched_edge_forces.data() : nullptr, execution);
     matrix_locals.insert(matrix_locals.end(), {w.enriched_blocks.data(), w.enriched_edge_blocks.data()});
     vector_locals.insert(vector_locals.end(), {forces ? w.enriched_forces.data() : nullptr,
                                                forces ? w.enriched_edge_forces.data() : nullptr});

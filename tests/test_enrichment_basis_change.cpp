@@ -9,7 +9,8 @@
 //  - kernels::enriched_element_mass_and_load_weights (serial and parallel) equals
 //    enriched_element_mass and enriched_element_load_weights, and enriched_shape_values
 //    equals evaluate_enriched_shape's N;
-//  - the stiffness kernels given the quadrature's texel derivative tiles equal them without.
+//  - the stiffness kernels given the quadrature's texel derivative tiles equal them without;
+//  - the corotated edge kernel equals the edge rotations followed by the edge stiffness.
 // The cut advances across a 3x3 quad8 plate (and a 2x2 tri6 one) over several steps, so
 // elements far from the tip keep their textures while the others change.
 #include <gtest/gtest.h>
@@ -26,6 +27,7 @@
 #include "dgtex/free_dof_system.h"
 #include "dgtex/harmonic_enrichment.h"
 #include "dgtex/kernels/cut_rasterization.h"
+#include "dgtex/kernels/enriched_edge_kernel.h"
 #include "dgtex/kernels/enriched_element_rest_integrals.h"
 #include "dgtex/kernels/enriched_quadrature.h"
 #include "dgtex/kernels/enriched_rotation_clusters.h"
@@ -212,6 +214,58 @@ TEST(BasisChange, FusedMassAndLoadWeightsEqualTheTwoKernelsBitwise) {
     ASSERT_EQ(kernels::enriched_shape_values(batch, e, xi1, xi2, s, cache, values), full.count);
     ASSERT_EQ(std::memcmp(values, full.N, sizeof(double) * full.count), 0) << "point " << trial;
   }
+}
+
+// The corotated edge kernel forms each point's rotation in its stiffness pass: bitwise
+// enriched_edge_rotations followed by enriched_edge_stiffness with those rotations, on the
+// interior edge between the two enriched elements and on their boundary edges.
+TEST(BasisChange, CorotatedEdgeStiffnessIsTheRotationsThenTheStiffnessBitwise) {
+  const TwoEnrichedElements setup;
+  const Topology topology = build_topology(setup.mesh);
+  std::vector<int> edges;
+  for (const auto* list : {&topology.interior_edges, &topology.boundary_edges})
+    for (const MeshEdge& m : *list)
+      edges.insert(edges.end(), {m.plus_element, m.plus_local_edge, m.minus_element, m.minus_local_edge});
+  const std::int64_t count = static_cast<std::int64_t>(edges.size() / 4);
+  ASSERT_EQ(topology.interior_edges.size(), 1u);
+  const std::vector<double> edge_size(count, 0.5);
+  const std::vector<int> enriched_index = {0, 1};
+  const kernels::EnrichedEdgeBatch edge_batch{ElementType::quad8,         count, edges.data(), edge_size.data(), 10.0, 3,
+                                              setup.mesh.elements.data(),  setup.mesh.positions.data(),
+                                              setup.sections.data(),       &setup.batch, enriched_index.data()};
+  std::vector<std::int64_t> qs;
+  std::vector<double> qp;
+  kernels::enriched_edge_quadrature(edge_batch, kernels::EnrichedQuadratureOptions{}, qs, qp);
+  ASSERT_GT(qs.back(), 3 * count);  // the cuts refine some edges
+  const kernels::EdgeQuadrature quad{qs.data(), qp.data()};
+  // A deformed state: rest positions turned and bent, enriched DOFs random.
+  const int dofs = 3 * (100 + 3 * TwoEnrichedElements::npe);
+  std::vector<double> current(dofs, 0.0);
+  for (int d = 0; d < dofs; ++d) current[d] = 0.05 * std::sin(0.7 * d);
+  for (size_t n = 0; n < setup.mesh.positions.size() / 3; ++n) {
+    const double* X = &setup.mesh.positions[3 * n];
+    current[3 * n] += X[0] - 0.3 * X[1], current[3 * n + 1] += 0.3 * X[0] + X[1], current[3 * n + 2] += 0.2 * X[0] * X[0];
+  }
+  const int nb = 2 * setup.batch.width;
+  std::vector<double> rotations(static_cast<size_t>(qs.back()) * 9);
+  kernels::enriched_edge_rotations(edge_batch, quad, current.data(), rotations.data(), kernels::Execution::serial);
+  std::vector<double> blocks(count * nb * nb * 9, -1.0), forces(count * nb * 3, -1.0);
+  kernels::enriched_edge_stiffness(edge_batch, quad, rotations.data(), blocks.data(), forces.data(),
+                                   kernels::Execution::serial);
+  double largest = 0;
+  for (double r : rotations) largest = std::max(largest, std::abs(r));
+  ASSERT_GT(largest, 0.0);
+  for (auto execution : {kernels::Execution::serial, kernels::Execution::parallel}) {
+    std::vector<double> fused_blocks(blocks.size(), -1.0), fused_forces(forces.size(), -1.0);
+    kernels::enriched_edge_corotated_stiffness(edge_batch, quad, current.data(), fused_blocks.data(),
+                                               fused_forces.data(), execution);
+    EXPECT_TRUE(bitwise_equal(fused_blocks, blocks));
+    EXPECT_TRUE(bitwise_equal(fused_forces, forces));
+  }
+  // The rotations matter: the unrotated blocks differ.
+  std::vector<double> linear(blocks.size(), -1.0);
+  kernels::enriched_edge_stiffness(edge_batch, quad, nullptr, linear.data(), nullptr);
+  EXPECT_FALSE(bitwise_equal(linear, blocks));
 }
 
 // The stiffness kernels sample the textures at every point; given the quadrature's texel

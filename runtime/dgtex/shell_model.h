@@ -243,7 +243,6 @@ class ShellModel {
     std::vector<double> gradients, element_rotations, edge_rotations;
     std::vector<double> element_blocks, edge_blocks, element_forces, edge_forces;
     std::vector<double> element_rest_rows, edge_rest_rows, edge_factors;
-    std::vector<double> enriched_edge_rotations;
     std::vector<double> enriched_blocks, enriched_edge_blocks, enriched_forces, enriched_edge_forces;
     // Rotation clusters (options.rotation_cluster_texels > 0) and their rest sums: built at
     // the first corotated assembly after the enrichment changed (rebuild clears them).

@@ -63,6 +63,14 @@ void enriched_edge_stiffness(const EnrichedEdgeBatch& batch, const EdgeQuadratur
                              const double* rotations, double* blocks, double* forces,
                              Execution execution = Execution::parallel);
 
+// The corotated blocks and forces with each point's rotation (that of
+// enriched_edge_rotations) formed in the stiffness pass from the sides it evaluates anyway:
+// one evaluation of both sides per point instead of two (fracture: ~4 ms a step). Bitwise
+// enriched_edge_rotations followed by enriched_edge_stiffness.
+void enriched_edge_corotated_stiffness(const EnrichedEdgeBatch& batch, const EdgeQuadrature& quadrature,
+                                       const double* current, double* blocks, double* forces,
+                                       Execution execution = Execution::parallel);
+
 // Rotation of the edge frame (tangent, averaged normal) from rest to current, the current
 // frame taken from each side's whole basis. current: #(nodes + virtual nodes) x 3.
 void enriched_edge_rotations(const EnrichedEdgeBatch& batch, const EdgeQuadrature& quadrature,
