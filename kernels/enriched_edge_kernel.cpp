@@ -214,12 +214,19 @@ void edge_stiffness(const EnrichedEdgeBatch& b, const EdgeQuadrature& quad, std:
       const double sign = s == 0 ? 1.0 : -1.0;
       double nu_vec[3];
       cross3(sd.point.t0, tau, nu_vec);
+      // nu . dt for a displacement along each axis, without forming normal_change_operator's
+      // T = ([w]x - t0 t0^T [w]x) / j0, w = a1 dN_2 - a2 dN_1: nu = t0 x tau is normal to
+      // t0, so nu^T T = (nu x w)^T / j0 = dN_2 (nu x a1) / j0 - dN_1 (nu x a2) / j0. Two
+      // vectors per side and point, 6 multiply-adds a function (the operator's form took
+      // ~5 % of fracture's run).
+      double c1[3], c2[3];
+      cross3(nu_vec, sd.point.a1, c1);
+      cross3(nu_vec, sd.point.a2, c2);
+      for (int c = 0; c < 3; ++c) c1[c] = sign * c1[c] / sd.point.j0, c2[c] = sign * c2[c] / sd.point.j0;
       for (int a = 0; a < counts[s]; ++a) {
-        double T[9];
-        normal_change_operator(sd.point, sd.shape.dN[a], T);
         const int i = s == 0 ? a : counts[0] + a;
-        for (int c = 0; c < 3; ++c)
-          G[3 * i + c] = sign * (nu_vec[0] * T[0 * 3 + c] + nu_vec[1] * T[1 * 3 + c] + nu_vec[2] * T[2 * 3 + c]);
+        const double* dN = sd.shape.dN[a];
+        for (int c = 0; c < 3; ++c) G[3 * i + c] = dN[1] * c1[c] - dN[0] * c2[c];
       }
     }
     double fused_rotation[9];
