@@ -140,7 +140,6 @@ void current_normal(const Side& s, const int* global, const double* current, dou
   normalize3(normal);
 }
 
-
 // R = Cur Rest^T of one point: the edge frame (tangent, averaged normal) from rest to
 // current, each side's current normal from its whole basis (global: the edge's 2W slots).
 void edge_point_rotation(const Side& plus, const Side* minus, const int* global, int W, const double* current,
@@ -154,7 +153,6 @@ void edge_point_rotation(const Side& plus, const Side* minus, const int* global,
     for (int j = 0; j < 3; ++j)
       R[i * 3 + j] = cur[i * 3 + 0] * rest[j * 3 + 0] + cur[i * 3 + 1] * rest[j * 3 + 1] + cur[i * 3 + 2] * rest[j * 3 + 2];
 }
-
 
 // rotations: one per point, or null; current (with rotations null): each point's rotation
 // formed here from the sides this pass evaluates anyway (edge_point_rotation), or null: linear.
