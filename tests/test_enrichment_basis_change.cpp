@@ -252,9 +252,10 @@ TEST(BasisChange, CorotatedEdgeStiffnessIsTheRotationsThenTheStiffnessBitwise) {
   std::vector<double> blocks(count * nb * nb * 9, -1.0), forces(count * nb * 3, -1.0);
   kernels::enriched_edge_stiffness(edge_batch, quad, rotations.data(), blocks.data(), forces.data(),
                                    kernels::Execution::serial);
-  double largest = 0;
-  for (double r : rotations) largest = std::max(largest, std::abs(r));
-  ASSERT_GT(largest, 0.0);
+  double turned = 0;  // the state turns the edge frames: largest |R - I|
+  for (size_t k = 0; k < rotations.size(); ++k)
+    turned = std::max(turned, std::abs(rotations[k] - (k % 9 % 4 == 0 ? 1.0 : 0.0)));
+  ASSERT_GT(turned, 0.1);
   for (auto execution : {kernels::Execution::serial, kernels::Execution::parallel}) {
     std::vector<double> fused_blocks(blocks.size(), -1.0), fused_forces(forces.size(), -1.0);
     kernels::enriched_edge_corotated_stiffness(edge_batch, quad, current.data(), fused_blocks.data(),
