@@ -144,22 +144,17 @@ std::vector<int> block_components_fast(ElementType type, int T, const std::uint8
       parent[t] = run_start;
     }
   }
-  const auto root = [&parent](int x) {
-    while (parent[x] != x) x = parent[x] = parent[parent[x]];  // path halving
-    return x;
-  };
   for (int j = 0; j + 1 < T; ++j)
     for (int i = 0; i < T; ++i) {
       const int t = j * T + i;
-      if (!(inside[t] && inside[t + T] && !(flags[t] & wall_north) && block[t] == block[t + T])) continue;
-      const int a = root(t), b = root(t + T);
-      if (a != b) parent[std::max(a, b)] = std::min(a, b);
+      if (inside[t] && inside[t + T] && !(flags[t] & wall_north) && block[t] == block[t + T])
+        unite_smaller_root(parent, t, t + T);
     }
   std::vector<int> label(n, -1);
   count = 0;
   for (std::size_t t = 0; t < n; ++t) {
     if (!inside[t]) continue;
-    const int r = root(static_cast<int>(t));
+    const int r = find_root_halving(parent, static_cast<int>(t));
     label[t] = r == static_cast<int>(t) ? count++ : label[r];
   }
   return label;

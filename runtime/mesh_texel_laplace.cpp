@@ -9,6 +9,7 @@
 #include <Eigen/CholmodSupport>
 #include <Eigen/SparseCore>
 
+#include "dgtex/kernels/flood_fill.h"
 #include "dgtex/kernels/forall.h"
 #include "dgtex/kernels/multigrid_unknowns.h"
 #include "seamed_patch_laplace.h"
@@ -221,11 +222,6 @@ bool place_region_in_plane(const std::vector<RegionTile>& tiles, ElementType typ
   return true;
 }
 
-int find_root(std::vector<int>& parent, int x) {
-  while (parent[x] != x) x = parent[x] = parent[parent[x]];
-  return x;
-}
-
 }  // namespace
 
 MeshLaplaceStats solve_mesh_texel_laplace(std::vector<RegionTile>& tiles, ElementType type,
@@ -257,10 +253,7 @@ MeshLaplaceStats solve_mesh_texel_laplace(std::vector<RegionTile>& tiles, Elemen
   }
   std::vector<int> parent(n);
   for (int v = 0; v < n; ++v) parent[v] = v;
-  auto unite = [&](int v, int w) {
-    const int a = find_root(parent, v), b = find_root(parent, w);
-    if (a != b) parent[std::max(a, b)] = std::min(a, b);
-  };
+  auto unite = [&](int v, int w) { kernels::unite_smaller_root(parent, v, w); };
   for (int l = 0; l < static_cast<int>(tiles.size()); ++l) {
     const std::uint8_t* flags = tiles[l].tile.flags.data();
     for (int j = 0; j < t; ++j)
