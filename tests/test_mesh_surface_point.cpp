@@ -79,6 +79,48 @@ TEST_P(SurfacePointPlane, BeyondEdgesAndCorners) {
   }
 }
 
+// Small elements (fracture's 1/16-wide tri6 and quad8; a 1 cm cylinder): Newton stops where
+// its steps stop shrinking (the gradient is round-off there), and not before: on the plane
+// the answer is the query itself to round-off, on the cylinder x - p is normal to the
+// surface to round-off of the element's size.
+TEST(SurfacePoint, SmallElementsConvergeToRoundOff) {
+  for (ElementType type : {ElementType::quad8, ElementType::tri6}) {
+    const Mesh plate = make_rectangle(1.0, 1.0, 16, 17, type);
+    std::mt19937 rng(5);
+    std::uniform_real_distribution<double> u(0, 1), uz(-0.01, 0.01);
+    for (int i = 0; i < 200; ++i) {
+      const double p[3] = {u(rng), u(rng), i < 100 ? 0.0 : uz(rng)};
+      const SurfacePoint sp = closest_surface_point(plate, p);
+      EXPECT_NEAR(sp.position[0], p[0], 4e-16) << "query " << i;
+      EXPECT_NEAR(sp.position[1], p[1], 4e-16) << "query " << i;
+      EXPECT_EQ(sp.position[2], 0.0);
+    }
+    const double R = 0.01;
+    const Mesh cylinder = make_cylinder(R, 2 * R, 0, 360, 24, 4, type);
+    std::uniform_real_distribution<double> angle(0, 2 * M_PI), along(0.05 * R, 1.95 * R), radius(0.5 * R, 1.5 * R);
+    int interior_count = 0;
+    for (int i = 0; i < 100; ++i) {
+      const double t = angle(rng), r = radius(rng);
+      const double p[3] = {r * std::sin(t), along(rng), r * std::cos(t)};
+      const SurfacePoint sp = closest_surface_point(cylinder, p);
+      expect_consistent(cylinder, sp, p);
+      const bool interior = type == ElementType::quad8
+                                ? std::fabs(sp.xi[0]) < 1 && std::fabs(sp.xi[1]) < 1
+                                : sp.xi[0] > 0 && sp.xi[1] > 0 && sp.xi[0] + sp.xi[1] < 1;
+      if (!interior) continue;
+      ++interior_count;
+      double x[3], t1[3], t2[3];
+      surface_at(cylinder, sp.element, sp.xi, x, t1, t2);
+      const double g[3] = {x[0] - p[0], x[1] - p[1], x[2] - p[2]};
+      EXPECT_LT(std::fabs(g[0] * t1[0] + g[1] * t1[1] + g[2] * t1[2]) / std::hypot(t1[0], t1[1], t1[2]), 1e-16)
+          << "query " << i;
+      EXPECT_LT(std::fabs(g[0] * t2[0] + g[1] * t2[1] + g[2] * t2[2]) / std::hypot(t2[0], t2[1], t2[2]), 1e-16)
+          << "query " << i;
+    }
+    EXPECT_GT(interior_count, 50);
+  }
+}
+
 TEST(SurfacePoint, TiesGoToTheLowestElement) {
   // Above the interior node (1, 1) of a 2x2 quad8 grid: all four elements touch it.
   const Mesh mesh = make_rectangle(2.0, 2.0, 2, 2, ElementType::quad8);
