@@ -149,8 +149,21 @@ CutManager::CutManager(const Mesh& mesh, const Topology& topology, const std::ve
       edge_walls_(options.texture_resolution) {
   if (resolution_ < 2)
     throw std::invalid_argument("enrichment.texture_resolution: must be at least 2, got " + std::to_string(resolution_));
-  for (std::size_t c = 0; c < cuts_.size(); ++c)
-    paths_.push_back(trace_cut_path(mesh, adjacency_, cuts_[c], resolution_, "cuts[" + std::to_string(c) + "]"));
+  // The cuts trace independently (each reads only the mesh), one per thread: fracture's six
+  // took 9.7 ms in a row. The first failing cut's error is the one reported, as in a loop.
+  const int count = static_cast<int>(cuts_.size());
+  paths_.resize(cuts_.size());
+  std::vector<std::exception_ptr> failures(cuts_.size());
+#pragma omp parallel for schedule(dynamic, 1) if (count > 1 && !omp_in_parallel())
+  for (int c = 0; c < count; ++c) {
+    try {
+      paths_[c] = trace_cut_path(mesh, adjacency_, cuts_[c], resolution_, "cuts[" + std::to_string(c) + "]");
+    } catch (...) {
+      failures[c] = std::current_exception();
+    }
+  }
+  for (const std::exception_ptr& failure : failures)
+    if (failure) std::rethrow_exception(failure);
   // Boundaries closer than half a texel (of a mean-sized element) are merged.
   const double texel = cut_point_tolerance(mesh) * 4.0 / resolution_;
   boundaries_ = segment_cut_paths(paths_, cuts_, options_, 0.5 * texel);

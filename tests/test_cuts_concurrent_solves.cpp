@@ -90,3 +90,27 @@ TEST(CutsConcurrentSolves, ProgressiveMixedRegionsAreThreadCountIndependent) {
   for (Cut& cut : cuts) cut.has_schedule = true, cut.speed = 1.5;
   expect_thread_count_independent(mesh, cuts, multigrid_enrichment(16), {0.2, 0.6, 1.0, 1.4, 2.0}, 6);
 }
+
+TEST(CutsConcurrentSolves, TheFirstFailingCutIsReportedForAnyThreadCount) {
+  // The cuts are traced concurrently too; of two bad cuts the error names the first, also
+  // where it fails late (its last point, after 400 good ones) and the second at once.
+  const Mesh mesh = make_rectangle(3, 2, 3, 2, ElementType::tri6);
+  const Topology topology = build_topology(mesh);
+  std::vector<Vec3> late_failure;
+  for (int k = 0; k < 400; ++k) late_failure.push_back({0.1 + 0.007 * k, 0.8, 0});
+  late_failure.push_back({1.5, 1.0, 2.0});
+  const std::vector<Cut> cuts = {points_cut({{0.1, 0.35, 0}, {2.6, 0.6, 0}}), points_cut(late_failure),
+                                 points_cut({{0.2, 1.5, 0}, {2.7, 1.3, 0}}), points_cut({{1.5, 1.0, 0}})};
+  const int saved = omp_get_max_threads();
+  for (int threads : {1, 2, 4}) {
+    omp_set_num_threads(threads);
+    try {
+      CutManager manager(mesh, topology, cuts, cholmod_enrichment(16));
+      ADD_FAILURE() << "expected an error for cuts[1] with " << threads << " threads";
+    } catch (const std::invalid_argument& e) {
+      const std::string m = e.what();
+      EXPECT_NE(m.find("cuts[1].points[400]: off the surface"), std::string::npos) << m;
+    }
+  }
+  omp_set_num_threads(saved);
+}
