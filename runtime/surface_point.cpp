@@ -180,14 +180,22 @@ void refine(const ElementDistance& f, ElementType type, double xi[2]) {
     // Near a minimum (positive curvature, small step) take the Newton step as it is: f stops
     // resolving progress at sqrt(machine epsilon) relative accuracy, the step does not.
     if (exact_newton && step_size < 1e-6) {
-      // Newton steps shrink quadratically until the gradient is round-off; a step that did
-      // not halve is that round-off (on small elements it flipped xi by ~1e-15 back and
-      // forth until the iteration cap: 85 % of fracture's cut tracing).
-      if (step_size >= 0.5 * last_newton_step) return;
+      // Newton steps shrink quadratically until the gradient is round-off. A step that did
+      // not halve and moves x (after the projection onto the element) by round-off of its
+      // coordinates, or not at all, only repeats: on small elements xi flipped by ~1e-15
+      // back and forth, or a step the projection undid came again, until the iteration cap
+      // (85 % of fracture's refinement iterations). A slowly converging step (near a centre
+      // of curvature) moves x by more and goes on.
+      double next[2] = {xi[0] + step[0], xi[1] + step[1]};
+      project_to_reference(type, next);
+      const double moved = std::max(std::fabs(next[0] - xi[0]), std::fabs(next[1] - xi[1])) *
+                           std::sqrt(std::max(gn[0][0], gn[1][1]));
+      const double size = std::max({std::fabs(x[0]), std::fabs(x[1]), std::fabs(x[2]), std::fabs(p[0]),
+                                    std::fabs(p[1]), std::fabs(p[2])});
+      if (step_size >= 0.5 * last_newton_step && moved <= 64 * std::numeric_limits<double>::epsilon() * size) return;
       last_newton_step = step_size;
-      xi[0] += step[0];
-      xi[1] += step[1];
-      project_to_reference(type, xi);
+      xi[0] = next[0];
+      xi[1] = next[1];
       continue;
     }
 

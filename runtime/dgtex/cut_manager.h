@@ -33,8 +33,9 @@
 //    staircase walks to it from its side), that spur is dropped from both (at most 2
 //    edges), else its texels get contradicting +-1 data and a V's wedge stays attached.
 // CutManager owns its paths, segments, wall tiles and enrichment functions; it keeps a
-// reference to the mesh (the mesh and topology must outlive it). Not thread-safe; update()
-// uses all OpenMP threads. Times in the scene's unit (SI: s), lengths in the mesh's (m).
+// reference to the mesh (the mesh and topology must outlive it). Not thread-safe; the
+// constructor (one cut per thread) and update() use all OpenMP threads. Times in the
+// scene's unit (SI: s), lengths in the mesh's (m).
 #include <cstdint>
 #include <map>
 #include <string>
