@@ -3,6 +3,7 @@
 // optimality, and a brute-force oracle on a curved tri6 mesh.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <random>
 
@@ -38,6 +39,29 @@ void expect_consistent(const Mesh& mesh, const SurfacePoint& sp, const double p[
   surface_at(mesh, sp.element, sp.xi, x, t1, t2);
   for (int d = 0; d < 3; ++d) EXPECT_NEAR(sp.position[d], x[d], 1e-14);
   EXPECT_NEAR(sp.distance, std::hypot(x[0] - p[0], x[1] - p[1], x[2] - p[2]), 1e-14);
+}
+
+// Strictly inside the reference element: on an element edge the surface has a kink and
+// only the constrained optimality holds there.
+bool strictly_inside(ElementType type, const double xi[2]) {
+  return type == ElementType::quad8 ? std::fabs(xi[0]) < 1 && std::fabs(xi[1]) < 1
+                                    : xi[0] > 0 && xi[1] > 0 && xi[0] + xi[1] < 1;
+}
+
+// x(xi) - p at the answer: its largest component along the surface's unit tangents there
+// (0 at a first-order optimum inside an element) and its length.
+struct TangentialGap {
+  double largest = 0, length = 0;
+};
+TangentialGap tangential_gap(const Mesh& mesh, const SurfacePoint& sp, const double p[3]) {
+  double x[3], t1[3], t2[3];
+  surface_at(mesh, sp.element, sp.xi, x, t1, t2);
+  const double g[3] = {x[0] - p[0], x[1] - p[1], x[2] - p[2]};
+  TangentialGap gap;
+  gap.largest = std::max(std::fabs(g[0] * t1[0] + g[1] * t1[1] + g[2] * t1[2]) / std::hypot(t1[0], t1[1], t1[2]),
+                         std::fabs(g[0] * t2[0] + g[1] * t2[1] + g[2] * t2[2]) / std::hypot(t2[0], t2[1], t2[2]));
+  gap.length = std::hypot(g[0], g[1], g[2]);
+  return gap;
 }
 
 }  // namespace
@@ -104,18 +128,9 @@ TEST(SurfacePoint, SmallElementsConvergeToRoundOff) {
       const double p[3] = {r * std::sin(t), along(rng), r * std::cos(t)};
       const SurfacePoint sp = closest_surface_point(cylinder, p);
       expect_consistent(cylinder, sp, p);
-      const bool interior = type == ElementType::quad8
-                                ? std::fabs(sp.xi[0]) < 1 && std::fabs(sp.xi[1]) < 1
-                                : sp.xi[0] > 0 && sp.xi[1] > 0 && sp.xi[0] + sp.xi[1] < 1;
-      if (!interior) continue;
+      if (!strictly_inside(type, sp.xi)) continue;
       ++interior_count;
-      double x[3], t1[3], t2[3];
-      surface_at(cylinder, sp.element, sp.xi, x, t1, t2);
-      const double g[3] = {x[0] - p[0], x[1] - p[1], x[2] - p[2]};
-      EXPECT_LT(std::fabs(g[0] * t1[0] + g[1] * t1[1] + g[2] * t1[2]) / std::hypot(t1[0], t1[1], t1[2]), 1e-16)
-          << "query " << i;
-      EXPECT_LT(std::fabs(g[0] * t2[0] + g[1] * t2[1] + g[2] * t2[2]) / std::hypot(t2[0], t2[1], t2[2]), 1e-16)
-          << "query " << i;
+      EXPECT_LT(tangential_gap(cylinder, sp, p).largest, 1e-16) << "query " << i;
     }
     EXPECT_GT(interior_count, 50);
   }
@@ -165,20 +180,12 @@ TEST(SurfacePoint, CylinderDistanceIsRadialOffset) {
         // The surface lies between radii R - deviation and R + deviation.
         EXPECT_NEAR(sp.distance, std::fabs(r - R), deviation + 1e-14) << "r = " << r << " t = " << t;
         EXPECT_NEAR(sp.position[1], y, 1e-9);
-        // First-order optimality where xi is inside the element (on an element edge the
-        // surface has a kink and only the constrained optimality holds): (x - p) is normal
-        // to the surface up to rounding.
-        const bool interior = type == ElementType::quad8
-                                  ? std::fabs(sp.xi[0]) < 1 && std::fabs(sp.xi[1]) < 1
-                                  : sp.xi[0] > 0 && sp.xi[1] > 0 && sp.xi[0] + sp.xi[1] < 1;
-        if (!interior) continue;
+        // First-order optimality where xi is inside the element: (x - p) is normal to the
+        // surface up to rounding.
+        if (!strictly_inside(type, sp.xi)) continue;
         ++interior_count;
-        double x[3], t1[3], t2[3];
-        surface_at(mesh, sp.element, sp.xi, x, t1, t2);
-        const double g[3] = {x[0] - p[0], x[1] - p[1], x[2] - p[2]};
-        const double gn = std::hypot(g[0], g[1], g[2]);
-        EXPECT_LT(std::fabs(g[0] * t1[0] + g[1] * t1[1] + g[2] * t1[2]) / std::hypot(t1[0], t1[1], t1[2]), 1e-10 * gn + 1e-15);
-        EXPECT_LT(std::fabs(g[0] * t2[0] + g[1] * t2[1] + g[2] * t2[2]) / std::hypot(t2[0], t2[1], t2[2]), 1e-10 * gn + 1e-15);
+        const TangentialGap gap = tangential_gap(mesh, sp, p);
+        EXPECT_LT(gap.largest, 1e-10 * gap.length + 1e-15);
       }
     }
     EXPECT_GT(interior_count, 24);  // the optimality check ran on most of the 48 queries
