@@ -125,3 +125,46 @@ TEST(LaplaceMeshComponents, TheSolvedComponentMatchesAcrossSolvers) {
   EXPECT_LT(worst, 1e-8);
   EXPECT_GT(spread, 0.4);  // not the warm start: the comparison is not vacuous
 }
+
+// A region of one tile takes the tile multigrid on the tile itself: the boxes are settled
+// as above, the solved component agrees with CHOLMOD, and the tile's flags come back as
+// they were (the settled texels are data only while the multigrid runs).
+TEST(LaplaceMeshComponents, OneTileSettlesItsBoxesAndReturnsItsFlags) {
+  const Mesh mesh = make_rectangle(1, 1, 1, 1, ElementType::quad8);
+  const ElementAdjacency adjacency(mesh, build_topology(mesh));
+  std::vector<RegionTile> start = testing_support::make_test_region(mesh, {0}, T);
+  wall_in(start[0].tile, empty_box);
+  wall_in(start[0].tile, constant_box);
+  start[0].tile.flags[40 * T + 50] |= kernels::dirichlet;
+  start[0].tile.values[40 * T + 50] = constant_value;
+  LaplaceMultigridOptions options;
+  options.tolerance = 1e-12;
+  std::vector<RegionTile> multigrid = start, direct = start;
+  const MeshLaplaceStats mg =
+      solve_mesh_texel_laplace(multigrid, mesh.type, adjacency, MeshEdgeWalls(T), LaplaceSolver::multigrid, options);
+  const MeshLaplaceStats chol =
+      solve_mesh_texel_laplace(direct, mesh.type, adjacency, MeshEdgeWalls(T), LaplaceSolver::cholmod, options);
+  EXPECT_TRUE(mg.multigrid);
+  EXPECT_FALSE(chol.multigrid);
+  for (const MeshLaplaceStats& stats : {mg, chol}) {
+    EXPECT_EQ(stats.solved_components, 1);
+    EXPECT_EQ(stats.constant_components, 1);
+  }
+  EXPECT_EQ(multigrid[0].tile.flags, start[0].tile.flags);
+  EXPECT_EQ(direct[0].tile.flags, start[0].tile.flags);
+  double worst = 0, spread = 0;
+  for (int j = 0; j < T; ++j)
+    for (int i = 0; i < T; ++i) {
+      const int k = j * T + i;
+      if (empty_box.contains(i, j)) {
+        EXPECT_EQ(multigrid[0].tile.values[k], 0.0) << i << ", " << j;
+      }
+      if (constant_box.contains(i, j)) {
+        EXPECT_EQ(multigrid[0].tile.values[k], constant_value) << i << ", " << j;
+      }
+      worst = std::max(worst, std::abs(multigrid[0].tile.values[k] - direct[0].tile.values[k]));
+      spread = std::max(spread, std::abs(direct[0].tile.values[k] - 0.5));
+    }
+  EXPECT_LT(worst, 1e-8);
+  EXPECT_GT(spread, 0.4);  // not the warm start
+}
