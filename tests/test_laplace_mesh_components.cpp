@@ -3,7 +3,8 @@
 // walled box with no data gets 0, a box touching one data value gets exactly that value
 // (neither is solved), and the rest (+1 and -1 data in the two tiles) is the one solved
 // component; the answer is bitwise the same for 1, 2 and 4 threads, with the multigrid and
-// with CHOLMOD, and the two solvers agree on the solved component.
+// with CHOLMOD, and the two solvers agree on the solved component. The same boxes in a
+// region of one tile (the tile multigrid on the tile itself) leave its flags as they were.
 #include <gtest/gtest.h>
 
 #include <omp.h>
