@@ -11,6 +11,7 @@
 #include "dgtex/kernels/cut_rasterization.h"
 #include "dgtex/kernels/enriched_basis.h"
 #include "dgtex/kernels/fast_marching.h"
+#include "dgtex/surface_point.h"
 
 namespace dgtex {
 
@@ -100,10 +101,11 @@ std::vector<EnrichmentFunction> build_crease_functions(const Mesh& mesh, const T
   for (int e = 0; e < mesh.num_elements(); ++e)
     for (int a = 0; a < npe; ++a) node_elements[mesh.element_nodes(e)[a]].push_back(e);
   const double scale = 1.0 / (4.0 * cut_point_tolerance(mesh));  // 1 / mean element edge length
+  const SurfacePointSearch search(mesh);  // one for all creases
 
   for (std::size_t c = 0; c < creases.size(); ++c) {
     const std::string name = "creases[" + std::to_string(c) + "]";
-    const MeshCutPath path = trace_cut_path(mesh, adjacency, creases[c], resolution, name);
+    const MeshCutPath path = trace_cut_path(mesh, search, adjacency, creases[c], resolution, name);
     std::set<int> touched;
     std::vector<Vec3> line;
     for (std::size_t v = 0; v < path.vertices.size(); ++v) {

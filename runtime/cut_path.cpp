@@ -288,6 +288,11 @@ double cut_point_tolerance(const Mesh& mesh) { return 0.25 * PathTracer::mean_ed
 
 MeshCutPath trace_cut_path(const Mesh& mesh, const ElementAdjacency& adjacency, const Cut& cut, int resolution,
                            const std::string& name) {
+  return trace_cut_path(mesh, SurfacePointSearch(mesh), adjacency, cut, resolution, name);
+}
+
+MeshCutPath trace_cut_path(const Mesh& mesh, const SurfacePointSearch& search, const ElementAdjacency& adjacency,
+                           const Cut& cut, int resolution, const std::string& name) {
   constexpr double kSlack = 1e-12;
   if (mesh.num_elements() == 0) throw std::invalid_argument(name + ": the mesh has no elements to cut");
   if (resolution <= 0) throw std::invalid_argument(name + ": texture resolution must be positive, got " + std::to_string(resolution));
@@ -299,7 +304,6 @@ MeshCutPath trace_cut_path(const Mesh& mesh, const ElementAdjacency& adjacency, 
 
   std::vector<CutPathVertex> anchors;
   const double tolerance = cut_point_tolerance(mesh);
-  const SurfacePointSearch search(mesh);
   for (std::size_t k = 0; k < count; ++k) {
     const std::string where = name + list + "[" + std::to_string(k) + "]";
     if (given_on_surface) {

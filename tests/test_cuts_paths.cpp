@@ -9,6 +9,7 @@
 #include "dgtex/cut_manager.h"
 #include "dgtex/cut_path.h"
 #include "dgtex/mesh_generators.h"
+#include "dgtex/surface_point.h"
 #include "dgtex/topology.h"
 
 using namespace dgtex;
@@ -218,5 +219,27 @@ TEST(CutPaths, LargeMeshUsesTheSamePathAsTheWholeMeshSearch) {
     // every vertex (crossings unsnapped in `position`) lies on the chord
     EXPECT_NEAR((v.position[0] - 0.05) * 4.8 - (v.position[1] - 0.3) * 5.88, 0.0, 1e-9);
     EXPECT_LT(distance(x, v.position), 6.0 / 12 / 16);  // snapped within a texel
+  }
+}
+
+TEST(CutPaths, OneSearchForManyCutsGivesEachCutsOwnPath) {
+  // CutManager traces its cuts concurrently with one SurfacePointSearch: each path is
+  // bitwise the one traced with a search of its own, whatever the order of the cuts.
+  const Mesh mesh = make_cylinder(1.0, 2.0, 0, 180, 12, 4, ElementType::tri6);
+  const ElementAdjacency adjacency(mesh, build_topology(mesh));
+  const std::vector<Cut> cuts = {points_cut({{0.0, 0.2, 1.0}, {1.0, 1.8, 0.0}}),
+                                 points_cut({{0.43589, 0.5, -0.9}, {0.6, 0.9, 0.8}, {0.31225, 1.5, 0.95}})};
+  const SurfacePointSearch search(mesh);
+  for (int c : {1, 0, 1}) {
+    const MeshCutPath own = trace_cut_path(mesh, adjacency, cuts[c], 32, "cuts[0]");
+    const MeshCutPath shared = trace_cut_path(mesh, search, adjacency, cuts[c], 32, "cuts[0]");
+    ASSERT_EQ(own.vertices.size(), shared.vertices.size());
+    ASSERT_GT(own.vertices.size(), 10u);
+    for (std::size_t k = 0; k < own.vertices.size(); ++k) {
+      EXPECT_EQ(own.vertices[k].element, shared.vertices[k].element);
+      EXPECT_EQ(own.vertices[k].xi, shared.vertices[k].xi);
+      EXPECT_EQ(own.vertices[k].arc_length, shared.vertices[k].arc_length);
+      EXPECT_EQ(own.vertices[k].position, shared.vertices[k].position);
+    }
   }
 }

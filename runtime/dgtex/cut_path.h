@@ -26,6 +26,8 @@
 
 namespace dgtex {
 
+class SurfacePointSearch;  // surface_point.h
+
 // Neighbour across each local edge: neighbour(e, k) = {element, its local edge} or
 // {-1, -1} on the mesh boundary. Built from a Topology.
 class ElementAdjacency {
@@ -71,6 +73,11 @@ double cut_point_tolerance(const Mesh& mesh);
 // on parts of the mesh that do not touch).
 MeshCutPath trace_cut_path(const Mesh& mesh, const ElementAdjacency& adjacency, const Cut& cut, int resolution,
                            const std::string& name);
+// The same with a SurfacePointSearch of `mesh` built once for many cuts: its queries are
+// const, so cuts may be traced concurrently with one search (and its per-element samples,
+// ~0.6 KB an element, exist once instead of per cut).
+MeshCutPath trace_cut_path(const Mesh& mesh, const SurfacePointSearch& search, const ElementAdjacency& adjacency,
+                           const Cut& cut, int resolution, const std::string& name);
 
 // Rest position and unit normal at xi of an element.
 void element_surface_point(const Mesh& mesh, int element, const double xi[2], Vec3& position, Vec3& normal);
