@@ -7,6 +7,8 @@
 #include <emmintrin.h>
 #endif
 
+#include "dgtex/kernels/flood_fill.h"
+
 namespace dgtex::kernels {
 
 int classify_laplace_texels_reference(const TexelTile& tile, std::vector<std::uint8_t>& bits) {
@@ -162,15 +164,6 @@ inline bool any_bit(const std::uint64_t* words, int first, int last) {
   return words[k1] & to_last;
 }
 
-// Root of run r with path halving (serial union-find).
-inline int find_run(std::vector<int>& parent, int r) {
-  while (parent[r] != r) {
-    parent[r] = parent[parent[r]];
-    r = parent[r];
-  }
-  return r;
-}
-
 // Core of the fast classification; writes texel (i, j) to out[base + j * stride + i], and
 // with `ghosts` also zeroes out[base + j * stride - 1] and out[base + j * stride + width]
 // (the padded layout's ghost columns).
@@ -278,8 +271,7 @@ int classify_into(const TexelTile& tile, std::uint8_t* out, std::int64_t base, s
     while (a < runs_in_row[j + 1] && b < runs_in_row[j]) {
       const int lo = std::max(run_first[a], run_first[b]), hi = std::min(run_last[a], run_last[b]);
       if (lo <= hi && any_bit(links, lo, hi)) {
-        const int ra = find_run(parent, a), rb = find_run(parent, b);
-        if (ra != rb) parent[std::max(ra, rb)] = std::min(ra, rb);
+        unite_smaller_root(parent, a, b);
       }
       if (run_last[a] < run_last[b]) ++a;
       else ++b;
@@ -296,7 +288,7 @@ int classify_into(const TexelTile& tile, std::uint8_t* out, std::int64_t base, s
       execution);
   for (int band = 1; band < bands; ++band) unite_with_south(band * band_rows);
   for (int r = 0; r < run_count; ++r) {
-    const int root = find_run(parent, r);
+    const int root = find_root_halving(parent, r);
     has_dirichlet[root] |= has_dirichlet[r];
   }
 
@@ -307,7 +299,7 @@ int classify_into(const TexelTile& tile, std::uint8_t* out, std::int64_t base, s
   for (int j = 0; j < h; ++j) {
     std::uint8_t* dst = out + base + j * stride;
     for (int r = runs_in_row[j]; r < runs_in_row[j + 1]; ++r) {
-      if (has_dirichlet[find_run(parent, r)]) continue;
+      if (has_dirichlet[find_root_halving(parent, r)]) continue;
       for (int i = run_first[r]; i <= run_last[r]; ++i) dst[i] &= laplace_degree_mask;
       zeroed += run_last[r] - run_first[r] + 1;
     }

@@ -9,14 +9,10 @@
 #include <unordered_map>
 
 #include "dgtex/deformed_shell.h"
+#include "dgtex/kernels/flood_fill.h"
 
 namespace dgtex {
 namespace {
-
-int find_root(std::vector<int>& parent, int i) {
-  while (parent[i] != i) i = parent[i] = parent[parent[i]];
-  return i;
-}
 
 struct Builder {
   const DeformedShell& shell;
@@ -129,23 +125,23 @@ void texelate_enriched(Builder& b, int e, float cut_threshold) {
       for (int s = 0; s < 4; ++s) present[s] = valid(ti[s], tj[s]);
       for (auto [s, t] : {std::pair{0, 1}, std::pair{2, 3}, std::pair{0, 2}, std::pair{1, 3}})
         if (present[s] && present[t] && !separated(ti[s], tj[s], ti[t], tj[t]))
-          parent[find_root(parent, s)] = find_root(parent, t);
+          parent[kernels::find_root_halving(parent, s)] = kernels::find_root_halving(parent, t);
       double xi1, xi2;
       grid_xi(type, T, ci, cj, xi1, xi2);
       const bool boundary = grid_boundary(type, T, ci, cj);
       for (int s = 0; s < 4; ++s) {
-        if (!present[s] || find_root(parent, s) != s) continue;
+        if (!present[s] || kernels::find_root_halving(parent, s) != s) continue;
         std::fill(mean.begin(), mean.end(), 0.0);
         int members = 0;
         for (int t = 0; t < 4; ++t)
-          if (present[t] && find_root(parent, t) == s) {
+          if (present[t] && kernels::find_root_halving(parent, t) == s) {
             for (int k = 0; k < K; ++k) mean[k] += value(ti[t], tj[t], k);
             ++members;
           }
         for (double& m : mean) m /= members;
         const int vertex = b.add_vertex(e, xi1, xi2, mean.data(), boundary);
         for (int t = 0; t < 4; ++t)
-          if (present[t] && find_root(parent, t) == s) corner_vertex[(static_cast<size_t>(cj) * (T + 1) + ci) * 4 + t] = vertex;
+          if (present[t] && kernels::find_root_halving(parent, t) == s) corner_vertex[(static_cast<size_t>(cj) * (T + 1) + ci) * 4 + t] = vertex;
       }
     }
   auto v = [&](int ci, int cj, int s) { return corner_vertex[(static_cast<size_t>(cj) * (T + 1) + ci) * 4 + s]; };
@@ -203,14 +199,14 @@ void weld(Builder& b) {
             if (w <= v || b.vertex_element[w] == b.vertex_element[v]) continue;
             double d2 = 0;
             for (int d = 0; d < 3; ++d) d2 += std::pow(p[3 * v + d] - p[3 * w + d], 2);
-            if (d2 <= tolerance * tolerance) parent[find_root(parent, w)] = find_root(parent, v);
+            if (d2 <= tolerance * tolerance) parent[kernels::find_root_halving(parent, w)] = kernels::find_root_halving(parent, v);
           }
         }
   }
   // A cluster is welded only if each element meets it at most once.
   std::unordered_map<int, std::vector<int>> clusters;
   for (int v = 0; v < n; ++v)
-    if (b.on_boundary[v]) clusters[find_root(parent, v)].push_back(v);
+    if (b.on_boundary[v]) clusters[kernels::find_root_halving(parent, v)].push_back(v);
   std::vector<int> target(n);
   std::iota(target.begin(), target.end(), 0);
   for (auto& [root, members] : clusters) {

@@ -14,6 +14,7 @@
 
 #include "dgtex/boundary_selection.h"
 #include "dgtex/cut_path.h"
+#include "dgtex/kernels/flood_fill.h"
 #include "dgtex/surface_point.h"
 #include "dgtex/scene_io.h"
 
@@ -111,10 +112,7 @@ void check_surface_points(const Scene& scene, const Mesh& mesh) {
 std::vector<int> part_of_node(const Mesh& mesh) {
   std::vector<int> parent(mesh.num_nodes());
   std::iota(parent.begin(), parent.end(), 0);
-  auto root = [&](int n) {
-    while (parent[n] != n) n = parent[n] = parent[parent[n]];
-    return n;
-  };
+  auto root = [&](int n) { return kernels::find_root_halving(parent, n); };
   for (int e = 0; e < mesh.num_elements(); ++e) {
     const int* nodes = mesh.element_nodes(e);
     for (int a = 1; a < mesh.nodes_per_element(); ++a) parent[root(nodes[a])] = root(nodes[0]);

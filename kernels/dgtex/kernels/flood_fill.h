@@ -27,14 +27,14 @@ int label_components_reference(const TexelTile& tile, std::vector<int>& labels);
 // texel; roots are renumbered with a prefix sum over rows.
 int label_components(const TexelTile& tile, std::vector<int>& labels, Execution execution = Execution::parallel);
 
-// Serial union-find over an int parent array with parent[x] <= x (the form above and its
-// callers with their own coupling rules): the root of x, halving the path on the way.
+// Serial union-find over an int parent array (roots: parent[x] == x), for the callers with
+// their own coupling rules: the root of x, halving the path on the way.
 inline int find_root_halving(std::vector<int>& parent, int x) {
   while (parent[x] != x) x = parent[x] = parent[parent[x]];
   return x;
 }
-// Joins the sets of a and b, hanging the larger root below the smaller (so each set's root
-// stays its smallest member).
+// Joins the sets of a and b, hanging the larger root below the smaller (so parent[x] <= x
+// holds and each set's root stays its smallest member).
 inline void unite_smaller_root(std::vector<int>& parent, int a, int b) {
   a = find_root_halving(parent, a), b = find_root_halving(parent, b);
   if (a != b) parent[a < b ? b : a] = a < b ? a : b;
