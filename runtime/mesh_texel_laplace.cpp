@@ -252,27 +252,43 @@ MeshLaplaceStats solve_mesh_texel_laplace(std::vector<RegionTile>& tiles, Elemen
     }
   }
   std::vector<int> parent(n);
-  for (int v = 0; v < n; ++v) parent[v] = v;
-  auto unite = [&](int v, int w) { kernels::unite_smaller_root(parent, v, w); };
   for (int l = 0; l < static_cast<int>(tiles.size()); ++l) {
+    // Within the tile, in texel order: a free texel joins its west or south neighbour's set
+    // by pointing where that neighbour points (an earlier texel, so parent[v] < v), and only
+    // where both neighbours are coupled are two sets united (one find each, most texels
+    // none). The same sets and roots as uniting every coupling, in half the time (chad).
     const std::uint8_t* flags = tiles[l].tile.flags.data();
+    const int base = l * tt;
     for (int j = 0; j < t; ++j)
       for (int i = 0; i < t; ++i) {
-        const int v = l * tt + j * t + i;
+        const int k = j * t + i, v = base + k;
+        parent[v] = v;
         if (!is_free[v]) continue;
-        const bool border = i == 0 || j == 0 || i == t - 1 || j == t - 1 || (type == ElementType::tri6 && i + j >= t - 1);
-        if (border) {
-          graph.for_each_coupling(v, [&](int w) {
-            if (w > v && is_free[w]) unite(v, w);
-          });
-          continue;
-        }
-        // Interior texel: its east and north neighbours are in the tile.
-        const std::uint8_t f = flags[j * t + i];
-        if (!(f & kernels::wall_east) && is_free[v + 1]) unite(v, v + 1);
-        if (!(f & kernels::wall_north) && is_free[v + t]) unite(v, v + t);
+        const bool west = i > 0 && is_free[v - 1] && !(flags[k - 1] & kernels::wall_east);
+        const bool south = j > 0 && is_free[v - t] && !(flags[k - t] & kernels::wall_north);
+        if (west) parent[v] = parent[v - 1];
+        else if (south) parent[v] = parent[v - t];
+        if (west && south && parent[v - 1] != parent[v - t]) kernels::unite_smaller_root(parent, v - 1, v - t);
       }
   }
+  // Couplings across mesh edges: only element-border texels (tri6: also the hypotenuse) have them.
+  auto unite_across = [&](int l, int i, int j) {
+    const int v = l * tt + j * t + i;
+    if (!is_free[v]) return;
+    graph.for_each_coupling(v, [&](int w) {
+      if (w / tt != l && is_free[w]) kernels::unite_smaller_root(parent, v, w);
+    });
+  };
+  for (int l = 0; l < static_cast<int>(tiles.size()); ++l)
+    for (int j = 0; j < t; ++j) {
+      // Row j's border texels: all of the first (and the quad8's last) row, else the first
+      // texel and the last one (tri6: those on or past the hypotenuse, i + j >= t - 1).
+      const bool whole_row = j == 0 || (type == ElementType::quad8 && j == t - 1);
+      const int tail = whole_row ? 1 : std::max(1, type == ElementType::quad8 ? t - 1 : t - 1 - j);
+      unite_across(l, 0, j);
+      for (int i = tail; i < t; ++i) unite_across(l, i, j);
+    }
+  // Each set's root is its smallest texel and parent[v] <= v, so one forward pass flattens.
   for (int v = 0; v < n; ++v) parent[v] = parent[parent[v]];
   enum : std::uint8_t { no_data = 0, constant = 1, varying = 2 };
   std::vector<std::uint8_t> state(n, no_data);
@@ -350,13 +366,15 @@ MeshLaplaceStats solve_mesh_texel_laplace(std::vector<RegionTile>& tiles, Elemen
         kernels::forall(static_cast<std::int64_t>(tiles.size()) * t, [&](std::int64_t row) {
           const int l = static_cast<int>(row / t), j = static_cast<int>(row % t);
           if (tiles[l].frozen) return;
-          const std::vector<std::uint8_t>& flags = tiles[l].tile.flags;
+          const std::uint8_t* flags = tiles[l].tile.flags.data() + j * t;
+          const double* values = tiles[l].tile.values.data() + j * t;
+          const int* unknown = unknown_of.data() + l * tt + j * t;
+          const int row_start = patch_index(l, 0, j);
+          std::fill(in_tile.begin() + row_start, in_tile.begin() + row_start + t, 1);
           for (int i = 0; i < t; ++i) {
-            const int v = l * tt + j * t + i;
-            const int g = patch_index(l, i, j);
-            in_tile[g] = 1;
-            if (!graph.active(v)) continue;
-            std::uint8_t f = flags[j * t + i] & (kernels::wall_east | kernels::wall_north);
+            if (flags[i] & kernels::inactive) continue;
+            const int g = row_start + i;
+            std::uint8_t f = flags[i] & (kernels::wall_east | kernels::wall_north);
             // Seam edges are walls in the patch (the seamed solve couples them).
             if (i == t - 1)
               f = (f & ~kernels::wall_east) |
@@ -364,9 +382,9 @@ MeshLaplaceStats solve_mesh_texel_laplace(std::vector<RegionTile>& tiles, Elemen
             if (j == t - 1)
               f = (f & ~kernels::wall_north) |
                   (graph.couples_across(l, 2, t - 1 - i) && !(seam_edges[l] & 4u) ? 0 : kernels::wall_north);
-            if (unknown_of[v] < 0) f |= kernels::dirichlet;
+            if (unknown[i] < 0) f |= kernels::dirichlet;
             patch.flags[g] = f;
-            patch.values[g] = graph.value(v);  // data, or the initial guess (the previous H)
+            patch.values[g] = values[i];  // data, or the initial guess (the previous H)
           }
         });
         // Ghost texels: the frozen texel coupled across a placed tile's edge, as Dirichlet

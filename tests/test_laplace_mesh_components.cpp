@@ -5,12 +5,15 @@
 // component; the answer is bitwise the same for 1, 2 and 4 threads, with the multigrid and
 // with CHOLMOD, and the two solvers agree on the solved component. The same boxes in a
 // region of one tile (the tile multigrid on the tile itself) leave its flags as they were.
+// Components that join late (a comb's teeth above their band, a box across the element
+// edge) are found whole.
 #include <gtest/gtest.h>
 
 #include <omp.h>
 
 #include <algorithm>
 #include <cmath>
+#include <string>
 #include <vector>
 
 #include "dgtex/kernels/texel_grid.h"
@@ -168,4 +171,69 @@ TEST(LaplaceMeshComponents, OneTileSettlesItsBoxesAndReturnsItsFlags) {
     }
   EXPECT_LT(worst, 1e-8);
   EXPECT_GT(spread, 0.4);  // not the warm start
+}
+
+// Components that join late. The teeth of a comb meet only in a band above them: the
+// component search meets each tooth as a set of its own and unites them in the band. A box
+// cut by the shared element edge is one component across the two tiles. With data in one
+// tooth, and on one side of the edge, every texel of the comb and of the box gets that value.
+TEST(LaplaceMeshComponents, CombTeethAndABoxAcrossTheElementEdgeJoin) {
+  const Mesh mesh = make_rectangle(2, 1, 2, 1, ElementType::quad8);
+  const ElementAdjacency adjacency(mesh, build_topology(mesh));
+  std::vector<RegionTile> start = testing_support::make_test_region(mesh, {0, 1}, T);
+  constexpr Box comb{10, 59, 10, 60};
+  constexpr int teeth_top = 54;  // the teeth's walls end here; rows 55-60 are the band
+  constexpr double comb_value = 0.75, bridge_value = -0.25;
+  kernels::TexelTile& left = start[0].tile;
+  kernels::TexelTile& right = start[1].tile;
+  wall_in(left, comb);
+  for (int x : {19, 29, 39, 49})
+    for (int j = comb.y0; j <= teeth_top; ++j) left.flags[j * T + x] |= kernels::wall_east;
+  left.flags[12 * T + 12] |= kernels::dirichlet;  // in the first tooth
+  left.values[12 * T + 12] = comb_value;
+  // The bridge: texels 100-127 of tile 0 and 0-20 of tile 1, rows 80-100, open across the
+  // shared edge (element 0's east, element 1's west).
+  constexpr Box bridge_left{100, T - 1, 80, 100}, bridge_right{0, 20, 80, 100};
+  for (int j = bridge_left.y0; j <= bridge_left.y1; ++j) {
+    left.flags[j * T + bridge_left.x0 - 1] |= kernels::wall_east;
+    right.flags[j * T + bridge_right.x1] |= kernels::wall_east;
+  }
+  for (kernels::TexelTile* tile : {&left, &right}) {
+    const Box& b = tile == &left ? bridge_left : bridge_right;
+    for (int i = b.x0; i <= b.x1; ++i) {
+      tile->flags[(b.y0 - 1) * T + i] |= kernels::wall_north;
+      tile->flags[b.y1 * T + i] |= kernels::wall_north;
+    }
+  }
+  right.flags[90 * T + 10] |= kernels::dirichlet;
+  right.values[90 * T + 10] = bridge_value;
+
+  LaplaceMultigridOptions options;
+  options.tolerance = 1e-12;
+  std::vector<std::vector<RegionTile>> answers;
+  for (LaplaceSolver solver : {LaplaceSolver::multigrid, LaplaceSolver::cholmod})
+    for (int threads : {1, 2}) {
+      SCOPED_TRACE(std::string(solver == LaplaceSolver::multigrid ? "multigrid" : "cholmod") + ", " +
+                   std::to_string(threads) + " threads");
+      std::vector<RegionTile> region = start;
+      const int saved = omp_get_max_threads();
+      omp_set_num_threads(threads);
+      const MeshLaplaceStats stats = solve_mesh_texel_laplace(region, mesh.type, adjacency, MeshEdgeWalls(T), solver, options);
+      omp_set_num_threads(saved);
+      EXPECT_EQ(stats.multigrid, solver == LaplaceSolver::multigrid);
+      EXPECT_EQ(stats.constant_components, 2);
+      EXPECT_EQ(stats.solved_components, 1);
+      int wrong = 0;
+      for (int j = 0; j < T; ++j)
+        for (int i = 0; i < T; ++i) {
+          const int k = j * T + i;
+          if (comb.contains(i, j)) wrong += region[0].tile.values[k] != comb_value;
+          if (bridge_left.contains(i, j)) wrong += region[0].tile.values[k] != bridge_value;
+          if (bridge_right.contains(i, j)) wrong += region[1].tile.values[k] != bridge_value;
+        }
+      EXPECT_EQ(wrong, 0);
+      answers.push_back(std::move(region));
+    }
+  for (std::size_t a : {1u, 3u})  // each solver: 2 threads bitwise as 1
+    for (std::size_t l = 0; l < 2; ++l) EXPECT_EQ(answers[a][l].tile.values, answers[a - 1][l].tile.values);
 }
