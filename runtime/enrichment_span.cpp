@@ -21,6 +21,9 @@ const kernels::TexelTile* texture_of(const EnrichmentFunction& f, int element) {
 // Eight interleaved partial sums, combined pairwise: one running sum waits on the adder's
 // latency for every texel (accordion's 18 functions on one T=256 tile: 342 dot products,
 // ~30 ms); eight chains vectorize. A fixed order: the same sum on every run and thread.
+// Clones per instruction set: wider vectors hold the same eight sums (no FMA contraction
+// in this file), so every clone rounds the same.
+__attribute__((target_clones("avx512f", "avx2", "default")))
 double dot(const std::vector<double>& a, const std::vector<double>& b) {
   double s[8] = {0, 0, 0, 0, 0, 0, 0, 0};
   const std::size_t n = a.size(), blocked = n - n % 8;
@@ -28,6 +31,18 @@ double dot(const std::vector<double>& a, const std::vector<double>& b) {
     for (int l = 0; l < 8; ++l) s[l] += a[k + l] * b[k + l];
   for (std::size_t k = blocked; k < n; ++k) s[k - blocked] += a[k] * b[k];
   return ((s[0] + s[1]) + (s[2] + s[3])) + ((s[4] + s[5]) + (s[6] + s[7]));
+}
+
+// column -= (q . column) q, the cloned loops as dot's.
+__attribute__((target_clones("avx512f", "avx2", "default")))
+void subtract_projection(std::vector<double>& column, const std::vector<double>& q) {
+  const double c = dot(q, column);
+  for (std::size_t p = 0; p < column.size(); ++p) column[p] -= c * q[p];
+}
+
+__attribute__((target_clones("avx512f", "avx2", "default")))
+void divide(std::vector<double>& column, double norm) {
+  for (double& v : column) v /= norm;
 }
 
 // Count, mean and sum of squared deviations of one tile's active texel values (two
@@ -153,13 +168,10 @@ std::vector<std::vector<int>> independent_enriched_nodes(const std::vector<std::
                                     std::to_string(a) + " differ in size or active texels from function " +
                                     std::to_string(list[0]) + "'s");
       for (int pass = 0; pass < 2; ++pass)  // twice: classical Gram-Schmidt loses orthogonality once
-        for (const std::vector<double>& q : basis) {
-          const double c = dot(q, column);
-          for (std::size_t p = 0; p < n; ++p) column[p] -= c * q[p];
-        }
+        for (const std::vector<double>& q : basis) subtract_projection(column, q);
       const double norm = std::sqrt(dot(column, column));
       if (!(norm > tolerance * std::sqrt(static_cast<double>(n)))) continue;  // adds nothing at a
-      for (double& v : column) v /= norm;
+      divide(column, norm);
       basis.push_back(column);
       kept[list[k]].push_back(a);
       keeps[k] = 1;
