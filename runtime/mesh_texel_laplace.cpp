@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <memory>
 #include <stdexcept>
 #include <string>
 #include <unordered_map>
@@ -292,7 +293,8 @@ MeshLaplaceStats solve_mesh_texel_laplace(std::vector<RegionTile>& tiles, Elemen
   for (int v = 0; v < n; ++v) parent[v] = parent[parent[v]];
   enum : std::uint8_t { no_data = 0, constant = 1, varying = 2 };
   std::vector<std::uint8_t> state(n, no_data);
-  std::vector<double> constant_value(n, 0.0);
+  // Read only where state is constant, which the write of the value comes with: no zero-fill.
+  const std::unique_ptr<double[]> constant_value(new double[n]);
   // (The order in which a component meets its data does not matter: it ends constant
   // with the one value it met, or varying.)
   for (int l = 0; l < static_cast<int>(tiles.size()); ++l) {
@@ -324,6 +326,7 @@ MeshLaplaceStats solve_mesh_texel_laplace(std::vector<RegionTile>& tiles, Elemen
   }
   std::vector<int> unknown_of(n, -1);
   std::vector<int> node_of;
+  node_of.reserve(n);
   for (int v = 0; v < n; ++v) {
     if (!is_free[v]) continue;
     const int root = parent[v];
