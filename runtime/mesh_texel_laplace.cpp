@@ -289,7 +289,6 @@ MeshLaplaceStats solve_mesh_texel_laplace(std::vector<RegionTile>& tiles, Elemen
       unite_across(l, 0, j);
       for (int i = tail; i < t; ++i) unite_across(l, i, j);
     }
-  // Each set's root is its smallest texel and parent[v] <= v, so one forward pass flattens.
   for (int v = 0; v < n; ++v) parent[v] = parent[parent[v]];
   enum : std::uint8_t { no_data = 0, constant = 1, varying = 2 };
   std::vector<std::uint8_t> state(n, no_data);

@@ -36,16 +36,21 @@ constexpr Box empty_box{10, 30, 20, 50};       // tile 0
 constexpr Box constant_box{40, 100, 25, 100};  // tile 1
 constexpr double constant_value = 0.75;
 
-// Walls all around the box (texel flags hold the walls on their east and north sides).
+// Walls below and above the box (texel flags hold the walls on their east and north sides).
+void wall_below_and_above(kernels::TexelTile& tile, const Box& b) {
+  for (int i = b.x0; i <= b.x1; ++i) {
+    tile.flags[(b.y0 - 1) * T + i] |= kernels::wall_north;
+    tile.flags[b.y1 * T + i] |= kernels::wall_north;
+  }
+}
+
+// Walls all around the box.
 void wall_in(kernels::TexelTile& tile, const Box& b) {
   for (int j = b.y0; j <= b.y1; ++j) {
     tile.flags[j * T + b.x0 - 1] |= kernels::wall_east;
     tile.flags[j * T + b.x1] |= kernels::wall_east;
   }
-  for (int i = b.x0; i <= b.x1; ++i) {
-    tile.flags[(b.y0 - 1) * T + i] |= kernels::wall_north;
-    tile.flags[b.y1 * T + i] |= kernels::wall_north;
-  }
+  wall_below_and_above(tile, b);
 }
 
 std::vector<RegionTile> boxed_region(const Mesh& mesh) {
@@ -198,13 +203,8 @@ TEST(LaplaceMeshComponents, CombTeethAndABoxAcrossTheElementEdgeJoin) {
     left.flags[j * T + bridge_left.x0 - 1] |= kernels::wall_east;
     right.flags[j * T + bridge_right.x1] |= kernels::wall_east;
   }
-  for (kernels::TexelTile* tile : {&left, &right}) {
-    const Box& b = tile == &left ? bridge_left : bridge_right;
-    for (int i = b.x0; i <= b.x1; ++i) {
-      tile->flags[(b.y0 - 1) * T + i] |= kernels::wall_north;
-      tile->flags[b.y1 * T + i] |= kernels::wall_north;
-    }
-  }
+  wall_below_and_above(left, bridge_left);
+  wall_below_and_above(right, bridge_right);
   right.flags[90 * T + 10] |= kernels::dirichlet;
   right.values[90 * T + 10] = bridge_value;
 
