@@ -118,10 +118,6 @@ class TexelGraph {
   // The region tile across local edge `edge` of tile l and its local edge there ({-1, -1}: none).
   std::array<int, 2> across(int l, int edge) const { return across_[4 * l + edge]; }
   bool active(int node) const { return !(flags(node) & kernels::inactive); }
-  bool data(int node) const {
-    return active(node) && (tiles_[node / tt_].frozen || (flags(node) & kernels::dirichlet));
-  }
-  bool free(int node) const { return active(node) && !data(node); }
   double& value(int node) { return tiles_[node / tt_].tile.values[node % tt_]; }
 
   // Calls f(neighbour node) for every active texel coupled to `node` (an active texel).
@@ -240,7 +236,8 @@ MeshLaplaceStats solve_mesh_texel_laplace(std::vector<RegionTile>& tiles, Elemen
   // flattens every texel to its root.
   const int t = tiles.front().tile.width, tt = t * t;
   std::vector<char> is_free(n), is_data(n);
-  for (int l = 0; l < static_cast<int>(tiles.size()); ++l) {  // graph.free / graph.data per tile
+  // Data: active texels of frozen tiles and Dirichlet texels; free: the other active ones.
+  for (int l = 0; l < static_cast<int>(tiles.size()); ++l) {
     const std::uint8_t* flags = tiles[l].tile.flags.data();
     const bool frozen = tiles[l].frozen;
     char* free_texel = is_free.data() + static_cast<std::size_t>(l) * tt;
