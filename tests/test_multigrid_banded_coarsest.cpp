@@ -2,6 +2,8 @@
 // bandwidth, solutions against Eigen's sparse LLT, a non-positive pivot reported, and the
 // spiral at T = 256 (coarsening stops at 32 x 32 nodes, factored in band form) solved like
 // CHOLMOD does. Also where coarsening stops: not at a large level for one isolated orphan.
+// Coarsest levels too wide for the band go to CHOLMOD in nested-dissection order
+// (runtime/grid_nested_dissection.h): the order, its fill, and combs solved like CHOLMOD.
 #include <gtest/gtest.h>
 #include <omp.h>
 
@@ -12,7 +14,8 @@
 
 #include <Eigen/SparseCholesky>
 
-#include "banded_cholesky.h"  // internal (runtime/)
+#include "banded_cholesky.h"         // internal (runtime/)
+#include "grid_nested_dissection.h"  // internal (runtime/)
 #include "dgtex/laplace_domains.h"
 #include "dgtex/laplace_multigrid.h"
 #include "dgtex/laplace_solver.h"
@@ -123,6 +126,99 @@ TEST(CoarsestLevel, AnIsolatedOrphanDoesNotStopALargeHierarchy) {
   EXPECT_LT(diff, 1e-8);
   // (Many orphans, as in a spiral's channels, still stop coarsening where they appear:
   // test_multigrid_convergence's spiral_128_tri cases fail otherwise.)
+}
+
+// Non-zeros of the Cholesky factor of `a` in the order `perm` (new index of each row).
+long factor_nonzeros(const Eigen::SparseMatrix<double>& a, const Eigen::VectorXi& perm) {
+  const Eigen::PermutationMatrix<Eigen::Dynamic, Eigen::Dynamic, int> p(perm);
+  const Eigen::SparseMatrix<double> permuted = p * a * p.transpose();
+  Eigen::SimplicialLLT<Eigen::SparseMatrix<double>, Eigen::Lower, Eigen::NaturalOrdering<int>> llt(permuted);
+  EXPECT_EQ(llt.info(), Eigen::Success);
+  return static_cast<long>(llt.matrixL().nestedExpression().nonZeros());
+}
+
+TEST(GridNestedDissection, OrdersEveryActiveNodeOnceWithLessFillThanAmd) {
+  std::mt19937 rng(5);
+  for (auto [nx, ny] : {std::pair{97, 33}, std::pair{40, 40}, std::pair{1, 30}, std::pair{30, 1}, std::pair{3, 2}}) {
+    const kernels::GridShape g{nx, ny};
+    std::vector<std::uint8_t> active(g.padded_size(), 0);
+    std::bernoulli_distribution keep(0.9);
+    int count = 0;
+    for (int j = 0; j < ny; ++j)
+      for (int i = 0; i < nx; ++i) count += active[g.at(i, j)] = keep(rng) ? 1 : 0;
+    const std::vector<std::int64_t> order = detail::grid_nested_dissection_order(g, active.data());
+    ASSERT_EQ(static_cast<int>(order.size()), count) << nx << " x " << ny;
+    std::vector<int> seen(g.padded_size(), 0);
+    for (std::int64_t t : order) {
+      ASSERT_TRUE(active[t]) << nx << " x " << ny;
+      EXPECT_EQ(++seen[t], 1) << nx << " x " << ny;
+    }
+  }
+  // On the whole 97 x 33 grid (the slinky's coarsest level), the factor is no fuller than
+  // with AMD's order and far below the band of the row-by-row numbering.
+  const int nx = 97, ny = 33;
+  const Eigen::SparseMatrix<double> a = grid_operator(nx, ny, 11u);
+  const kernels::GridShape g{nx, ny};
+  std::vector<std::uint8_t> active(g.padded_size(), 0);
+  for (int j = 0; j < ny; ++j)
+    for (int i = 0; i < nx; ++i) active[g.at(i, j)] = 1;
+  const std::vector<std::int64_t> order = detail::grid_nested_dissection_order(g, active.data());
+  Eigen::VectorXi nested(nx * ny), row_by_row(nx * ny);
+  for (int k = 0; k < nx * ny; ++k) {
+    const std::int64_t t = order[k];
+    const int i = static_cast<int>(t % g.stride()) - 1, j = static_cast<int>(t / g.stride()) - 1;
+    nested[j * nx + i] = k;
+    row_by_row[k] = k;
+  }
+  Eigen::SimplicialLLT<Eigen::SparseMatrix<double>, Eigen::Lower, Eigen::AMDOrdering<int>> amd(a);
+  ASSERT_EQ(amd.info(), Eigen::Success);
+  const long fill_amd = static_cast<long>(amd.matrixL().nestedExpression().nonZeros());
+  const long fill_nested = factor_nonzeros(a, nested), fill_band = factor_nonzeros(a, row_by_row);
+  EXPECT_LE(fill_nested, fill_amd) << "nested " << fill_nested << ", AMD " << fill_amd;
+  EXPECT_LT(3 * fill_nested, fill_band) << "nested " << fill_nested << ", row by row " << fill_band;
+}
+
+// A W x 64 tile, 0 at the left column and 1 at the right, with walls north of every
+// `gap`-th row over the middle columns: channels gap texels high, which coarsening cannot
+// represent, so it stops with a wide coarsest level (gap 2: the texels themselves, 12k
+// nodes; gap 3: 96 x 32 nodes, as in the slinky) that goes to CHOLMOD.
+TexelTile comb(int gap) {
+  const int w = 192, h = 64;
+  TexelTile tile(w, h);
+  for (int j = 0; j < h; ++j) {
+    tile.flags[tile.index(0, j)] |= kernels::dirichlet;
+    tile.flags[tile.index(w - 1, j)] |= kernels::dirichlet;
+    tile.values[tile.index(w - 1, j)] = 1;
+  }
+  for (int j = 0; j + 1 < h; j += gap)
+    for (int i = 16; i < w - 16; ++i) tile.flags[tile.index(i, j)] |= kernels::wall_north;
+  return tile;
+}
+
+TEST(CoarsestLevel, WideCoarsestLevelsGiveCholmodsSolutionForAnyThreadCount) {
+  for (auto [gap, levels] : {std::pair{2, 1}, std::pair{3, 2}}) {
+    const TexelTile tile = comb(gap);
+    EXPECT_EQ(LaplaceMultigrid(tile).level_count(), levels) << "gap " << gap;
+    TexelTile direct = tile;
+    solve_laplace(direct, LaplaceSolver::cholmod);
+    LaplaceMultigridOptions options;
+    options.tolerance = 1e-11;
+    std::vector<double> one_thread;
+    for (int threads : {1, 2}) {
+      omp_set_num_threads(threads);
+      TexelTile solved = tile;
+      solve_laplace_multigrid(solved, options);
+      if (threads == 2) {
+        EXPECT_EQ(solved.values, one_thread) << "gap " << gap;
+        continue;
+      }
+      one_thread = solved.values;
+      double diff = 0;
+      for (std::size_t k = 0; k < solved.values.size(); ++k)
+        diff = std::max(diff, std::abs(solved.values[k] - direct.values[k]));
+      EXPECT_LT(diff, 1e-8) << "gap " << gap;
+    }
+  }
 }
 
 }  // namespace
