@@ -21,7 +21,7 @@ struct Dissection {
   void box(int i0, int i1, int j0, int j1) {
     const int w = i1 - i0, h = j1 - j0;
     if (w <= 0 || h <= 0) return;
-    if (static_cast<long>(w) * h <= leaf_nodes || (w < 3 && h < 3)) {
+    if (static_cast<long>(w) * h <= leaf_nodes) {
       emit(i0, i1, j0, j1);
       return;
     }

@@ -439,7 +439,8 @@ struct LaplaceMultigrid::Hierarchy {
       for_each_lower_entry([&](int row, int column, double value) { coarsest_banded.set_lower(row, column, value); });
       ok = coarsest_banded.factorize();
     } else if (n > 0) {
-      // Renumbered in nested-dissection order, which CHOLMOD keeps (no AMD analysis).
+      // Renumbered in nested-dissection order, which CHOLMOD keeps (no AMD analysis); the
+      // new numbers put some couplings above the diagonal, so each is stored below it.
       coarsest_nodes = detail::grid_nested_dissection_order(g, level.active.data());
       for (int k = 0; k < n; ++k) index[coarsest_nodes[k]] = k;
       std::vector<Eigen::Triplet<double>> entries;  // the lower triangle, which CHOLMOD reads (Eigen::Lower)
