@@ -22,7 +22,6 @@
 #include "dgtex/kernels/multigrid_unknowns.h"
 #include "dgtex/stage_timer.h"
 #include "banded_cholesky.h"
-#include "cholmod_lock.h"
 #include "grid_nested_dissection.h"
 #include "multigrid_buffer.h"
 
@@ -449,7 +448,7 @@ struct LaplaceMultigrid::Hierarchy {
       });
       Eigen::SparseMatrix<double> m(n, n);
       m.setFromTriplets(entries.begin(), entries.end());
-      const auto lock = detail::lock_cholmod();
+      // Simplicial in a given order: neither BLAS nor METIS, so no lock (cholmod_lock.h).
       cholmod_common& common = coarsest_factor.cholmod();
       common.nmethods = 1;
       common.method[0].ordering = CHOLMOD_NATURAL;
@@ -488,7 +487,6 @@ struct LaplaceMultigrid::Hierarchy {
     } else if (coarsest_kind == CoarsestFactor::banded) {
       coarsest_banded.solve(rhs, solution);
     } else {
-      const auto lock = detail::lock_cholmod();
       solution = coarsest_factor.solve(rhs);
     }
     for (int k = 0; k < n; ++k) level.x[coarsest_nodes[k]] = static_cast<Real>(solution[k]);

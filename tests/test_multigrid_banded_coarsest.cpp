@@ -3,7 +3,8 @@
 // spiral at T = 256 (coarsening stops at 32 x 32 nodes, factored in band form) solved like
 // CHOLMOD does. Also where coarsening stops: not at a large level for one isolated orphan.
 // Coarsest levels too wide for the band go to CHOLMOD in nested-dissection order
-// (runtime/grid_nested_dissection.h): the order, its fill, and combs solved like CHOLMOD.
+// (runtime/grid_nested_dissection.h): the order, its fill, and combs solved like CHOLMOD,
+// also by four threads at once (that factor takes no process-wide lock).
 #include <gtest/gtest.h>
 #include <omp.h>
 
@@ -11,6 +12,7 @@
 #include <cmath>
 #include <random>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include <Eigen/SparseCholesky>
@@ -209,6 +211,30 @@ TEST(CoarsestLevel, WideCoarsestLevelsGiveCholmodsSolutionForAnyThreadCount) {
     EXPECT_EQ(LaplaceMultigrid(tile).level_count(), levels) << "gap " << gap;
     expect_cholmods_solution_on_any_thread_count(tile, "comb gap " + std::to_string(gap));
   }
+}
+
+TEST(CoarsestLevel, ConcurrentSolvesOfAWideCoarsestLevelGiveTheSoloBits) {
+  // The CHOLMOD factor of a wide coarsest level is simplicial in a given order (no BLAS, no
+  // METIS), so it runs without the process-wide CHOLMOD lock: four threads solving at once
+  // must each get exactly the solo solution.
+  const TexelTile tile = comb(3);
+  LaplaceMultigridOptions options;
+  options.tolerance = 1e-11;
+  options.execution = kernels::Execution::serial;  // one thread per solve
+  TexelTile solo = tile;
+  solve_laplace_multigrid(solo, options);
+  std::vector<int> mismatches(4, 0);  // per thread: solves that differ from the solo one
+  std::vector<std::thread> threads;
+  for (std::size_t k = 0; k < mismatches.size(); ++k)
+    threads.emplace_back([&, k] {
+      for (int repeat = 0; repeat < 3; ++repeat) {
+        TexelTile solved = tile;
+        solve_laplace_multigrid(solved, options);
+        mismatches[k] += solved.values != solo.values;
+      }
+    });
+  for (std::thread& t : threads) t.join();
+  for (int m : mismatches) EXPECT_EQ(m, 0);
 }
 
 }  // namespace
