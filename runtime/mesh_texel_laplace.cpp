@@ -470,20 +470,25 @@ MeshLaplaceStats solve_mesh_texel_laplace(std::vector<RegionTile>& tiles, Elemen
       }
     } else if (solver == LaplaceSolver::multigrid && tiles.size() == 1) {
       // One tile, no neighbours: the tile multigrid on the tile itself (no copy), with the
-      // settled texels (their values set above) marked as data while it runs. The
-      // multigrid writes only the unknowns; should it fail, CHOLMOD below writes them all.
-      TexelTile& tile = tiles.front().tile;
-      std::vector<int> settled;
+      // settled texels (their values set above) marked as data while it runs (unmarked on
+      // every way out, an exception too). The multigrid writes only the unknowns; should it
+      // fail, CHOLMOD below writes them all.
+      struct SettledAsData {
+        TexelTile& tile;
+        std::vector<int> texels;
+        ~SettledAsData() {
+          for (int v : texels) tile.flags[v] &= static_cast<std::uint8_t>(~kernels::dirichlet);
+        }
+      } settled{tiles.front().tile, {}};
       for (int v = 0; v < n; ++v)
-        if (is_free[v] && unknown_of[v] < 0) settled.push_back(v), tile.flags[v] |= kernels::dirichlet;
+        if (is_free[v] && unknown_of[v] < 0) settled.texels.push_back(v), settled.tile.flags[v] |= kernels::dirichlet;
       try {
-        const LaplaceSolveStats s = solve_laplace(tile, LaplaceSolver::multigrid, options);
+        const LaplaceSolveStats s = solve_laplace(settled.tile, LaplaceSolver::multigrid, options);
         stats.relative_residual = s.relative_residual;
         stats.multigrid = true;
       } catch (const std::runtime_error&) {
         stats.multigrid = false;
       }
-      for (int v : settled) tile.flags[v] &= static_cast<std::uint8_t>(~kernels::dirichlet);
     }
     if (!stats.multigrid) {
       // Lower triangle, column by column (rows in increasing order: cheap inserts).
