@@ -18,6 +18,7 @@
 #include "dgtex/kernels/multigrid_unknowns.h"
 #include "dgtex/laplace_domains.h"
 #include "dgtex/stage_timer.h"
+#include "cholmod_lock.h"
 
 namespace dgtex {
 namespace {
@@ -136,6 +137,7 @@ LaplaceBenchRun run_once(LaplaceBenchSolver solver, const kernels::TexelTile& pr
     case LaplaceBenchSolver::cholmod_solve: {
       auto start = Clock::now();
       Eigen::CholmodSupernodalLLT<Eigen::SparseMatrix<double>, Eigen::Lower> cholesky;
+      const auto lock = detail::lock_cholmod();  // as dgtex's own CHOLMOD calls (cholmod_lock.h)
       cholesky.compute(system.A);
       if (cholesky.info() != Eigen::Success) throw std::runtime_error("bench: CHOLMOD factorisation failed");
       if (solver == LaplaceBenchSolver::cholmod_solve) start = Clock::now();
