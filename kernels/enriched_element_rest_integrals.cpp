@@ -47,7 +47,8 @@ void enriched_element_mass_and_load_weights(const EnrichedElementBatch& b, const
 
 void enriched_element_mass_and_load_weights(const EnrichedElementBatch& b, const EnrichedQuadrature& quad,
                                             const TexelDerivativeTile* const* derivatives, double* mass,
-                                            double* area_weights, double* mass_weights, Execution execution) {
+                                            double* area_weights, double* mass_weights, Execution execution,
+                                            double* basis_values) {
   const int W = b.width;
   const int npe = nodes_per_element(b.type);
   constexpr std::int64_t block = rest_integral_block_points;
@@ -64,7 +65,10 @@ void enriched_element_mass_and_load_weights(const EnrichedElementBatch& b, const
     GramAccumulator M(n);
     for (std::int64_t begin = quad.start[e]; begin < quad.start[e + 1]; begin += span) {
       const std::int64_t count = std::min(span, quad.start[e + 1] - begin);
-      values.resize(static_cast<std::size_t>(count) * n);
+      // The span's values: in the caller's array (W slots a point) if it keeps them.
+      const int stride = basis_values ? W : n;
+      if (!basis_values) values.resize(static_cast<std::size_t>(count) * n);
+      double* span_values = basis_values ? basis_values + begin * W : values.data();
       weights.resize(static_cast<std::size_t>(count));
       forall(
           (count + block - 1) / block,
@@ -74,14 +78,14 @@ void enriched_element_mass_and_load_weights(const EnrichedElementBatch& b, const
               const double* q = quad.points + 3 * (begin + p);
               ShapeValues s;
               evaluate_shape(b.type, q[0], q[1], s);
-              enriched_shape_values(b, e, q[0], q[1], s, cache, values.data() + p * n, derivatives);
+              enriched_shape_values(b, e, q[0], q[1], s, cache, span_values + p * stride, derivatives);
               weights[p] = q[2] * rest_area_factor(s, nodes, b.positions);
             }
           },
           execution);
       // The two kernels' sums, in point order.
       for (std::int64_t p = 0; p < count; ++p) {
-        const double* N = values.data() + p * n;
+        const double* N = span_values + p * stride;
         const double w = weights[p];
         const double s = std::sqrt(w * rho_h);
         double* row = M.next();

@@ -380,6 +380,11 @@ void ShellModel::integrate_enriched_elements(const kernels::EnrichedElementBatch
   std::vector<std::shared_ptr<const ElementIntegrals>> reused(count);
   std::vector<char> same_textures(count, 0);
   const size_t texels = static_cast<size_t>(T) * T;
+  // Kept basis values of the integrals reused below (the first build of a pruned basis):
+  // per enriched element, its local functions' columns among them (empty: none).
+  const KeptBasisValues previous = std::move(kept_);
+  kept_ = KeptBasisValues{};
+  std::vector<std::vector<int>> kept_columns(count);
   for (std::int64_t x = 0; x < count; ++x) {
     const int e = enriched_elements_[x];
     const ElementIntegrals* old =
@@ -409,6 +414,9 @@ void ShellModel::integrate_enriched_elements(const kernels::EnrichedElementBatch
       o += was;
     }
     if (!subset) continue;
+    if (keep_basis_values_ && e < static_cast<int>(previous.start.size()) && previous.start[e] >= 0 &&
+        previous.owner[e].get() == old)
+      kept_columns[x] = old_function;
     if (static_cast<int>(old_function.size()) == old->count) {
       reused[x] = element_integrals_[e];
       continue;
@@ -506,8 +514,35 @@ void ShellModel::integrate_enriched_elements(const kernels::EnrichedElementBatch
   for (const auto& tile : sub_derivatives) sub_tiles.push_back(tile.get());
   std::vector<double> sub_mass(static_cast<size_t>(todo) * W * W), sub_area(static_cast<size_t>(todo) * W),
       sub_mass_weights(sub_area.size());
+  // Kept basis values: the computed elements' points first (where the kernel writes them),
+  // then those taken from `previous`. Every slot the projection reads is written: no
+  // zero-filling.
+  std::shared_ptr<double[]> basis_values;
+  std::vector<std::int64_t> kept_start(count, -1);
+  if (keep_basis_values_) {
+    std::int64_t points = sub_start.back();
+    for (std::int64_t t = 0; t < todo; ++t) kept_start[todo_index[t]] = sub_start[t];
+    for (std::int64_t x = 0; x < count; ++x)
+      if (!kept_columns[x].empty()) {
+        kept_start[x] = points;
+        points += static_cast<std::int64_t>(element_integrals_[enriched_elements_[x]]->points.size() / 3);
+      }
+    basis_values.reset(new double[static_cast<size_t>(points) * W]);
+    for (std::int64_t x = 0; x < count; ++x) {
+      const std::vector<int>& columns = kept_columns[x];
+      if (columns.empty()) continue;
+      const int e = enriched_elements_[x], n = static_cast<int>(columns.size());
+      const std::int64_t element_points = static_cast<std::int64_t>(element_integrals_[e]->points.size() / 3);
+      for (std::int64_t p = 0; p < element_points; ++p) {
+        const double* from = previous.values.get() + (previous.start[e] + p) * previous.width;
+        double* to = basis_values.get() + (kept_start[x] + p) * W;
+        for (int a = 0; a < n; ++a) to[a] = from[columns[a]];
+      }
+    }
+  }
   kernels::enriched_element_mass_and_load_weights(sub, {sub_start.data(), sub_points.data()}, sub_tiles.data(),
-                                                  sub_mass.data(), sub_area.data(), sub_mass_weights.data());
+                                                  sub_mass.data(), sub_area.data(), sub_mass_weights.data(),
+                                                  kernels::Execution::parallel, basis_values.get());
   for (std::int64_t t = 0; t < todo; ++t) {
     auto entry = std::make_shared<ElementIntegrals>();
     const int x = todo_index[t];
@@ -548,6 +583,18 @@ void ShellModel::integrate_enriched_elements(const kernels::EnrichedElementBatch
       enriched_mass_weights_[x * W + a] = in.mass_weights[a];
     }
     element_integrals_[enriched_elements_[x]] = std::move(reused[x]);
+  }
+  if (basis_values) {
+    kept_.values = std::move(basis_values);
+    kept_.width = W;
+    kept_.start.assign(mesh_.num_elements(), -1);
+    kept_.owner.assign(mesh_.num_elements(), nullptr);
+    for (std::int64_t x = 0; x < count; ++x) {
+      if (kept_start[x] < 0) continue;
+      const int e = enriched_elements_[x];
+      kept_.start[e] = kept_start[x];
+      kept_.owner[e] = element_integrals_[e];
+    }
   }
 }
 
@@ -1055,6 +1102,12 @@ std::vector<std::vector<double>> ShellModel::moments_of_fields(const ShellModel&
       else xi[0] = element_qp_[3 * q], xi[1] = element_qp_[3 * q + 1], weight = element_qp_[3 * q + 2];
       return sections_[e];
     };
+    // The basis values the mass integration kept for this element (keep_basis_values), if any.
+    const double* kept = has_kept_basis_values(e) ? kept_.values.get() + kept_.start[e] * kept_.width : nullptr;
+    if (kept) {
+      basis_count = kernels::enriched_basis_count(enriched_element_batch(), index);
+      std::copy_n(enriched_global_nodes_.begin() + static_cast<std::ptrdiff_t>(index) * width_, basis_count, global.begin());
+    }
     for (std::int64_t begin = 0; begin < total; begin += span) {
       const std::int64_t count = std::min(span, total - begin);
       auto evaluate = [&](std::int64_t item) {
@@ -1070,8 +1123,10 @@ std::vector<std::vector<double>> ShellModel::moments_of_fields(const ShellModel&
           d[0] = weight * kernels::rest_area_factor(shape, mesh_.element_nodes(e), mesh_.positions.data()) *
                  section.density * section.thickness;
           const int m = source.basis_values_at(e, xi, shape, source_cache, source_global, source_values);
-          const int n = basis_values_at(e, xi, shape, cache, p == 0 ? global.data() : unused_global, d + 1);
-          if (p == 0) basis_count = n;
+          if (!kept) {
+            const int n = basis_values_at(e, xi, shape, cache, p == 0 ? global.data() : unused_global, d + 1);
+            if (p == 0) basis_count = n;
+          }
           for (int f = 0; f < nf; ++f) {
             const double* u = fields[f]->data();
             double* value = d + 1 + stride + 3 * f;
@@ -1095,7 +1150,7 @@ std::vector<std::vector<double>> ShellModel::moments_of_fields(const ShellModel&
         for (std::int64_t p = 0; p < count; ++p) {
           const double* d = data.data() + p * per_point;
           const double w = d[0];
-          const double* values = d + 1;
+          const double* values = kept ? kept + (begin + p) * kept_.width : d + 1;
           const double* value = d + 1 + stride + 3 * f;
           for (int a = 0; a < m; ++a)
             for (int c = 0; c < 3; ++c) local[3 * a + c] += w * values[a] * value[c];

@@ -110,6 +110,22 @@ class ShellModel {
   }
   int num_pruned_enriched_nodes() const { return pruned_enriched_nodes_; }
   void clear_enrichments() { set_enrichments({}); }
+  // For a model about to receive a basis change: from the next set_enrichments on, keep the
+  // new basis's values at the enriched elements' quadrature points as the mass integration
+  // evaluates them, so that moments_of_fields on this model reads them instead of evaluating
+  // the basis a second time (the same bits). Elements whose integrals a rebuild reuses from
+  // another set_enrichments call have none kept and are evaluated as before. Memory: points
+  // x width() doubles (spiral6 at the end of its cut: ~8 MB) until release_basis_values(),
+  // which also stops the keeping.
+  void keep_basis_values() { keep_basis_values_ = true; }
+  void release_basis_values() {
+    keep_basis_values_ = false;
+    kept_ = {};
+  }
+  // Whether moments_of_fields will read kept values for mesh element `element`.
+  bool has_kept_basis_values(int element) const {
+    return element >= 0 && element < static_cast<int>(kept_.start.size()) && kept_.start[element] >= 0;
+  }
   const std::vector<EnrichmentFunction>& enrichments() const { return enrichments_; }
   int num_enriched_nodes() const { return static_cast<int>(virtual_node_function_.size()); }  // virtual nodes
   int num_enriched_dofs() const { return 3 * num_enriched_nodes(); }
@@ -276,6 +292,18 @@ class ShellModel {
     std::vector<double> area_weights, mass_weights;  // count
   };
   std::vector<std::shared_ptr<const ElementIntegrals>> element_integrals_;  // per mesh element, may be null
+  // The kept basis values (keep_basis_values), `width` doubles a point. Per mesh element: the
+  // index of its first point among them, or -1 (none kept), and the integrals they belong to:
+  // a rebuild that reuses those integrals (a pruned basis keeps a subset of the functions)
+  // takes the matching columns instead of evaluating again. Shared by copies of the model.
+  struct KeptBasisValues {
+    std::shared_ptr<const double[]> values;
+    int width = 0;
+    std::vector<std::int64_t> start;
+    std::vector<std::shared_ptr<const ElementIntegrals>> owner;
+  };
+  bool keep_basis_values_ = false;
+  KeptBasisValues kept_;
   // Per element enrichment (like textures_): its ElementIntegrals' texel derivatives or null.
   std::vector<const kernels::TexelDerivativeTile*> texture_derivatives_;
   // Fills element_qp_start_/element_qp_, the enriched load weights and `mass` (#enriched

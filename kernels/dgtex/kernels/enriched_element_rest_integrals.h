@@ -24,10 +24,14 @@ void enriched_element_mass_and_load_weights(const EnrichedElementBatch& batch, c
                                             Execution execution = Execution::parallel);
 // The same (bitwise), reading texel derivatives from derivatives[m] for the batch's texture
 // m (enrichment_start order) where that is not null (texel_derivative_tile.h).
+// basis_values (optional): the local basis values the sums use, kept for the caller. Point q
+// (numbered as in quadrature.start) gets W slots at basis_values + q * W, and its element's
+// first enriched_basis_count entries are written. A basis change's projection reads them
+// instead of evaluating the new basis at every point again.
 void enriched_element_mass_and_load_weights(const EnrichedElementBatch& batch, const EnrichedQuadrature& quadrature,
                                             const TexelDerivativeTile* const* derivatives, double* mass,
                                             double* area_weights, double* mass_weights,
-                                            Execution execution = Execution::parallel);
+                                            Execution execution = Execution::parallel, double* basis_values = nullptr);
 
 // evaluate_enriched_shape's N (bitwise) at xi of enriched element e, standard shape s;
 // `cache` holds the texel derivatives of e's textures at texel (cache_i, cache_j) and is
