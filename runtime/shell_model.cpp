@@ -869,6 +869,7 @@ void ShellModel::add_area_force(const double q[3], std::vector<double>& f) const
 
 void ShellModel::set_enrichments(std::vector<EnrichmentFunction> functions) {
   pruned_enriched_nodes_ = 0;
+  kept_ = KeptBasisValues{};  // of the basis being replaced (a basis without enriched elements integrates nothing)
   const bool test_masses = options_.min_enrichment_mass_ratio > 0;
   install_enrichments(std::move(functions), !test_masses);
   if (!test_masses) return;
@@ -1103,7 +1104,8 @@ std::vector<std::vector<double>> ShellModel::moments_of_fields(const ShellModel&
       return sections_[e];
     };
     // The basis values the mass integration kept for this element (keep_basis_values), if any.
-    const double* kept = has_kept_basis_values(e) ? kept_.values.get() + kept_.start[e] * kept_.width : nullptr;
+    const double* kept =
+        index >= 0 && has_kept_basis_values(e) ? kept_.values.get() + kept_.start[e] * kept_.width : nullptr;
     if (kept) {
       basis_count = kernels::enriched_basis_count(enriched_element_batch(), index);
       std::copy_n(enriched_global_nodes_.begin() + static_cast<std::ptrdiff_t>(index) * width_, basis_count, global.begin());

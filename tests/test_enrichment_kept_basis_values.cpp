@@ -18,16 +18,6 @@ using namespace dgtex::testing_support;
 
 namespace {
 
-std::unique_ptr<ShellModel> plate(const Mesh& mesh, double min_mass_ratio) {
-  const Topology topology = build_topology(mesh);
-  const testing_support::Material m;
-  std::vector<kernels::ShellSection> sections(mesh.num_elements(), {m.E, m.nu, m.h, m.rho});
-  ShellModelOptions options;
-  options.penalty = 1.0;
-  options.min_enrichment_mass_ratio = min_mass_ratio;
-  return std::make_unique<ShellModel>(mesh, topology, sections, std::vector<int>{}, options);
-}
-
 std::vector<double> random_field(int size, unsigned seed) {
   std::mt19937 random(seed);
   std::uniform_real_distribution<double> value(-1.0, 1.0);
@@ -67,8 +57,8 @@ std::unique_ptr<ShellModel> expect_kept_moments_bitwise(const ShellModel& old_mo
 
 TEST(KeptBasisValues, ProjectionMomentsEqualTheEvaluatedOnesBitwise) {
   const Mesh mesh = make_rectangle(1, 0.5, 2, 1, ElementType::quad8);
-  auto old_model = plate(mesh, 0.0);
-  old_model->set_enrichments({straight_cut_enrichment(mesh, 32, [](const double* x) { return x[0] - 0.25; })});
+  const auto old_model =
+      enriched_model(mesh, {straight_cut_enrichment(mesh, 32, [](const double* x) { return x[0] - 0.25; })}, 0.0);
   const std::vector<EnrichmentFunction> next = {
       straight_cut_enrichment(mesh, 32, [](const double* x) { return x[0] + 0.4 * x[1] - 0.55; }, false)};
   const auto keeping = expect_kept_moments_bitwise(*old_model, next);
@@ -79,10 +69,23 @@ TEST(KeptBasisValues, APrunedBasisTakesItsColumnsOfTheFirstBuildsValues) {
   // A cut one texel from the left edge leaves nodes with almost no enriched mass: the
   // first build evaluates every element, the pruned rebuild reuses all their integrals.
   const Mesh mesh = make_rectangle(1, 0.5, 2, 1, ElementType::quad8);
-  auto old_model = plate(mesh, 1e-3);
-  old_model->set_enrichments({straight_cut_enrichment(mesh, 64, [](const double* x) { return x[0] - 0.25; })});
+  const auto old_model =
+      enriched_model(mesh, {straight_cut_enrichment(mesh, 64, [](const double* x) { return x[0] - 0.25; })}, 1e-3);
   const std::vector<EnrichmentFunction> sliver = {
       straight_cut_enrichment(mesh, 64, [](const double* x) { return x[0] - 0.5 / 64; })};
   const auto keeping = expect_kept_moments_bitwise(*old_model, sliver);
   EXPECT_GT(keeping->num_pruned_enriched_nodes(), 0);
+}
+
+TEST(KeptBasisValues, ABasisWithoutEnrichedElementsKeepsNone) {
+  const Mesh mesh = make_rectangle(1, 0.5, 2, 1, ElementType::quad8);
+  const auto model = enriched_model(mesh, {}, 0.0);
+  model->keep_basis_values();
+  model->set_enrichments({straight_cut_enrichment(mesh, 32, [](const double* x) { return x[0] - 0.25; })});
+  int kept_elements = 0;
+  for (int e = 0; e < mesh.num_elements(); ++e) kept_elements += model->has_kept_basis_values(e);
+  EXPECT_EQ(kept_elements, model->num_enriched_elements());
+  // The cut removed: nothing is integrated, and the values of the old basis must not stay.
+  model->set_enrichments({});
+  for (int e = 0; e < mesh.num_elements(); ++e) EXPECT_FALSE(model->has_kept_basis_values(e));
 }
