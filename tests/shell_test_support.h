@@ -48,6 +48,21 @@ inline std::unique_ptr<ShellModel> make_model(const Mesh& mesh, const Material& 
   return std::make_unique<ShellModel>(mesh, topology, sections, clamped, options);
 }
 
+// A model of the default material (penalty 1) with these enrichment functions; enriched
+// nodes below min_mass_ratio (ShellModelOptions::min_enrichment_mass_ratio) are dropped.
+inline std::unique_ptr<ShellModel> enriched_model(const Mesh& mesh, std::vector<EnrichmentFunction> functions,
+                                                  double min_mass_ratio) {
+  const Topology topology = build_topology(mesh);
+  const Material m;
+  std::vector<kernels::ShellSection> sections(mesh.num_elements(), {m.E, m.nu, m.h, m.rho});
+  ShellModelOptions options;
+  options.penalty = 1.0;
+  options.min_enrichment_mass_ratio = min_mass_ratio;
+  auto model = std::make_unique<ShellModel>(mesh, topology, sections, std::vector<int>{}, options);
+  model->set_enrichments(std::move(functions));
+  return model;
+}
+
 // Fixed-DOF flags: components (x, y, z) held on nodes matching the predicate.
 inline void fix_nodes(const Mesh& mesh, const NodePredicate& where, bool x, bool y, bool z, std::vector<char>& fixed) {
   if (fixed.empty()) fixed.assign(3 * mesh.num_nodes(), 0);

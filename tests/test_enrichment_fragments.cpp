@@ -39,20 +39,6 @@ std::pair<double, double> scaled_mass_spectrum(const ShellModel& model) {
   return {eig(0), eig(n - 1)};
 }
 
-// A model of the default material with these enrichment functions.
-std::unique_ptr<ShellModel> enriched_model(const Mesh& mesh, std::vector<EnrichmentFunction> functions,
-                                           double min_mass_ratio) {
-  const Topology topology = build_topology(mesh);
-  const testing_support::Material m;
-  std::vector<kernels::ShellSection> sections(mesh.num_elements(), {m.E, m.nu, m.h, m.rho});
-  ShellModelOptions options;
-  options.penalty = 1.0;
-  options.min_enrichment_mass_ratio = min_mass_ratio;
-  auto model = std::make_unique<ShellModel>(mesh, topology, sections, std::vector<int>{}, options);
-  model->set_enrichments(std::move(functions));
-  return model;
-}
-
 std::unique_ptr<ShellModel> sliver_model(const Mesh& mesh, double min_mass_ratio) {
   // 1 texel from the left edge of a 2 x 1 plate of 0.5-wide elements at T = 64.
   return enriched_model(mesh, {straight_cut_enrichment(mesh, 64, [](const double* x) { return x[0] - 0.5 / 64; })},

@@ -35,6 +35,7 @@ int process_threads() {
 }  // namespace
 
 TEST(CholmodLock, KeepsTheHoldersParallelRegionsOnOneThreadAndRestoresItsSetting) {
+  const int levels = omp_get_max_active_levels();
   omp_set_max_active_levels(3);
   {
     const auto lock = dgtex::detail::lock_cholmod();
@@ -46,6 +47,7 @@ TEST(CholmodLock, KeepsTheHoldersParallelRegionsOnOneThreadAndRestoresItsSetting
   }
   EXPECT_EQ(omp_get_max_active_levels(), 3);
   EXPECT_EQ(team_size(2), 2);
+  omp_set_max_active_levels(levels);
 }
 
 TEST(CholmodLock, SupernodalFactorisationStartsNoOpenMpThreads) {
