@@ -21,8 +21,3 @@ set_source_files_properties(${CMAKE_CURRENT_SOURCE_DIR}/kernels/multigrid_galerk
 # and the baseline; without contraction all clones give the same bits.
 set_source_files_properties(${CMAKE_CURRENT_SOURCE_DIR}/runtime/banded_cholesky.cpp
                             PROPERTIES COMPILE_OPTIONS "-ffp-contract=off")
-
-# The Gram-Schmidt of the enriched-node test (runtime/enrichment_span.cpp) is cloned for
-# AVX-512, AVX2 and the baseline; without contraction all clones keep or drop the same nodes.
-set_source_files_properties(${CMAKE_CURRENT_SOURCE_DIR}/runtime/enrichment_span.cpp
-                            PROPERTIES COMPILE_OPTIONS "-ffp-contract=off")
