@@ -3,16 +3,22 @@
 // for 1 and 6 enrichment functions, each for complete cuts (constant H: cells merge away
 // from the cuts) and partial cuts (harmonic H: texel-resolved near the cuts). Counters:
 // enriched DOFs and quadrature points. Argument pairs: (enrichments, partial?).
+// BM_BendingSums*: the frame split's six bending sums of a curved element for one block of
+// 16 stacked points over `cols` reduced functions, as one weighted Gram kernel against six
+// products of weighted rows (the form it replaced).
 #include <benchmark/benchmark.h>
 
 #include <algorithm>
 #include <cmath>
 #include <map>
 #include <memory>
+#include <random>
+#include <vector>
 
 #include "dgtex/harmonic_enrichment.h"
 #include "dgtex/heaviside.h"
 #include "dgtex/kernels/cut_rasterization.h"
+#include "dgtex/kernels/gram_accumulation.h"
 #include "dgtex/mesh_generators.h"
 #include "dgtex/shell_model.h"
 #include "dgtex/topology.h"
@@ -113,6 +119,45 @@ void BM_EnrichedStiffnessPerTexel(benchmark::State& state) {
   counters(state, dense);
 }
 
+struct BendingBlock {
+  static constexpr int points = 16, sums = 6;
+  std::vector<double> rows, weights, weighted_rows;  // 3 rows a point; per sum, its weighted rows
+  std::vector<std::vector<double>> G;
+  explicit BendingBlock(int cols)
+      : rows(static_cast<std::size_t>(points) * 3 * cols), weights(points * sums),
+        weighted_rows(sums * rows.size()), G(sums, std::vector<double>(static_cast<std::size_t>(cols) * cols)) {
+    std::mt19937 rng(3);
+    std::uniform_real_distribution<double> u(-1, 1);
+    for (double& x : rows) x = u(rng);
+    for (double& x : weights) x = u(rng);
+    for (double& x : weighted_rows) x = u(rng);
+  }
+};
+
+void BM_BendingSumsWeightedGrams(benchmark::State& state) {
+  const int cols = static_cast<int>(state.range(0));
+  BendingBlock b(cols);
+  double* sums[BendingBlock::sums];
+  for (int k = 0; k < BendingBlock::sums; ++k) sums[k] = b.G[k].data();
+  const bool overwrite[BendingBlock::sums] = {};
+  for (auto _ : state) {
+    kernels::accumulate_weighted_grams(BendingBlock::points, 3, cols, b.rows.data(), b.weights.data(),
+                                       BendingBlock::sums, sums, overwrite);
+    benchmark::ClobberMemory();
+  }
+}
+
+void BM_BendingSumsSixProducts(benchmark::State& state) {
+  const int cols = static_cast<int>(state.range(0));
+  BendingBlock b(cols);
+  for (auto _ : state) {
+    for (int k = 0; k < BendingBlock::sums; ++k)
+      kernels::accumulate_product(3 * BendingBlock::points, cols, b.weighted_rows.data() + k * b.rows.size(),
+                                  b.weighted_rows.data() + k * b.rows.size(), b.G[k].data(), false, true);
+    benchmark::ClobberMemory();
+  }
+}
+
 void enriched_args(benchmark::internal::Benchmark* b) {
   b->Args({1, 0})->Args({6, 0})->Args({1, 1})->Args({6, 1})->Unit(benchmark::kMillisecond);
 }
@@ -120,6 +165,8 @@ BENCHMARK(BM_EnrichedSetUp)->Apply(enriched_args);
 BENCHMARK(BM_EnrichedStiffnessLinear)->Apply(enriched_args);
 BENCHMARK(BM_EnrichedStiffnessCorotated)->Apply(enriched_args);
 BENCHMARK(BM_EnrichedStiffnessPerTexel) ->Args({1, 1})->Args({6, 1})->Unit(benchmark::kMillisecond)->Iterations(1);
+BENCHMARK(BM_BendingSumsWeightedGrams)->Arg(16)->Arg(32)->Arg(64);
+BENCHMARK(BM_BendingSumsSixProducts)->Arg(16)->Arg(32)->Arg(64);
 
 }  // namespace
 

@@ -281,8 +281,13 @@ struct PointRows {
 // the functions, U^T W_kl U + q2_k q2_l B^T B with U the two membrane factors, B the three
 // bending factors and W_kl = sum_rho c[rho][k] c[rho][l]^T (2 x 2). The diagonal blocks
 // take W_kk = L_k L_k^T as two rows L_k^T U; the bending products are symmetric in every
-// block. Per point 18 m^2 multiply-adds over m functions instead of 27 m^2 for the six
-// rows of 3 m columns.
+// block, and all six (k <= l) are sums of the same B^T B weighted by q2_k q2_l: each entry
+// forms a point's B^T B once and adds it with the six weights (accumulate_weighted_grams).
+// Per point 13.5 m^2 multiply-adds over m functions instead of 27 m^2 for the six rows of
+// 3 m columns. Six products of weighted bending rows (18 m^2) took as long for the bending
+// sums as the membrane's products; the weighted Grams are 1.3-1.4x faster
+// (bench_enriched_assembly BM_BendingSums*, AVX-512), the slinky's whole run at one thread
+// 3-4 % (its probes move by 7e-12 relative).
 constexpr int frame_split_pairs[3][2] = {{0, 1}, {0, 2}, {1, 2}};
 
 struct FrameSplit {
@@ -350,12 +355,15 @@ constexpr int planar_block_points = 32;
 
 // Stacked rows of a block of P points (stride columns each), in units of P rows: U (the
 // membrane factors u0, u1 of each point), M_k = L_k^T U, WU_p = W_p U (2 P rows each), and
-// B_k = q2_k B (3 P rows each).
-constexpr int split_row_units = 2 + 3 * 2 + 3 * 2 + 3 * 3;
+// B (the three bending factors of each point, 3 P rows); with the bending weights of each
+// point (split_bending_weights of them: q2_k q2_k for k = 0, 1, 2, then q2_k q2_l for the
+// frame_split_pairs).
+constexpr int split_row_units = 2 + 3 * 2 + 3 * 2 + 3;
 constexpr int split_u = 0;
 inline int split_m(int k) { return 2 + 2 * k; }
 inline int split_wu(int p) { return 8 + 2 * p; }
-inline int split_b(int k) { return 14 + 3 * k; }
+constexpr int split_b = 14;
+constexpr int split_bending_weights = 6;
 
 struct Group {
   std::uint32_t varying = 0;
@@ -370,6 +378,7 @@ struct Group {
   int stride = 0;
   double* sums = nullptr;       // D_0..2, O_0..2, Bs_0..2
   double* rows = nullptr;       // split_row_units x group_block_points rows
+  double* bending_weights = nullptr;  // split_bending_weights per stacked point
   std::vector<double> g;        // 3 x stride
   // Planar elements (PlanarFrame): the membrane sums from 1 row a point (gradient products,
   // padded length >= 2 m) and the bending sums from 3 rows (>= m).
@@ -416,20 +425,20 @@ void flush(Group& group) {
     group.pending = 0;
     return;
   }
-  const int S = group.stride, two = 2 * group.pending, three = 3 * group.pending;
+  const int S = group.stride, two = 2 * group.pending;
   const bool first = !group.written;
   const double* U = group.row_block(split_u);
   for (int k = 0; k < 3; ++k) {
     const double* M = group.row_block(split_m(k));
-    const double* B = group.row_block(split_b(k));
     accumulate_product(two, S, M, M, group.D(k), first, true);
-    accumulate_product(three, S, B, B, group.D(k), false, true);
   }
-  for (int p = 0; p < 3; ++p) {
-    const int k = frame_split_pairs[p][0], l = frame_split_pairs[p][1];
-    accumulate_product(two, S, U, group.row_block(split_wu(p)), group.O(p), first, false);
-    accumulate_product(three, S, group.row_block(split_b(k)), group.row_block(split_b(l)), group.Bs(p), first, true);
-  }
+  for (int p = 0; p < 3; ++p) accumulate_product(two, S, U, group.row_block(split_wu(p)), group.O(p), first, false);
+  // The bending parts: D_k += sum q2_k^2 B^T B (after the membrane part), Bs_p = sum q2_k q2_l B^T B.
+  double* const bending_sums[split_bending_weights] = {group.D(0),  group.D(1),  group.D(2),
+                                                       group.Bs(0), group.Bs(1), group.Bs(2)};
+  const bool overwrite[split_bending_weights] = {false, false, false, first, first, first};
+  accumulate_weighted_grams(group.pending, 3, S, group.row_block(split_b), group.bending_weights,
+                            split_bending_weights, bending_sums, overwrite);
   group.written = true;
   group.pending = 0;
 }
@@ -645,9 +654,11 @@ void chunk_stiffness(const EnrichedElementBatch& b, const EnrichedQuadrature& qu
         fresh.stride = padded(fresh.m);
         const std::size_t N = 3 * static_cast<std::size_t>(fresh.m);
         const int row_count = split_row_units * group_block_points;
-        fresh.sums = space.take(9 * fresh.square() + static_cast<std::size_t>(row_count) * fresh.stride + N * N);
+        fresh.sums = space.take(9 * fresh.square() + static_cast<std::size_t>(row_count) * fresh.stride + N * N +
+                                split_bending_weights * group_block_points);
         fresh.rows = fresh.sums + 9 * fresh.square();
         fresh.G = fresh.rows + static_cast<std::size_t>(row_count) * fresh.stride;
+        fresh.bending_weights = fresh.G + N * N;
         zero_padding(fresh.rows, row_count, fresh.m, fresh.stride);
         if (want_forces) fresh.g.assign(3 * static_cast<std::size_t>(fresh.stride), 0.0);
       }
@@ -740,10 +751,13 @@ void chunk_stiffness(const EnrichedElementBatch& b, const EnrichedQuadrature& qu
     const std::size_t S = group.stride;
     double* const U0 = group.row_block(split_u) + 2 * group.pending * S;
     double* const U1 = U0 + S;
-    double bending[3][max_enriched_basis];
+    double* const bending = group.row_block(split_b) + 3 * group.pending * S;  // the point's 3 rows
     for (int r = 0; r < m; ++r) U0[r] = A[0][0] * d[0][r] + A[0][1] * d[1][r];
     for (int r = 0; r < m; ++r) U1[r] = A[1][0] * d[0][r] + A[1][1] * d[1][r];
-    for (int t = 0; t < 3; ++t) combine_derivatives(Bf[t], d, m, bending[t]);
+    for (int t = 0; t < 3; ++t) combine_derivatives(Bf[t], d, m, bending + t * S);
+    double* const weights = group.bending_weights + split_bending_weights * group.pending;
+    for (int k = 0; k < 3; ++k) weights[k] = fs.t[k] * fs.t[k];
+    for (int p = 0; p < 3; ++p) weights[3 + p] = fs.t[frame_split_pairs[p][0]] * fs.t[frame_split_pairs[p][1]];
     for (int k = 0; k < 3; ++k) {
       double* const M0 = group.row_block(split_m(k)) + 2 * group.pending * S;
       double* const M1 = M0 + S;
@@ -753,13 +767,10 @@ void chunk_stiffness(const EnrichedElementBatch& b, const EnrichedQuadrature& qu
       double* const W1 = W0 + S;
       const double* w = fs.W[k];
       for (int r = 0; r < m; ++r) W0[r] = w[0] * U0[r] + w[1] * U1[r], W1[r] = w[2] * U0[r] + w[3] * U1[r];
-      double* const B = group.row_block(split_b(k)) + 3 * group.pending * S;
-      for (int t = 0; t < 3; ++t)
-        for (int r = 0; r < m; ++r) B[t * S + r] = fs.t[k] * bending[t][r];
     }
     if (point_forces)
       for (int r = 0; r < m; ++r) {
-        const double beta = sv[3] * bending[0][r] + sv[4] * bending[1][r] + sv[5] * bending[2][r];
+        const double beta = sv[3] * bending[r] + sv[4] * bending[S + r] + sv[5] * bending[2 * S + r];
         for (int k = 0; k < 3; ++k)
           group.g[k * S + r] += alpha[k][0] * U0[r] + alpha[k][1] * U1[r] + fs.t[k] * beta;
       }

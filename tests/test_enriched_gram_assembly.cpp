@@ -6,7 +6,8 @@
 // cuts (1e-13 relative to max |K|) and to the flat tolerance for harmonic partial cuts
 // (1e-9), on flat and curved elements, writes exact zeros into padding slots, is
 // exactly symmetric, and is bitwise the same for 1, 2 and 4 threads; GramAccumulator (the
-// mass and edge sums) matches the plain sum to round-off. The fused corotated
+// mass and edge sums) matches the plain sum to round-off, and so do the weighted Gram sums
+// of the bending rows (bitwise their reference on every path). The fused corotated
 // form (F and rotation per point inside the stiffness pass) is bitwise the three kernels.
 #include <gtest/gtest.h>
 #include <omp.h>
@@ -14,6 +15,7 @@
 #include <algorithm>
 #include <cmath>
 #include <random>
+#include <stdexcept>
 #include <vector>
 
 #include "dgtex/kernels/gram_accumulation.h"
@@ -92,6 +94,63 @@ TEST(EnrichedGram, ProductOnEveryPathIsBitwiseTheReference) {
         }
     }
   }
+}
+
+TEST(EnrichedGram, WeightedGramsOnEveryPathAreBitwiseTheReference) {
+  // Six weighted sums of 3-row points (the frame split's bending sums), stored or added per
+  // sum, with column counts that end in a tile narrower than the widest; the reference is
+  // itself within round-off of six products of the weighted rows (sqrt(w) a_r, w >= 0).
+  std::mt19937 rng(13);
+  std::uniform_real_distribution<double> u(-1, 1), positive(0, 1);
+  constexpr int sums = 6, rows_per_point = 3;
+  for (int cols : {8, 24, 40}) {
+    for (int points : {1, 16}) {
+      std::vector<double> A(static_cast<std::size_t>(points) * rows_per_point * cols), weights(points * sums);
+      for (double& x : A) x = u(rng);
+      for (int c = 0; c < cols; c += 6) A[c] = 0;
+      for (double& w : weights) w = positive(rng);
+      std::vector<std::vector<double>> start(sums, std::vector<double>(static_cast<std::size_t>(cols) * cols));
+      for (auto& G : start)
+        for (double& x : G) x = u(rng);
+      const bool overwrite[sums] = {false, true, false, true, true, false};
+      std::vector<std::vector<double>> expected = start;
+      double* expected_at[sums];
+      for (int k = 0; k < sums; ++k) expected_at[k] = expected[k].data();
+      kernels::accumulate_weighted_grams_reference(points, rows_per_point, cols, A.data(), weights.data(), sums,
+                                                   expected_at, overwrite);
+      for (int k = 0; k < sums; ++k) {  // the same sums as products of weighted rows
+        std::vector<double> weighted(A.size()), plain = start[k];
+        for (int p = 0; p < points; ++p)
+          for (std::size_t x = 0; x < static_cast<std::size_t>(rows_per_point) * cols; ++x)
+            weighted[p * rows_per_point * cols + x] = std::sqrt(weights[p * sums + k]) * A[p * rows_per_point * cols + x];
+        kernels::accumulate_product_reference(points * rows_per_point, cols, weighted.data(), weighted.data(),
+                                              plain.data(), overwrite[k], true);
+        for (int i = 0; i < cols; ++i)
+          for (int j = i; j < cols; ++j)
+            ASSERT_NEAR(expected[k][static_cast<std::size_t>(i) * cols + j], plain[static_cast<std::size_t>(i) * cols + j],
+                        1e-13 * (1 + points))
+                << "sum " << k << " (" << i << ", " << j << ")";
+      }
+      for (kernels::GramPath path : {kernels::GramPath::best, kernels::GramPath::avx512, kernels::GramPath::avx2,
+                                     kernels::GramPath::baseline}) {
+        if (!kernels::gram_path_supported(path)) continue;
+        std::vector<std::vector<double>> G = start;
+        double* at[sums];
+        for (int k = 0; k < sums; ++k) at[k] = G[k].data();
+        kernels::accumulate_weighted_grams(points, rows_per_point, cols, A.data(), weights.data(), sums, at, overwrite,
+                                           path);
+        for (int k = 0; k < sums; ++k)
+          for (int i = 0; i < cols; ++i)
+            for (int j = i; j < cols; ++j)
+              ASSERT_EQ(G[k][static_cast<std::size_t>(i) * cols + j], expected[k][static_cast<std::size_t>(i) * cols + j])
+                  << "path " << static_cast<int>(path) << " cols " << cols << " points " << points << " sum " << k
+                  << " (" << i << ", " << j << ")";
+      }
+    }
+  }
+  double* none[1] = {nullptr};
+  const bool no[1] = {false};
+  EXPECT_THROW(kernels::accumulate_weighted_grams(1, 3, 8, nullptr, nullptr, 7, none, no), std::invalid_argument);
 }
 
 TEST(EnrichedGram, AccumulatorMatchesThePlainSum) {

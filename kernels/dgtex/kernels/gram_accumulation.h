@@ -34,6 +34,22 @@ void accumulate_gram_upper(int rows, int cols, const double* A, double* G, bool 
 void accumulate_product(int rows, int cols, const double* A, const double* B, double* G, bool overwrite,
                         bool upper, GramPath path = GramPath::best);
 
+// Several Gram sums of the same rows with per-point weights, upper entries only:
+//   G_k += sum_p w_pk sum_r a_pr a_pr^T   (k < count, r < rows_per_point),
+// A holding each point's rows_per_point rows in turn (points x rows_per_point rows of cols,
+// row-major), weights point by point (points x count). Why: the bending rows of a curved
+// element's point enter six sums of the frame split (weights t_k t_l of the rotated normal),
+// and one product of the point's rows per entry, scaled into each sum, costs about half of
+// six products of scaled rows. Each entry (i, j >= i): per point in order, P = the sum over
+// its rows in order of a_ri a_rj, then acc_k += w_pk P, from 0; finally stored
+// (overwrite[k]) or added. Every path rounds alike, as above; entries below the diagonal
+// are scratch. Cols a multiple of gram_column_multiple.
+constexpr int max_weighted_grams = 6;
+void accumulate_weighted_grams(int points, int rows_per_point, int cols, const double* A, const double* weights,
+                               int count, double* const* G, const bool* overwrite, GramPath path = GramPath::best);
+void accumulate_weighted_grams_reference(int points, int rows_per_point, int cols, const double* A,
+                                         const double* weights, int count, double* const* G, const bool* overwrite);
+
 // out[j] += (s * scales[j]) * g[j] for j < count (the scaled gather of a G row into K).
 void add_scaled_row(int count, double s, const double* scales, const double* g, double* out);
 
