@@ -781,9 +781,9 @@ void ShellModel::assemble_stiffness(const double* current, std::vector<double>& 
                                    std::to_string(max_rotation_cluster_doubles * 8 >> 20) +
                                    " MiB); use larger blocks (enrichment.rotation_cluster_texels) or 0 (per point)");
         // A progressive cut's next model needs a slightly different size; the block cache
-        // hands it the block of the model before last if it spans as many huge pages
-        // (spiral6 at B = 16: ~23 MB a step, otherwise fresh pages faulted in every step).
-        // The kernel writes every entry, so a cached block needs no zeroing.
+        // hands it the block of an earlier model that serves it (spiral6 at B = 16: ~23 MB a
+        // step, otherwise fresh pages faulted in every step). The kernel writes every entry,
+        // so a cached block needs no zeroing.
         const std::size_t bytes = static_cast<std::size_t>(size) * sizeof(double);
         {
           const detail::SkipCachedBlockZeroing written_by_the_kernel;

@@ -1,7 +1,9 @@
 // The multigrid's array allocator (runtime/multigrid_buffer.h): every MultigridBuffer(n)
 // holds n zeros, also when its block comes back from the cache with old values in it, for
 // heap-sized, cached and huge-page-mapped sizes; blocks are reused for the same size, mapped
-// ones for any size of as many huge pages.
+// ones for any size of as many huge pages, and for a larger request within the room a fresh
+// mapping leaves (an eighth) or a smaller one of at least half their capacity, which they
+// keep when they come back.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -65,6 +67,38 @@ TEST(MultigridBuffer, MappedBlocksAreReusedForSizesOfAsManyHugePages) {
   MultigridBuffer two_pages(300000);
   EXPECT_NE(two_pages.data(), first);
   EXPECT_TRUE(all_zero(two_pages));
+#else
+  GTEST_SKIP() << "huge-page mapping is Linux only";
+#endif
+}
+
+TEST(MultigridBuffer, MappedBlocksServeAGrowingCutAndKeepTheirCapacity) {
+#if defined(__linux__)
+  constexpr std::size_t mib = std::size_t{1} << 20, per_mib = mib / sizeof(double);
+  const double* first = nullptr;
+  {
+    MultigridBuffer v(15 * per_mib);  // 16 MiB of huge pages asked for, 18 MiB mapped
+    first = v.data();
+    std::fill(v.begin(), v.end(), -2.0);
+  }
+  {
+    MultigridBuffer grown(17 * per_mib);  // a next model a little larger: the same block
+    EXPECT_EQ(grown.data(), first);
+    EXPECT_TRUE(all_zero(grown));
+    std::fill(grown.begin(), grown.end(), -3.0);
+  }
+  {
+    MultigridBuffer smaller(17 * per_mib / 2);  // 10 MiB of pages: served by the 18 MiB block
+    EXPECT_EQ(smaller.data(), first);
+    EXPECT_TRUE(all_zero(smaller));
+  }
+  {
+    MultigridBuffer again(17 * per_mib);  // it came back as 18 MiB, not as the 10 it served
+    EXPECT_EQ(again.data(), first);
+    EXPECT_TRUE(all_zero(again));
+  }
+  MultigridBuffer other(3 * per_mib);  // 4 MiB: not served by an 18 MiB block (more than twice)
+  EXPECT_NE(other.data(), first);
 #else
   GTEST_SKIP() << "huge-page mapping is Linux only";
 #endif
