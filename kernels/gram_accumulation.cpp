@@ -134,7 +134,8 @@ __attribute__((always_inline)) inline void weighted_gram_tiles(int points, int c
   }
 }
 
-// The frame split's bending sums: 3 rows a point, 6 weights; 6 x TR accumulators.
+// The frame split's bending sums: 3 rows a point, 6 weights; 6 x TR accumulators (TR = 4
+// spilled registers on AVX-512 and was no faster than six products).
 __attribute__((target("avx512f"))) void weighted_grams_avx512(int points, int cols, const double* A,
                                                               const double* weights, double* const* G,
                                                               const bool* overwrite) {
@@ -236,9 +237,13 @@ void accumulate_gram_upper(int rows, int cols, const double* A, double* G, bool 
 
 void add_scaled_row(int count, double s, const double* scales, const double* g, double* out) {
   using RowKernel = void (*)(int, double, const double*, const double*, double*);
-  static const RowKernel kernel = supported(GramPath::avx512) ? scaled_row_avx512
-                                  : supported(GramPath::avx2) ? scaled_row_avx2
-                                                              : scaled_row_baseline;
+  static const RowKernel kernel = [] {
+    switch (widest(GramPath::best)) {
+      case GramPath::avx512: return scaled_row_avx512;
+      case GramPath::avx2: return scaled_row_avx2;
+      default: return scaled_row_baseline;
+    }
+  }();
   kernel(count, s, scales, g, out);
 }
 
