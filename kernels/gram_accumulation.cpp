@@ -189,7 +189,18 @@ bool supported(GramPath path) {
 
 GramPath widest(GramPath path) {
   if (path != GramPath::best) return path;
-  return supported(GramPath::avx512) ? GramPath::avx512 : supported(GramPath::avx2) ? GramPath::avx2 : GramPath::baseline;
+  if (supported(GramPath::avx512)) return GramPath::avx512;
+  return supported(GramPath::avx2) ? GramPath::avx2 : GramPath::baseline;
+}
+
+// A kernel family's function for `path` (best: the widest the machine supports).
+template <class Kernel>
+Kernel kernel_of(GramPath path, Kernel avx512, Kernel avx2, Kernel baseline) {
+  switch (widest(path)) {
+    case GramPath::avx512: return avx512;
+    case GramPath::avx2: return avx2;
+    default: return baseline;
+  }
 }
 
 }  // namespace
@@ -198,16 +209,9 @@ bool gram_path_supported(GramPath path) { return supported(path); }
 
 void accumulate_product(int rows, int cols, const double* A, const double* B, double* G, bool overwrite,
                         bool upper, GramPath path) {
-  using ProductKernel = void (*)(int, int, const double*, const double*, double*, bool, bool);
-  const auto kernel_for = [](GramPath p) -> ProductKernel {
-    switch (widest(p)) {
-      case GramPath::avx512: return product_avx512;
-      case GramPath::avx2: return product_avx2;
-      default: return product_baseline;
-    }
-  };
-  static const ProductKernel best = kernel_for(GramPath::best);
-  (path == GramPath::best ? best : kernel_for(path))(rows, cols, A, B, G, overwrite, upper);
+  static const auto best = kernel_of(GramPath::best, product_avx512, product_avx2, product_baseline);
+  (path == GramPath::best ? best : kernel_of(path, product_avx512, product_avx2, product_baseline))(
+      rows, cols, A, B, G, overwrite, upper);
 }
 
 void accumulate_weighted_grams(int points, int rows_per_point, int cols, const double* A, const double* weights,
@@ -219,16 +223,11 @@ void accumulate_weighted_grams(int points, int rows_per_point, int cols, const d
     accumulate_weighted_grams_reference(points, rows_per_point, cols, A, weights, count, G, overwrite);
     return;
   }
-  using WeightedKernel = void (*)(int, int, const double*, const double*, double* const*, const bool*);
-  const auto kernel_for = [](GramPath p) -> WeightedKernel {
-    switch (widest(p)) {
-      case GramPath::avx512: return weighted_grams_avx512;
-      case GramPath::avx2: return weighted_grams_avx2;
-      default: return weighted_grams_baseline;
-    }
+  const auto of = [](GramPath p) {
+    return kernel_of(p, weighted_grams_avx512, weighted_grams_avx2, weighted_grams_baseline);
   };
-  static const WeightedKernel best = kernel_for(GramPath::best);
-  (path == GramPath::best ? best : kernel_for(path))(points, cols, A, weights, G, overwrite);
+  static const auto best = of(GramPath::best);
+  (path == GramPath::best ? best : of(path))(points, cols, A, weights, G, overwrite);
 }
 
 void accumulate_gram_upper(int rows, int cols, const double* A, double* G, bool overwrite, GramPath path) {
@@ -236,14 +235,7 @@ void accumulate_gram_upper(int rows, int cols, const double* A, double* G, bool 
 }
 
 void add_scaled_row(int count, double s, const double* scales, const double* g, double* out) {
-  using RowKernel = void (*)(int, double, const double*, const double*, double*);
-  static const RowKernel kernel = [] {
-    switch (widest(GramPath::best)) {
-      case GramPath::avx512: return scaled_row_avx512;
-      case GramPath::avx2: return scaled_row_avx2;
-      default: return scaled_row_baseline;
-    }
-  }();
+  static const auto kernel = kernel_of(GramPath::best, scaled_row_avx512, scaled_row_avx2, scaled_row_baseline);
   kernel(count, s, scales, g, out);
 }
 
@@ -271,7 +263,8 @@ void accumulate_weighted_grams_reference(int points, int rows_per_point, int col
         const double* rows = A + static_cast<std::size_t>(p) * rows_per_point * cols;
         double product = rows[i] * rows[j];
         for (int r = 1; r < rows_per_point; ++r)
-          product = product + rows[static_cast<std::size_t>(r) * cols + i] * rows[static_cast<std::size_t>(r) * cols + j];
+          product = product + rows[static_cast<std::size_t>(r) * cols + i] *
+                                  rows[static_cast<std::size_t>(r) * cols + j];
         for (int k = 0; k < count; ++k) sum[k] = sum[k] + weights[static_cast<std::size_t>(p) * count + k] * product;
       }
       for (int k = 0; k < count; ++k) {

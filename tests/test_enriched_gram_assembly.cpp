@@ -122,13 +122,14 @@ TEST(EnrichedGram, WeightedGramsOnEveryPathAreBitwiseTheReference) {
         std::vector<double> weighted(A.size()), plain = start[k];
         for (int p = 0; p < points; ++p)
           for (std::size_t x = 0; x < static_cast<std::size_t>(rows_per_point) * cols; ++x)
-            weighted[p * rows_per_point * cols + x] = std::sqrt(weights[p * sums + k]) * A[p * rows_per_point * cols + x];
+            weighted[p * rows_per_point * cols + x] =
+                std::sqrt(weights[p * sums + k]) * A[p * rows_per_point * cols + x];
         kernels::accumulate_product_reference(points * rows_per_point, cols, weighted.data(), weighted.data(),
                                               plain.data(), overwrite[k], true);
         for (int i = 0; i < cols; ++i)
           for (int j = i; j < cols; ++j)
-            ASSERT_NEAR(expected[k][static_cast<std::size_t>(i) * cols + j], plain[static_cast<std::size_t>(i) * cols + j],
-                        1e-13 * (1 + points))
+            ASSERT_NEAR(expected[k][static_cast<std::size_t>(i) * cols + j],
+                        plain[static_cast<std::size_t>(i) * cols + j], 1e-13 * (1 + points))
                 << "sum " << k << " (" << i << ", " << j << ")";
       }
       for (kernels::GramPath path : {kernels::GramPath::best, kernels::GramPath::avx512, kernels::GramPath::avx2,
@@ -142,7 +143,8 @@ TEST(EnrichedGram, WeightedGramsOnEveryPathAreBitwiseTheReference) {
         for (int k = 0; k < sums; ++k)
           for (int i = 0; i < cols; ++i)
             for (int j = i; j < cols; ++j)
-              ASSERT_EQ(G[k][static_cast<std::size_t>(i) * cols + j], expected[k][static_cast<std::size_t>(i) * cols + j])
+              ASSERT_EQ(G[k][static_cast<std::size_t>(i) * cols + j],
+                        expected[k][static_cast<std::size_t>(i) * cols + j])
                   << "path " << static_cast<int>(path) << " cols " << cols << " points " << points << " sum " << k
                   << " (" << i << ", " << j << ")";
       }
