@@ -31,7 +31,7 @@ namespace dgtex::detail {
 // larger or smaller from model to model, take the last model's block (the slinky: 124 of
 // 131 blocks from the cache instead of ~10; its system time 0.78-0.84 -> 0.38-0.46 s).
 // A request no cached block serves first gives cached mapped blocks back to the system,
-// oldest first, as much as it maps (see acquire_zeroed_block).
+// oldest first, as much as it maps, so that the mapping gets pages the host has backed.
 void* acquire_zeroed_block(std::size_t bytes);
 void release_block(void* block, std::size_t bytes) noexcept;
 
