@@ -1,5 +1,6 @@
 #pragma once
-// Internal to the Laplace multigrid: the allocator of its level and CG arrays.
+// Internal: the allocator of the Laplace multigrid's level and CG arrays, also used for the
+// rotation clusters' rest sums (shell_model.cpp).
 // Why: a hierarchy is built per solve, and its arrays (T = 1024: ~95 MB in ~55 arrays) were
 // fresh 4 KiB pages, faulted in one by one and then zero-filled by vector::assign: 18k page
 // faults per setup at open T = 1024, ~800 at T = 256 (10% of a whole T = 256 solve).
