@@ -178,44 +178,17 @@ void scaled_row_baseline(int count, double s, const double* scales, const double
   scaled_row<V2, 2>(count, s, scales, g, out);
 }
 
-bool supported(GramPath path) {
-  __builtin_cpu_init();
-  switch (path) {
-    case GramPath::avx512: return __builtin_cpu_supports("avx512f");
-    case GramPath::avx2: return __builtin_cpu_supports("avx2");
-    default: return true;
-  }
-}
-
-GramPath widest(GramPath path) {
-  if (path != GramPath::best) return path;
-  if (supported(GramPath::avx512)) return GramPath::avx512;
-  return supported(GramPath::avx2) ? GramPath::avx2 : GramPath::baseline;
-}
-
-// A kernel family's function for `path` (best: the widest the machine supports).
-template <class Kernel>
-Kernel kernel_of(GramPath path, Kernel avx512, Kernel avx2, Kernel baseline) {
-  switch (widest(path)) {
-    case GramPath::avx512: return avx512;
-    case GramPath::avx2: return avx2;
-    default: return baseline;
-  }
-}
-
 }  // namespace
 
-bool gram_path_supported(GramPath path) { return supported(path); }
-
 void accumulate_product(int rows, int cols, const double* A, const double* B, double* G, bool overwrite,
-                        bool upper, GramPath path) {
-  static const auto best = kernel_of(GramPath::best, product_avx512, product_avx2, product_baseline);
-  (path == GramPath::best ? best : kernel_of(path, product_avx512, product_avx2, product_baseline))(
+                        bool upper, VectorPath path) {
+  static const auto best = kernel_of(VectorPath::best, product_avx512, product_avx2, product_baseline);
+  (path == VectorPath::best ? best : kernel_of(path, product_avx512, product_avx2, product_baseline))(
       rows, cols, A, B, G, overwrite, upper);
 }
 
 void accumulate_weighted_grams(int points, int rows_per_point, int cols, const double* A, const double* weights,
-                               int count, double* const* G, const bool* overwrite, GramPath path) {
+                               int count, double* const* G, const bool* overwrite, VectorPath path) {
   if (count < 0 || count > max_weighted_grams)
     throw std::invalid_argument("accumulate_weighted_grams: " + std::to_string(count) + " sums (at most " +
                                 std::to_string(max_weighted_grams) + ")");
@@ -223,19 +196,19 @@ void accumulate_weighted_grams(int points, int rows_per_point, int cols, const d
     accumulate_weighted_grams_reference(points, rows_per_point, cols, A, weights, count, G, overwrite);
     return;
   }
-  const auto of = [](GramPath p) {
+  const auto of = [](VectorPath p) {
     return kernel_of(p, weighted_grams_avx512, weighted_grams_avx2, weighted_grams_baseline);
   };
-  static const auto best = of(GramPath::best);
-  (path == GramPath::best ? best : of(path))(points, cols, A, weights, G, overwrite);
+  static const auto best = of(VectorPath::best);
+  (path == VectorPath::best ? best : of(path))(points, cols, A, weights, G, overwrite);
 }
 
-void accumulate_gram_upper(int rows, int cols, const double* A, double* G, bool overwrite, GramPath path) {
+void accumulate_gram_upper(int rows, int cols, const double* A, double* G, bool overwrite, VectorPath path) {
   accumulate_product(rows, cols, A, A, G, overwrite, true, path);
 }
 
 void add_scaled_row(int count, double s, const double* scales, const double* g, double* out) {
-  static const auto kernel = kernel_of(GramPath::best, scaled_row_avx512, scaled_row_avx2, scaled_row_baseline);
+  static const auto kernel = kernel_of(VectorPath::best, scaled_row_avx512, scaled_row_avx2, scaled_row_baseline);
   kernel(count, s, scales, g, out);
 }
 

@@ -47,9 +47,9 @@ TEST(EnrichedGram, EveryPathIsBitwiseTheReference) {
       for (bool overwrite : {true, false}) {
         std::vector<double> expected = start;
         kernels::accumulate_gram_upper_reference(rows, cols, A.data(), expected.data(), overwrite);
-        for (kernels::GramPath path : {kernels::GramPath::best, kernels::GramPath::avx512, kernels::GramPath::avx2,
-                                       kernels::GramPath::baseline}) {
-          if (!kernels::gram_path_supported(path)) continue;
+        for (kernels::VectorPath path : {kernels::VectorPath::best, kernels::VectorPath::avx512, kernels::VectorPath::avx2,
+                                       kernels::VectorPath::baseline}) {
+          if (!kernels::vector_path_supported(path)) continue;
           std::vector<double> G = start;
           kernels::accumulate_gram_upper(rows, cols, A.data(), G.data(), overwrite, path);
           for (int i = 0; i < cols; ++i)
@@ -80,9 +80,9 @@ TEST(EnrichedGram, ProductOnEveryPathIsBitwiseTheReference) {
         for (bool overwrite : {true, false}) {
           std::vector<double> expected = start;
           kernels::accumulate_product_reference(rows, cols, A.data(), B.data(), expected.data(), overwrite, upper);
-          for (kernels::GramPath path : {kernels::GramPath::best, kernels::GramPath::avx512, kernels::GramPath::avx2,
-                                         kernels::GramPath::baseline}) {
-            if (!kernels::gram_path_supported(path)) continue;
+          for (kernels::VectorPath path : {kernels::VectorPath::best, kernels::VectorPath::avx512, kernels::VectorPath::avx2,
+                                         kernels::VectorPath::baseline}) {
+            if (!kernels::vector_path_supported(path)) continue;
             std::vector<double> G = start;
             kernels::accumulate_product(rows, cols, A.data(), B.data(), G.data(), overwrite, upper, path);
             for (int i = 0; i < cols; ++i)
@@ -132,9 +132,9 @@ TEST(EnrichedGram, WeightedGramsOnEveryPathAreBitwiseTheReference) {
                         plain[static_cast<std::size_t>(i) * cols + j], 1e-13 * (1 + points))
                 << "sum " << k << " (" << i << ", " << j << ")";
       }
-      for (kernels::GramPath path : {kernels::GramPath::best, kernels::GramPath::avx512, kernels::GramPath::avx2,
-                                     kernels::GramPath::baseline}) {
-        if (!kernels::gram_path_supported(path)) continue;
+      for (kernels::VectorPath path : {kernels::VectorPath::best, kernels::VectorPath::avx512, kernels::VectorPath::avx2,
+                                     kernels::VectorPath::baseline}) {
+        if (!kernels::vector_path_supported(path)) continue;
         std::vector<std::vector<double>> G = start;
         double* at[sums];
         for (int k = 0; k < sums; ++k) at[k] = G[k].data();

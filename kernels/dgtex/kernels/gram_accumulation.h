@@ -16,23 +16,22 @@
 #include <memory>
 #include <vector>
 
+#include "dgtex/kernels/vector_path.h"
+
 namespace dgtex::kernels {
 
 constexpr int gram_column_multiple = 8;
 
-// best: the widest the machine supports (chosen once); the others for tests (must be
-// supported: gram_path_supported).
-enum class GramPath { best, avx512, avx2, baseline };
-bool gram_path_supported(GramPath path);
+// path: the instruction-set path (vector_path.h); every path gives the same bits.
 void accumulate_gram_upper(int rows, int cols, const double* A, double* G, bool overwrite,
-                           GramPath path = GramPath::best);
+                           VectorPath path = VectorPath::best);
 
 // G += A^T B for blocks of rows A and B (rows x cols each, row-major, cols a multiple of
 // gram_column_multiple: pad with zero columns), G cols x cols with row stride cols.
 // upper: only the entries (i, j >= i) are summed (those below are scratch, as above; for
 // products known to be symmetric), else all. accumulate_gram_upper is the upper A^T A.
 void accumulate_product(int rows, int cols, const double* A, const double* B, double* G, bool overwrite,
-                        bool upper, GramPath path = GramPath::best);
+                        bool upper, VectorPath path = VectorPath::best);
 
 // Several Gram sums of the same rows with per-point weights, upper entries only:
 //   G_k += sum_p w_pk sum_r a_pr a_pr^T   (k < count, r < rows_per_point),
@@ -46,7 +45,7 @@ void accumulate_product(int rows, int cols, const double* A, const double* B, do
 // are scratch. Cols a multiple of gram_column_multiple.
 constexpr int max_weighted_grams = 6;
 void accumulate_weighted_grams(int points, int rows_per_point, int cols, const double* A, const double* weights,
-                               int count, double* const* G, const bool* overwrite, GramPath path = GramPath::best);
+                               int count, double* const* G, const bool* overwrite, VectorPath path = VectorPath::best);
 void accumulate_weighted_grams_reference(int points, int rows_per_point, int cols, const double* A,
                                          const double* weights, int count, double* const* G, const bool* overwrite);
 

@@ -1,0 +1,20 @@
+#include "dgtex/kernels/vector_path.h"
+
+namespace dgtex::kernels {
+
+bool vector_path_supported(VectorPath path) {
+  __builtin_cpu_init();
+  switch (path) {
+    case VectorPath::avx512: return __builtin_cpu_supports("avx512f");
+    case VectorPath::avx2: return __builtin_cpu_supports("avx2");
+    default: return true;
+  }
+}
+
+VectorPath widest(VectorPath path) {
+  if (path != VectorPath::best) return path;
+  if (vector_path_supported(VectorPath::avx512)) return VectorPath::avx512;
+  return vector_path_supported(VectorPath::avx2) ? VectorPath::avx2 : VectorPath::baseline;
+}
+
+}  // namespace dgtex::kernels
