@@ -177,52 +177,41 @@ void FactorReusingSolver::precondition(const SparseCholesky& cholesky, const std
   stats_.precondition_ms += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
 }
 
+void FactorReusingSolver::spread(const std::vector<double>& x) const {
+  spread_.resize(3 * x.size());
+  kernels::spread_block_vector(pattern_.num_nodes(), x.data(), spread_.data());
+}
+
+void FactorReusingSolver::multiply_mass_rows(std::int64_t first, std::int64_t last, double* y) const {
+  if (mass_scalar_.empty())
+    kernels::block_rows_product(pattern_.rows(), first, last, mass_.data(), spread_.data(), y);
+  else
+    kernels::scalar_rows_product(pattern_.rows(), first, last, mass_scalar_.data(), spread_.data(), y);
+}
+
 void FactorReusingSolver::multiply_mass(const std::vector<double>& x, std::vector<double>& y) const {
   y.resize(x.size());
-  if (mass_scalar_.empty()) {
-    block_multiply(pattern_, mass_.data(), x.data(), y.data());
-    return;
-  }
-  const auto& start = pattern_.row_start();
-  const auto& col = pattern_.column();
-  kernels::forall(
-      pattern_.num_nodes(),
-      [&](std::int64_t r) {
-        double sum[3] = {0, 0, 0};
-        for (std::int64_t k = start[r]; k < start[r + 1]; ++k) {
-          const double m = mass_scalar_[k];
-          const double* xv = x.data() + 3 * static_cast<std::int64_t>(col[k]);
-          for (int i = 0; i < 3; ++i) sum[i] += m * xv[i];
-        }
-        for (int i = 0; i < 3; ++i) y[3 * r + i] = sum[i];
-      },
-      block_product_execution(pattern_));
+  spread(x);
+  for_row_ranges(pattern_, [&](std::int64_t first, std::int64_t last) { multiply_mass_rows(first, last, y.data()); });
 }
 
 void FactorReusingSolver::multiply(const ScaledBlockSum& A, const std::vector<double>& x, std::vector<double>& y) const {
   y.resize(x.size());
-  const auto& start = pattern_.row_start();
-  const auto& col = pattern_.column();
-  const double* K = A.stiffness->data();
-  const double ms = A.mass_scale, ks = A.stiffness_scale;
-  const bool scalar_mass = !mass_scalar_.empty();
-  const auto row = [&](std::int64_t r) {
-    double k_sum[3] = {0, 0, 0}, m_sum[3] = {0, 0, 0};
-    for (std::int64_t k = start[r]; k < start[r + 1]; ++k) {
-      const double* b = K + 9 * k;
-      const double* xv = x.data() + 3 * static_cast<std::int64_t>(col[k]);
-      for (int i = 0; i < 3; ++i) k_sum[i] += b[i * 3] * xv[0] + b[i * 3 + 1] * xv[1] + b[i * 3 + 2] * xv[2];
-      if (scalar_mass) {
-        const double m = mass_scalar_[k];
-        for (int i = 0; i < 3; ++i) m_sum[i] += m * xv[i];
-      } else {
-        const double* mb = mass_.data() + 9 * k;
-        for (int i = 0; i < 3; ++i) m_sum[i] += mb[i * 3] * xv[0] + mb[i * 3 + 1] * xv[1] + mb[i * 3 + 2] * xv[2];
-      }
+  k_product_.resize(x.size());
+  m_product_.resize(x.size());
+  spread(x);
+  // The same products and combination as pcg's initial residual from a given K x.
+  for_row_ranges(pattern_, [&](std::int64_t first, std::int64_t last) {
+    if (mass_scalar_.empty()) {
+      kernels::block_rows_product(pattern_.rows(), first, last, A.stiffness->data(), spread_.data(), k_product_.data());
+      multiply_mass_rows(first, last, m_product_.data());
+    } else {
+      kernels::block_and_scalar_rows_product(pattern_.rows(), first, last, A.stiffness->data(), mass_scalar_.data(),
+                                             spread_.data(), k_product_.data(), m_product_.data());
     }
-    for (int i = 0; i < 3; ++i) y[3 * r + i] = free_[3 * r + i] ? ms * m_sum[i] + ks * k_sum[i] : 0.0;
-  };
-  kernels::forall(pattern_.num_nodes(), row, block_product_execution(pattern_));
+    for (std::int64_t d = 3 * first; d < 3 * last; ++d)
+      y[d] = free_[d] ? A.mass_scale * m_product_[d] + A.stiffness_scale * k_product_[d] : 0.0;
+  });
 }
 
 int FactorReusingSolver::pcg(const ScaledBlockSum& A, const std::vector<double>& b, std::vector<double>& x,

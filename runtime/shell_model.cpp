@@ -1166,36 +1166,22 @@ std::vector<std::vector<double>> ShellModel::moments_of_fields(const ShellModel&
 }
 
 void block_multiply(const BlockAssembly& pattern, const double* blocks, const double* x, double* y) {
-  const auto& start = pattern.row_start();
-  const auto& col = pattern.column();
-  kernels::forall(pattern.num_nodes(), [&](std::int64_t r) {
-    double sum[3] = {0, 0, 0};
-    for (std::int64_t k = start[r]; k < start[r + 1]; ++k) {
-      const double* b = blocks + k * 9;
-      const double* xv = x + 3 * static_cast<std::int64_t>(col[k]);
-      for (int i = 0; i < 3; ++i) sum[i] += b[i * 3] * xv[0] + b[i * 3 + 1] * xv[1] + b[i * 3 + 2] * xv[2];
-    }
-    for (int i = 0; i < 3; ++i) y[3 * r + i] = sum[i];
-  }, block_product_execution(pattern));
+  std::vector<double> spread(9 * static_cast<std::size_t>(pattern.num_nodes()));
+  kernels::spread_block_vector(pattern.num_nodes(), x, spread.data());
+  for_row_ranges(pattern, [&](std::int64_t first, std::int64_t last) {
+    kernels::block_rows_product(pattern.rows(), first, last, blocks, spread.data(), y);
+  });
 }
 
 void block_multiply_pair(const BlockAssembly& pattern, const double* blocks, const double* x1, const double* x2,
                          double* y1, double* y2) {
-  const auto& start = pattern.row_start();
-  const auto& col = pattern.column();
-  kernels::forall(pattern.num_nodes(), [&](std::int64_t r) {
-    double sum1[3] = {0, 0, 0}, sum2[3] = {0, 0, 0};
-    for (std::int64_t k = start[r]; k < start[r + 1]; ++k) {
-      const double* b = blocks + k * 9;
-      const double* u = x1 + 3 * static_cast<std::int64_t>(col[k]);
-      const double* v = x2 + 3 * static_cast<std::int64_t>(col[k]);
-      for (int i = 0; i < 3; ++i) {
-        sum1[i] += b[i * 3] * u[0] + b[i * 3 + 1] * u[1] + b[i * 3 + 2] * u[2];
-        sum2[i] += b[i * 3] * v[0] + b[i * 3 + 1] * v[1] + b[i * 3 + 2] * v[2];
-      }
-    }
-    for (int i = 0; i < 3; ++i) y1[3 * r + i] = sum1[i], y2[3 * r + i] = sum2[i];
-  }, block_product_execution(pattern));
+  const std::size_t size = 9 * static_cast<std::size_t>(pattern.num_nodes());
+  std::vector<double> spread(2 * size);
+  kernels::spread_block_vector(pattern.num_nodes(), x1, spread.data());
+  kernels::spread_block_vector(pattern.num_nodes(), x2, spread.data() + size);
+  for_row_ranges(pattern, [&](std::int64_t first, std::int64_t last) {
+    kernels::block_rows_product_pair(pattern.rows(), first, last, blocks, spread.data(), spread.data() + size, y1, y2);
+  });
 }
 
 }  // namespace dgtex

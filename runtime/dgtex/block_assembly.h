@@ -11,6 +11,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "dgtex/kernels/block_product.h"
 #include "dgtex/kernels/forall.h"
 
 namespace dgtex {
@@ -42,6 +43,8 @@ class BlockAssembly {
   std::int64_t num_blocks() const { return static_cast<std::int64_t>(column_.size()); }
   const std::vector<std::int64_t>& row_start() const { return row_start_; }
   const std::vector<int>& column() const { return column_; }
+  // The pattern's rows for the block product kernels (kernels/block_product.h).
+  kernels::BlockRows rows() const { return {row_start_.data(), column_.data()}; }
 
   // values: num_blocks x 9. locals[f] points to family f's local blocks, or is null to skip it.
   void assemble_matrix(const std::vector<const double*>& locals, double* values, bool parallel = true) const;
@@ -93,6 +96,21 @@ class BlockAssembly {
 inline kernels::Execution block_product_execution(const BlockAssembly& pattern) {
   constexpr std::int64_t min_parallel_blocks = 1 << 15;
   return pattern.num_blocks() >= min_parallel_blocks ? kernels::Execution::parallel : kernels::Execution::serial;
+}
+
+// Calls body(first, last) over ranges of the pattern's node rows that together cover them
+// once: all rows at once where block_product_execution says serial, else chunks of rows over
+// the OpenMP threads. For products whose rows are independent (the same bits either way).
+template <class Body>
+void for_row_ranges(const BlockAssembly& pattern, Body&& body) {
+  const std::int64_t rows = pattern.num_nodes();
+  if (block_product_execution(pattern) == kernels::Execution::serial) {
+    body(std::int64_t{0}, rows);
+    return;
+  }
+  constexpr std::int64_t chunk = 32;
+  kernels::forall((rows + chunk - 1) / chunk,
+                  [&](std::int64_t c) { body(c * chunk, c * chunk + chunk < rows ? c * chunk + chunk : rows); });
 }
 
 }  // namespace dgtex

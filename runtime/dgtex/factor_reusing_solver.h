@@ -168,6 +168,8 @@ class FactorReusingSolver {
   bool factor_current_ = false;  // cholesky holds a factor of some earlier A
   bool factorization_pending_ = false;  // values_ holds an A_k (element-local or whole pattern) to factorise
   std::vector<double> values_, r_, z_, p_, q_, reduced_in_, reduced_out_, b_free_, guess_;
+  // Scratch of the block products: the spread vector (kernels/block_product.h), K x and M x.
+  mutable std::vector<double> spread_, k_product_, m_product_;
   std::vector<char> free_;
   SparseCholesky* pending_factor_ = nullptr;  // whole pattern: the caller's factor that factorize_pending() refreshes
   // Element-local preconditioner: the blocks it keeps, its system and factor (built on
@@ -190,6 +192,10 @@ class FactorReusingSolver {
   void factorize_full_values(SparseCholesky& cholesky);
   void fall_back_to_full_pattern();
   void precondition(const SparseCholesky& cholesky, const std::vector<double>& r, std::vector<double>& z);
+  // spread_ = x spread for the block product kernels.
+  void spread(const std::vector<double>& x) const;
+  // Rows [first, last) of M x, x in spread_.
+  void multiply_mass_rows(std::int64_t first, std::int64_t last, double* y) const;
   // y = A x over free DOFs (fixed entries of y set to zero).
   void multiply(const ScaledBlockSum& A, const std::vector<double>& x, std::vector<double>& y) const;
   // Runs PCG from x; returns iterations used, or -1 if max_iterations did not suffice.
