@@ -1,8 +1,3 @@
-# The single-precision preconditioner solve (runtime/sparse_cholesky.cpp) calls BLAS
-# (sgemv_, strsv_) directly; Debian's libblas is the same OpenBLAS CHOLMOD uses.
-find_library(DGTEX_BLAS_LIBRARY NAMES blas openblas REQUIRED)
-target_link_libraries(dgtex PRIVATE ${DGTEX_BLAS_LIBRARY})
-
 # The shell stiffness kernels compile their hot products for several instruction sets
 # (target_clones, chosen at run time). Without contraction into FMA every clone rounds
 # exactly like baseline x86-64, so K does not depend on the machine's vector unit.
