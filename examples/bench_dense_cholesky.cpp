@@ -2,7 +2,8 @@
 // dense path, runtime/dense_cholesky.h): a fully coupled SPD matrix of n unknowns, the
 // sizes of the cut single-element scenes (spiral1 ~48, chad 126, spiral6 168, accordion
 // 441, slinky 498), factorised through SparseCholesky (Eigen's LLT below 128 unknowns,
-// LAPACK's dpotrf from 128 on) and, for the ratio in the same run, by Eigen's LLT alone.
+// LAPACK's dpotrf from 128 on) and, for the ratio in the same run, by Eigen's LLT alone;
+// and the solve with the factor (kernels::dense_cholesky_solve) against Eigen's solves.
 #include <benchmark/benchmark.h>
 
 #include <Eigen/Dense>
@@ -47,9 +48,36 @@ void eigen_llt(benchmark::State& state) {
   }
 }
 
+void dense_solve(benchmark::State& state) {
+  const LowerPattern a(static_cast<int>(state.range(0)));
+  dgtex::SparseCholesky cholesky;
+  cholesky.analyze(static_cast<int>(state.range(0)), a.column_start, a.row_index);
+  cholesky.factorize(a.values);
+  const std::vector<double> b(state.range(0), 1.0);
+  std::vector<double> x;
+  for (auto _ : state) {
+    cholesky.solve(b, x);
+    benchmark::DoNotOptimize(x.data());
+  }
+}
+
+void eigen_solve(benchmark::State& state) {
+  const LowerPattern a(static_cast<int>(state.range(0)));
+  const Eigen::LLT<Eigen::MatrixXd, Eigen::Lower> llt(a.matrix);
+  const Eigen::VectorXd b = Eigen::VectorXd::Ones(state.range(0));
+  Eigen::VectorXd x;
+  for (auto _ : state) {
+    x = llt.solve(b);
+    benchmark::DoNotOptimize(x.data());
+  }
+}
+
 }  // namespace
 
 BENCHMARK(sparse_cholesky_dense_path)->Arg(48)->Arg(126)->Arg(168)->Arg(441)->Arg(498)->Unit(benchmark::kMicrosecond);
 BENCHMARK(eigen_llt)->Arg(48)->Arg(126)->Arg(168)->Arg(441)->Arg(498)->Unit(benchmark::kMicrosecond);
+
+BENCHMARK(dense_solve)->Arg(48)->Arg(168)->Arg(447)->Unit(benchmark::kMicrosecond);
+BENCHMARK(eigen_solve)->Arg(48)->Arg(168)->Arg(447)->Unit(benchmark::kMicrosecond);
 
 BENCHMARK_MAIN();
