@@ -73,6 +73,15 @@ inline void fix_nodes(const Mesh& mesh, const NodePredicate& where, bool x, bool
         if (comp[c]) fixed[3 * n + c] = 1;
 }
 
+// count values uniformly in [-1, 1], reproducible from the seed.
+inline std::vector<double> random_values(std::size_t count, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> uniform(-1.0, 1.0);
+  std::vector<double> values(count);
+  for (double& v : values) v = uniform(rng);
+  return values;
+}
+
 // count proper rotations (3x3, row-major), uniformly random (normalised Gaussian quaternions),
 // reproducible from the seed: the kernels take any R per point.
 inline std::vector<double> random_rotations(std::int64_t count, unsigned seed) {

@@ -7,7 +7,6 @@
 #include <gtest/gtest.h>
 
 #include <memory>
-#include <random>
 #include <vector>
 
 #include "enrichment_test_support.h"
@@ -17,14 +16,6 @@ using namespace dgtex;
 using namespace dgtex::testing_support;
 
 namespace {
-
-std::vector<double> random_field(int size, unsigned seed) {
-  std::mt19937 random(seed);
-  std::uniform_real_distribution<double> value(-1.0, 1.0);
-  std::vector<double> field(size);
-  for (double& v : field) v = value(random);
-  return field;
-}
 
 // The old model's state projected onto `functions`: moments from a copy that keeps its
 // basis values against a copy that evaluates them, bitwise; every enriched element of the
@@ -43,7 +34,7 @@ std::unique_ptr<ShellModel> expect_kept_moments_bitwise(const ShellModel& old_mo
     kept_elements += keeping->has_kept_basis_values(e);
   }
   EXPECT_EQ(kept_elements, keeping->num_enriched_elements());
-  const std::vector<double> u = random_field(old_model.num_dofs(), 1), v = random_field(old_model.num_dofs(), 2);
+  const std::vector<double> u = random_values(old_model.num_dofs(), 1), v = random_values(old_model.num_dofs(), 2);
   const auto evaluated = evaluating->moments_of_fields(old_model, {&u, &v});
   const auto kept = keeping->moments_of_fields(old_model, {&u, &v});
   EXPECT_TRUE(bitwise_equal(evaluated[0], kept[0]));

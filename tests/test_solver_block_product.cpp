@@ -16,8 +16,10 @@
 #include "dgtex/block_assembly.h"
 #include "dgtex/kernels/block_product.h"
 #include "dgtex/shell_model.h"
+#include "shell_test_support.h"
 
 using namespace dgtex;
+using dgtex::testing_support::random_values;
 
 namespace {
 
@@ -50,13 +52,6 @@ RandomBlockMatrix random_block_matrix(int nodes, unsigned seed) {
   return m;
 }
 
-std::vector<double> random_vector(int size, unsigned seed) {
-  std::mt19937 rng(seed);
-  std::uniform_real_distribution<double> u(-1, 1);
-  std::vector<double> x(size);
-  for (double& v : x) v = u(rng);
-  return x;
-}
 
 std::vector<double> spread_of(const std::vector<double>& x) {
   std::vector<double> spread(3 * x.size());
@@ -69,7 +64,7 @@ constexpr kernels::VectorPath all_paths[] = {kernels::VectorPath::best, kernels:
 
 TEST(BlockProduct, EveryPathIsBitwiseTheReference) {
   const RandomBlockMatrix m = random_block_matrix(60, 3u);
-  const std::vector<double> x = random_vector(3 * m.nodes, 5u), x2 = random_vector(3 * m.nodes, 7u);
+  const std::vector<double> x = random_values(3 * m.nodes, 5u), x2 = random_values(3 * m.nodes, 7u);
   const std::vector<double> spread = spread_of(x), spread2 = spread_of(x2);
   const int n = 3 * m.nodes;
   std::vector<double> kx(n), kx2(n), sx(n);
@@ -100,7 +95,7 @@ TEST(BlockProduct, EveryPathIsBitwiseTheReference) {
 
 TEST(BlockProduct, ARowRangeWritesOnlyItsRows) {
   const RandomBlockMatrix m = random_block_matrix(40, 9u);
-  const std::vector<double> x = random_vector(3 * m.nodes, 11u);
+  const std::vector<double> x = random_values(3 * m.nodes, 11u);
   const std::vector<double> spread = spread_of(x);
   std::vector<double> whole(3 * m.nodes), part(3 * m.nodes, -5.0);
   kernels::block_rows_product(m.rows(), 0, m.nodes, m.blocks.data(), spread.data(), whole.data());
@@ -113,7 +108,7 @@ TEST(BlockProduct, ARowRangeWritesOnlyItsRows) {
 
 TEST(BlockProduct, ReferencesAreTheDenseProductToRoundOff) {
   const RandomBlockMatrix m = random_block_matrix(50, 13u);
-  const std::vector<double> x = random_vector(3 * m.nodes, 17u);
+  const std::vector<double> x = random_values(3 * m.nodes, 17u);
   const int n = 3 * m.nodes;
   std::vector<double> kx(n), sx(n), dense_k(n, 0.0), dense_s(n, 0.0);
   kernels::block_rows_product_reference(m.rows(), 0, m.nodes, m.blocks.data(), x.data(), kx.data());
@@ -142,8 +137,8 @@ TEST(BlockProduct, BlockMultiplyIsTheReferenceOnOneAndTwoThreads) {
   for (int i = 0; i < 400 * 10; ++i) families[0].global_nodes.push_back(node(rng));
   const BlockAssembly pattern(nodes, families);
   ASSERT_EQ(block_product_execution(pattern), kernels::Execution::parallel);
-  const std::vector<double> blocks = random_vector(static_cast<int>(9 * pattern.num_blocks()), 23u);
-  const std::vector<double> x = random_vector(3 * nodes, 29u), x2 = random_vector(3 * nodes, 31u);
+  const std::vector<double> blocks = random_values(9 * pattern.num_blocks(), 23u);
+  const std::vector<double> x = random_values(3 * nodes, 29u), x2 = random_values(3 * nodes, 31u);
   std::vector<double> expected(3 * nodes), expected2(3 * nodes);
   kernels::block_rows_product_reference(pattern.rows(), 0, nodes, blocks.data(), x.data(), expected.data());
   kernels::block_rows_product_reference(pattern.rows(), 0, nodes, blocks.data(), x2.data(), expected2.data());
