@@ -1,6 +1,7 @@
 #include "dgtex/kernels/block_product.h"
 
 #include <cstddef>
+#include <type_traits>
 
 namespace dgtex::kernels {
 namespace {
@@ -22,36 +23,40 @@ struct RowSums {
   V scalar_lanes[streams][scalar_vectors];
 };
 
-// Adds block `b` (node column offset c9 in the spread vectors) to stream U, and with
-// Scalars the scalar block m I (same x: the first lanes of its spread node).
-template <int U, bool Scalars, class V, int L, int NX>
+// Adds to stream U, with Blocks the block `b`, with Scalars the scalar block m I (the same
+// x: the first lanes of its spread node); c9: the node column's offset in the spread vectors.
+template <int U, bool Blocks, bool Scalars, class V, int L, int NX>
 __attribute__((always_inline)) inline void add_block(const double* __restrict b, double m,
                                                      const double* const* spread, std::int64_t c9,
                                                      RowSums<V, L, NX>& sums) {
-  constexpr int NV = RowSums<V, L, NX>::vectors;
-  V block[NV];
-#pragma GCC unroll 4
-  for (int v = 0; v < NV; ++v) __builtin_memcpy(&block[v], b + v * L, sizeof(V));
+  using Sums = RowSums<V, L, NX>;
+  constexpr int NV = Sums::vectors, NS = Sums::scalar_vectors;
+  constexpr int loaded = Blocks ? NV : NS;  // NS <= NV
 #pragma GCC unroll 2
   for (int x = 0; x < NX; ++x) {
     const double* s = spread[x] + c9;
     V xs[NV];
 #pragma GCC unroll 4
-    for (int v = 0; v < NV; ++v) {
-      __builtin_memcpy(&xs[v], s + v * L, sizeof(V));
-      sums.lanes[x][U][v] = sums.lanes[x][U][v] + block[v] * xs[v];
+    for (int v = 0; v < loaded; ++v) __builtin_memcpy(&xs[v], s + v * L, sizeof(V));
+    if constexpr (Blocks) {
+#pragma GCC unroll 4
+      for (int v = 0; v < NV; ++v) {
+        V block;
+        __builtin_memcpy(&block, b + v * L, sizeof(V));
+        sums.lanes[x][U][v] = sums.lanes[x][U][v] + block * xs[v];
+      }
+      sums.last[x][U] = sums.last[x][U] + b[8] * s[8];
     }
-    sums.last[x][U] = sums.last[x][U] + b[8] * s[8];
     if constexpr (Scalars) {
 #pragma GCC unroll 4
-      for (int v = 0; v < RowSums<V, L, NX>::scalar_vectors; ++v)
-        sums.scalar_lanes[U][v] = sums.scalar_lanes[U][v] + m * xs[v];
+      for (int v = 0; v < NS; ++v) sums.scalar_lanes[U][v] = sums.scalar_lanes[U][v] + m * xs[v];
     }
   }
 }
 
-// Rows of K x (NX vectors), with Scalars also of S x (NX = 1, S given by its scalars).
-template <bool Scalars, class V, int L, int NX>
+// Rows of K x (with Blocks; NX vectors) and of S x (with Scalars; NX = 1, S given by its
+// scalars).
+template <bool Blocks, bool Scalars, class V, int L, int NX>
 __attribute__((always_inline)) inline void block_rows(BlockRows rows, std::int64_t first, std::int64_t last,
                                                       const double* __restrict blocks,
                                                       const double* __restrict scalars, const double* const* spread,
@@ -69,27 +74,36 @@ __attribute__((always_inline)) inline void block_rows(BlockRows rows, std::int64
       for (int v = 0; v < NS; ++v) sums.scalar_lanes[u][v] = V{};
     }
     const std::int64_t begin = rows.row_start[r], end = rows.row_start[r + 1];
-    const auto block = [&](std::int64_t k) { return blocks + 9 * k; };
+    const auto block = [&](std::int64_t k) { return Blocks ? blocks + 9 * k : nullptr; };
     const auto scalar = [&](std::int64_t k) { return Scalars ? scalars[k] : 0.0; };
     const auto c9 = [&](std::int64_t k) { return 9 * static_cast<std::int64_t>(rows.column[k]); };
+    const auto add = [&](auto stream, std::int64_t k) {
+      add_block<decltype(stream)::value, Blocks, Scalars>(block(k), scalar(k), spread, c9(k), sums);
+    };
+    using S0 = std::integral_constant<int, 0>;
+    using S1 = std::integral_constant<int, 1>;
+    using S2 = std::integral_constant<int, 2>;
+    using S3 = std::integral_constant<int, 3>;
     std::int64_t k = begin;
     for (; k + streams <= end; k += streams) {
-      add_block<0, Scalars>(block(k), scalar(k), spread, c9(k), sums);
-      add_block<1, Scalars>(block(k + 1), scalar(k + 1), spread, c9(k + 1), sums);
-      add_block<2, Scalars>(block(k + 2), scalar(k + 2), spread, c9(k + 2), sums);
-      add_block<3, Scalars>(block(k + 3), scalar(k + 3), spread, c9(k + 3), sums);
+      add(S0{}, k);
+      add(S1{}, k + 1);
+      add(S2{}, k + 2);
+      add(S3{}, k + 3);
     }
-    if (k < end) add_block<0, Scalars>(block(k), scalar(k), spread, c9(k), sums);
-    if (k + 1 < end) add_block<1, Scalars>(block(k + 1), scalar(k + 1), spread, c9(k + 1), sums);
-    if (k + 2 < end) add_block<2, Scalars>(block(k + 2), scalar(k + 2), spread, c9(k + 2), sums);
-    for (int x = 0; x < NX; ++x) {
-      double t[9];
-      for (int v = 0; v < NV; ++v) {
-        const V sum = (sums.lanes[x][0][v] + sums.lanes[x][1][v]) + (sums.lanes[x][2][v] + sums.lanes[x][3][v]);
-        __builtin_memcpy(t + v * L, &sum, sizeof(V));
+    if (k < end) add(S0{}, k);
+    if (k + 1 < end) add(S1{}, k + 1);
+    if (k + 2 < end) add(S2{}, k + 2);
+    if constexpr (Blocks) {
+      for (int x = 0; x < NX; ++x) {
+        double t[9];
+        for (int v = 0; v < NV; ++v) {
+          const V sum = (sums.lanes[x][0][v] + sums.lanes[x][1][v]) + (sums.lanes[x][2][v] + sums.lanes[x][3][v]);
+          __builtin_memcpy(t + v * L, &sum, sizeof(V));
+        }
+        t[8] = (sums.last[x][0] + sums.last[x][1]) + (sums.last[x][2] + sums.last[x][3]);
+        for (int i = 0; i < 3; ++i) y[x][3 * r + i] = (t[3 * i] + t[3 * i + 1]) + t[3 * i + 2];
       }
-      t[8] = (sums.last[x][0] + sums.last[x][1]) + (sums.last[x][2] + sums.last[x][3]);
-      for (int i = 0; i < 3; ++i) y[x][3 * r + i] = (t[3 * i] + t[3 * i + 1]) + t[3 * i + 2];
     }
     if constexpr (Scalars) {
       double t[NS * L];
@@ -103,60 +117,19 @@ __attribute__((always_inline)) inline void block_rows(BlockRows rows, std::int64
   }
 }
 
-// Scalar blocks: entries 0..2 of the spread node in the first lanes (at least 4).
-template <class V, int L>
-__attribute__((always_inline)) inline void scalar_rows(BlockRows rows, std::int64_t first, std::int64_t last,
-                                                       const double* __restrict scalars, const double* spread,
-                                                       double* y) {
-  constexpr int NV = L >= 4 ? 1 : 4 / L;
-  for (std::int64_t r = first; r < last; ++r) {
-    V lanes[streams][NV];
-    for (int u = 0; u < streams; ++u)
-      for (int v = 0; v < NV; ++v) lanes[u][v] = V{};
-    const auto add = [&](int u, std::int64_t k) {
-      const double* s = spread + 9 * static_cast<std::int64_t>(rows.column[k]);
-      for (int v = 0; v < NV; ++v) {
-        V xs;
-        __builtin_memcpy(&xs, s + v * L, sizeof(V));
-        lanes[u][v] = lanes[u][v] + scalars[k] * xs;
-      }
-    };
-    const std::int64_t begin = rows.row_start[r], end = rows.row_start[r + 1];
-    std::int64_t k = begin;
-    for (; k + streams <= end; k += streams) {
-      add(0, k);
-      add(1, k + 1);
-      add(2, k + 2);
-      add(3, k + 3);
-    }
-    if (k < end) add(0, k);
-    if (k + 1 < end) add(1, k + 1);
-    if (k + 2 < end) add(2, k + 2);
-    double t[NV * L];
-    for (int v = 0; v < NV; ++v) {
-      const V sum = (lanes[0][v] + lanes[1][v]) + (lanes[2][v] + lanes[3][v]);
-      __builtin_memcpy(t + v * L, &sum, sizeof(V));
-    }
-    for (int i = 0; i < 3; ++i) y[3 * r + i] = t[i];
-  }
-}
-
-// count: 1 or 2 vectors; scalars (with one vector) non-null: also y_scalars = S x.
+// One path: K x for `count` (1 or 2) vectors when blocks is non-null, and S x (one vector)
+// when scalars is non-null.
 using BlockRowsKernel = void (*)(BlockRows, std::int64_t, std::int64_t, const double*, const double*,
                                  const double* const*, double* const*, double*, int);
-using ScalarRowsKernel = void (*)(BlockRows, std::int64_t, std::int64_t, const double*, const double*, double*);
 
-#define DGTEX_BLOCK_ROWS_PATH(attribute, name, V, L)                                                              \
-  attribute void block_rows_##name(BlockRows rows, std::int64_t first, std::int64_t last, const double* blocks,   \
-                                   const double* scalars, const double* const* spread, double* const* y,          \
-                                   double* y_scalars, int count) {                                                \
-    if (count == 2) block_rows<false, V, L, 2>(rows, first, last, blocks, nullptr, spread, y, nullptr);           \
-    else if (scalars) block_rows<true, V, L, 1>(rows, first, last, blocks, scalars, spread, y, y_scalars);        \
-    else block_rows<false, V, L, 1>(rows, first, last, blocks, nullptr, spread, y, nullptr);                      \
-  }                                                                                                               \
-  attribute void scalar_rows_##name(BlockRows rows, std::int64_t first, std::int64_t last,                       \
-                                    const double* scalars, const double* spread, double* y) {                    \
-    scalar_rows<V, L>(rows, first, last, scalars, spread, y);                                                     \
+#define DGTEX_BLOCK_ROWS_PATH(attribute, name, V, L)                                                               \
+  attribute void block_rows_##name(BlockRows rows, std::int64_t first, std::int64_t last, const double* blocks,    \
+                                   const double* scalars, const double* const* spread, double* const* y,           \
+                                   double* y_scalars, int count) {                                                 \
+    if (count == 2) block_rows<true, false, V, L, 2>(rows, first, last, blocks, nullptr, spread, y, nullptr);      \
+    else if (!scalars) block_rows<true, false, V, L, 1>(rows, first, last, blocks, nullptr, spread, y, nullptr);   \
+    else if (!blocks) block_rows<false, true, V, L, 1>(rows, first, last, nullptr, scalars, spread, y, y_scalars); \
+    else block_rows<true, true, V, L, 1>(rows, first, last, blocks, scalars, spread, y, y_scalars);                \
   }
 DGTEX_BLOCK_ROWS_PATH(__attribute__((target("avx512f"))), avx512, V8, 8)
 DGTEX_BLOCK_ROWS_PATH(__attribute__((target("avx2"))), avx2, V4, 4)
@@ -199,11 +172,7 @@ void block_rows_product_pair(BlockRows rows, std::int64_t first, std::int64_t la
 
 void scalar_rows_product(BlockRows rows, std::int64_t first, std::int64_t last, const double* scalars,
                          const double* spread, double* y, VectorPath path) {
-  static const ScalarRowsKernel best =
-      kernel_of(VectorPath::best, scalar_rows_avx512, scalar_rows_avx2, scalar_rows_baseline);
-  const ScalarRowsKernel kernel =
-      path == VectorPath::best ? best : kernel_of(path, scalar_rows_avx512, scalar_rows_avx2, scalar_rows_baseline);
-  kernel(rows, first, last, scalars, spread, y);
+  block_rows_of(path, rows, first, last, nullptr, scalars, &spread, nullptr, y, 1);
 }
 
 void block_rows_product_reference(BlockRows rows, std::int64_t first, std::int64_t last, const double* blocks,
