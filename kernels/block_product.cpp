@@ -119,9 +119,6 @@ __attribute__((always_inline)) inline void block_rows(BlockRows rows, std::int64
 
 // One path: K x for `count` (1 or 2) vectors when blocks is non-null, and S x (one vector)
 // when scalars is non-null.
-using BlockRowsKernel = void (*)(BlockRows, std::int64_t, std::int64_t, const double*, const double*,
-                                 const double* const*, double* const*, double*, int);
-
 #define DGTEX_BLOCK_ROWS_PATH(attribute, name, V, L)                                                               \
   attribute void block_rows_##name(BlockRows rows, std::int64_t first, std::int64_t last, const double* blocks,    \
                                    const double* scalars, const double* const* spread, double* const* y,           \
@@ -139,10 +136,8 @@ DGTEX_BLOCK_ROWS_PATH(, baseline, V2, 2)
 void block_rows_of(VectorPath path, BlockRows rows, std::int64_t first, std::int64_t last, const double* blocks,
                    const double* scalars, const double* const* spread, double* const* y, double* y_scalars,
                    int count) {
-  static const BlockRowsKernel best = kernel_of(VectorPath::best, block_rows_avx512, block_rows_avx2, block_rows_baseline);
-  const BlockRowsKernel kernel =
-      path == VectorPath::best ? best : kernel_of(path, block_rows_avx512, block_rows_avx2, block_rows_baseline);
-  kernel(rows, first, last, blocks, scalars, spread, y, y_scalars, count);
+  kernel_of(path, block_rows_avx512, block_rows_avx2, block_rows_baseline)(rows, first, last, blocks, scalars, spread,
+                                                                          y, y_scalars, count);
 }
 
 }  // namespace

@@ -66,9 +66,7 @@ void solve_baseline(int n, const double* factor, double* x) { solve<V2, 2>(n, fa
 }  // namespace
 
 void dense_cholesky_solve(int n, const double* L, double* x, VectorPath path) {
-  using Kernel = void (*)(int, const double*, double*);
-  static const Kernel best = kernel_of(VectorPath::best, solve_avx512, solve_avx2, solve_baseline);
-  (path == VectorPath::best ? best : kernel_of(path, solve_avx512, solve_avx2, solve_baseline))(n, L, x);
+  kernel_of(path, solve_avx512, solve_avx2, solve_baseline)(n, L, x);
 }
 
 void dense_cholesky_solve_reference(int n, const double* L, double* x) {

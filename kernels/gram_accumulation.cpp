@@ -182,9 +182,7 @@ void scaled_row_baseline(int count, double s, const double* scales, const double
 
 void accumulate_product(int rows, int cols, const double* A, const double* B, double* G, bool overwrite,
                         bool upper, VectorPath path) {
-  static const auto best = kernel_of(VectorPath::best, product_avx512, product_avx2, product_baseline);
-  (path == VectorPath::best ? best : kernel_of(path, product_avx512, product_avx2, product_baseline))(
-      rows, cols, A, B, G, overwrite, upper);
+  kernel_of(path, product_avx512, product_avx2, product_baseline)(rows, cols, A, B, G, overwrite, upper);
 }
 
 void accumulate_weighted_grams(int points, int rows_per_point, int cols, const double* A, const double* weights,
@@ -196,11 +194,8 @@ void accumulate_weighted_grams(int points, int rows_per_point, int cols, const d
     accumulate_weighted_grams_reference(points, rows_per_point, cols, A, weights, count, G, overwrite);
     return;
   }
-  const auto of = [](VectorPath p) {
-    return kernel_of(p, weighted_grams_avx512, weighted_grams_avx2, weighted_grams_baseline);
-  };
-  static const auto best = of(VectorPath::best);
-  (path == VectorPath::best ? best : of(path))(points, cols, A, weights, G, overwrite);
+  kernel_of(path, weighted_grams_avx512, weighted_grams_avx2, weighted_grams_baseline)(points, cols, A, weights, G,
+                                                                                      overwrite);
 }
 
 void accumulate_gram_upper(int rows, int cols, const double* A, double* G, bool overwrite, VectorPath path) {
@@ -208,8 +203,7 @@ void accumulate_gram_upper(int rows, int cols, const double* A, double* G, bool 
 }
 
 void add_scaled_row(int count, double s, const double* scales, const double* g, double* out) {
-  static const auto kernel = kernel_of(VectorPath::best, scaled_row_avx512, scaled_row_avx2, scaled_row_baseline);
-  kernel(count, s, scales, g, out);
+  kernel_of(VectorPath::best, scaled_row_avx512, scaled_row_avx2, scaled_row_baseline)(count, s, scales, g, out);
 }
 
 void accumulate_product_reference(int rows, int cols, const double* A, const double* B, double* G, bool overwrite,

@@ -13,8 +13,11 @@ bool vector_path_supported(VectorPath path) {
 
 VectorPath widest(VectorPath path) {
   if (path != VectorPath::best) return path;
-  if (vector_path_supported(VectorPath::avx512)) return VectorPath::avx512;
-  return vector_path_supported(VectorPath::avx2) ? VectorPath::avx2 : VectorPath::baseline;
+  // Asked once (thread-safe): kernels pick their path on every call.
+  static const VectorPath machine = vector_path_supported(VectorPath::avx512) ? VectorPath::avx512
+                                    : vector_path_supported(VectorPath::avx2) ? VectorPath::avx2
+                                                                              : VectorPath::baseline;
+  return machine;
 }
 
 }  // namespace dgtex::kernels

@@ -9,10 +9,10 @@ namespace dgtex::kernels {
 enum class VectorPath { best, avx512, avx2, baseline };
 
 bool vector_path_supported(VectorPath path);
-// `path`, or for best the widest path the machine supports.
+// `path`, or for best the widest path the machine supports (found once per process).
 VectorPath widest(VectorPath path);
 
-// A kernel family's function for `path`.
+// A kernel family's function for `path` (cheap: call it per kernel call).
 template <class Kernel>
 Kernel kernel_of(VectorPath path, Kernel avx512, Kernel avx2, Kernel baseline) {
   switch (widest(path)) {
