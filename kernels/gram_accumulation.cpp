@@ -178,6 +178,13 @@ void scaled_row_baseline(int count, double s, const double* scales, const double
   scaled_row<V2, 2>(count, s, scales, g, out);
 }
 
+// The sums' count check of accumulate_weighted_grams and its reference.
+void require_weighted_gram_count(const char* kernel, int count) {
+  if (count < 0 || count > max_weighted_grams)
+    throw std::invalid_argument(std::string(kernel) + ": " + std::to_string(count) + " sums (at most " +
+                                std::to_string(max_weighted_grams) + ")");
+}
+
 }  // namespace
 
 void accumulate_product(int rows, int cols, const double* A, const double* B, double* G, bool overwrite,
@@ -187,9 +194,7 @@ void accumulate_product(int rows, int cols, const double* A, const double* B, do
 
 void accumulate_weighted_grams(int points, int rows_per_point, int cols, const double* A, const double* weights,
                                int count, double* const* G, const bool* overwrite, VectorPath path) {
-  if (count < 0 || count > max_weighted_grams)
-    throw std::invalid_argument("accumulate_weighted_grams: " + std::to_string(count) + " sums (at most " +
-                                std::to_string(max_weighted_grams) + ")");
+  require_weighted_gram_count("accumulate_weighted_grams", count);
   if (rows_per_point != 3 || count != 6) {  // no tiled path: the same sums entry by entry
     accumulate_weighted_grams_reference(points, rows_per_point, cols, A, weights, count, G, overwrite);
     return;
@@ -220,9 +225,7 @@ void accumulate_product_reference(int rows, int cols, const double* A, const dou
 
 void accumulate_weighted_grams_reference(int points, int rows_per_point, int cols, const double* A,
                                          const double* weights, int count, double* const* G, const bool* overwrite) {
-  if (count < 0 || count > max_weighted_grams)
-    throw std::invalid_argument("accumulate_weighted_grams_reference: " + std::to_string(count) + " sums (at most " +
-                                std::to_string(max_weighted_grams) + ")");
+  require_weighted_gram_count("accumulate_weighted_grams_reference", count);
   for (int i = 0; i < cols; ++i)
     for (int j = i; j < cols; ++j) {
       double sum[max_weighted_grams] = {};

@@ -22,6 +22,11 @@ constexpr std::int64_t parallel_vector_length = 1 << 15;
 kernels::Execution vector_execution(std::size_t n) {
   return static_cast<std::int64_t>(n) >= parallel_vector_length ? kernels::Execution::parallel : kernels::Execution::serial;
 }
+// An entry of A x from those of M x and K x (0 at a fixed DOF): the one formula of multiply()
+// and of pcg's initial residual from a given K x, so both give the same bits.
+double scaled_sum_entry(const ScaledBlockSum& A, bool free, double mass_x, double stiffness_x) {
+  return free ? A.mass_scale * mass_x + A.stiffness_scale * stiffness_x : 0.0;
+}
 }  // namespace
 
 std::vector<char> element_local_blocks(const std::vector<double>& mass) {
@@ -200,7 +205,7 @@ void FactorReusingSolver::multiply(const ScaledBlockSum& A, const std::vector<do
   k_product_.resize(x.size());
   m_product_.resize(x.size());
   spread(x);
-  // The same products and combination as pcg's initial residual from a given K x.
+  // The same products as pcg's initial residual from a given K x.
   for_row_ranges(pattern_, [&](std::int64_t first, std::int64_t last) {
     if (mass_scalar_.empty()) {
       kernels::block_rows_product(pattern_.rows(), first, last, A.stiffness->data(), spread_.data(), k_product_.data());
@@ -210,7 +215,7 @@ void FactorReusingSolver::multiply(const ScaledBlockSum& A, const std::vector<do
                                              spread_.data(), k_product_.data(), m_product_.data());
     }
     for (std::int64_t d = 3 * first; d < 3 * last; ++d)
-      y[d] = free_[d] ? A.mass_scale * m_product_[d] + A.stiffness_scale * k_product_[d] : 0.0;
+      y[d] = scaled_sum_entry(A, free_[d], m_product_[d], k_product_[d]);
   });
 }
 
@@ -218,9 +223,9 @@ int FactorReusingSolver::pcg(const ScaledBlockSum& A, const std::vector<double>&
                              const SparseCholesky& cholesky, double& relative_residual,
                              const std::vector<double>* kx) {
   const size_t n = b.size();
-  if (kx) {  // A x from the given K x: the same arithmetic as multiply()
+  if (kx) {  // A x from the given K x
     multiply_mass(x, q_);
-    for (size_t d = 0; d < n; ++d) q_[d] = free_[d] ? A.mass_scale * q_[d] + A.stiffness_scale * (*kx)[d] : 0.0;
+    for (size_t d = 0; d < n; ++d) q_[d] = scaled_sum_entry(A, free_[d], q_[d], (*kx)[d]);
   } else {
     multiply(A, x, q_);
   }
