@@ -28,6 +28,7 @@
 #include "dgtex/mesh_generators.h"
 #include "cut_element_fixture.h"
 #include "shell_test_support.h"
+#include "vector_path_support.h"
 
 using namespace dgtex;
 
@@ -47,9 +48,7 @@ TEST(EnrichedGram, EveryPathIsBitwiseTheReference) {
       for (bool overwrite : {true, false}) {
         std::vector<double> expected = start;
         kernels::accumulate_gram_upper_reference(rows, cols, A.data(), expected.data(), overwrite);
-        for (kernels::VectorPath path : {kernels::VectorPath::best, kernels::VectorPath::avx512, kernels::VectorPath::avx2,
-                                       kernels::VectorPath::baseline}) {
-          if (!kernels::vector_path_supported(path)) continue;
+        for (kernels::VectorPath path : testing_support::supported_vector_paths()) {
           std::vector<double> G = start;
           kernels::accumulate_gram_upper(rows, cols, A.data(), G.data(), overwrite, path);
           for (int i = 0; i < cols; ++i)
@@ -80,9 +79,7 @@ TEST(EnrichedGram, ProductOnEveryPathIsBitwiseTheReference) {
         for (bool overwrite : {true, false}) {
           std::vector<double> expected = start;
           kernels::accumulate_product_reference(rows, cols, A.data(), B.data(), expected.data(), overwrite, upper);
-          for (kernels::VectorPath path : {kernels::VectorPath::best, kernels::VectorPath::avx512, kernels::VectorPath::avx2,
-                                         kernels::VectorPath::baseline}) {
-            if (!kernels::vector_path_supported(path)) continue;
+          for (kernels::VectorPath path : testing_support::supported_vector_paths()) {
             std::vector<double> G = start;
             kernels::accumulate_product(rows, cols, A.data(), B.data(), G.data(), overwrite, upper, path);
             for (int i = 0; i < cols; ++i)
@@ -132,9 +129,7 @@ TEST(EnrichedGram, WeightedGramsOnEveryPathAreBitwiseTheReference) {
                         plain[static_cast<std::size_t>(i) * cols + j], 1e-13 * (1 + points))
                 << "sum " << k << " (" << i << ", " << j << ")";
       }
-      for (kernels::VectorPath path : {kernels::VectorPath::best, kernels::VectorPath::avx512, kernels::VectorPath::avx2,
-                                     kernels::VectorPath::baseline}) {
-        if (!kernels::vector_path_supported(path)) continue;
+      for (kernels::VectorPath path : testing_support::supported_vector_paths()) {
         std::vector<std::vector<double>> G = start;
         double* at[sums];
         for (int k = 0; k < sums; ++k) at[k] = G[k].data();

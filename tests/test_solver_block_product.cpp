@@ -17,6 +17,7 @@
 #include "dgtex/kernels/block_product.h"
 #include "dgtex/shell_model.h"
 #include "shell_test_support.h"
+#include "vector_path_support.h"
 
 using namespace dgtex;
 using dgtex::testing_support::random_values;
@@ -52,15 +53,11 @@ RandomBlockMatrix random_block_matrix(int nodes, unsigned seed) {
   return m;
 }
 
-
 std::vector<double> spread_of(const std::vector<double>& x) {
   std::vector<double> spread(3 * x.size());
   kernels::spread_block_vector(static_cast<std::int64_t>(x.size() / 3), x.data(), spread.data());
   return spread;
 }
-
-constexpr kernels::VectorPath all_paths[] = {kernels::VectorPath::best, kernels::VectorPath::avx512,
-                                             kernels::VectorPath::avx2, kernels::VectorPath::baseline};
 
 TEST(BlockProduct, EveryPathIsBitwiseTheReference) {
   const RandomBlockMatrix m = random_block_matrix(60, 3u);
@@ -71,8 +68,7 @@ TEST(BlockProduct, EveryPathIsBitwiseTheReference) {
   kernels::block_rows_product_reference(m.rows(), 0, m.nodes, m.blocks.data(), x.data(), kx.data());
   kernels::block_rows_product_reference(m.rows(), 0, m.nodes, m.blocks.data(), x2.data(), kx2.data());
   kernels::scalar_rows_product_reference(m.rows(), 0, m.nodes, m.scalars.data(), x.data(), sx.data());
-  for (kernels::VectorPath path : all_paths) {
-    if (!kernels::vector_path_supported(path)) continue;
+  for (kernels::VectorPath path : testing_support::supported_vector_paths()) {
     SCOPED_TRACE("path " + std::to_string(static_cast<int>(path)));
     std::vector<double> y(n, 7.0), y2(n, 7.0), ys(n, 7.0);
     kernels::block_rows_product(m.rows(), 0, m.nodes, m.blocks.data(), spread.data(), y.data(), path);

@@ -15,6 +15,7 @@
 
 #include "dgtex/kernels/dense_cholesky_solve.h"
 #include "dgtex/sparse_cholesky.h"
+#include "vector_path_support.h"
 
 namespace {
 
@@ -135,9 +136,7 @@ TEST(DenseCholesky, TriangularSolvesAreBitwiseTheReferenceOnEveryPath) {
     const Eigen::VectorXd eigen = a.llt().solve(Eigen::Map<const Eigen::VectorXd>(b.data(), n));
     for (int i = 0; i < n; ++i)
       EXPECT_NEAR(expected[i], eigen[i], 1e-11 * eigen.cwiseAbs().maxCoeff()) << "n = " << n << ", entry " << i;
-    for (dgtex::kernels::VectorPath path : {dgtex::kernels::VectorPath::best, dgtex::kernels::VectorPath::avx512,
-                                            dgtex::kernels::VectorPath::avx2, dgtex::kernels::VectorPath::baseline}) {
-      if (!dgtex::kernels::vector_path_supported(path)) continue;
+    for (dgtex::kernels::VectorPath path : dgtex::testing_support::supported_vector_paths()) {
       std::vector<double> x = b;
       dgtex::kernels::dense_cholesky_solve(n, L.data(), x.data(), path);
       EXPECT_EQ(x, expected) << "n = " << n << ", path " << static_cast<int>(path);
