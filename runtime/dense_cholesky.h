@@ -25,12 +25,23 @@ class DenseCholesky {
   // non-finite pivot.
   void factorize(const std::vector<double>& values);
   void solve(const std::vector<double>& b, std::vector<double>& x) const;
+  // From SparseCholesky::dense_single_precision_min_unknowns (256) on, a float copy of L for solve_single_precision()
+  // (the preconditioner): the accordion's 450-unknown factor, 0.8 MB of lower triangle in
+  // double, no longer stays in a 1 MB L2 cache beside K between the two sweeps. Smaller
+  // factors keep solving in double: there a fresh factor solves the system in one PCG
+  // iteration, a float copy in two (spiral6 and the slinky: 958 -> 1132 and 862 -> 1061
+  // iterations over their runs in session 25, when every dense factor had a float copy).
+  void copy_factor_to_single_precision();
+  // x ~= A^-1 b with the float copy where copy_factor_to_single_precision() made one for
+  // the current factor, solve() otherwise.
+  void solve_single_precision(const std::vector<double>& b, std::vector<double>& x) const;
   std::int64_t factor_nonzeros() const { return static_cast<std::int64_t>(n_) * (n_ + 1) / 2; }
 
  private:
   int n_ = 0;
   std::vector<int> column_start_, row_index_;
   Eigen::MatrixXd factor_;  // the lower triangle of A, then its Cholesky factor L
+  std::vector<float> single_factor_;  // L's lower triangle in float (same layout), if current
   void fill_lower(const std::vector<double>& values);  // factor_ = the lower triangle of A
 };
 

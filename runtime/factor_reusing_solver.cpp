@@ -86,6 +86,7 @@ FactorReusingSolver::FactorReusingSolver(const BlockAssembly& pattern, const Fre
   for (char kept : element_local_blocks_) element_local_differs_ |= !kept;
   whole_pattern_dense_ =
       SparseCholesky::factors_densely(system.size(), static_cast<std::int64_t>(system.row_index().size()));
+  large_dense_ = whole_pattern_dense_ && system.size() >= SparseCholesky::dense_single_precision_min_unknowns;
   set_options(options);
 }
 
@@ -311,7 +312,7 @@ void FactorReusingSolver::solve(const ScaledBlockSum& A, const std::vector<doubl
                              std::to_string(options_.relative_tolerance) + " even with a fresh factor (residual " +
                              std::to_string(residual) + "); the system is ill-conditioned");
   // Judged by the factor now held (a fresh one after a failed attempt).
-  if (iterations > options_.refactor_after_iterations) {
+  if (iterations > (large_dense_ ? options_.large_dense_refactor_after_iterations : options_.refactor_after_iterations)) {
     if (options_.overlap_factorization) {
       // A_k now: the caller overwrites its K before the next solve.
       if (use_element_local_) {

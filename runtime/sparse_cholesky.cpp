@@ -181,7 +181,7 @@ void SparseCholesky::solve(const std::vector<double>& b, std::vector<double>& x)
 
 void SparseCholesky::copy_factor_to_single_precision() {
   Impl& m = *impl_;
-  if (m.dense) return;
+  if (m.dense) return m.dense->copy_factor_to_single_precision();
   const cholmod_factor* f = m.factor;
   if (!f || !f->is_super || f->xtype != CHOLMOD_REAL || f->itype != CHOLMOD_INT)
     throw std::logic_error("SparseCholesky::copy_factor_to_single_precision needs a real supernodal factor (call factorize first)");
@@ -250,7 +250,7 @@ void SparseCholesky::build_solve_schedule() {
 void SparseCholesky::solve_single_precision(const std::vector<double>& b, std::vector<double>& x) const {
   const Impl& m = *impl_;
   if (m.dense) {
-    m.dense->solve(b, x);
+    m.dense->solve_single_precision(b, x);
     return;
   }
   const cholmod_factor* f = m.factor;

@@ -1,8 +1,9 @@
 // SparseCholesky's dense path for small systems (runtime/dense_cholesky.h) against its
 // CHOLMOD path on the same matrices: solutions, errors for indefinite and non-finite
-// matrices, and which systems take which path. Its triangular solves
-// (dgtex/kernels/dense_cholesky_solve.h) are bitwise their reference on every path the
-// machine supports and Eigen's solves to round-off.
+// matrices, which systems take which path, and the float copy of large factors. Its
+// triangular solves (dgtex/kernels/dense_cholesky_solve.h), with the factor in double and
+// in float, are bitwise their reference on every path the machine supports and Eigen's
+// solves to round-off (double) or to float's rounding of L.
 #include <gtest/gtest.h>
 #include <omp.h>
 
@@ -109,7 +110,7 @@ TEST(DenseCholesky, LargeOrSparseSystemsStayWithCholmod) {
   EXPECT_FALSE(dense);
 }
 
-TEST(DenseCholesky, SinglePrecisionSolveIsTheDoubleSolve) {
+TEST(DenseCholesky, SinglePrecisionSolveIsTheDoubleSolveBelow256Unknowns) {
   const LowerCsc m = lower_csc(random_spd(60, 60, 11u));
   dgtex::SparseCholesky c;
   c.analyze(m.n, m.column_start, m.row_index);
@@ -122,9 +123,36 @@ TEST(DenseCholesky, SinglePrecisionSolveIsTheDoubleSolve) {
   EXPECT_EQ(c.factor_nonzeros(), 60 * 61 / 2);
 }
 
+TEST(DenseCholesky, LargeFactorsPreconditionWithAFloatCopyOfTheCurrentFactor) {
+  // 300 unknowns, fully coupled: dense, and at least 256 unknowns, so a float copy is made.
+  const int n = 300;
+  const Eigen::MatrixXd a = random_spd(n, n, 23u);
+  const LowerCsc m = lower_csc(a);
+  dgtex::SparseCholesky c;
+  c.analyze(m.n, m.column_start, m.row_index);
+  ASSERT_TRUE(c.dense());
+  c.factorize(m.values);
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> u(-1, 1);
+  std::vector<double> b(n), x, y;
+  for (double& v : b) v = u(rng);
+  c.solve(b, x);
+  c.copy_factor_to_single_precision();
+  c.solve_single_precision(b, y);
+  double largest = 0, difference = 0;
+  for (int i = 0; i < n; ++i) largest = std::max(largest, std::abs(x[i])), difference = std::max(difference, std::abs(y[i] - x[i]));
+  EXPECT_NE(x, y);  // the float copy is used
+  EXPECT_LE(difference, 1e-6 * largest);  // float's rounding of L (a well-conditioned matrix)
+  // A new factorisation drops the copy: until the next copy, the double factor is used.
+  c.factorize(m.values);
+  c.solve_single_precision(b, y);
+  EXPECT_EQ(x, y);
+}
+
 TEST(DenseCholesky, TriangularSolvesAreBitwiseTheReferenceOnEveryPath) {
-  // Sizes around the 8 lanes and the vector widths, and the accordion's 447.
-  for (int n : {1, 2, 3, 7, 8, 9, 16, 17, 33, 130, 447}) {
+  // Sizes around the 8 lanes, the vector widths and the forward sweep's blocks of 8
+  // columns, and the accordion's 447.
+  for (int n : {1, 2, 3, 7, 8, 9, 15, 16, 17, 23, 33, 130, 447}) {
     const Eigen::MatrixXd a = random_spd(n, n, 41u + n);
     const Eigen::MatrixXd L = a.llt().matrixL();
     std::mt19937 rng(n);
@@ -136,10 +164,19 @@ TEST(DenseCholesky, TriangularSolvesAreBitwiseTheReferenceOnEveryPath) {
     const Eigen::VectorXd eigen = a.llt().solve(Eigen::Map<const Eigen::VectorXd>(b.data(), n));
     for (int i = 0; i < n; ++i)
       EXPECT_NEAR(expected[i], eigen[i], 1e-11 * eigen.cwiseAbs().maxCoeff()) << "n = " << n << ", entry " << i;
+    // The float factor: L rounded, every other operation as in double.
+    const std::vector<float> single(L.data(), L.data() + static_cast<std::size_t>(n) * n);
+    std::vector<double> expected_single = b;
+    dgtex::kernels::dense_cholesky_solve_reference(n, single.data(), expected_single.data());
+    for (int i = 0; i < n; ++i)
+      EXPECT_NEAR(expected_single[i], eigen[i], 1e-5 * eigen.cwiseAbs().maxCoeff()) << "n = " << n << ", entry " << i;
     for (dgtex::kernels::VectorPath path : dgtex::testing_support::supported_vector_paths()) {
       std::vector<double> x = b;
       dgtex::kernels::dense_cholesky_solve(n, L.data(), x.data(), path);
       EXPECT_EQ(x, expected) << "n = " << n << ", path " << static_cast<int>(path);
+      x = b;
+      dgtex::kernels::dense_cholesky_solve(n, single.data(), x.data(), path);
+      EXPECT_EQ(x, expected_single) << "float factor, n = " << n << ", path " << static_cast<int>(path);
     }
   }
 }

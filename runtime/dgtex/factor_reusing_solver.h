@@ -31,7 +31,8 @@
 // factorised and PCG restarts from the same guess; if a fresh element-local factor does
 // not suffice either, the whole pattern of A_k is.
 // Refactorisation happens when a solve took more than `refactor_after_iterations`
-// iterations or did not converge in `max_iterations` (then A_k at once). In the first case
+// iterations (`large_dense_refactor_after_iterations` for dense systems of 256 unknowns or
+// more) or did not converge in `max_iterations` (then A_k at once). In the first case
 // the matrix of A_k itself (element-local or whole pattern) is factorised while the caller
 // assembles A_k+1 (FactorReuseOptions::overlap_factorization, factorize_pending()): CHOLMOD
 // factorises on one core, and waiting for it cost ~4 ms of the cylinder scene's ~22 ms step
@@ -71,6 +72,15 @@ struct FactorReuseOptions {
   // 40-43 ms; 24: 5 + 1257, 42-44 ms (a shared machine: the spread is noise). Flat from 8
   // to 20; 12 also was the optimum of the whole-pattern factor (11 + 730, 61-64 ms).
   int refactor_after_iterations = 12;
+  // The same for systems factored densely with a float copy of the factor (256 to 512
+  // unknowns, SparseCholesky::dense_single_precision_min_unknowns: the accordion's 450).
+  // There an iteration reads K and L from the L3 cache (~2.4 MB, ~70 us), while the dense
+  // factorisation (~1 ms) runs beside the next assembly. The accordion (200 steps, three
+  // runs of each, `dgtex bench scenes --scenes accordion`, 2-core machine): 3 gives 21
+  // factorisations + 565 iterations, solve 0.36-0.37 ms a step, against 1 + 945 and
+  // 0.48-0.49 ms with 12; the assembly 7.1 ms and the steps/s (126-128 against 120-127)
+  // unchanged. 4: 5 + 713, 0.44 ms; 2: 49 + 453, 0.38 ms.
+  int large_dense_refactor_after_iterations = 3;
   int max_iterations = 40;            // beyond this, factorise the current system now
   // Apply the preconditioner with a float copy of L (SparseCholesky::solve_single_precision):
   // half the memory traffic per iteration; the residual bound is unchanged (the PCG
@@ -179,6 +189,7 @@ class FactorReusingSolver {
   std::unique_ptr<SparseCholesky> element_local_factor_;
   bool element_local_differs_ = false;  // some coupling block is not element-local
   bool whole_pattern_dense_ = false;     // SparseCholesky factors the whole pattern densely
+  bool large_dense_ = false;             // ... and keeps a float copy of the factor
   bool use_element_local_ = false;
 
   // Factorises A (element-local, or the whole pattern into `cholesky`); an element-local

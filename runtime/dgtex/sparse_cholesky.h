@@ -55,7 +55,9 @@ class SparseCholesky {
   // factor's structure, so x is bitwise independent of the thread count. Not safe for
   // concurrent calls on one instance. copy_factor_to_single_precision() must follow
   // each factorize() whose factor solve_single_precision() is to use. A dense factor
-  // (small systems) keeps no float copy: solve_single_precision() is solve() there.
+  // (small systems) keeps a float copy from dense_single_precision_min_unknowns on
+  // (dense_cholesky.h); below that solve_single_precision() is solve().
+  static constexpr int dense_single_precision_min_unknowns = 256;
   void copy_factor_to_single_precision();
   void solve_single_precision(const std::vector<double>& b, std::vector<double>& x) const;
   int size() const { return n_; }

@@ -6,7 +6,8 @@
 //
 // Order of the operations (every path, and the reference, round exactly alike: no FMA
 // contraction, lanes never mix): forward, column by column, y_j = y_j / L_jj and then
-// y_i = y_i - L_ij y_j for i > j; backward, from the last column, x_j = (y_j - d_j) / L_jj
+// y_i = y_i - L_ij y_j for i > j (the paths take 8 columns per pass over y, each entry
+// still updated in column order: one load and store of y_i per 8 columns); backward, from the last column, x_j = (y_j - d_j) / L_jj
 // with d_j = sum_{i > j} L_ij x_i summed in 8 lanes (term q = i - j - 1 in lane q mod 8,
 // each lane in order of q from 0), the lanes added as l + 4, then l + 2, l + 1 (8 lanes,
 // not 16: in the scenes the sweeps wait on memory, and 16 cost more on short columns).
@@ -21,7 +22,12 @@ namespace dgtex::kernels {
 
 // x holds b on entry, the solution on return.
 void dense_cholesky_solve(int n, const double* L, double* x, VectorPath path = VectorPath::best);
+// The same with L rounded to float (the stale preconditioner of large dense systems: half
+// the bytes to read). x stays in double and each entry of L is widened exactly, so only the
+// rounding of L differs: the operations and their order are those above.
+void dense_cholesky_solve(int n, const float* L, double* x, VectorPath path = VectorPath::best);
 // The same operations one entry at a time.
 void dense_cholesky_solve_reference(int n, const double* L, double* x);
+void dense_cholesky_solve_reference(int n, const float* L, double* x);
 
 }  // namespace dgtex::kernels
