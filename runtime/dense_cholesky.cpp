@@ -92,7 +92,8 @@ void DenseCholesky::copy_factor_to_single_precision() {
   if (n_ < SparseCholesky::dense_single_precision_min_unknowns) return;
   single_factor_.resize(static_cast<std::size_t>(n_) * n_);
   for (int j = 0; j < n_; ++j)
-    for (int i = j; i < n_; ++i) single_factor_[static_cast<std::size_t>(j) * n_ + i] = static_cast<float>(factor_(i, j));
+    for (int i = j; i < n_; ++i)
+      single_factor_[static_cast<std::size_t>(j) * n_ + i] = static_cast<float>(factor_(i, j));
 }
 
 void DenseCholesky::solve_single_precision(const std::vector<double>& b, std::vector<double>& x) const {

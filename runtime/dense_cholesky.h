@@ -25,8 +25,8 @@ class DenseCholesky {
   // non-finite pivot.
   void factorize(const std::vector<double>& values);
   void solve(const std::vector<double>& b, std::vector<double>& x) const;
-  // From SparseCholesky::dense_single_precision_min_unknowns (256) on, a float copy of L for solve_single_precision()
-  // (the preconditioner): the accordion's 450-unknown factor, 0.8 MB of lower triangle in
+  // From SparseCholesky::dense_single_precision_min_unknowns (256) on, a float copy of L
+  // for solve_single_precision() (the preconditioner): the accordion's 450-unknown factor, 0.8 MB of lower triangle in
   // double, no longer stays in a 1 MB L2 cache beside K between the two sweeps. Smaller
   // factors keep solving in double: there a fresh factor solves the system in one PCG
   // iteration, a float copy in two (spiral6 and the slinky: 958 -> 1132 and 862 -> 1061

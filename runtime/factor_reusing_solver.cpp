@@ -312,7 +312,9 @@ void FactorReusingSolver::solve(const ScaledBlockSum& A, const std::vector<doubl
                              std::to_string(options_.relative_tolerance) + " even with a fresh factor (residual " +
                              std::to_string(residual) + "); the system is ill-conditioned");
   // Judged by the factor now held (a fresh one after a failed attempt).
-  if (iterations > (large_dense_ ? options_.large_dense_refactor_after_iterations : options_.refactor_after_iterations)) {
+  const int refactor_after =
+      large_dense_ ? options_.large_dense_refactor_after_iterations : options_.refactor_after_iterations;
+  if (iterations > refactor_after) {
     if (options_.overlap_factorization) {
       // A_k now: the caller overwrites its K before the next solve.
       if (use_element_local_) {

@@ -286,6 +286,41 @@ TEST(FactorReuse, ASystemFactoredDenselyUsesTheWholePattern) {
   EXPECT_TRUE(large.element_local());
 }
 
+TEST(FactorReuse, LargeDenseSystemsRefactoriseSooner) {
+  // A cylinder of 8 x 4 elements held at the bottom: 288 free DOFs, factored densely with a
+  // float copy of the factor. A stale solve of more than large_dense_refactor_after_iterations
+  // (3) leaves its factorisation pending, though it stays under refactor_after_iterations.
+  Mesh mesh = make_cylinder(0.5, 2.0, 0, 360, 8, 4, ElementType::quad8);
+  auto bottom = [](const double* x) { return x[1] < 1e-9; };
+  auto model = make_model(mesh, Material{}, 1.0, bottom);
+  std::vector<char> fixed;
+  fix_nodes(mesh, bottom, true, true, true, fixed);
+  const FreeDofSystem system(model->pattern(), fixed);
+  ASSERT_GE(system.size(), SparseCholesky::dense_single_precision_min_unknowns);
+  ASSERT_TRUE(SparseCholesky::factors_densely(system.size(), static_cast<std::int64_t>(system.row_index().size())));
+  std::vector<double> K, load(model->num_dofs(), 0.0);
+  model->assemble_stiffness(nullptr, K, nullptr);
+  const double g[3] = {0, -400, 0};
+  model->add_gravity(g, load);
+  // A_1 factorised; then A_2 = M + 2e-6 K, which the factor of A_1 = M + 1e-6 K solves in
+  // about 6 iterations.
+  for (int threshold : {FactorReuseOptions{}.large_dense_refactor_after_iterations, 12}) {
+    FactorReuseOptions options;
+    options.large_dense_refactor_after_iterations = threshold;
+    SparseCholesky cholesky;
+    FactorReusingSolver solver(model->pattern(), system, model->mass_blocks(), options);
+    std::vector<double> x(model->num_dofs(), 0.0);
+    solver.solve(ScaledBlockSum{1.0, &K, 1e-6}, load, x, cholesky);
+    std::fill(x.begin(), x.end(), 0.0);
+    solver.solve(ScaledBlockSum{1.0, &K, 2e-6}, load, x, cholesky);
+    const int iterations = solver.statistics().last_iterations;
+    ASSERT_GT(iterations, 3);
+    ASSERT_LE(iterations, options.refactor_after_iterations);
+    EXPECT_LE(solver.statistics().last_relative_residual, options.relative_tolerance);
+    EXPECT_EQ(solver.factorization_pending(), iterations > threshold) << "threshold " << threshold;
+  }
+}
+
 TEST(FactorReuse, FallsBackToTheWholePatternWhenElementLocalIsTooWeak) {
   // With one iteration allowed and an exact (double) preconditioner only a factor of A
   // itself converges: the element-local factor fails twice (stale, then fresh) and the
@@ -324,38 +359,3 @@ TEST(DeterministicDot, IsIndependentOfThreadCount) {
 }
 
 }  // namespace
-
-TEST(FactorReuse, LargeDenseSystemsRefactoriseSooner) {
-  // A cylinder of 8 x 4 elements held at the bottom: 288 free DOFs, factored densely with a
-  // float copy of the factor. A stale solve of more than large_dense_refactor_after_iterations
-  // (3) leaves its factorisation pending, though it stays under refactor_after_iterations.
-  Mesh mesh = make_cylinder(0.5, 2.0, 0, 360, 8, 4, ElementType::quad8);
-  auto bottom = [](const double* x) { return x[1] < 1e-9; };
-  auto model = make_model(mesh, Material{}, 1.0, bottom);
-  std::vector<char> fixed;
-  fix_nodes(mesh, bottom, true, true, true, fixed);
-  const FreeDofSystem system(model->pattern(), fixed);
-  ASSERT_GE(system.size(), SparseCholesky::dense_single_precision_min_unknowns);
-  ASSERT_TRUE(SparseCholesky::factors_densely(system.size(), static_cast<std::int64_t>(system.row_index().size())));
-  std::vector<double> K, load(model->num_dofs(), 0.0);
-  model->assemble_stiffness(nullptr, K, nullptr);
-  const double g[3] = {0, -400, 0};
-  model->add_gravity(g, load);
-  // A_1 factorised; then A_2 = M + 2e-6 K, which the factor of A_1 = M + 1e-6 K solves in
-  // about 6 iterations.
-  for (int threshold : {FactorReuseOptions{}.large_dense_refactor_after_iterations, 12}) {
-    FactorReuseOptions options;
-    options.large_dense_refactor_after_iterations = threshold;
-    SparseCholesky cholesky;
-    FactorReusingSolver solver(model->pattern(), system, model->mass_blocks(), options);
-    std::vector<double> x(model->num_dofs(), 0.0);
-    solver.solve(ScaledBlockSum{1.0, &K, 1e-6}, load, x, cholesky);
-    std::fill(x.begin(), x.end(), 0.0);
-    solver.solve(ScaledBlockSum{1.0, &K, 2e-6}, load, x, cholesky);
-    const int iterations = solver.statistics().last_iterations;
-    ASSERT_GT(iterations, 3);
-    ASSERT_LE(iterations, options.refactor_after_iterations);
-    EXPECT_LE(solver.statistics().last_relative_residual, options.relative_tolerance);
-    EXPECT_EQ(solver.factorization_pending(), iterations > threshold) << "threshold " << threshold;
-  }
-}

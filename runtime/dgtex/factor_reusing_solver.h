@@ -76,10 +76,10 @@ struct FactorReuseOptions {
   // unknowns, SparseCholesky::dense_single_precision_min_unknowns: the accordion's 450).
   // There an iteration reads K and L from the L3 cache (~2.4 MB, ~70 us), while the dense
   // factorisation (~1 ms) runs beside the next assembly. The accordion (200 steps, three
-  // runs of each, `dgtex bench scenes --scenes accordion`, 2-core machine): 3 gives 21
-  // factorisations + 565 iterations, solve 0.36-0.37 ms a step, against 1 + 945 and
-  // 0.48-0.49 ms with 12; the assembly 7.1 ms and the steps/s (126-128 against 120-127)
-  // unchanged. 4: 5 + 713, 0.44 ms; 2: 49 + 453, 0.38 ms.
+  // alternating runs of each, `dgtex bench scenes --scenes accordion`, 2-core machine): 3
+  // gives 21 factorisations + 565 iterations, solve 0.32-0.36 ms a step, against 1 + 945
+  // and 0.46-0.47 ms with 12; assembly 6.9-7.2 against 7.2-7.4 ms, CPU 11.6-12.0 against
+  // 12.6-13.1 ms a step. 4: 5 + 713, 0.44 ms; 2: 49 + 453, 0.38 ms.
   int large_dense_refactor_after_iterations = 3;
   int max_iterations = 40;            // beyond this, factorise the current system now
   // Apply the preconditioner with a float copy of L (SparseCholesky::solve_single_precision):
