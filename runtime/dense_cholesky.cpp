@@ -20,6 +20,7 @@ void DenseCholesky::set_pattern(int n, const std::vector<int>& column_start, con
   n_ = n;
   column_start_ = column_start;
   row_index_ = row_index;
+  single_factor_current_ = false;
 }
 
 namespace {
@@ -40,7 +41,7 @@ void DenseCholesky::fill_lower(const std::vector<double>& values) {
 void DenseCholesky::factorize(const std::vector<double>& values) {
   if (values.size() != row_index_.size())
     throw std::invalid_argument("SparseCholesky::factorize: value count does not match the pattern");
-  single_factor_.clear();  // it belonged to the previous factor
+  single_factor_current_ = false;  // it belonged to the previous factor
   fill_lower(values);
   int bad = -1;
   if (n_ >= lapack_min_unknowns) {
@@ -88,16 +89,16 @@ void DenseCholesky::solve(const std::vector<double>& b, std::vector<double>& x) 
 }
 
 void DenseCholesky::copy_factor_to_single_precision() {
-  single_factor_.clear();
   if (n_ < SparseCholesky::dense_single_precision_min_unknowns) return;
-  single_factor_.resize(static_cast<std::size_t>(n_) * n_);
+  single_factor_.resize(static_cast<std::size_t>(n_) * n_);  // allocated once, kept between factors
   for (int j = 0; j < n_; ++j)
     for (int i = j; i < n_; ++i)
       single_factor_[static_cast<std::size_t>(j) * n_ + i] = static_cast<float>(factor_(i, j));
+  single_factor_current_ = true;
 }
 
 void DenseCholesky::solve_single_precision(const std::vector<double>& b, std::vector<double>& x) const {
-  if (single_factor_.empty()) return solve(b, x);
+  if (!single_factor_current_) return solve(b, x);
   x.assign(b.begin(), b.begin() + n_);
   kernels::dense_cholesky_solve(n_, single_factor_.data(), x.data());
 }

@@ -41,7 +41,8 @@ class DenseCholesky {
   int n_ = 0;
   std::vector<int> column_start_, row_index_;
   Eigen::MatrixXd factor_;  // the lower triangle of A, then its Cholesky factor L
-  std::vector<float> single_factor_;  // L's lower triangle in float (same layout), if current
+  std::vector<float> single_factor_;  // L's lower triangle in float (same layout; upper unused)
+  bool single_factor_current_ = false;  // single_factor_ holds the current factor
   void fill_lower(const std::vector<double>& values);  // factor_ = the lower triangle of A
 };
 
