@@ -51,6 +51,29 @@ struct CylinderSystem {
   CylinderSystem() : system(c.model->pattern(), c.fixed) { c.model->assemble_stiffness(nullptr, K, nullptr); }
 };
 
+// A cylinder of `around` x `high` quad8 elements clamped at the bottom, and its free-DOF
+// system (at the sizes used here, small enough to be factored densely).
+struct BottomHeldCylinder {
+  static bool bottom(const double* x) { return x[1] < 1e-9; }
+  static std::vector<char> bottom_fixed(const Mesh& mesh) {
+    std::vector<char> fixed;
+    fix_nodes(mesh, bottom, true, true, true, fixed);
+    return fixed;
+  }
+  Mesh mesh;
+  std::unique_ptr<ShellModel> model;
+  std::vector<char> fixed;
+  FreeDofSystem system;
+  BottomHeldCylinder(int around, int high)
+      : mesh(make_cylinder(0.5, 2.0, 0, 360, around, high, ElementType::quad8)),
+        model(make_model(mesh, Material{}, 1.0, bottom)),
+        fixed(bottom_fixed(mesh)),
+        system(model->pattern(), fixed) {}
+  bool factored_densely() const {
+    return SparseCholesky::factors_densely(system.size(), static_cast<std::int64_t>(system.row_index().size()));
+  }
+};
+
 double norm_free(const std::vector<double>& v, const std::vector<char>& fixed) {
   double s = 0;
   for (size_t d = 0; d < v.size(); ++d)
@@ -267,16 +290,11 @@ TEST(FactorReuse, ASystemFactoredDenselyUsesTheWholePattern) {
   // an element-local factor would be no smaller, only a weaker preconditioner. The
   // compressed cylinder above (10 x 6 elements, factored sparse) keeps the element-local
   // default.
-  Mesh mesh = make_cylinder(0.5, 2.0, 0, 360, 4, 2, ElementType::quad8);
-  auto bottom = [](const double* x) { return x[1] < 1e-9; };
-  auto model = make_model(mesh, Material{}, 1.0, bottom);
-  std::vector<char> fixed;
-  fix_nodes(mesh, bottom, true, true, true, fixed);
-  const FreeDofSystem system(model->pattern(), fixed);
-  ASSERT_TRUE(SparseCholesky::factors_densely(system.size(), static_cast<std::int64_t>(system.row_index().size())));
-  const std::vector<char> kept = element_local_blocks(model->mass_blocks());
+  const BottomHeldCylinder c(4, 2);
+  ASSERT_TRUE(c.factored_densely());
+  const std::vector<char> kept = element_local_blocks(c.model->mass_blocks());
   ASSERT_NE(std::count(kept.begin(), kept.end(), 0), 0) << "the element-local pattern must differ";
-  const FactorReusingSolver small(model->pattern(), system, model->mass_blocks());
+  const FactorReusingSolver small(c.model->pattern(), c.system, c.model->mass_blocks());
   EXPECT_FALSE(small.element_local());
 
   CylinderSystem cylinder;
@@ -290,26 +308,21 @@ TEST(FactorReuse, LargeDenseSystemsRefactoriseSooner) {
   // A cylinder of 8 x 4 elements held at the bottom: 288 free DOFs, factored densely with a
   // float copy of the factor. A stale solve of more than large_dense_refactor_after_iterations
   // (3) leaves its factorisation pending, though it stays under refactor_after_iterations.
-  Mesh mesh = make_cylinder(0.5, 2.0, 0, 360, 8, 4, ElementType::quad8);
-  auto bottom = [](const double* x) { return x[1] < 1e-9; };
-  auto model = make_model(mesh, Material{}, 1.0, bottom);
-  std::vector<char> fixed;
-  fix_nodes(mesh, bottom, true, true, true, fixed);
-  const FreeDofSystem system(model->pattern(), fixed);
-  ASSERT_GE(system.size(), SparseCholesky::dense_single_precision_min_unknowns);
-  ASSERT_TRUE(SparseCholesky::factors_densely(system.size(), static_cast<std::int64_t>(system.row_index().size())));
-  std::vector<double> K, load(model->num_dofs(), 0.0);
-  model->assemble_stiffness(nullptr, K, nullptr);
+  const BottomHeldCylinder c(8, 4);
+  ASSERT_GE(c.system.size(), SparseCholesky::dense_single_precision_min_unknowns);
+  ASSERT_TRUE(c.factored_densely());
+  std::vector<double> K, load(c.model->num_dofs(), 0.0);
+  c.model->assemble_stiffness(nullptr, K, nullptr);
   const double g[3] = {0, -400, 0};
-  model->add_gravity(g, load);
+  c.model->add_gravity(g, load);
   // A_1 factorised; then A_2 = M + 2e-6 K, which the factor of A_1 = M + 1e-6 K solves in
   // about 6 iterations.
   for (int threshold : {FactorReuseOptions{}.large_dense_refactor_after_iterations, 12}) {
     FactorReuseOptions options;
     options.large_dense_refactor_after_iterations = threshold;
     SparseCholesky cholesky;
-    FactorReusingSolver solver(model->pattern(), system, model->mass_blocks(), options);
-    std::vector<double> x(model->num_dofs(), 0.0);
+    FactorReusingSolver solver(c.model->pattern(), c.system, c.model->mass_blocks(), options);
+    std::vector<double> x(c.model->num_dofs(), 0.0);
     solver.solve(ScaledBlockSum{1.0, &K, 1e-6}, load, x, cholesky);
     std::fill(x.begin(), x.end(), 0.0);
     solver.solve(ScaledBlockSum{1.0, &K, 2e-6}, load, x, cholesky);
