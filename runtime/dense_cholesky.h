@@ -26,11 +26,12 @@ class DenseCholesky {
   void factorize(const std::vector<double>& values);
   void solve(const std::vector<double>& b, std::vector<double>& x) const;
   // From SparseCholesky::dense_single_precision_min_unknowns (256) on, a float copy of L
-  // for solve_single_precision() (the preconditioner): the accordion's 450-unknown factor, 0.8 MB of lower triangle in
-  // double, no longer stays in a 1 MB L2 cache beside K between the two sweeps. Smaller
-  // factors keep solving in double: there a fresh factor solves the system in one PCG
-  // iteration, a float copy in two (spiral6 and the slinky: 958 -> 1132 and 862 -> 1061
-  // iterations over their runs in session 25, when every dense factor had a float copy).
+  // for solve_single_precision() (the preconditioner): the accordion's 450-unknown factor,
+  // 0.8 MB of lower triangle in double, no longer stays in a 1 MB L2 cache beside K
+  // between the two sweeps. Smaller factors keep solving in double: there a fresh factor
+  // solves the system in one PCG iteration, a float copy in two (spiral6 and the slinky:
+  // 958 -> 1132 and 862 -> 1061 iterations over their runs in session 25, when every dense
+  // factor had a float copy).
   void copy_factor_to_single_precision();
   // x ~= A^-1 b with the float copy where copy_factor_to_single_precision() made one for
   // the current factor, solve() otherwise.

@@ -140,7 +140,10 @@ TEST(DenseCholesky, LargeFactorsPreconditionWithAFloatCopyOfTheCurrentFactor) {
   c.copy_factor_to_single_precision();
   c.solve_single_precision(b, y);
   double largest = 0, difference = 0;
-  for (int i = 0; i < n; ++i) largest = std::max(largest, std::abs(x[i])), difference = std::max(difference, std::abs(y[i] - x[i]));
+  for (int i = 0; i < n; ++i) {
+    largest = std::max(largest, std::abs(x[i]));
+    difference = std::max(difference, std::abs(y[i] - x[i]));
+  }
   EXPECT_NE(x, y);  // the float copy is used
   EXPECT_LE(difference, 1e-6 * largest);  // float's rounding of L (a well-conditioned matrix)
   // A new factorisation drops the copy: until the next copy, the double factor is used.

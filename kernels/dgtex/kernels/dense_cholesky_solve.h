@@ -8,9 +8,10 @@
 // contraction, lanes never mix): forward, column by column, y_j = y_j / L_jj and then
 // y_i = y_i - L_ij y_j for i > j (the paths take 8 columns per pass over y, each entry
 // still updated in column order: one load and store of y_i per 8 columns); backward,
-// from the last column, x_j = (y_j - d_j) / L_jj with d_j = sum_{i > j} L_ij x_i summed in 8 lanes (term q = i - j - 1 in lane q mod 8,
-// each lane in order of q from 0), the lanes added as l + 4, then l + 2, l + 1 (8 lanes,
-// not 16: in the scenes the sweeps wait on memory, and 16 cost more on short columns).
+// from the last column, x_j = (y_j - d_j) / L_jj with d_j = sum_{i > j} L_ij x_i summed
+// in 8 lanes (term q = i - j - 1 in lane q mod 8, each lane in order of q from 0), the
+// lanes added as l + 4, then l + 2, l + 1 (8 lanes, not 16: in the scenes the sweeps wait
+// on memory, and 16 cost more on short columns).
 // Both sweeps read the same columns, so the backward one finds much of L still in cache
 // (a transposed copy for column updates there was faster alone but slower in the scenes:
 // twice the memory). Why its own loops: Eigen's triangular solves in this baseline x86-64
