@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <cstdlib>
 #include <cstring>
+#include <limits>
 #include <strings.h>
 #include <type_traits>
 
@@ -240,6 +241,7 @@ struct LaplaceMultigrid::Hierarchy {
   bool robust_coarse_solve() const { return options.coarse_solve_tolerance > 0 && levels.size() > 2; }
   int orphans_at_stop = 0;
   double setup_ms = 0;
+  bool coarse_levels_built = false;
   bool float_cycle = false;  // levels >= 1 of the preconditioner in float (single_precision_min_texels)
 
   Execution execution_for(GridShape shape) const {
@@ -247,7 +249,8 @@ struct LaplaceMultigrid::Hierarchy {
                ? Execution::parallel : Execution::serial;
   }
 
-  void build(const kernels::TexelTile& tile) {
+  // Level 0: the texels' operator bits and the solve's vectors.
+  void build_fine(const kernels::TexelTile& tile) {
     width = tile.width;
     height = tile.height;
     tile_flags = tile.flags;
@@ -268,12 +271,26 @@ struct LaplaceMultigrid::Hierarchy {
     // The solve's first pass writes every level-0 entry (frame_zeroed_buffer).
     for (auto* v : {&fine.x, &fine.b, &fine.r}) *v = frame_buffer(fine.shape);
     levels.clear();
+    // Room for every coarse level (each halves a dimension of at most 2^31): solve() holds a
+    // reference to level 0 while it has the coarse levels built.
+    levels.reserve(std::numeric_limits<int>::digits + 2);
     levels.push_back(std::move(fine));
     float_cycle = static_cast<long>(width) * height >= options.single_precision_min_texels &&
                   options.use_as_cg_preconditioner &&
                   options.coarse_solve_tolerance == 0 &&
                   options.pre_smoothing > 0 && options.post_smoothing > 0;
+  }
 
+  // The coarse levels, the coarsest factor and the CG vectors, once (setup_ms grows by their time).
+  void ensure_coarse_levels() {
+    if (coarse_levels_built) return;
+    const auto start = Clock::now();
+    build_coarse_levels();
+    coarse_levels_built = true;
+    setup_ms += ms_since(start);
+  }
+
+  void build_coarse_levels() {
     while (static_cast<long>(levels.back().shape.nx) * levels.back().shape.ny > options.coarsest_nodes &&
            (levels.back().shape.nx > 1 || levels.back().shape.ny > 1)) {
       const std::size_t l = levels.size() - 1;
@@ -668,7 +685,8 @@ struct LaplaceMultigrid::Hierarchy {
   double dot(const MultigridBuffer& a, const MultigridBuffer& b) { return dot_on(0, a, b, row_partial); }
 };
 
-LaplaceMultigrid::LaplaceMultigrid(const kernels::TexelTile& tile, LaplaceMultigridOptions options)
+LaplaceMultigrid::LaplaceMultigrid(const kernels::TexelTile& tile, LaplaceMultigridOptions options,
+                                   CoarseLevels coarse_levels)
     : hierarchy_(std::make_unique<Hierarchy>()) {
   const auto start = Clock::now();
   validate_laplace_tile(tile);
@@ -684,8 +702,9 @@ LaplaceMultigrid::LaplaceMultigrid(const kernels::TexelTile& tile, LaplaceMultig
         "Laplace multigrid: a CG preconditioner must be symmetric: use V-cycles with pre_smoothing == post_smoothing "
         "(got " + std::to_string(options.pre_smoothing) + " and " + std::to_string(options.post_smoothing) + ")");
   hierarchy_->options = options;
-  hierarchy_->build(tile);
+  hierarchy_->build_fine(tile);
   hierarchy_->setup_ms = ms_since(start);
+  if (coarse_levels == CoarseLevels::at_construction) hierarchy_->ensure_coarse_levels();
 }
 
 LaplaceMultigrid::~LaplaceMultigrid() = default;
@@ -774,6 +793,7 @@ LaplaceSolveStats LaplaceMultigrid::solve(kernels::TexelTile& tile, std::vector<
   if (b_norm > 0) {
     double relative = zero_guess ? 1.0 : h.level0_residual_norm() / b_norm;  // r = b for x = 0
     record(relative);
+    if (relative > o.tolerance) h.ensure_coarse_levels();
     if (!o.use_as_cg_preconditioner) {
       while (relative > o.tolerance && stats.iterations < o.max_cycles) {
         h.cycle(0, o.cycle, false);
@@ -893,6 +913,7 @@ void LaplaceMultigrid::precondition(const std::vector<double>& r, std::vector<do
   if (r.size() != texels)
     throw std::invalid_argument("LaplaceMultigrid::precondition: " + std::to_string(r.size()) + " values for a " +
                                 std::to_string(h.width) + "x" + std::to_string(h.height) + " tile");
+  h.ensure_coarse_levels();
   if (!h.options.use_as_cg_preconditioner || h.robust_coarse_solve())
     throw std::logic_error("LaplaceMultigrid::precondition needs use_as_cg_preconditioner and the plain cycle "
                            "(coarse_solve_tolerance = 0): only then is M a fixed symmetric operator");
@@ -928,7 +949,7 @@ void LaplaceMultigrid::precondition(const std::vector<double>& r, std::vector<do
 LaplaceSolveStats solve_laplace_multigrid(kernels::TexelTile& tile, const LaplaceMultigridOptions& options,
                                           std::vector<LaplaceConvergencePoint>* history) {
   const auto start = Clock::now();
-  LaplaceMultigrid multigrid(tile, options);
+  LaplaceMultigrid multigrid(tile, options, LaplaceMultigrid::CoarseLevels::on_demand);
   LaplaceSolveStats stats = multigrid.solve(tile, history);
   stats.ms = ms_since(start);
   return stats;

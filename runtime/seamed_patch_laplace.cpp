@@ -90,7 +90,10 @@ LaplaceSolveStats solve_seamed_patch_laplace(kernels::TexelTile& tile, const std
       bits[at(t)] = b | static_cast<std::uint8_t>(degree << kernels::degree_shift);
     }
   }
-  LaplaceMultigrid chain(pinned, options);
+  // Coarse levels and the strip factor only once a solve needs them (below): a warm start
+  // that meets the tolerance already (a settled enrichment solved again for a new wall
+  // elsewhere) needs neither.
+  LaplaceMultigrid chain(pinned, options, LaplaceMultigrid::CoarseLevels::on_demand);
   std::vector<char> unknown(n, 0);
   for (int t = 0; t < n; ++t) {
     unknown[t] = (bits[at(t)] & kernels::is_unknown) != 0;
@@ -184,7 +187,8 @@ LaplaceSolveStats solve_seamed_patch_laplace(kernels::TexelTile& tile, const std
   // Slinky's step-17 ring from x = 0: 34 -> 14 iterations.
   std::vector<std::int64_t> strip;  // padded indices, ordered for a narrow band
   BandedCholesky strip_factor;
-  {
+  Eigen::VectorXd strip_r, strip_z;
+  const auto factor_strip = [&] {
     std::vector<char> in_strip(padded, 0);
     for (const std::int64_t k : seam_texel) {
       const int i = static_cast<int>(k % g.stride()) - 1, j = static_cast<int>(k / g.stride()) - 1;
@@ -237,8 +241,8 @@ LaplaceSolveStats solve_seamed_patch_laplace(kernels::TexelTile& tile, const std
     const bool use_rows = BandedCholesky::bandwidth(rows_block) <= BandedCholesky::bandwidth(columns_block);
     strip = use_rows ? by_rows : by_columns;
     if (!strip_factor.factorize(use_rows ? rows_block : columns_block)) strip.clear();  // (SPD: not expected)
-  }
-  Eigen::VectorXd strip_r(static_cast<Eigen::Index>(strip.size())), strip_z;
+    strip_r.resize(static_cast<Eigen::Index>(strip.size()));
+  };
   // z[strip] += D^-1 v[strip].
   const auto strip_solve = [&](const std::vector<double>& v) {
     for (std::size_t m = 0; m < strip.size(); ++m) strip_r[static_cast<Eigen::Index>(m)] = v[strip[m]];
@@ -320,6 +324,7 @@ LaplaceSolveStats solve_seamed_patch_laplace(kernels::TexelTile& tile, const std
     }
   }
   if (relative > options.tolerance) {
+    factor_strip();
     double rz = precondition();
     p = z;
     double pq = apply_and_dot(p, q);

@@ -5,9 +5,9 @@
 // coarse levels that keep cuts as walls, a dense (small), band (narrow) or CHOLMOD (large)
 // Cholesky on the coarsest level, used as V/F-cycles or as the preconditioner of conjugate
 // gradients (the default: see laplace_multigrid.cpp for the measurements behind it).
-// LaplaceMultigrid owns its level hierarchy (built from the tile at construction, no
-// reference kept to it). Not thread-safe per instance; solve() uses all OpenMP threads.
-// Values dimensionless, times in ms.
+// LaplaceMultigrid owns its level hierarchy (built from the tile at construction, the
+// coarse levels then or on demand; no reference kept to the tile). Not thread-safe per
+// instance; solve() uses all OpenMP threads. Values dimensionless, times in ms.
 #include <memory>
 #include <vector>
 
@@ -59,7 +59,13 @@ struct LaplaceConvergencePoint {
 // solve() may be called repeatedly with new Dirichlet values / warm starts.
 class LaplaceMultigrid {
  public:
-  explicit LaplaceMultigrid(const kernels::TexelTile& tile, LaplaceMultigridOptions options = {});
+  // When the coarse levels are built: with the level-0 operator at construction, or by the
+  // first solve() or precondition() that needs them. A solve whose warm start already meets
+  // the tolerance needs none: an enrichment solved again because a wall appeared elsewhere in
+  // its elements often is one (the slinky: 421 of its 1,232 multigrid solves).
+  enum class CoarseLevels { at_construction, on_demand };
+  explicit LaplaceMultigrid(const kernels::TexelTile& tile, LaplaceMultigridOptions options = {},
+                            CoarseLevels coarse_levels = CoarseLevels::at_construction);
   ~LaplaceMultigrid();
   LaplaceMultigrid(LaplaceMultigrid&&) noexcept;
   LaplaceMultigrid& operator=(LaplaceMultigrid&&) noexcept;
@@ -80,8 +86,8 @@ class LaplaceMultigrid {
   // Whether texel t (tile.index(i, j)) is an unknown of the hierarchy.
   bool is_unknown(int t) const;
 
-  int level_count() const;
-  double setup_ms() const;
+  int level_count() const;  // the levels built so far
+  double setup_ms() const;   // the setup so far (with on-demand coarse levels, theirs once built)
   const LaplaceMultigridOptions& options() const;
 
  private:
@@ -89,7 +95,7 @@ class LaplaceMultigrid {
   std::unique_ptr<Hierarchy> hierarchy_;
 };
 
-// Setup + solve in one call (stats.ms includes the setup).
+// Setup + solve in one call (stats.ms includes the setup; coarse levels on demand).
 LaplaceSolveStats solve_laplace_multigrid(kernels::TexelTile& tile, const LaplaceMultigridOptions& options = {},
                                           std::vector<LaplaceConvergencePoint>* history = nullptr);
 
