@@ -22,8 +22,7 @@ bool same_bits(const std::vector<double>& a, const std::vector<double>& b) {
   return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(double)) == 0;
 }
 
-// The spiral domain solved once, then given a new wall far from most of the field: the old
-// solution is the warm start of a solve that needs a few iterations.
+// The spiral domain, solved to the default tolerance.
 TexelTile solved_spiral() {
   TexelTile tile = make_laplace_domain(LaplaceDomain::spiral, 128);
   solve_laplace_multigrid(tile);
@@ -47,8 +46,9 @@ TEST(MultigridCoarseLevelsOnDemand, ConvergedWarmStartBuildsNoCoarseLevelAndKeep
 }
 
 TEST(MultigridCoarseLevelsOnDemand, SolvesThatIterateGiveTheBitsOfAWholeHierarchy) {
+  // A new wall: the old field becomes a warm start that needs a few iterations.
   TexelTile changed = solved_spiral();
-  add_vertical_wall(changed, 100, 10, 40);  // the old field is now a warm start, not a solution
+  add_vertical_wall(changed, 100, 10, 40);
   for (const bool warm : {true, false}) {
     LaplaceMultigridOptions options;
     options.warm_start = warm;
