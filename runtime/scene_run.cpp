@@ -142,13 +142,14 @@ void SceneRun::change_basis(std::vector<EnrichmentFunction> functions, int edge_
   // that depends on them); the old one stays alive for the projection.
   auto next = std::make_unique<ShellModel>(*model_);
   next->set_cut_edge_texels(edge_resolution, std::move(edge_flags));
-  next->keep_basis_values();  // for the projection's moments, released right after them
+  // The new basis's values at its quadrature points: for this projection's moments, and kept
+  // for the next one, which reads them where the two bases share points.
+  next->keep_basis_values();
   next->set_enrichments(std::move(functions));
   std::vector<char> fixed = scene_fixed_dofs(scene_, *next);
   std::vector<double> force = scene_external_force(scene_, *next);
   ProjectedState projected =
       project_onto_basis(*model_, simulation_->displacement(), simulation_->velocity(), *next, fixed);
-  next->release_basis_values();
   auto simulation = std::make_unique<ShellSimulation>(*next, std::move(fixed), std::move(force));
   // Once an element-local preconditioner has failed (its matrix not positive definite, or
   // too weak), the next bases, much like this one, get the whole pattern from the start

@@ -1,12 +1,14 @@
 #include "dgtex/shell_model.h"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <cstring>
 #include <stdexcept>
 #include <string>
 
 #include <Eigen/Dense>
+#include <omp.h>
 
 #include "dgtex/kernels/enriched_element_rest_integrals.h"
 #include "dgtex/kernels/polar_decomposition.h"
@@ -14,6 +16,7 @@
 #include "dgtex/mesh_validation.h"
 #include "dgtex/model_error.h"
 #include "multigrid_buffer.h"
+#include "parametric_point_index.h"
 
 namespace dgtex {
 
@@ -1063,7 +1066,8 @@ int ShellModel::basis_values_at(int element, const double xi[2], const kernels::
 }
 
 std::vector<std::vector<double>> ShellModel::moments_of_fields(const ShellModel& source,
-                                                               const std::vector<const std::vector<double>*>& fields) const {
+                                                               const std::vector<const std::vector<double>*>& fields,
+                                                               std::int64_t* points_read_from_source) const {
   if (source.mesh_.num_nodes() != mesh_.num_nodes() || source.mesh_.num_elements() != mesh_.num_elements())
     throw std::invalid_argument("moments_of_fields: the source model has another mesh (" +
                                 std::to_string(source.mesh_.num_elements()) + " elements, this one " +
@@ -1080,14 +1084,15 @@ std::vector<std::vector<double>> ShellModel::moments_of_fields(const ShellModel&
   constexpr std::int64_t block = kernels::rest_integral_block_points;
   constexpr std::int64_t span = 16 * block;
   // Per point of a span: w, this basis's values and every field's value there, evaluated in
-  // parallel (fixed blocks); then w N_A g_c added serially in point order: exactly the sums
-  // of mass_weighted_moments with g = source.interpolate. Every point of an element has the
+  // parallel (fixed blocks); then w N_A g_c added in point order: exactly the sums of
+  // mass_weighted_moments with g = source.interpolate. Every point of an element has the
   // same basis (its element's global nodes), so the span's first point records them.
   const int per_point = 1 + stride + 3 * nf;
   std::vector<int> global(stride);
   int basis_count = 0;
   std::vector<double> data(static_cast<size_t>(span) * per_point);
-  std::vector<double> local(3 * static_cast<size_t>(stride));
+  std::vector<double> local(3 * static_cast<size_t>(stride) * nf);  // the sums of one element's span
+  std::atomic<std::int64_t> read_from_source{0};
   for (int e = 0; e < mesh_.num_elements(); ++e) {
     const int index = enriched_index_.empty() ? -1 : enriched_index_[e];
     const int textured = textured_index_.empty() ? -1 : textured_index_[e];
@@ -1110,12 +1115,29 @@ std::vector<std::vector<double>> ShellModel::moments_of_fields(const ShellModel&
       basis_count = kernels::enriched_basis_count(enriched_element_batch(), index);
       std::copy_n(enriched_global_nodes_.begin() + static_cast<std::ptrdiff_t>(index) * width_, basis_count, global.begin());
     }
+    // The source basis's values kept by the source (keep_basis_values), at its points: read
+    // where a point of this element is one of them (most points, between two bases of a
+    // progressive cut), evaluated elsewhere; the same bits either way.
+    const int source_index = source.enriched_index_.empty() ? -1 : source.enriched_index_[e];
+    const ElementIntegrals* source_owner =
+        index >= 0 && source_index >= 0 && source.has_kept_basis_values(e) ? source.kept_.owner[e].get() : nullptr;
+    const double* source_kept = nullptr;
+    const int* source_kept_global = nullptr;
+    detail::ParametricPointIndex source_points;
+    if (source_owner &&
+        source_owner->count == kernels::enriched_basis_count(source.enriched_element_batch(), source_index)) {
+      source_kept = source.kept_.values.get() + source.kept_.start[e] * source.kept_.width;
+      source_kept_global = source.enriched_global_nodes_.data() + static_cast<std::ptrdiff_t>(source_index) * source.width_;
+      source_points = detail::ParametricPointIndex(source_owner->points.data(),
+                                                   static_cast<std::int64_t>(source_owner->points.size() / 3));
+    }
     for (std::int64_t begin = 0; begin < total; begin += span) {
       const std::int64_t count = std::min(span, total - begin);
       auto evaluate = [&](std::int64_t item) {
         TexelCache cache, source_cache;
         int source_global[kernels::max_enriched_basis], unused_global[kernels::max_enriched_basis];
         double source_values[kernels::max_enriched_basis];
+        std::int64_t read = 0, next_source_point = -1;
         for (std::int64_t p = item * block; p < std::min(count, (item + 1) * block); ++p) {
           double xi[2], weight;
           const kernels::ShellSection& section = point(first + begin + p, xi, weight);
@@ -1124,7 +1146,18 @@ std::vector<std::vector<double>> ShellModel::moments_of_fields(const ShellModel&
           double* d = data.data() + p * per_point;
           d[0] = weight * kernels::rest_area_factor(shape, mesh_.element_nodes(e), mesh_.positions.data()) *
                  section.density * section.thickness;
-          const int m = source.basis_values_at(e, xi, shape, source_cache, source_global, source_values);
+          const std::int64_t at = source_kept ? source_points.find(xi[0], xi[1], next_source_point) : -1;
+          next_source_point = at >= 0 ? at + 1 : -1;
+          int m;
+          const int* g;
+          const double* values;
+          if (at >= 0) {
+            m = source_owner->count, g = source_kept_global, values = source_kept + at * source.kept_.width;
+            ++read;
+          } else {
+            m = source.basis_values_at(e, xi, shape, source_cache, source_global, source_values);
+            g = source_global, values = source_values;
+          }
           if (!kept) {
             const int n = basis_values_at(e, xi, shape, cache, p == 0 ? global.data() : unused_global, d + 1);
             if (p == 0) basis_count = n;
@@ -1134,34 +1167,47 @@ std::vector<std::vector<double>> ShellModel::moments_of_fields(const ShellModel&
             double* value = d + 1 + stride + 3 * f;
             value[0] = value[1] = value[2] = 0;
             for (int a = 0; a < m; ++a)
-              for (int c = 0; c < 3; ++c) value[c] += source_values[a] * u[3 * source_global[a] + c];
+              for (int c = 0; c < 3; ++c) value[c] += values[a] * u[3 * g[a] + c];
           }
         }
+        if (read > 0) read_from_source += read;
       };
       // Plain elements have a handful of points: no parallel region for them.
-      kernels::forall((count + block - 1) / block, evaluate,
-                      count > block ? kernels::Execution::parallel : kernels::Execution::serial);
-      // The element's global nodes are distinct, so each field's sums run in a local copy,
-      // point after point: the same additions in the same order as adding into out
-      // directly, without the scattered stores (2x faster).
-      const int m = basis_count;
-      for (int f = 0; f < nf; ++f) {
-        double* o = out[f].data();
-        for (int a = 0; a < m; ++a)
-          for (int c = 0; c < 3; ++c) local[3 * a + c] = o[3 * global[a] + c];
+      const bool parallel = count > block;
+      const std::int64_t slices = parallel ? std::max(1, omp_get_max_threads()) : 1;
+      // Then w N_A g_c summed per basis function: each of `slices` items takes a run of the
+      // element's basis functions (its global nodes are distinct) and adds, for every field,
+      // point after point into a local copy of their sums: the same additions in the same
+      // order as the serial loop, so the bits do not depend on the slices (one per thread:
+      // each reads the span's values once), and no scattered stores (2x faster).
+      auto accumulate = [&](std::int64_t slice) {
+        const int m = basis_count;
+        const int a_begin = static_cast<int>(slice * m / slices), a_end = static_cast<int>((slice + 1) * m / slices);
+        double* sums = local.data() + static_cast<std::ptrdiff_t>(3 * a_begin) * nf;
+        const int run = 3 * (a_end - a_begin);
+        for (int f = 0; f < nf; ++f)
+          for (int a = a_begin; a < a_end; ++a)
+            for (int c = 0; c < 3; ++c) sums[f * run + 3 * (a - a_begin) + c] = out[f][3 * global[a] + c];
         for (std::int64_t p = 0; p < count; ++p) {
           const double* d = data.data() + p * per_point;
           const double w = d[0];
-          const double* values = kept ? kept + (begin + p) * kept_.width : d + 1;
-          const double* value = d + 1 + stride + 3 * f;
-          for (int a = 0; a < m; ++a)
-            for (int c = 0; c < 3; ++c) local[3 * a + c] += w * values[a] * value[c];
+          const double* values = (kept ? kept + (begin + p) * kept_.width : d + 1) + a_begin;
+          for (int f = 0; f < nf; ++f) {
+            const double* value = d + 1 + stride + 3 * f;
+            double* into = sums + f * run;
+            for (int a = 0; a < a_end - a_begin; ++a)
+              for (int c = 0; c < 3; ++c) into[3 * a + c] += w * values[a] * value[c];
+          }
         }
-        for (int a = 0; a < m; ++a)
-          for (int c = 0; c < 3; ++c) o[3 * global[a] + c] = local[3 * a + c];
-      }
+        for (int f = 0; f < nf; ++f)
+          for (int a = a_begin; a < a_end; ++a)
+            for (int c = 0; c < 3; ++c) out[f][3 * global[a] + c] = sums[f * run + 3 * (a - a_begin) + c];
+      };
+      kernels::forall_then((count + block - 1) / block, evaluate, slices, accumulate,
+                           parallel ? kernels::Execution::parallel : kernels::Execution::serial);
     }
   }
+  if (points_read_from_source) *points_read_from_source = read_from_source;
   return out;
 }
 

@@ -13,6 +13,7 @@
 // standard ones. Without enrichments everything is exactly the plain DG shell.
 // Units: those of the scene.
 // Keeps no reference to the topology or sections it was built from.
+#include <cstdint>
 #include <functional>
 #include <memory>
 #include <vector>
@@ -113,10 +114,12 @@ class ShellModel {
   // For a model about to receive a basis change: from the next set_enrichments on, keep the
   // new basis's values at the enriched elements' quadrature points as the mass integration
   // evaluates them, so that moments_of_fields on this model reads them instead of evaluating
-  // the basis a second time (the same bits). Elements whose integrals a rebuild reuses from
-  // another set_enrichments call have none kept and are evaluated as before. Memory: points
-  // x width() doubles (spiral6 at the end of its cut: ~8 MB) until release_basis_values(),
-  // which also stops the keeping.
+  // the basis a second time (the same bits), and so does moments_of_fields of a later basis
+  // projecting from this one, at the points the two bases share. Elements whose integrals a
+  // rebuild reuses from another set_enrichments call have none kept and are evaluated as
+  // before. Memory: points x width() doubles (spiral6 at the end of its cut: ~11 MB, the
+  // slinky ~21 MB) until the next set_enrichments or release_basis_values(), which also
+  // stops the keeping.
   void keep_basis_values() { keep_basis_values_ = true; }
   void release_basis_values() {
     keep_basis_values_ = false;
@@ -181,10 +184,14 @@ class ShellModel {
   // out[f] = mass_weighted_moments(g_f) with g_f = source.interpolate(*fields[f], ...),
   // bitwise equal to those calls (same arithmetic and order), but every basis is evaluated
   // once per quadrature point for all fields, and texel derivatives are reused while
-  // consecutive points lie in one texel. The right-hand sides of the projection of a state
-  // onto this basis (basis_projection.h).
+  // consecutive points lie in one texel. Where `source` kept its basis values
+  // (keep_basis_values) and a point of this basis is one of the source's points (bitwise
+  // the same coordinates in the same element), the source's values there are read instead
+  // of evaluated; `points_read_from_source`, if given, receives how many points were. The
+  // right-hand sides of the projection of a state onto this basis (basis_projection.h).
   std::vector<std::vector<double>> moments_of_fields(const ShellModel& source,
-                                                     const std::vector<const std::vector<double>*>& fields) const;
+                                                     const std::vector<const std::vector<double>*>& fields,
+                                                     std::int64_t* points_read_from_source = nullptr) const;
 
   // Displacement at a parametric point of an element (enriched functions included).
   void interpolate(const std::vector<double>& u, int element, const double xi[2], double out[3]) const;
