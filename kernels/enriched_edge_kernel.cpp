@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <memory>
+#include <stdexcept>
+#include <string>
 #include <cmath>
 #include <vector>
 
@@ -60,6 +62,43 @@ void side_global_nodes(const EnrichedEdgeBatch& b, int element, int* out) {
   for (int a = 0; a < W; ++a) out[a] = a < npe ? b.connectivity[static_cast<std::int64_t>(element) * npe + a] : -1;
 }
 
+
+// One side of an edge point as the stiffness passes read it: its rest frame and tangent and
+// the first derivatives of its local basis, from a Side just evaluated or from the records
+// of enriched_edge_rest_sides (the same numbers).
+struct SideView {
+  int count = 0;
+  const double* tangent = nullptr;  // [3]
+  const double* t0 = nullptr;       // [3]
+  const double* a1 = nullptr;       // [3]
+  const double* a2 = nullptr;       // [3]
+  double j0 = 0;
+  const double* dxi_dt = nullptr;   // [2]
+  const double* dN = nullptr;       // count x 2
+};
+
+SideView view_of(const Side& s) {
+  return {s.shape.count, s.tangent, s.point.t0, s.point.a1, s.point.a2, s.point.j0, s.dxi_dt, &s.shape.dN[0][0]};
+}
+
+// A side's record in EnrichedEdgeRestSides::data: tangent, t0, a1, a2 (3 each), j0,
+// dxi_dt (2), then dN (count x 2).
+constexpr int side_record_head = 15;
+int side_record_size(int count) { return side_record_head + 2 * count; }
+
+void write_side_record(const Side& s, double* out) {
+  std::copy_n(s.tangent, 3, out);
+  std::copy_n(s.point.t0, 3, out + 3);
+  std::copy_n(s.point.a1, 3, out + 6);
+  std::copy_n(s.point.a2, 3, out + 9);
+  out[12] = s.point.j0;
+  std::copy_n(s.dxi_dt, 2, out + 13);
+  std::copy_n(&s.shape.dN[0][0], 2 * s.shape.count, out + side_record_head);
+}
+
+SideView view_of_record(int count, const double* r) {
+  return {count, r, r + 3, r + 6, r + 9, r[12], r + 13, r + side_record_head};
+}
 
 // --- Quadrature ------------------------------------------------------------------------
 
@@ -129,11 +168,11 @@ void edge_points(const EnrichedEdgeBatch& b, std::int64_t e, const EnrichedQuadr
 // --- Stiffness -------------------------------------------------------------------------
 
 // Current unit normal of one side from its whole basis.
-void current_normal(const Side& s, const int* global, const double* current, double tangent[3], double normal[3]) {
+void current_normal(const SideView& s, const int* global, const double* current, double tangent[3], double normal[3]) {
   double a1[3] = {0, 0, 0}, a2[3] = {0, 0, 0};
-  for (int a = 0; a < s.shape.count; ++a) {
+  for (int a = 0; a < s.count; ++a) {
     const double* x = current + 3 * static_cast<std::int64_t>(global[a]);
-    for (int k = 0; k < 3; ++k) a1[k] += s.shape.dN[a][0] * x[k], a2[k] += s.shape.dN[a][1] * x[k];
+    for (int k = 0; k < 3; ++k) a1[k] += s.dN[2 * a] * x[k], a2[k] += s.dN[2 * a + 1] * x[k];
   }
   for (int k = 0; k < 3; ++k) tangent[k] = a1[k] * s.dxi_dt[0] + a2[k] * s.dxi_dt[1];
   cross3(a1, a2, normal);
@@ -142,10 +181,10 @@ void current_normal(const Side& s, const int* global, const double* current, dou
 
 // R = Cur Rest^T of one point: the edge frame (tangent, averaged normal) from rest to
 // current, each side's current normal from its whole basis (global: the edge's 2W slots).
-void edge_point_rotation(const Side& plus, const Side* minus, const int* global, int W, const double* current,
-                         double* R) {
+void edge_point_rotation(const SideView& plus, const SideView* minus, const int* global, int W,
+                         const double* current, double* R) {
   double rest[9], cur[9], tangent[3], n_plus[3], n_minus[3], unused[3];
-  edge_frame(plus.tangent, plus.point.t0, minus ? minus->point.t0 : nullptr, rest);
+  edge_frame(plus.tangent, plus.t0, minus ? minus->t0 : nullptr, rest);
   current_normal(plus, global, current, tangent, n_plus);
   if (minus) current_normal(*minus, global + W, current, unused, n_minus);
   edge_frame(tangent, n_plus, minus ? n_minus : nullptr, cur);
@@ -156,8 +195,10 @@ void edge_point_rotation(const Side& plus, const Side* minus, const int* global,
 
 // rotations: one per point, or null; current (with rotations null): each point's rotation
 // formed here from the sides this pass evaluates anyway (edge_point_rotation), or null: linear.
+// rest_sides: the sides' records (enriched_edge_rest_sides) read instead of evaluating them.
 void edge_stiffness(const EnrichedEdgeBatch& b, const EdgeQuadrature& quad, std::int64_t e, const double* rotations,
-                    const double* current, double* blocks, double* forces) {
+                    const double* current, double* blocks, double* forces,
+                    const EnrichedEdgeRestSides* rest_sides = nullptr) {
   const int npe = nodes_per_element(b.type);
   const int W = b.elements->width;
   const int nb = 2 * W;
@@ -192,45 +233,58 @@ void edge_stiffness(const EnrichedEdgeBatch& b, const EdgeQuadrature& quad, std:
     global.resize(static_cast<std::size_t>(nb));
     enriched_edge_global_nodes(b, e, global.data());
   }
+  SideView side_view[2];
   for (std::int64_t q = quad.start[e]; q < quad.start[e + 1]; ++q) {
     const double t = quad.points[2 * q], wt = quad.points[2 * q + 1];
-    evaluate_side(b, ed[0], ed[1], t, side_data[0]);
-    if (interior) evaluate_side(b, ed[2], ed[3], -t, side_data[1]);
+    if (rest_sides) {
+      const int* c = rest_sides->counts.data() + 2 * e;
+      const double* record = rest_sides->data.data() + rest_sides->offset[e] +
+                             (q - quad.start[e]) * (side_record_size(c[0]) + (interior ? side_record_size(c[1]) : 0));
+      side_view[0] = view_of_record(c[0], record);
+      if (interior) side_view[1] = view_of_record(c[1], record + side_record_size(c[0]));
+    } else {
+      evaluate_side(b, ed[0], ed[1], t, side_data[0]);
+      side_view[0] = view_of(side_data[0]);
+      if (interior) {
+        evaluate_side(b, ed[2], ed[3], -t, side_data[1]);
+        side_view[1] = view_of(side_data[1]);
+      }
+    }
     if (q == quad.start[e]) {
-      for (int s = 0; s < sides; ++s) counts[s] = side_data[s].shape.count;
+      for (int s = 0; s < sides; ++s) counts[s] = side_view[s].count;
       m = counts[0] + counts[1];
       K = std::make_unique<GramAccumulator>(3 * m, quad.start[e + 1] - quad.start[e]);
       f.assign(3 * m, 0.0);
       G.resize(3 * m);
     }
-    const Side& plus = side_data[0];
+    const SideView& plus = side_view[0];
     const double ds = std::sqrt(dot3(plus.tangent, plus.tangent)) * wt;
     double tau[3] = {plus.tangent[0], plus.tangent[1], plus.tangent[2]};
     normalize3(tau);
     for (int s = 0; s < sides; ++s) {
-      const Side& sd = side_data[s];
+      const SideView& sd = side_view[s];
       const double sign = s == 0 ? 1.0 : -1.0;
       double nu_vec[3];
-      cross3(sd.point.t0, tau, nu_vec);
+      cross3(sd.t0, tau, nu_vec);
       // nu . dt for a displacement along each axis, without forming normal_change_operator's
       // T = ([w]x - t0 t0^T [w]x) / j0, w = a1 dN_2 - a2 dN_1: nu = t0 x tau is normal to
       // t0, so nu^T T = (nu x w)^T / j0 = dN_2 (nu x a1) / j0 - dN_1 (nu x a2) / j0. Two
       // vectors per side and point, 6 multiply-adds a function (the operator's form took
       // ~5 % of fracture's run).
       double c1[3], c2[3];
-      cross3(nu_vec, sd.point.a1, c1);
-      cross3(nu_vec, sd.point.a2, c2);
-      for (int c = 0; c < 3; ++c) c1[c] = sign * c1[c] / sd.point.j0, c2[c] = sign * c2[c] / sd.point.j0;
+      cross3(nu_vec, sd.a1, c1);
+      cross3(nu_vec, sd.a2, c2);
+      for (int c = 0; c < 3; ++c) c1[c] = sign * c1[c] / sd.j0, c2[c] = sign * c2[c] / sd.j0;
       for (int a = 0; a < counts[s]; ++a) {
         const int i = s == 0 ? a : counts[0] + a;
-        const double* dN = sd.shape.dN[a];
+        const double* dN = sd.dN + 2 * a;
         for (int c = 0; c < 3; ++c) G[3 * i + c] = dN[1] * c1[c] - dN[0] * c2[c];
       }
     }
     double fused_rotation[9];
     const double* R = rotations ? rotations + 9 * q : nullptr;
     if (current) {
-      edge_point_rotation(side_data[0], interior ? &side_data[1] : nullptr, global.data(), W, current, fused_rotation);
+      edge_point_rotation(side_view[0], interior ? &side_view[1] : nullptr, global.data(), W, current, fused_rotation);
       R = fused_rotation;
     }
     double gd = 0;  // over the standard functions; enriched X0 = 0
@@ -331,6 +385,58 @@ void enriched_edge_corotated_stiffness(const EnrichedEdgeBatch& batch, const Edg
                 execution);
 }
 
+void enriched_edge_rest_sides(const EnrichedEdgeBatch& batch, const EdgeQuadrature& quadrature,
+                              EnrichedEdgeRestSides& out, Execution execution) {
+  // Sizes first (a side's count is its element's basis count, the same at every point).
+  out.counts.assign(2 * static_cast<std::size_t>(batch.count), 0);
+  out.offset.assign(static_cast<std::size_t>(batch.count) + 1, 0);
+  const int npe = nodes_per_element(batch.type);
+  for (std::int64_t e = 0; e < batch.count; ++e) {
+    const int* ed = batch.edges + 4 * e;
+    std::int64_t record = 0;
+    for (int s = 0; s < 2; ++s) {
+      const int element = ed[2 * s];
+      if (element < 0) continue;
+      const std::int64_t enriched = batch.enriched_index[element];
+      const int count = enriched >= 0 ? enriched_basis_count(*batch.elements, enriched) : npe;
+      out.counts[2 * e + s] = count;
+      record += side_record_size(count);
+    }
+    out.offset[e + 1] = out.offset[e] + record * (quadrature.start[e + 1] - quadrature.start[e]);
+  }
+  out.data.resize(static_cast<std::size_t>(out.offset[batch.count]));
+  for_each_edge(
+      batch.count,
+      [&](std::int64_t e) {
+        const int* ed = batch.edges + 4 * e;
+        const bool interior = ed[2] >= 0;
+        double* record = out.data.data() + out.offset[e];
+        Side side;
+        for (std::int64_t q = quadrature.start[e]; q < quadrature.start[e + 1]; ++q) {
+          const double t = quadrature.points[2 * q];
+          for (int s = 0; s < (interior ? 2 : 1); ++s) {
+            evaluate_side(batch, ed[2 * s], ed[2 * s + 1], s == 0 ? t : -t, side);
+            if (side.shape.count != out.counts[2 * e + s])
+              throw std::logic_error("enriched_edge_rest_sides: a side evaluated to " +
+                                     std::to_string(side.shape.count) + " functions, its element has " +
+                                     std::to_string(out.counts[2 * e + s]));
+            write_side_record(side, record);
+            record += side_record_size(side.shape.count);
+          }
+        }
+      },
+      execution);
+}
+
+void enriched_edge_corotated_stiffness(const EnrichedEdgeBatch& batch, const EdgeQuadrature& quadrature,
+                                       const EnrichedEdgeRestSides& rest_sides, const double* current,
+                                       double* blocks, double* forces, Execution execution) {
+  for_each_edge(
+      batch.count,
+      [&](std::int64_t e) { edge_stiffness(batch, quadrature, e, nullptr, current, blocks, forces, &rest_sides); },
+      execution);
+}
+
 void enriched_edge_rotations(const EnrichedEdgeBatch& b, const EdgeQuadrature& quad, const double* current,
                              double* rotations, Execution execution) {
   const int W = b.elements->width;
@@ -346,7 +452,9 @@ void enriched_edge_rotations(const EnrichedEdgeBatch& b, const EdgeQuadrature& q
           const double t = quad.points[2 * q];
           evaluate_side(b, ed[0], ed[1], t, plus);
           if (interior) evaluate_side(b, ed[2], ed[3], -t, minus);
-          edge_point_rotation(plus, interior ? &minus : nullptr, global.data(), W, current, rotations + 9 * q);
+          const SideView plus_view = view_of(plus), minus_view = view_of(minus);
+          edge_point_rotation(plus_view, interior ? &minus_view : nullptr, global.data(), W, current,
+                              rotations + 9 * q);
         }
       },
       execution);

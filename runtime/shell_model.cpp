@@ -148,6 +148,8 @@ void ShellModel::rebuild(std::vector<double>* integrated_mass) {
   workspace_.element_rest_rows.clear();  // the plain elements and edges may have changed
   workspace_.edge_rest_rows.clear();
   workspace_.cluster_rest.reset();  // the enriched quadrature may have changed
+  workspace_.edge_rest_sides = {};
+  workspace_.edge_rest_sides_built = false;
 
   // Mass and load weights depend on the rest geometry only.
   std::vector<double> element_mass(static_cast<size_t>(num_plain) * npe * npe);
@@ -807,11 +809,17 @@ void ShellModel::assemble_stiffness(const double* current, std::vector<double>& 
                                                     forces ? w.enriched_forces.data() : nullptr, execution);
     else
       kernels::enriched_element_stiffness(xb, element_quad, nullptr, w.enriched_blocks.data(), nullptr, execution);
-    // Edges: each point's rotation formed in the stiffness pass (one side evaluation a point).
-    if (current)
-      kernels::enriched_edge_corotated_stiffness(xg, edge_quad, current, w.enriched_edge_blocks.data(),
+    // Edges: each point's rotation formed in the stiffness pass, the sides' rest data (frames,
+    // basis derivatives) evaluated once per basis.
+    if (current) {
+      if (!w.edge_rest_sides_built) {
+        kernels::enriched_edge_rest_sides(xg, edge_quad, w.edge_rest_sides, execution);
+        w.edge_rest_sides_built = true;
+      }
+      kernels::enriched_edge_corotated_stiffness(xg, edge_quad, w.edge_rest_sides, current,
+                                                 w.enriched_edge_blocks.data(),
                                                  forces ? w.enriched_edge_forces.data() : nullptr, execution);
-    else
+    } else
       kernels::enriched_edge_stiffness(xg, edge_quad, nullptr, w.enriched_edge_blocks.data(),
                                        forces ? w.enriched_edge_forces.data() : nullptr, execution);
     matrix_locals.insert(matrix_locals.end(), {w.enriched_blocks.data(), w.enriched_edge_blocks.data()});

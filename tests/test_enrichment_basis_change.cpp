@@ -10,7 +10,8 @@
 //    enriched_element_mass and enriched_element_load_weights, and enriched_shape_values
 //    equals evaluate_enriched_shape's N;
 //  - the stiffness kernels given the quadrature's texel derivative tiles equal them without;
-//  - the corotated edge kernel equals the edge rotations followed by the edge stiffness.
+//  - the corotated edge kernel equals the edge rotations followed by the edge stiffness,
+//    also from the sides' rest data made once per basis.
 // The cut advances across a 3x3 quad8 plate (and a 2x2 tri6 one) over several steps, so
 // elements far from the tip keep their textures while the others change.
 #include <gtest/gtest.h>
@@ -22,6 +23,7 @@
 
 #include "cut_test_support.h"
 #include "enrichment_test_support.h"
+#include "shell_test_support.h"
 #include "dgtex/basis_projection.h"
 #include "dgtex/cut_manager.h"
 #include "dgtex/free_dof_system.h"
@@ -218,7 +220,8 @@ TEST(BasisChange, FusedMassAndLoadWeightsEqualTheTwoKernelsBitwise) {
 
 // The corotated edge kernel forms each point's rotation in its stiffness pass: bitwise
 // enriched_edge_rotations followed by enriched_edge_stiffness with those rotations, on the
-// interior edge between the two enriched elements and on their boundary edges.
+// interior edge between the two enriched elements and on their boundary edges; also when it
+// reads the sides' rest data made beforehand (enriched_edge_rest_sides).
 TEST(BasisChange, CorotatedEdgeStiffnessIsTheRotationsThenTheStiffnessBitwise) {
   const TwoEnrichedElements setup;
   const Topology topology = build_topology(setup.mesh);
@@ -262,6 +265,17 @@ TEST(BasisChange, CorotatedEdgeStiffnessIsTheRotationsThenTheStiffnessBitwise) {
                                                fused_forces.data(), execution);
     EXPECT_TRUE(bitwise_equal(fused_blocks, blocks));
     EXPECT_TRUE(bitwise_equal(fused_forces, forces));
+    // The same with both sides' rest data evaluated once beforehand (a model does it once per
+    // basis): every point's record, then bitwise the same blocks and forces.
+    kernels::EnrichedEdgeRestSides sides;
+    kernels::enriched_edge_rest_sides(edge_batch, quad, sides, execution);
+    ASSERT_EQ(sides.counts.size(), static_cast<size_t>(2 * count));
+    EXPECT_GT(sides.counts[0], TwoEnrichedElements::npe);  // an enriched side
+    std::vector<double> cached_blocks(blocks.size(), -1.0), cached_forces(forces.size(), -1.0);
+    kernels::enriched_edge_corotated_stiffness(edge_batch, quad, sides, current.data(), cached_blocks.data(),
+                                               cached_forces.data(), execution);
+    EXPECT_TRUE(bitwise_equal(cached_blocks, blocks));
+    EXPECT_TRUE(bitwise_equal(cached_forces, forces));
   }
   // The rotations matter: the unrotated blocks differ.
   std::vector<double> linear(blocks.size(), -1.0);
@@ -320,3 +334,34 @@ TEST(BasisChange, StiffnessKernelsReadingTheTexelTilesAreBitwiseTheSame) {
 }
 
 }  // namespace
+
+// A model keeps its enriched edges' rest data (sides' frames and basis derivatives) between
+// corotated assemblies; a basis change must drop them: after the cut moves, the model's
+// corotated stiffness and forces equal, bitwise, those of a model built with the new cut.
+TEST(BasisChange, CorotatedAssemblyAfterABasisChangeEqualsAFreshModels) {
+  const Mesh mesh = make_rectangle(1, 0.5, 4, 2, ElementType::quad8);
+  const auto cut = [](double at) {
+    return [at](const double* x) { return x[0] + 0.2 * x[1] - at; };
+  };
+  auto model = testing_support::enriched_model(
+      mesh, {testing_support::straight_cut_enrichment(mesh, 16, cut(0.33), false)}, 0.0);
+  auto turned = [](const ShellModel& m) {
+    std::vector<double> current = m.rest_state();
+    for (std::size_t n = 0; n < current.size() / 3; ++n) {
+      const double x = current[3 * n], y = current[3 * n + 1];
+      current[3 * n] = 0.9 * x - 0.3 * y, current[3 * n + 1] = 0.3 * x + 0.9 * y, current[3 * n + 2] += 0.1 * x * x;
+    }
+    return current;
+  };
+  std::vector<double> K, f;
+  model->assemble_stiffness(turned(*model).data(), K, &f);  // keeps the first cut's edge data
+  ASSERT_GT(model->num_enriched_edges(), 0);
+  const auto moved = testing_support::straight_cut_enrichment(mesh, 16, cut(0.61), false);
+  model->set_enrichments({moved});
+  auto fresh = testing_support::enriched_model(mesh, {moved}, 0.0);
+  std::vector<double> K_fresh, f_fresh;
+  model->assemble_stiffness(turned(*model).data(), K, &f);
+  fresh->assemble_stiffness(turned(*fresh).data(), K_fresh, &f_fresh);
+  EXPECT_TRUE(bitwise_equal(K, K_fresh));
+  EXPECT_TRUE(bitwise_equal(f, f_fresh));
+}

@@ -276,6 +276,10 @@ class ShellModel {
     std::shared_ptr<double> cluster_rest;
     std::int64_t cluster_rest_size = 0;
     std::vector<double> cluster_rotations;
+    // The enriched edges' rest sides (kernels::enriched_edge_rest_sides): built at the first
+    // corotated assembly after the enrichment changed (rebuild clears them).
+    kernels::EnrichedEdgeRestSides edge_rest_sides;
+    bool edge_rest_sides_built = false;
     AssemblyWorkspace() = default;
     AssemblyWorkspace(const AssemblyWorkspace&) {}
     AssemblyWorkspace& operator=(const AssemblyWorkspace&) { return *this; }
