@@ -1,9 +1,9 @@
 #include "dgtex/kernels/enriched_edge_kernel.h"
 
 #include <algorithm>
+#include <atomic>
 #include <memory>
 #include <stdexcept>
-#include <string>
 #include <cmath>
 #include <vector>
 
@@ -405,6 +405,9 @@ void enriched_edge_rest_sides(const EnrichedEdgeBatch& batch, const EdgeQuadratu
     out.offset[e + 1] = out.offset[e] + record * (quadrature.start[e + 1] - quadrature.start[e]);
   }
   out.data.resize(static_cast<std::size_t>(out.offset[batch.count]));
+  // An evaluated side whose count is not its element's would break the layout: reported after
+  // the loop (nothing may be thrown out of a parallel region).
+  std::atomic<bool> mismatch{false};
   for_each_edge(
       batch.count,
       [&](std::int64_t e) {
@@ -416,16 +419,18 @@ void enriched_edge_rest_sides(const EnrichedEdgeBatch& batch, const EdgeQuadratu
           const double t = quadrature.points[2 * q];
           for (int s = 0; s < (interior ? 2 : 1); ++s) {
             evaluate_side(batch, ed[2 * s], ed[2 * s + 1], s == 0 ? t : -t, side);
-            if (side.shape.count != out.counts[2 * e + s])
-              throw std::logic_error("enriched_edge_rest_sides: a side evaluated to " +
-                                     std::to_string(side.shape.count) + " functions, its element has " +
-                                     std::to_string(out.counts[2 * e + s]));
+            if (side.shape.count != out.counts[2 * e + s]) {
+              mismatch = true;
+              return;
+            }
             write_side_record(side, record);
             record += side_record_size(side.shape.count);
           }
         }
       },
       execution);
+  if (mismatch)
+    throw std::logic_error("enriched_edge_rest_sides: a side's basis count differs from its element's");
 }
 
 void enriched_edge_corotated_stiffness(const EnrichedEdgeBatch& batch, const EdgeQuadrature& quadrature,
@@ -452,7 +457,9 @@ void enriched_edge_rotations(const EnrichedEdgeBatch& b, const EdgeQuadrature& q
           const double t = quad.points[2 * q];
           evaluate_side(b, ed[0], ed[1], t, plus);
           if (interior) evaluate_side(b, ed[2], ed[3], -t, minus);
-          const SideView plus_view = view_of(plus), minus_view = view_of(minus);
+          const SideView plus_view = view_of(plus);
+          SideView minus_view;
+          if (interior) minus_view = view_of(minus);
           edge_point_rotation(plus_view, interior ? &minus_view : nullptr, global.data(), W, current,
                               rotations + 9 * q);
         }

@@ -149,7 +149,6 @@ void ShellModel::rebuild(std::vector<double>* integrated_mass) {
   workspace_.edge_rest_rows.clear();
   workspace_.cluster_rest.reset();  // the enriched quadrature may have changed
   workspace_.edge_rest_sides = {};
-  workspace_.edge_rest_sides_built = false;
 
   // Mass and load weights depend on the rest geometry only.
   std::vector<double> element_mass(static_cast<size_t>(num_plain) * npe * npe);
@@ -812,10 +811,7 @@ void ShellModel::assemble_stiffness(const double* current, std::vector<double>& 
     // Edges: each point's rotation formed in the stiffness pass, the sides' rest data (frames,
     // basis derivatives) evaluated once per basis.
     if (current) {
-      if (!w.edge_rest_sides_built) {
-        kernels::enriched_edge_rest_sides(xg, edge_quad, w.edge_rest_sides, execution);
-        w.edge_rest_sides_built = true;
-      }
+      if (w.edge_rest_sides.offset.empty()) kernels::enriched_edge_rest_sides(xg, edge_quad, w.edge_rest_sides, execution);
       kernels::enriched_edge_corotated_stiffness(xg, edge_quad, w.edge_rest_sides, current,
                                                  w.enriched_edge_blocks.data(),
                                                  forces ? w.enriched_edge_forces.data() : nullptr, execution);

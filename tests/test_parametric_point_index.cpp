@@ -16,8 +16,8 @@ using dgtex::detail::ParametricPointIndex;
 
 namespace {
 
-// Points as the quadrature lays them out: (xi1, xi2, weight), here on texel-aligned
-// fractions (k / 256, whose low mantissa bits are all zero) and Gauss offsets.
+// Points as the quadrature lays them out: (xi1, xi2, weight), here texel-aligned (-1 + k / 128,
+// whose low mantissa bits are all zero), two thirds of them moved by a Gauss offset.
 std::vector<double> quadrature_like_points(int count) {
   std::mt19937 random(7);
   std::uniform_int_distribution<int> texel(0, 255);

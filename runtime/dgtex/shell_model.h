@@ -277,9 +277,9 @@ class ShellModel {
     std::int64_t cluster_rest_size = 0;
     std::vector<double> cluster_rotations;
     // The enriched edges' rest sides (kernels::enriched_edge_rest_sides): built at the first
-    // corotated assembly after the enrichment changed (rebuild clears them).
+    // corotated assembly after the enrichment changed (rebuild clears them; offset is empty
+    // until then).
     kernels::EnrichedEdgeRestSides edge_rest_sides;
-    bool edge_rest_sides_built = false;
     AssemblyWorkspace() = default;
     AssemblyWorkspace(const AssemblyWorkspace&) {}
     AssemblyWorkspace& operator=(const AssemblyWorkspace&) { return *this; }
