@@ -339,20 +339,6 @@ void edge_stiffness(const EnrichedEdgeBatch& b, const EdgeQuadrature& quad, std:
   }
 }
 
-// The stiffness kernels' loop over edges. A few edges of very different cost (two sides or
-// one, texel-resolving points beside a cut or the standard rule) are handed out
-// dynamically: the slinky's eight took 2.0 ms a step on 2 threads with static chunks, 1.35
-// dynamically (1 thread: 2.4). Each edge writes only its own blocks and forces.
-template <class Body>
-void for_each_edge(std::int64_t count, Body&& body, Execution execution) {
-  if (execution == Execution::parallel) {
-#pragma omp parallel for schedule(dynamic, 1)
-    for (std::int64_t e = 0; e < count; ++e) body(e);
-  } else {
-    for (std::int64_t e = 0; e < count; ++e) body(e);
-  }
-}
-
 }  // namespace
 
 void enriched_edge_quadrature(const EnrichedEdgeBatch& batch, const EnrichedQuadratureOptions& options,
@@ -373,16 +359,22 @@ void enriched_edge_global_nodes(const EnrichedEdgeBatch& b, std::int64_t e, int*
   side_global_nodes(b, b.edges[4 * e + 2], out + W);
 }
 
+// The edge passes below hand out their edges dynamically (forall_dynamic): a few edges of
+// very different cost (two sides or one, texel-resolving points beside a cut or the
+// standard rule). The slinky's eight took 2.0 ms a step on 2 threads with static chunks,
+// 1.35 dynamically (1 thread: 2.4). Each edge writes only its own blocks, forces or records.
 void enriched_edge_stiffness(const EnrichedEdgeBatch& batch, const EdgeQuadrature& quadrature, const double* rotations,
                              double* blocks, double* forces, Execution execution) {
-  for_each_edge(batch.count, [&](std::int64_t e) { edge_stiffness(batch, quadrature, e, rotations, nullptr, blocks, forces); },
-                execution);
+  forall_dynamic(
+      batch.count, [&](std::int64_t e) { edge_stiffness(batch, quadrature, e, rotations, nullptr, blocks, forces); },
+      execution);
 }
 
 void enriched_edge_corotated_stiffness(const EnrichedEdgeBatch& batch, const EdgeQuadrature& quadrature,
                                        const double* current, double* blocks, double* forces, Execution execution) {
-  for_each_edge(batch.count, [&](std::int64_t e) { edge_stiffness(batch, quadrature, e, nullptr, current, blocks, forces); },
-                execution);
+  forall_dynamic(
+      batch.count, [&](std::int64_t e) { edge_stiffness(batch, quadrature, e, nullptr, current, blocks, forces); },
+      execution);
 }
 
 void enriched_edge_rest_sides(const EnrichedEdgeBatch& batch, const EdgeQuadrature& quadrature,
@@ -408,7 +400,7 @@ void enriched_edge_rest_sides(const EnrichedEdgeBatch& batch, const EdgeQuadratu
   // An evaluated side whose count is not its element's would break the layout: reported after
   // the loop (nothing may be thrown out of a parallel region).
   std::atomic<bool> mismatch{false};
-  for_each_edge(
+  forall_dynamic(
       batch.count,
       [&](std::int64_t e) {
         const int* ed = batch.edges + 4 * e;
@@ -436,7 +428,7 @@ void enriched_edge_rest_sides(const EnrichedEdgeBatch& batch, const EdgeQuadratu
 void enriched_edge_corotated_stiffness(const EnrichedEdgeBatch& batch, const EdgeQuadrature& quadrature,
                                        const EnrichedEdgeRestSides& rest_sides, const double* current,
                                        double* blocks, double* forces, Execution execution) {
-  for_each_edge(
+  forall_dynamic(
       batch.count,
       [&](std::int64_t e) { edge_stiffness(batch, quadrature, e, nullptr, current, blocks, forces, &rest_sides); },
       execution);

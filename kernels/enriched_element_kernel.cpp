@@ -922,12 +922,7 @@ void stiffness_by_chunks(const EnrichedElementBatch& batch, const EnrichedQuadra
   auto run = [&](std::int64_t c) {
     chunk_stiffness(batch, quadrature, chunks[c], rotations, current, want_forces, Kc[c], fc[c]);
   };
-  if (execution == Execution::parallel) {
-#pragma omp parallel for schedule(dynamic, 1)
-    for (std::int64_t c = 0; c < num_chunks; ++c) run(c);
-  } else {
-    for (std::int64_t c = 0; c < num_chunks; ++c) run(c);
-  }
+  forall_dynamic(num_chunks, run, execution);
   // Per element: its chunks summed in order, then the padded symmetric layout; one work
   // item per block row (a single element with hundreds of functions uses every thread).
   std::vector<std::int64_t> first_chunk(static_cast<std::size_t>(batch.count) + 1, 0);

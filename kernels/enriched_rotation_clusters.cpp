@@ -385,13 +385,7 @@ void enriched_cluster_rest_stiffness(const EnrichedElementBatch& batch, const En
           for (std::size_t j = 0; j < 3; ++j) out[(i * 3 + j) * plane + p] = K[(3 * a + i) * N3 + 3 * b + j];
       }
   };
-  const std::int64_t total = clusters.count();
-  if (execution == Execution::parallel) {
-#pragma omp parallel for schedule(dynamic, 1)
-    for (std::int64_t c = 0; c < total; ++c) cluster(c);
-  } else {
-    for (std::int64_t c = 0; c < total; ++c) cluster(c);
-  }
+  forall_dynamic(clusters.count(), cluster, execution);
 }
 
 void enriched_cluster_rotations(const EnrichedElementBatch& batch, const EnrichedRotationClusters& clusters,

@@ -1,8 +1,9 @@
 #pragma once
-// forall: the one parallel loop of dgtex kernels (forall_then, below: two in a row). Every
-// kernel is written as a body over an index so the same code runs serially (the reference) or
-// with OpenMP (and later on a device). Static scheduling keeps each index's work on a fixed
-// thread per count, but kernels never rely on that: each index writes only its own outputs.
+// forall: the one parallel loop of dgtex kernels (below, forall_dynamic: its indices handed
+// out as threads free up; forall_then: two in a row). Every kernel is written as a body over
+// an index so the same code runs serially (the reference) or with OpenMP (and later on a
+// device). Static scheduling keeps each index's work on a fixed thread per count, but
+// kernels never rely on that: each index writes only its own outputs.
 // Conventions of every dgtex::kernels header: arrays (structure of arrays) belong to the
 // caller; *Batch / *View structs only point into them and must outlive the call; a kernel
 // keeps nothing and has no global state, so calls on distinct outputs are thread-safe.
@@ -18,6 +19,19 @@ template <class Body>
 void forall(std::int64_t n, Body&& body, Execution execution = Execution::parallel) {
   if (execution == Execution::parallel) {
 #pragma omp parallel for schedule(static)
+    for (std::int64_t i = 0; i < n; ++i) body(i);
+  } else {
+    for (std::int64_t i = 0; i < n; ++i) body(i);
+  }
+}
+
+// forall with the indices handed out one at a time as threads free up: for a few items of
+// very different cost (rotation clusters, stiffness chunks, enriched edges). Each index must
+// write only its own outputs, so the result is that of forall.
+template <class Body>
+void forall_dynamic(std::int64_t n, Body&& body, Execution execution = Execution::parallel) {
+  if (execution == Execution::parallel) {
+#pragma omp parallel for schedule(dynamic, 1)
     for (std::int64_t i = 0; i < n; ++i) body(i);
   } else {
     for (std::int64_t i = 0; i < n; ++i) body(i);
