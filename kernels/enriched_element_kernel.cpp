@@ -563,7 +563,7 @@ void point_deformation_gradient(const ElementLayout& L, const ShapeValues& s, co
 // Rotations: given per point (`rotations`), or computed here from `current` exactly as
 // enriched_element_deformation_gradients and polar_rotation would (the fused form), or none.
 // tangent_weights (may be null): receives D_f = sum_q w_q dN_f(q) over the chunk's points
-// for every element function f (2 W slots; the arithmetic of evaluate_enriched_shape).
+// for every element function f (2 n slots; the arithmetic of evaluate_enriched_shape).
 void chunk_stiffness(const EnrichedElementBatch& b, const EnrichedQuadrature& quad, const Chunk& chunk,
                      const double* rotations, const double* current, bool want_forces, std::vector<double>& Kc,
                      std::vector<double>& fc, double* tangent_weights = nullptr) {
@@ -592,7 +592,7 @@ void chunk_stiffness(const EnrichedElementBatch& b, const EnrichedQuadrature& qu
   // Unrotated rows of a planar element take the split membrane / bending sums.
   PlanarFrame frame;
   const bool planar = !rotations && !current && enriched_element_planar_frame(b, e, &frame.E[0][0]);
-  if (tangent_weights) std::fill(tangent_weights, tangent_weights + 2 * b.width, 0.0);
+  if (tangent_weights) std::fill(tangent_weights, tangent_weights + 2 * n, 0.0);
   for (std::int64_t k = chunk.begin; k < chunk.end; ++k) {
     const std::int64_t q = chunk.point(k);
     const double* pt = quad.points + 3 * q;

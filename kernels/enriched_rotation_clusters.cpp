@@ -22,8 +22,9 @@ constexpr std::int64_t cluster_tile_blocks = 2048;
 // Functions per work item of the corrective forces.
 constexpr int cluster_force_tile = 32;
 
-std::int64_t packed_row_start(int W, int a) {
-  return static_cast<std::int64_t>(a) * W - static_cast<std::int64_t>(a) * (a - 1) / 2;
+// Where row a of the packed upper blocks of n functions starts.
+std::int64_t packed_row_start(int n, int a) {
+  return static_cast<std::int64_t>(a) * n - static_cast<std::int64_t>(a) * (a - 1) / 2;
 }
 
 // Cut tips of one element: texel corners (x, y) inside the tile where exactly one wall edge
@@ -216,6 +217,17 @@ EnrichedRotationClusters concatenate(const std::vector<ElementClusters>& element
   return out;
 }
 
+// Where each cluster's rest data starts (#clusters + 1; the last: the size of them all).
+std::vector<std::int64_t> rest_starts(const EnrichedElementBatch& batch, const EnrichedRotationClusters& clusters) {
+  std::vector<std::int64_t> start(1, 0);
+  for (std::int64_t e = 0; e < batch.count; ++e) {
+    const std::int64_t stride = enriched_cluster_rest_stride(batch, e);
+    for (std::int64_t c = clusters.element_start[e]; c < clusters.element_start[e + 1]; ++c)
+      start.push_back(start.back() + stride);
+  }
+  return start;
+}
+
 // Mean-tangent weights D_f = sum_q w_q dN_f(q) of one cluster (2 per function, W slots).
 void tangent_weights(const EnrichedElementBatch& b, const EnrichedQuadrature& quad, std::int64_t e,
                      const std::int64_t* points, std::int64_t count, double* D) {
@@ -295,25 +307,25 @@ void add_rotated_planar_blocks(int count, const double* B, std::int64_t plane, c
   }
 }
 
-int rest_planes(bool planar) { return planar ? 5 : 9; }
-
 }  // namespace
 
-std::int64_t enriched_cluster_packed_blocks(int width) {
-  const std::int64_t blocks = static_cast<std::int64_t>(width) * (width + 1) / 2;
+std::int64_t enriched_cluster_packed_blocks(int functions) {
+  const std::int64_t blocks = static_cast<std::int64_t>(functions) * (functions + 1) / 2;
   return (blocks + 7) / 8 * 8;
 }
 
-bool enriched_clusters_planar(const EnrichedElementBatch& batch) {
+int enriched_cluster_rest_planes(const EnrichedElementBatch& batch, std::int64_t e) {
   double frame[9];
-  for (std::int64_t e = 0; e < batch.count; ++e)
-    if (!enriched_element_planar_frame(batch, e, frame)) return false;
-  return true;
+  return enriched_element_planar_frame(batch, e, frame) ? 5 : 9;
 }
 
-std::int64_t enriched_cluster_rest_stride(const EnrichedElementBatch& batch) {
-  return rest_planes(enriched_clusters_planar(batch)) * enriched_cluster_packed_blocks(batch.width) +
-         2 * static_cast<std::int64_t>(batch.width);
+std::int64_t enriched_cluster_rest_stride(const EnrichedElementBatch& batch, std::int64_t e) {
+  const int n = enriched_basis_count(batch, e);
+  return enriched_cluster_rest_planes(batch, e) * enriched_cluster_packed_blocks(n) + 2 * static_cast<std::int64_t>(n);
+}
+
+std::int64_t enriched_cluster_rest_size(const EnrichedElementBatch& batch, const EnrichedRotationClusters& clusters) {
+  return rest_starts(batch, clusters).back();
 }
 
 EnrichedRotationClusters enriched_rotation_clusters(const EnrichedElementBatch& batch,
@@ -353,29 +365,31 @@ EnrichedRotationClusters enriched_rotation_clusters_reference(const EnrichedElem
 
 void enriched_cluster_rest_stiffness(const EnrichedElementBatch& batch, const EnrichedQuadrature& quadrature,
                                      const EnrichedRotationClusters& clusters, double* rest, Execution execution) {
-  const int W = batch.width;
-  const bool planar = enriched_clusters_planar(batch);
-  const int planes = rest_planes(planar);
-  const std::int64_t stride = enriched_cluster_rest_stride(batch), plane = enriched_cluster_packed_blocks(W);
+  const std::vector<std::int64_t> rest_start = rest_starts(batch, clusters);
   std::vector<std::int64_t> element_of(static_cast<std::size_t>(clusters.count()));
-  for (std::int64_t e = 0; e < batch.count; ++e)
+  std::vector<char> planar(static_cast<std::size_t>(batch.count));
+  for (std::int64_t e = 0; e < batch.count; ++e) {
+    planar[e] = enriched_cluster_rest_planes(batch, e) == 5;
     for (std::int64_t c = clusters.element_start[e]; c < clusters.element_start[e + 1]; ++c) element_of[c] = e;
+  }
   // Clusters differ much in cost (tip blocks hold few points): handed out dynamically;
   // each writes only its own rest data, so the result does not depend on the threads.
   auto cluster = [&](std::int64_t c) {
     const std::int64_t e = element_of[c];
     const int n = enriched_basis_count(batch, e);
+    const int planes = planar[e] ? 5 : 9;
+    const std::int64_t plane = enriched_cluster_packed_blocks(n);
     const std::int64_t* points = clusters.points.data() + clusters.point_start[c];
     const std::int64_t count = clusters.point_start[c + 1] - clusters.point_start[c];
     static thread_local std::vector<double> K;
-    double* out = rest + c * stride;
+    double* out = rest + rest_start[c];
     enriched_element_point_set_stiffness(batch, quadrature, e, points, count, K, out + planes * plane);
     std::fill(out, out + planes * plane, 0.0);
     const std::size_t N3 = 3 * static_cast<std::size_t>(n);
     for (std::size_t a = 0; a < static_cast<std::size_t>(n); ++a)
       for (std::size_t b = a; b < static_cast<std::size_t>(n); ++b) {
-        const std::int64_t p = packed_row_start(W, static_cast<int>(a)) + static_cast<std::int64_t>(b - a);
-        if (planar) {  // K = [Km | Kb] (enriched_element_point_set_stiffness)
+        const std::int64_t p = packed_row_start(n, static_cast<int>(a)) + static_cast<std::int64_t>(b - a);
+        if (planar[e]) {  // K = [Km | Kb] (enriched_element_point_set_stiffness)
           std::size_t at[5];
           enriched_planar_sum_offsets(n, a, b, at);
           for (int k = 0; k < 5; ++k) out[k * plane + p] = K[at[k]];
@@ -390,14 +404,14 @@ void enriched_cluster_rest_stiffness(const EnrichedElementBatch& batch, const En
 
 void enriched_cluster_rotations(const EnrichedElementBatch& batch, const EnrichedRotationClusters& clusters,
                                 const double* rest, const double* current, double* rotations, Execution execution) {
-  const int W = batch.width;
-  const std::int64_t stride = enriched_cluster_rest_stride(batch), plane = enriched_cluster_packed_blocks(W);
-  const std::int64_t weights = rest_planes(enriched_clusters_planar(batch)) * plane;
+  const std::vector<std::int64_t> rest_start = rest_starts(batch, clusters);
   forall(
       batch.count,
       [&](std::int64_t e) {
+        const std::int64_t weights = enriched_cluster_rest_planes(batch, e) *
+                                     enriched_cluster_packed_blocks(enriched_basis_count(batch, e));
         for (std::int64_t c = clusters.element_start[e]; c < clusters.element_start[e + 1]; ++c)
-          cluster_rotation(batch, e, rest + c * stride + weights, current, rotations + 9 * c);
+          cluster_rotation(batch, e, rest + rest_start[c] + weights, current, rotations + 9 * c);
       },
       execution);
 }
@@ -407,38 +421,46 @@ void enriched_element_clustered_stiffness(const EnrichedElementBatch& batch, con
                                           double* forces, Execution execution) {
   const int W = batch.width;
   const int npe = nodes_per_element(batch.type);
-  const bool planar = enriched_clusters_planar(batch);
-  const std::int64_t stride = enriched_cluster_rest_stride(batch), plane = enriched_cluster_packed_blocks(W);
+  const std::vector<std::int64_t> rest_start = rest_starts(batch, clusters);
+  std::vector<char> planar(static_cast<std::size_t>(batch.count));
   std::vector<double> frames(9 * static_cast<std::size_t>(batch.count));
-  for (std::int64_t e = 0; planar && e < batch.count; ++e) enriched_element_planar_frame(batch, e, &frames[9 * e]);
-  const std::int64_t packed = static_cast<std::int64_t>(W) * (W + 1) / 2;
-  const std::int64_t tiles = (packed + cluster_tile_blocks - 1) / cluster_tile_blocks;
+  for (std::int64_t e = 0; e < batch.count; ++e) planar[e] = enriched_element_planar_frame(batch, e, &frames[9 * e]);
+  const std::int64_t tiles = (static_cast<std::int64_t>(W) * (W + 1) / 2 + cluster_tile_blocks - 1) / cluster_tile_blocks;
   // Blocks: one work item per tile of an element's packed upper blocks; every cluster adds
   // its rotated stretch of the tile, in cluster order, to a sum that stays in cache, which
-  // is then written as blocks (a, c) and their mirrors (c, a). Padding blocks are 0 in the
-  // rest sums, so they come out 0.
+  // is then written as blocks (a, c) and their mirrors (c, a). The blocks of the slots
+  // beyond the element's n functions are 0.
   forall(
       batch.count * tiles,
       [&](std::int64_t item) {
         const std::int64_t e = item / tiles;
+        const int n = enriched_basis_count(batch, e);
+        const std::int64_t packed = static_cast<std::int64_t>(n) * (n + 1) / 2, plane = enriched_cluster_packed_blocks(n);
         const std::int64_t p0 = item % tiles * cluster_tile_blocks;
+        if (p0 == 0)
+          for (int a = 0; a < W; ++a)
+            for (int c = a < n ? n : 0; c < W; ++c) {
+              std::fill_n(blocks + ((e * W + a) * W + c) * 9, 9, 0.0);
+              std::fill_n(blocks + ((e * W + c) * W + a) * 9, 9, 0.0);
+            }
+        if (p0 >= packed) return;
         const int length = static_cast<int>(std::min(packed - p0, cluster_tile_blocks));
         static thread_local std::vector<double> acc;
         acc.assign(static_cast<std::size_t>(9) * length, 0.0);
         for (std::int64_t c = clusters.element_start[e]; c < clusters.element_start[e + 1]; ++c) {
-          if (planar) {
+          if (planar[e]) {
             double O[5][9];
             enriched_planar_frame_products(&frames[9 * e], rotations + 9 * c, &O[0][0]);
-            add_rotated_planar_blocks(length, rest + c * stride + p0, plane, O, acc.data(), length);
+            add_rotated_planar_blocks(length, rest + rest_start[c] + p0, plane, O, acc.data(), length);
           } else {
-            add_rotated_blocks(length, rest + c * stride + p0, plane, rotations + 9 * c, acc.data(), length);
+            add_rotated_blocks(length, rest + rest_start[c] + p0, plane, rotations + 9 * c, acc.data(), length);
           }
         }
         int a = 0;
-        while (packed_row_start(W, a + 1) <= p0) ++a;
+        while (packed_row_start(n, a + 1) <= p0) ++a;
         for (std::int64_t p = p0; p < p0 + length; ++p) {
-          if (p == packed_row_start(W, a + 1)) ++a;
-          const std::int64_t c = a + (p - packed_row_start(W, a));
+          if (p == packed_row_start(n, a + 1)) ++a;
+          const std::int64_t c = a + (p - packed_row_start(n, a));
           double* upper = blocks + ((e * W + a) * W + c) * 9;
           double* lower = blocks + ((e * W + c) * W + a) * 9;
           for (int i = 0; i < 3; ++i)
@@ -462,7 +484,7 @@ void enriched_element_clustered_stiffness(const EnrichedElementBatch& batch, con
             double d[3];
             for (int k = 0; k < 3; ++k) d[k] = X[k] - (R[0 * 3 + k] * X[0] + R[1 * 3 + k] * X[1] + R[2 * 3 + k] * X[2]);
             double* out = &z[(c * npe + b) * 3];
-            for (int y = 0; y < 3; ++y) out[y] = planar ? E[3 * y] * d[0] + E[3 * y + 1] * d[1] + E[3 * y + 2] * d[2] : d[y];
+            for (int y = 0; y < 3; ++y) out[y] = planar[e] ? E[3 * y] * d[0] + E[3 * y + 1] * d[1] + E[3 * y + 2] * d[2] : d[y];
           }
         }
       },
@@ -481,11 +503,14 @@ void enriched_element_clustered_stiffness(const EnrichedElementBatch& batch, con
         const std::int64_t e = item / force_tiles;
         const int a0 = static_cast<int>(item % force_tiles) * cluster_force_tile;
         const int a1 = std::min(W, a0 + cluster_force_tile);
-        const int used = std::max(a0, std::min(a1, enriched_basis_count(batch, e)));
+        const int n = enriched_basis_count(batch, e);
+        const int used = std::max(a0, std::min(a1, n));
+        const std::int64_t plane = enriched_cluster_packed_blocks(n);
+        const bool flat = planar[e];
         double f[cluster_force_tile][3] = {};
         const double* E = &frames[9 * e];
         for (std::int64_t c = clusters.element_start[e]; c < clusters.element_start[e + 1]; ++c) {
-          const double* B = rest + c * stride;
+          const double* B = rest + rest_start[c];
           const double* R = rotations + 9 * c;
           // planar: h[k][a] = sum_b g_k(a, b) (E_y . z_b); else h[i][a] = sum_b K0_c(a, b) z_b.
           double h[5][cluster_force_tile] = {};
@@ -493,15 +518,15 @@ void enriched_element_clustered_stiffness(const EnrichedElementBatch& batch, con
             const double* zb = &z[(c * npe + b) * 3];
             // a <= b: block (a, b) is stored, in row a.
             for (int a = a0; a < std::min(used, b + 1); ++a) {
-              const std::int64_t p = packed_row_start(W, a) + (b - a);
-              for (int k = 0; k < 5 && planar; ++k) h[k][a - a0] += B[k * plane + p] * zb[pair[k][1]];
-              for (int i = 0; i < 3 && !planar; ++i)
+              const std::int64_t p = packed_row_start(n, a) + (b - a);
+              for (int k = 0; k < 5 && flat; ++k) h[k][a - a0] += B[k * plane + p] * zb[pair[k][1]];
+              for (int i = 0; i < 3 && !flat; ++i)
                 for (int j = 0; j < 3; ++j) h[i][a - a0] += B[(i * 3 + j) * plane + p] * zb[j];
             }
             // a > b: the stored block (b, a), contiguous in row b, transposed.
             const int first = std::max(a0, b + 1);
-            const double* row = B + packed_row_start(W, b) - b;  // row[a]: block (b, a)
-            if (planar) {
+            const double* row = B + packed_row_start(n, b) - b;  // row[a]: block (b, a)
+            if (flat) {
               for (int k = 0; k < 5; ++k) {
                 const double* plane_k = row + transposed[k] * plane;
                 const double y = zb[pair[k][1]];
@@ -517,7 +542,7 @@ void enriched_element_clustered_stiffness(const EnrichedElementBatch& batch, con
           }
           for (int a = a0; a < used; ++a) {
             double g[3] = {0, 0, 0};  // sum_b K0_c(a, b) z_b
-            if (planar) {
+            if (flat) {
               for (int k = 0; k < 5; ++k)
                 for (int i = 0; i < 3; ++i) g[i] += E[3 * pair[k][0] + i] * h[k][a - a0];
             } else {

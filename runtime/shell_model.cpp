@@ -777,7 +777,7 @@ void ShellModel::assemble_stiffness(const double* current, std::vector<double>& 
         // with tips at 16 4.5e-3 with 193, B = 16 alone 3.6e-3 with 472).
         const int tip_block = std::max(1, options_.rotation_cluster_texels / 4);
         w.clusters = kernels::enriched_rotation_clusters(xb, element_quad, options_.rotation_cluster_texels, tip_block);
-        const std::int64_t size = w.clusters.count() * kernels::enriched_cluster_rest_stride(xb);
+        const std::int64_t size = kernels::enriched_cluster_rest_size(xb, w.clusters);
         if (size > max_rotation_cluster_doubles)
           throw ModelError("rotation clusters of " + std::to_string(options_.rotation_cluster_texels) +
                                    " texels: " + std::to_string(w.clusters.count()) + " clusters would take " +

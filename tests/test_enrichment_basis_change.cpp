@@ -327,7 +327,7 @@ TEST(BasisChange, StiffnessKernelsReadingTheTexelTilesAreBitwiseTheSame) {
   const kernels::EnrichedRotationClusters clusters = kernels::enriched_rotation_clusters(plain, quad, 8, 2);
   std::vector<double> rest[2];
   for (int k = 0; k < 2; ++k) {
-    rest[k].assign(clusters.count() * kernels::enriched_cluster_rest_stride(plain), -1.0);
+    rest[k].assign(kernels::enriched_cluster_rest_size(plain, clusters), -1.0);
     kernels::enriched_cluster_rest_stiffness(k == 0 ? plain : with_tiles, quad, clusters, rest[k].data());
   }
   EXPECT_TRUE(bitwise_equal(rest[0], rest[1]));

@@ -82,8 +82,8 @@ ClusteredPair clustered(const CutQuad8Element& one) {
   const kernels::EnrichedRotationClusters clusters =
       kernels::enriched_rotation_clusters(one.batch, one.quadrature(), 16, 16);
   ClusteredPair out;
-  out.stride = kernels::enriched_cluster_rest_stride(one.batch);
-  std::vector<double> rest(static_cast<std::size_t>(clusters.count() * out.stride)), R(9 * clusters.count());
+  out.stride = kernels::enriched_cluster_rest_stride(one.batch, 0);
+  std::vector<double> rest(static_cast<std::size_t>(kernels::enriched_cluster_rest_size(one.batch, clusters))), R(9 * clusters.count());
   kernels::enriched_cluster_rest_stiffness(one.batch, one.quadrature(), clusters, rest.data());
   kernels::enriched_cluster_rotations(one.batch, clusters, rest.data(), current.data(), R.data());
   out.K.resize(static_cast<std::size_t>(W) * W * 9), out.f.resize(3 * W);
@@ -158,16 +158,93 @@ TEST(PlanarEnrichedElements, ClusterRestSumsTakeFivePlanesWhenPlanar) {
   const std::int64_t packed = kernels::enriched_cluster_packed_blocks(W);
   curve_in_plane(one);
   turn_nodes(one, tilt());
-  ASSERT_TRUE(kernels::enriched_clusters_planar(one.batch));
+  ASSERT_EQ(kernels::enriched_cluster_rest_planes(one.batch, 0), 5);
   const ClusteredPair tilted = clustered(one);
   EXPECT_EQ(tilted.stride, 5 * packed + 2 * W);
   EXPECT_LE(max_difference(tilted.K, tilted.Kref), 1e-9 * max_abs(tilted.Kref));
   ASSERT_GT(max_abs(tilted.fref), 0.0);
   EXPECT_LE(max_difference(tilted.f, tilted.fref), 1e-9 * max_abs(tilted.fref));
   for (int a = 4; a < 8; ++a) one.mesh.positions[3 * one.mesh.element_nodes(0)[a] + 2] += 0.05 * (a % 2 ? 1 : -1);
-  ASSERT_FALSE(kernels::enriched_clusters_planar(one.batch));
+  ASSERT_EQ(kernels::enriched_cluster_rest_planes(one.batch, 0), 9);
   const ClusteredPair warped = clustered(one);
   EXPECT_EQ(warped.stride, 9 * packed + 2 * W);
   EXPECT_LE(max_difference(warped.K, warped.Kref), 1e-9 * max_abs(warped.Kref));
   EXPECT_LE(max_difference(warped.f, warped.fref), 1e-9 * max_abs(warped.fref));
+}
+
+// A batch may hold planar and curved elements (a cut running from a flat part of a shell
+// into a curved one): each element's rest data has its own planes and its own width. The
+// second element is a copy of the cut one on nodes of its own, beside it, warped out of its
+// plane and enriched by the first two of its three functions only (a narrower basis).
+TEST(PlanarEnrichedElements, PlanarAndCurvedElementsShareABatch) {
+  CutQuad8Element one(1, 2);
+  Mesh& mesh = one.mesh;
+  const int first_nodes = mesh.num_nodes();
+  for (int a = 0; a < 8; ++a) {
+    const double* x = mesh.node(mesh.element_nodes(0)[a]);
+    const double lift = a >= 4 ? 0.05 * (a % 2 ? 1 : -1) : 0.0;
+    mesh.positions.insert(mesh.positions.end(), {x[0] + 2.0, x[1], x[2] + lift});
+    mesh.elements.push_back(first_nodes + a);
+  }
+  const int functions[2] = {3, 2};
+  std::vector<int> element{0, 1}, start{0}, virtual_nodes;
+  std::vector<kernels::TextureView> views;
+  std::vector<double> shifts;
+  int v = mesh.num_nodes();
+  for (int e = 0; e < 2; ++e) {
+    for (int k = 0; k < functions[e]; ++k) {
+      views.push_back(one.views[k]);
+      for (int a = 0; a < 8; ++a) virtual_nodes.push_back(v++), shifts.push_back(one.shifts[8 * k + a]);
+    }
+    start.push_back(static_cast<int>(views.size()));
+  }
+  const std::vector<kernels::ShellSection> sections(2, one.sections[0]);
+  const int W = 8 * (1 + functions[0]);
+  const kernels::EnrichedElementBatch batch{ElementType::quad8, 2,     element.data(), mesh.elements.data(),
+                                            mesh.positions.data(), sections.data(), CutQuad8Element::T, W,
+                                            start.data(),          views.data(),    virtual_nodes.data(),
+                                            shifts.data()};
+  std::vector<std::int64_t> qp_start;
+  std::vector<double> qp;
+  kernels::enriched_element_quadrature(batch, kernels::EnrichedQuadratureOptions{}, qp_start, qp);
+  const kernels::EnrichedQuadrature quad{qp_start.data(), qp.data()};
+  ASSERT_EQ(kernels::enriched_cluster_rest_planes(batch, 0), 5);
+  ASSERT_EQ(kernels::enriched_cluster_rest_planes(batch, 1), 9);
+  EXPECT_EQ(kernels::enriched_cluster_rest_stride(batch, 1),
+            9 * kernels::enriched_cluster_packed_blocks(24) + 2 * 24);
+
+  // Bent about the xi2 axis, the enriched DOFs opened.
+  std::vector<double> current(3 * static_cast<std::size_t>(v));
+  for (int n = 0; n < v; ++n)
+    for (int i = 0; i < 3; ++i)
+      current[3 * n + i] = n < mesh.num_nodes() ? mesh.positions[3 * n + i] + (i == 2 ? 0.1 * std::pow(mesh.positions[3 * n], 2) : 0.0)
+                                                : 0.01 * std::sin(1.3 * n + i);
+  const kernels::EnrichedRotationClusters clusters = kernels::enriched_rotation_clusters(batch, quad, 16, 16);
+  auto clustered_stiffness = [&](std::vector<double>& K, std::vector<double>& f) {
+    std::vector<double> rest(static_cast<std::size_t>(kernels::enriched_cluster_rest_size(batch, clusters))), R(9 * clusters.count());
+    kernels::enriched_cluster_rest_stiffness(batch, quad, clusters, rest.data());
+    kernels::enriched_cluster_rotations(batch, clusters, rest.data(), current.data(), R.data());
+    K.assign(2 * static_cast<std::size_t>(W) * W * 9, -1.0), f.assign(2 * 3 * W, -1.0);
+    kernels::enriched_element_clustered_stiffness(batch, clusters, rest.data(), R.data(), K.data(), f.data());
+  };
+  std::vector<double> K, f, Kref(2 * static_cast<std::size_t>(W) * W * 9), fref(2 * 3 * W);
+  clustered_stiffness(K, f);
+  kernels::enriched_element_clustered_stiffness_reference(batch, quad, clusters, current.data(), Kref.data(), fref.data());
+  EXPECT_LE(max_difference(K, Kref), 1e-9 * max_abs(Kref));
+  EXPECT_LE(max_difference(f, fref), 1e-9 * max_abs(fref));
+  // The curved element's slots beyond its 24 functions are 0.
+  for (int a = 0; a < W; ++a)
+    for (int c = 24; c < W; ++c)
+      for (int i = 0; i < 9; ++i) {
+        ASSERT_EQ(K[((static_cast<std::size_t>(W) + a) * W + c) * 9 + i], 0.0);
+        ASSERT_EQ(K[((static_cast<std::size_t>(W) + c) * W + a) * 9 + i], 0.0);
+      }
+  for (int threads : {1, 2, 3}) {
+    omp_set_num_threads(threads);
+    std::vector<double> K_threads, f_threads;
+    clustered_stiffness(K_threads, f_threads);
+    EXPECT_EQ(K_threads, K) << threads << " threads";
+    EXPECT_EQ(f_threads, f) << threads << " threads";
+  }
+  omp_set_num_threads(omp_get_num_procs());
 }

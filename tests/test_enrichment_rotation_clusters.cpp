@@ -57,7 +57,7 @@ struct Clustered {
 Clustered clustered(const CutQuad8Element& one, const kernels::EnrichedRotationClusters& clusters,
                     const std::vector<double>& current, kernels::Execution execution) {
   const int W = one.batch.width;
-  std::vector<double> rest(static_cast<std::size_t>(clusters.count()) * kernels::enriched_cluster_rest_stride(one.batch));
+  std::vector<double> rest(static_cast<std::size_t>(kernels::enriched_cluster_rest_size(one.batch, clusters)));
   kernels::enriched_cluster_rest_stiffness(one.batch, one.quadrature(), clusters, rest.data(), execution);
   Clustered out{std::vector<double>(static_cast<std::size_t>(W) * W * 9), std::vector<double>(3 * W),
                 std::vector<double>(9 * static_cast<std::size_t>(clusters.count()))};

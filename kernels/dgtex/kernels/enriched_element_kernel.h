@@ -93,9 +93,9 @@ void enriched_element_stiffness_reference(const EnrichedElementBatch& batch, con
 // (enriched_element_planar_frame) K holds instead the membrane sums Km, 2n x 2n row-major
 // over (function, E1 | E2), then the bending sums Kb, n x n over functions along T, each
 // with block rows a <= c (2 x 2 and 1 x 1 blocks): block (a, c) of the stiffness is
-// sum_xy Km(2a + x, 2c + y) E_x E_y^T + Kb(a, c) T T^T. tangent_weights (optional, 2 W
-// doubles) receives D_f = sum_q w_q dN_f(q) (xi1 and xi2 parts; 0 beyond n) from the same
-// pass, bitwise as summed from evaluate_enriched_shape in point order. Serial.
+// sum_xy Km(2a + x, 2c + y) E_x E_y^T + Kb(a, c) T T^T. tangent_weights (optional, 2 n
+// doubles) receives D_f = sum_q w_q dN_f(q) (xi1 and xi2 parts) from the same pass,
+// bitwise as summed from evaluate_enriched_shape in point order. Serial.
 void enriched_element_point_set_stiffness(const EnrichedElementBatch& batch, const EnrichedQuadrature& quadrature,
                                           std::int64_t e, const std::int64_t* points, std::int64_t count,
                                           std::vector<double>& K, double* tangent_weights = nullptr);

@@ -22,16 +22,19 @@
 // from the rest positions. The error against per-point
 // rotations is of the order of the rotation's spread inside a cluster (B = 1: per texel).
 //
-// Shapes (W = batch.width): rest data per cluster, enriched_cluster_rest_stride(batch)
-// doubles: 9 planes (entry i*3+j of a block) of the packed upper blocks (a, c), a <= c < W,
-// at a*W - a*(a-1)/2 + (c-a), each plane enriched_cluster_packed_blocks(W) long (padded);
-// then D_f (xi1 and xi2 parts) for f < W. Where every element of the batch is planar
+// Shapes: rest data, cluster after cluster, enriched_cluster_rest_size doubles in all;
+// per cluster of element e (n = enriched_basis_count(batch, e)),
+// enriched_cluster_rest_stride(batch, e) doubles: 9 planes (entry i*3+j of a block) of the packed upper blocks (a, c), a <= c < n, at
+// a*n - a*(a-1)/2 + (c-a), each plane enriched_cluster_packed_blocks(n) long (padded); then
+// D_f (xi1 and xi2 parts) for f < n. Where the element is planar
 // (enriched_element_planar_frame), a block is sum_ab g_ab E_a E_b^T + g_T T T^T in its
-// element's frame (membrane rows in the plane, bending rows along T), so 5 planes hold
-// g_11, g_12, g_21, g_22, g_T (x^T B y for the frame pairs) instead of 9: 5/9 of the memory
-// and of the stream per step (accordion: 158 -> 88 MB), and K = sum_c sum_k g_k (R_c x)
-// (R_c y)^T. Rotations: 3 x 3 row-major per cluster. Blocks and
-// forces as enriched_element_stiffness's (#elements x W x W x 9, #elements x W x 3).
+// frame (membrane rows in the plane, bending rows along T), so 5 planes hold g_11, g_12,
+// g_21, g_22, g_T (x^T B y for the frame pairs) instead of 9: 5/9 of the memory and of the
+// stream per step (accordion: 158 -> 88 MB), and K = sum_c sum_k g_k (R_c x) (R_c y)^T.
+// Planar and curved elements may share a batch; each element's rest data is as wide as its
+// own basis. Rotations: 3 x 3 row-major per cluster. Blocks and forces as
+// enriched_element_stiffness's (#elements x W x W x 9, #elements x W x 3, W = batch.width;
+// the slots beyond an element's n functions are 0).
 // Kernel conventions (dgtex/kernels/forall.h); every entry is a sum in cluster order, so
 // the parallel forms equal the serial ones bitwise for any thread count.
 #include <cstdint>
@@ -63,13 +66,14 @@ EnrichedRotationClusters enriched_rotation_clusters_reference(const EnrichedElem
                                                               const EnrichedQuadrature& quadrature, int block_texels,
                                                               int tip_block_texels);
 
-std::int64_t enriched_cluster_packed_blocks(int width);
-// Whether every element of the batch is planar (the rest data then has 5 planes).
-bool enriched_clusters_planar(const EnrichedElementBatch& batch);
-std::int64_t enriched_cluster_rest_stride(const EnrichedElementBatch& batch);
+std::int64_t enriched_cluster_packed_blocks(int functions);
+// Planes of element e's rest blocks: 5 where it is planar, else 9.
+int enriched_cluster_rest_planes(const EnrichedElementBatch& batch, std::int64_t e);
+std::int64_t enriched_cluster_rest_stride(const EnrichedElementBatch& batch, std::int64_t e);
+std::int64_t enriched_cluster_rest_size(const EnrichedElementBatch& batch, const EnrichedRotationClusters& clusters);
 
-// K0_c and D_f of every cluster (rest data, #clusters x enriched_cluster_rest_stride(batch));
-// every entry is written (padding 0), so `rest` need not be zeroed.
+// K0_c and D_f of every cluster (rest data, enriched_cluster_rest_size doubles); every entry
+// is written (padding 0), so `rest` need not be zeroed.
 void enriched_cluster_rest_stiffness(const EnrichedElementBatch& batch, const EnrichedQuadrature& quadrature,
                                      const EnrichedRotationClusters& clusters, double* rest,
                                      Execution execution = Execution::parallel);
