@@ -87,13 +87,21 @@ std::vector<std::int64_t> texel_blocks(int T, const std::vector<std::pair<int, i
   }
   std::vector<std::int64_t> block(static_cast<std::size_t>(T) * T);
   for (int j = 0; j < T; ++j)
-    for (int i = 0; i < T; ++i) {
-      int s = B;
-      for (const Level& level : levels) {  // sizes in order: s is level.size here
-        if (!level.holds_tip[(j / s) * level.count + i / s]) break;
-        s = std::max(s / 2, tip_B);
+    for (int i0 = 0; i0 < T; i0 += B) {
+      std::int64_t* row = block.data() + static_cast<std::size_t>(j) * T;
+      const int i1 = std::min(i0 + B, T);
+      if (levels.empty() || !levels[0].holds_tip[(j / B) * levels[0].count + i0 / B]) {  // a whole block
+        std::fill(row + i0, row + i1, (static_cast<std::int64_t>(B) * T + j / B) * T + i0 / B);
+        continue;
       }
-      block[j * T + i] = (static_cast<std::int64_t>(s) * T + j / s) * T + i / s;
+      for (int i = i0; i < i1; ++i) {
+        int s = B;
+        for (const Level& level : levels) {  // sizes in order: s is level.size here
+          if (!level.holds_tip[(j / s) * level.count + i / s]) break;
+          s = std::max(s / 2, tip_B);
+        }
+        row[i] = (static_cast<std::int64_t>(s) * T + j / s) * T + i / s;
+      }
     }
   return block;
 }
@@ -136,21 +144,27 @@ std::vector<int> block_components_fast(ElementType type, int T, const std::uint8
     }
   const std::vector<std::int64_t> block = texel_blocks(T, cut_tips(T, flags, inside.data()), B, tip_B);
   std::vector<int> parent(n);
+  std::vector<char> joins_west(n);  // coupled to the texel before it in its row
   for (int j = 0; j < T; ++j) {
     int run_start = j * T;
     for (int i = 0; i < T; ++i) {
       const int t = j * T + i;
-      const bool joined = i > 0 && inside[t - 1] && inside[t] && !(flags[t - 1] & wall_east) && block[t - 1] == block[t];
-      if (!joined) run_start = t;
+      joins_west[t] = i > 0 && inside[t - 1] && inside[t] && !(flags[t - 1] & wall_east) && block[t - 1] == block[t];
+      if (!joins_west[t]) run_start = t;
       parent[t] = run_start;
     }
   }
-  for (int j = 0; j + 1 < T; ++j)
+  for (int j = 0; j + 1 < T; ++j) {
+    bool previous_coupled = false;
     for (int i = 0; i < T; ++i) {
       const int t = j * T + i;
-      if (inside[t] && inside[t + T] && !(flags[t] & wall_north) && block[t] == block[t + T])
-        unite_smaller_root(parent, t, t + T);
+      const bool coupled = inside[t] && inside[t + T] && !(flags[t] & wall_north) && block[t] == block[t + T];
+      // Where both texels continue the runs of the pair before them, which is coupled, their
+      // sets are joined already (a block's rows: one union instead of B).
+      if (coupled && !(previous_coupled && joins_west[t] && joins_west[t + T])) unite_smaller_root(parent, t, t + T);
+      previous_coupled = coupled;
     }
+  }
   std::vector<int> label(n, -1);
   count = 0;
   for (std::size_t t = 0; t < n; ++t) {
