@@ -607,18 +607,6 @@ void chunk_stiffness(const EnrichedElementBatch& b, const EnrichedQuadrature& qu
       values[k] = samples[k].value;
       if (!cache.flat[k]) mask |= 1u << k;
     }
-    if (tangent_weights) {
-      double* D = tangent_weights;
-      for (int a = 0; a < npe; ++a) D[2 * a] += weight * s.dN[a][0], D[2 * a + 1] += weight * s.dN[a][1];
-      for (int k = 0; k < L.count; ++k)
-        for (int a = 0; a < npe; ++a) {
-          const int f = L.slot[k][a];
-          if (f < 0) continue;
-          double dN[2], d2N[3];
-          product_rule(samples[k], L.shift[k][a], s, a, dN, d2N);
-          D[2 * f] += weight * dN[0], D[2 * f + 1] += weight * dN[1];
-        }
-    }
     int g = -1;
     if (last >= 0 && groups[last].matches(mask, values, L.count)) g = last;
     for (int c = 0; g < 0 && c < static_cast<int>(groups.size()); ++c)
@@ -686,6 +674,25 @@ void chunk_stiffness(const EnrichedElementBatch& b, const EnrichedQuadrature& qu
     for_reduced_functions(L, mask, s, samples, [&](const double* dN, const double* d2N, int r) {
       d[0][r] = dN[0], d[1][r] = dN[1], d[2][r] = d2N[0], d[3][r] = d2N[1], d[4][r] = d2N[2];
     });
+    if (tangent_weights) {
+      // Every element function's dN: a varying texture's are among the reduced ones just
+      // formed (the same product rule, so the same bits), a constant one's formed here.
+      double* D = tangent_weights;
+      for (int a = 0; a < npe; ++a) D[2 * a] += weight * s.dN[a][0], D[2 * a + 1] += weight * s.dN[a][1];
+      for (int k = 0, r = npe; k < L.count; ++k)
+        for (int a = 0; a < npe; ++a) {
+          const int f = L.slot[k][a];
+          if (f < 0) continue;
+          if (mask >> k & 1u) {
+            D[2 * f] += weight * d[0][r], D[2 * f + 1] += weight * d[1][r];
+            ++r;
+            continue;
+          }
+          double dN[2], d2N[3];
+          product_rule(samples[k], L.shift[k][a], s, a, dN, d2N);
+          D[2 * f] += weight * dN[0], D[2 * f + 1] += weight * dN[1];
+        }
+    }
     double A[2][2], Bf[3][5];
     pr.split_factors(A, Bf);
     if (planar) {
