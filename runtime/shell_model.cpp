@@ -15,6 +15,7 @@
 #include "dgtex/kernels/shell_point.h"
 #include "dgtex/mesh_validation.h"
 #include "dgtex/model_error.h"
+#include "enriched_sub_batch.h"
 #include "multigrid_buffer.h"
 #include "parametric_point_index.h"
 
@@ -446,28 +447,14 @@ void ShellModel::integrate_enriched_elements(const kernels::EnrichedElementBatch
   }
   // Batches of the elements to compute: a sub-batch of eb (kernels work per element, so
   // each element's result does not depend on which others are in the batch).
-  std::vector<int> todo_index, todo_element, todo_start(1, 0), todo_node;
-  std::vector<kernels::TextureView> todo_textures;
-  std::vector<double> todo_shift;
-  for (std::int64_t x = 0; x < count; ++x) {
-    if (reused[x]) continue;
-    todo_index.push_back(static_cast<int>(x));
-    todo_element.push_back(enriched_elements_[x]);
-    for (int k = enrichment_start_[x]; k < enrichment_start_[x + 1]; ++k) {
-      todo_textures.push_back(textures_[k]);
-      todo_node.insert(todo_node.end(), enriched_node_.begin() + k * npe, enriched_node_.begin() + (k + 1) * npe);
-      todo_shift.insert(todo_shift.end(), enriched_shift_.begin() + k * npe, enriched_shift_.begin() + (k + 1) * npe);
-    }
-    todo_start.push_back(static_cast<int>(todo_textures.size()));
-  }
-  const std::int64_t todo = static_cast<std::int64_t>(todo_index.size());
-  kernels::EnrichedElementBatch sub = eb;
-  sub.count = todo;
-  sub.element = todo_element.data();
-  sub.enrichment_start = todo_start.data();
-  sub.textures = todo_textures.data();
-  sub.enriched_node = todo_node.data();
-  sub.node_shift = todo_shift.data();
+  std::vector<int> todo_index;
+  for (std::int64_t x = 0; x < count; ++x)
+    if (!reused[x]) todo_index.push_back(static_cast<int>(x));
+  const detail::EnrichedSubBatch todo_batch(eb, todo_index);
+  const kernels::EnrichedElementBatch& sub = todo_batch.batch;
+  const std::vector<int>& todo_element = todo_batch.element;
+  const std::vector<int>& todo_start = todo_batch.enrichment_start;
+  const std::int64_t todo = sub.count;
   // Quadrature: reused where only the shifts changed.
   std::vector<std::int64_t> sub_start(1, 0);
   std::vector<double> sub_points;
@@ -481,18 +468,9 @@ void ShellModel::integrate_enriched_elements(const kernels::EnrichedElementBatch
     std::vector<int> quad_index;
     for (std::int64_t t = 0; t < todo; ++t)
       if (!same_textures[todo_index[t]]) quad_index.push_back(static_cast<int>(t));
-    kernels::EnrichedElementBatch qb = sub;
-    std::vector<int> q_element, q_start(1, 0);
-    std::vector<kernels::TextureView> q_textures;
-    for (int t : quad_index) {
-      q_element.push_back(todo_element[t]);
-      q_textures.insert(q_textures.end(), todo_textures.begin() + todo_start[t], todo_textures.begin() + todo_start[t + 1]);
-      q_start.push_back(static_cast<int>(q_textures.size()));
-    }
-    qb.count = static_cast<std::int64_t>(quad_index.size());
-    qb.element = q_element.data();
-    qb.enrichment_start = q_start.data();
-    qb.textures = q_textures.data();
+    const detail::EnrichedSubBatch quad_batch(sub, quad_index);
+    const kernels::EnrichedElementBatch& qb = quad_batch.batch;
+    const std::vector<int>& q_start = quad_batch.enrichment_start;
     std::vector<std::int64_t> q_point_start;
     std::vector<double> q_points;
     std::vector<std::shared_ptr<const kernels::TexelDerivativeTile>> q_derivatives;
