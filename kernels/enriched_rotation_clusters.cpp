@@ -209,6 +209,18 @@ ElementClusters bucket_points(const EnrichedElementBatch& batch, const EnrichedQ
   return out;
 }
 
+// The walls (and inactive texels) of all of element e's textures: their flags or'ed
+// together, in `merged` unless the element has one texture (its own flags then).
+const std::uint8_t* element_flags(const EnrichedElementBatch& batch, std::int64_t e, std::vector<std::uint8_t>& merged) {
+  const int first = batch.enrichment_start[e], last = batch.enrichment_start[e + 1];
+  if (last - first == 1) return batch.textures[first].flags;
+  merged.assign(batch.textures[first].flags,
+                batch.textures[first].flags + static_cast<std::size_t>(batch.resolution) * batch.resolution);
+  for (int k = first + 1; k < last; ++k)
+    for (std::size_t t = 0; t < merged.size(); ++t) merged[t] |= batch.textures[k].flags[t];
+  return merged.data();
+}
+
 void check_block_sizes(int block_texels, int tip_block_texels) {
   if (block_texels < 1)
     throw std::invalid_argument("enriched_rotation_clusters: block_texels is " + std::to_string(block_texels) +
@@ -353,9 +365,10 @@ EnrichedRotationClusters enriched_rotation_clusters(const EnrichedElementBatch& 
       batch.count,
       [&](std::int64_t e) {
         int labels = 0;
+        std::vector<std::uint8_t> merged;
         const std::vector<int> label = block_components_fast(batch.type, batch.resolution,
-                                                             batch.textures[batch.enrichment_start[e]].flags,
-                                                             block_texels, tip_block_texels, labels);
+                                                             element_flags(batch, e, merged), block_texels,
+                                                             tip_block_texels, labels);
         elements[e] = bucket_points(batch, quadrature, e, label, labels);
       },
       execution);
@@ -369,9 +382,9 @@ EnrichedRotationClusters enriched_rotation_clusters_reference(const EnrichedElem
   std::vector<ElementClusters> elements;
   for (std::int64_t e = 0; e < batch.count; ++e) {
     int labels = 0;
-    const std::vector<int> label = block_components(batch.type, batch.resolution,
-                                                    batch.textures[batch.enrichment_start[e]].flags, block_texels,
-                                                    tip_block_texels, labels);
+    std::vector<std::uint8_t> merged;
+    const std::vector<int> label = block_components(batch.type, batch.resolution, element_flags(batch, e, merged),
+                                                    block_texels, tip_block_texels, labels);
     elements.push_back(bucket_points(batch, quadrature, e, label, labels));
   }
   return concatenate(elements);

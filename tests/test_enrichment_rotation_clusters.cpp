@@ -171,6 +171,34 @@ TEST(EnrichedRotationClusters, NeverSpanACutAndHoldEveryPointOnce) {
   EXPECT_THROW(kernels::enriched_rotation_clusters(one.batch, one.quadrature(), 0, 1), std::invalid_argument);
 }
 
+// An element's textures need not share their walls (the fixture's first texture holds only
+// the first cut): the clusters follow the walls of all of them, as the quadrature does.
+TEST(EnrichedRotationClusters, NeverSpanTheCutOfAnyOfTheElementsTextures) {
+  const CutQuad8Element two(2, 0, /*per_texel_rule=*/true);  // two complete cuts: three strips
+  for (int block : {kT, 16}) {
+    const kernels::EnrichedRotationClusters clusters =
+        kernels::enriched_rotation_clusters(two.batch, two.quadrature(), block, block);
+    const kernels::EnrichedRotationClusters reference =
+        kernels::enriched_rotation_clusters_reference(two.batch, two.quadrature(), block, block);
+    EXPECT_EQ(clusters.point_start, reference.point_start);
+    EXPECT_EQ(clusters.points, reference.points);
+    if (block == kT) {
+      EXPECT_EQ(clusters.count(), 3);
+    }
+    for (std::int64_t c = 0; c < clusters.count(); ++c)
+      for (int k = 0; k < 2; ++k) {
+        double side = 0;
+        for (std::int64_t p = clusters.point_start[c]; p < clusters.point_start[c + 1]; ++p) {
+          const double* pt = two.qp.data() + 3 * clusters.points[p];
+          kernels::TextureSample s;
+          kernels::sample_texture(ElementType::quad8, kT, two.views[k], pt[0], pt[1], s);
+          if (side == 0) side = s.value;
+          ASSERT_EQ(s.value, side) << "cluster " << c << " of blocks of " << block << ", texture " << k;
+        }
+      }
+  }
+}
+
 // Tiles of several elements with partial cuts (tips inside, walls ending on the border,
 // tri6 diagonals), random points in every texel: the clusters equal the reference's (the
 // tile labelled by label_components, texel_in_domain per texel) for every block size and

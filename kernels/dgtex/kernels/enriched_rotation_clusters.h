@@ -12,10 +12,11 @@
 // sums. With one point per cluster this is the per-point corotation exactly.
 //
 // Clusters: the texels of one block of B x B texels that are connected without crossing a
-// wall (so a cluster never straddles a cut: the two sides of a cut turn apart), holding the
-// points whose texel (containing_texel) is among them. Blocks that hold a cut tip (a texel
-// corner inside the tile where one wall edge ends) are quartered toward it down to a
-// smaller size: the shell turns fastest around the tips (the hinges of an accordion).
+// wall of any of the element's textures (so a cluster never straddles a cut: the two sides
+// of a cut turn apart), holding the points whose texel (containing_texel) is among them.
+// Blocks that hold a cut tip (a texel corner inside the tile where one wall edge ends) are
+// quartered toward it down to a smaller size: the shell turns fastest around the tips (the
+// hinges of an accordion).
 // R_c is the polar rotation of the cluster's mean deformation gradient: the current
 // tangents are linear in the DOFs, so their weighted means over the cluster are
 // sum_f D_f x_f with D_f = sum_q w_q dN_f(q) (stored with K0_c); the rest ones likewise
