@@ -239,6 +239,11 @@ TEST(PlanarEnrichedElements, PlanarAndCurvedElementsShareABatch) {
         ASSERT_EQ(K[((static_cast<std::size_t>(W) + a) * W + c) * 9 + i], 0.0);
         ASSERT_EQ(K[((static_cast<std::size_t>(W) + c) * W + a) * 9 + i], 0.0);
       }
+  // The linear stiffness of the two, each in its own form, against the reference too.
+  std::vector<double> linear(Kref.size()), linear_ref(Kref.size());
+  kernels::enriched_element_stiffness(batch, quad, nullptr, linear.data(), nullptr);
+  kernels::enriched_element_stiffness_reference(batch, quad, nullptr, linear_ref.data(), fref.data());
+  EXPECT_LE(max_difference(linear, linear_ref), 1e-9 * max_abs(linear_ref));
   for (int threads : {1, 2, 3}) {
     omp_set_num_threads(threads);
     std::vector<double> K_threads, f_threads;
