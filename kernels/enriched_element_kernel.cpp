@@ -342,6 +342,44 @@ inline void combine_derivatives(const double f[5], const double (*d)[max_enriche
   for (int r = 0; r < m; ++r) out[r] = f[0] * d[0][r] + f[1] * d[1][r] + f[2] * d[2][r] + f[3] * d[3][r] + f[4] * d[4][r];
 }
 
+// A planar element's rows of one point (see chunk_stiffness): the membrane row, two columns
+// a function (2 r + a: Am d), and the three bending rows (f_t . d, bending_stride apart).
+// The per-point loops, cloned per instruction set like the Gram products: every entry is
+// the same expression in each clone and the file is compiled without contraction
+// (cmake/areas/enriched_assembly.cmake), so all clones give the same bits.
+__attribute__((target_clones("avx512f", "avx2", "default")))
+void planar_point_rows(int m, const double (*d)[max_enriched_basis], const double Am[2][2], const double f[3][5],
+                       double* __restrict membrane, double* __restrict bending, std::size_t bending_stride) {
+  for (int r = 0; r < m; ++r) {
+    membrane[2 * r] = Am[0][0] * d[0][r] + Am[0][1] * d[1][r];
+    membrane[2 * r + 1] = Am[1][0] * d[0][r] + Am[1][1] * d[1][r];
+  }
+  for (int t = 0; t < 3; ++t) combine_derivatives(f[t], d, m, bending + t * bending_stride);
+}
+
+// A curved element's rows of one point (the frame split, FrameSplit): the factors U = A d
+// (rows U0, U1), the three bending rows Bf d (S apart), and per frame component k the rows
+// L_k U (at M[k] and M[k] + S) and W_k U (at Wu[k] and Wu[k] + S). Cloned like
+// planar_point_rows.
+__attribute__((target_clones("avx512f", "avx2", "default")))
+void split_point_rows(int m, const double (*d)[max_enriched_basis], const double A[2][2], const double Bf[3][5],
+                      const FrameSplit& fs, std::size_t S, double* __restrict U0, double* __restrict U1,
+                      double* __restrict bending, double* const M[3], double* const Wu[3]) {
+  for (int r = 0; r < m; ++r) U0[r] = A[0][0] * d[0][r] + A[0][1] * d[1][r];
+  for (int r = 0; r < m; ++r) U1[r] = A[1][0] * d[0][r] + A[1][1] * d[1][r];
+  for (int t = 0; t < 3; ++t) combine_derivatives(Bf[t], d, m, bending + t * S);
+  for (int k = 0; k < 3; ++k) {
+    double* __restrict M0 = M[k];
+    double* __restrict M1 = M[k] + S;
+    const double* l = fs.L[k];
+    for (int r = 0; r < m; ++r) M0[r] = l[0] * U0[r] + l[1] * U1[r], M1[r] = l[2] * U1[r];
+    double* __restrict W0 = Wu[k];
+    double* __restrict W1 = Wu[k] + S;
+    const double* w = fs.W[k];
+    for (int r = 0; r < m; ++r) W0[r] = w[0] * U0[r] + w[1] * U1[r], W1[r] = w[2] * U0[r] + w[3] * U1[r];
+  }
+}
+
 // Points with the same varying textures (mask) and the same constant values: G = sum of
 // S^T S over the group's reduced basis (standard functions, then the varying textures'
 // enriched ones), upper triangle; g = sum of S^T s (corrective forces). Curved or rotated
@@ -710,17 +748,11 @@ void chunk_stiffness(const EnrichedElementBatch& b, const EnrichedQuadrature& qu
       for (int a = 0; a < 2; ++a)
         for (int j = 0; j < 2; ++j) Am[a][j] = A[0][j] * in_plane[0][a] + A[1][j] * in_plane[1][a];
       const std::size_t Sm = group.membrane_stride, Sb = group.bending_stride;
-      double* membrane = group.membrane_rows + group.pending * Sm;
-      for (int r = 0; r < m; ++r) {
-        membrane[2 * r] = Am[0][0] * d[0][r] + Am[0][1] * d[1][r];
-        membrane[2 * r + 1] = Am[1][0] * d[0][r] + Am[1][1] * d[1][r];
-      }
-      double* bending = group.bending_rows + 3 * group.pending * Sb;
-      for (int t = 0; t < 3; ++t) {
-        double f[5];
-        for (int j = 0; j < 5; ++j) f[j] = Bf[t][j] * normal;
-        combine_derivatives(f, d, m, bending + t * Sb);
-      }
+      double f[3][5];
+      for (int t = 0; t < 3; ++t)
+        for (int j = 0; j < 5; ++j) f[t][j] = Bf[t][j] * normal;
+      planar_point_rows(m, d, Am, f, group.membrane_rows + group.pending * Sm,
+                        group.bending_rows + 3 * group.pending * Sb, Sb);
       if (++group.pending == planar_block_points) flush(group);
       continue;
     }
@@ -759,22 +791,16 @@ void chunk_stiffness(const EnrichedElementBatch& b, const EnrichedQuadrature& qu
     double* const U0 = group.row_block(split_u) + 2 * group.pending * S;
     double* const U1 = U0 + S;
     double* const bending = group.row_block(split_b) + 3 * group.pending * S;  // the point's 3 rows
-    for (int r = 0; r < m; ++r) U0[r] = A[0][0] * d[0][r] + A[0][1] * d[1][r];
-    for (int r = 0; r < m; ++r) U1[r] = A[1][0] * d[0][r] + A[1][1] * d[1][r];
-    for (int t = 0; t < 3; ++t) combine_derivatives(Bf[t], d, m, bending + t * S);
+    double* M[3];
+    double* Wu[3];
+    for (int k = 0; k < 3; ++k) {
+      M[k] = group.row_block(split_m(k)) + 2 * group.pending * S;
+      Wu[k] = group.row_block(split_wu(k)) + 2 * group.pending * S;
+    }
+    split_point_rows(m, d, A, Bf, fs, S, U0, U1, bending, M, Wu);
     double* const weights = group.bending_weights + split_bending_weights * group.pending;
     for (int k = 0; k < 3; ++k) weights[k] = fs.t[k] * fs.t[k];
     for (int p = 0; p < 3; ++p) weights[3 + p] = fs.t[frame_split_pairs[p][0]] * fs.t[frame_split_pairs[p][1]];
-    for (int k = 0; k < 3; ++k) {
-      double* const M0 = group.row_block(split_m(k)) + 2 * group.pending * S;
-      double* const M1 = M0 + S;
-      const double* l = fs.L[k];
-      for (int r = 0; r < m; ++r) M0[r] = l[0] * U0[r] + l[1] * U1[r], M1[r] = l[2] * U1[r];
-      double* const W0 = group.row_block(split_wu(k)) + 2 * group.pending * S;
-      double* const W1 = W0 + S;
-      const double* w = fs.W[k];
-      for (int r = 0; r < m; ++r) W0[r] = w[0] * U0[r] + w[1] * U1[r], W1[r] = w[2] * U0[r] + w[3] * U1[r];
-    }
     if (point_forces)
       for (int r = 0; r < m; ++r) {
         const double beta = sv[3] * bending[r] + sv[4] * bending[S + r] + sv[5] * bending[2 * S + r];

@@ -1,8 +1,10 @@
-# The Gram accumulation of the enriched element stiffness (kernels/gram_accumulation.cpp)
-# and the rotated cluster blocks (kernels/enriched_rotation_clusters.cpp) have a path per
-# instruction set, chosen at run time. Without contraction into FMA every path rounds
-# exactly like baseline x86-64, so K does not depend on the machine's vector unit.
+# The Gram accumulation of the enriched element stiffness (kernels/gram_accumulation.cpp),
+# the per-point rows it sums (kernels/enriched_element_kernel.cpp) and the rotated cluster
+# blocks (kernels/enriched_rotation_clusters.cpp) have a path per instruction set, chosen at
+# run time. Without contraction into FMA every path rounds exactly like baseline x86-64, so
+# K does not depend on the machine's vector unit.
 set_source_files_properties(${CMAKE_CURRENT_SOURCE_DIR}/kernels/gram_accumulation.cpp
+                            ${CMAKE_CURRENT_SOURCE_DIR}/kernels/enriched_element_kernel.cpp
                             ${CMAKE_CURRENT_SOURCE_DIR}/kernels/enriched_rotation_clusters.cpp
                             PROPERTIES COMPILE_OPTIONS -ffp-contract=off)
 
