@@ -86,9 +86,9 @@ std::vector<std::int64_t> texel_blocks(int T, const std::vector<std::pair<int, i
     levels.push_back(std::move(level));
   }
   std::vector<std::int64_t> block(static_cast<std::size_t>(T) * T);
-  for (int j = 0; j < T; ++j)
+  for (int j = 0; j < T; ++j) {
+    std::int64_t* row = block.data() + static_cast<std::size_t>(j) * T;
     for (int i0 = 0; i0 < T; i0 += B) {
-      std::int64_t* row = block.data() + static_cast<std::size_t>(j) * T;
       const int i1 = std::min(i0 + B, T);
       if (levels.empty() || !levels[0].holds_tip[(j / B) * levels[0].count + i0 / B]) {  // a whole block
         std::fill(row + i0, row + i1, (static_cast<std::int64_t>(B) * T + j / B) * T + i0 / B);
@@ -103,6 +103,7 @@ std::vector<std::int64_t> texel_blocks(int T, const std::vector<std::pair<int, i
         row[i] = (static_cast<std::int64_t>(s) * T + j / s) * T + i / s;
       }
     }
+  }
   return block;
 }
 
@@ -211,7 +212,8 @@ ElementClusters bucket_points(const EnrichedElementBatch& batch, const EnrichedQ
 
 // The walls (and inactive texels) of all of element e's textures: their flags or'ed
 // together, in `merged` unless the element has one texture (its own flags then).
-const std::uint8_t* element_flags(const EnrichedElementBatch& batch, std::int64_t e, std::vector<std::uint8_t>& merged) {
+const std::uint8_t* element_flags(const EnrichedElementBatch& batch, std::int64_t e,
+                                  std::vector<std::uint8_t>& merged) {
   const int first = batch.enrichment_start[e], last = batch.enrichment_start[e + 1];
   if (last - first == 1) return batch.textures[first].flags;
   merged.assign(batch.textures[first].flags,
@@ -452,7 +454,8 @@ void enriched_element_clustered_stiffness(const EnrichedElementBatch& batch, con
   std::vector<char> planar(static_cast<std::size_t>(batch.count));
   std::vector<double> frames(9 * static_cast<std::size_t>(batch.count));
   for (std::int64_t e = 0; e < batch.count; ++e) planar[e] = enriched_element_planar_frame(batch, e, &frames[9 * e]);
-  const std::int64_t tiles = (static_cast<std::int64_t>(W) * (W + 1) / 2 + cluster_tile_blocks - 1) / cluster_tile_blocks;
+  const std::int64_t widest = static_cast<std::int64_t>(W) * (W + 1) / 2;
+  const std::int64_t tiles = (widest + cluster_tile_blocks - 1) / cluster_tile_blocks;
   // Blocks: one work item per tile of an element's packed upper blocks; every cluster adds
   // its rotated stretch of the tile, in cluster order, to a sum that stays in cache, which
   // is then written as blocks (a, c) and their mirrors (c, a). The blocks of the slots
@@ -462,7 +465,8 @@ void enriched_element_clustered_stiffness(const EnrichedElementBatch& batch, con
       [&](std::int64_t item) {
         const std::int64_t e = item / tiles;
         const int n = enriched_basis_count(batch, e);
-        const std::int64_t packed = static_cast<std::int64_t>(n) * (n + 1) / 2, plane = enriched_cluster_packed_blocks(n);
+        const std::int64_t packed = static_cast<std::int64_t>(n) * (n + 1) / 2;
+        const std::int64_t plane = enriched_cluster_packed_blocks(n);
         const std::int64_t p0 = item % tiles * cluster_tile_blocks;
         if (p0 == 0)
           for (int a = 0; a < W; ++a)
@@ -511,7 +515,8 @@ void enriched_element_clustered_stiffness(const EnrichedElementBatch& batch, con
             double d[3];
             for (int k = 0; k < 3; ++k) d[k] = X[k] - (R[0 * 3 + k] * X[0] + R[1 * 3 + k] * X[1] + R[2 * 3 + k] * X[2]);
             double* out = &z[(c * npe + b) * 3];
-            for (int y = 0; y < 3; ++y) out[y] = planar[e] ? E[3 * y] * d[0] + E[3 * y + 1] * d[1] + E[3 * y + 2] * d[2] : d[y];
+            for (int y = 0; y < 3; ++y)
+              out[y] = planar[e] ? E[3 * y] * d[0] + E[3 * y + 1] * d[1] + E[3 * y + 2] * d[2] : d[y];
           }
         }
       },
@@ -533,7 +538,7 @@ void enriched_element_clustered_stiffness(const EnrichedElementBatch& batch, con
         const int n = enriched_basis_count(batch, e);
         const int used = std::max(a0, std::min(a1, n));
         const std::int64_t plane = enriched_cluster_packed_blocks(n);
-        const bool flat = planar[e];
+        const bool is_planar = planar[e];
         double f[cluster_force_tile][3] = {};
         const double* E = &frames[9 * e];
         for (std::int64_t c = clusters.element_start[e]; c < clusters.element_start[e + 1]; ++c) {
@@ -546,14 +551,14 @@ void enriched_element_clustered_stiffness(const EnrichedElementBatch& batch, con
             // a <= b: block (a, b) is stored, in row a.
             for (int a = a0; a < std::min(used, b + 1); ++a) {
               const std::int64_t p = packed_row_start(n, a) + (b - a);
-              for (int k = 0; k < 5 && flat; ++k) h[k][a - a0] += B[k * plane + p] * zb[pair[k][1]];
-              for (int i = 0; i < 3 && !flat; ++i)
+              for (int k = 0; k < 5 && is_planar; ++k) h[k][a - a0] += B[k * plane + p] * zb[pair[k][1]];
+              for (int i = 0; i < 3 && !is_planar; ++i)
                 for (int j = 0; j < 3; ++j) h[i][a - a0] += B[(i * 3 + j) * plane + p] * zb[j];
             }
             // a > b: the stored block (b, a), contiguous in row b, transposed.
             const int first = std::max(a0, b + 1);
             const double* row = B + packed_row_start(n, b) - b;  // row[a]: block (b, a)
-            if (flat) {
+            if (is_planar) {
               for (int k = 0; k < 5; ++k) {
                 const double* plane_k = row + transposed[k] * plane;
                 const double y = zb[pair[k][1]];
@@ -569,7 +574,7 @@ void enriched_element_clustered_stiffness(const EnrichedElementBatch& batch, con
           }
           for (int a = a0; a < used; ++a) {
             double g[3] = {0, 0, 0};  // sum_b K0_c(a, b) z_b
-            if (flat) {
+            if (is_planar) {
               for (int k = 0; k < 5; ++k)
                 for (int i = 0; i < 3; ++i) g[i] += E[3 * pair[k][0] + i] * h[k][a - a0];
             } else {

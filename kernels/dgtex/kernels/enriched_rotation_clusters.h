@@ -23,11 +23,11 @@
 // from the rest positions. The error against per-point
 // rotations is of the order of the rotation's spread inside a cluster (B = 1: per texel).
 //
-// Shapes: rest data, cluster after cluster, enriched_cluster_rest_size doubles in all;
-// per cluster of element e (n = enriched_basis_count(batch, e)),
-// enriched_cluster_rest_stride(batch, e) doubles: 9 planes (entry i*3+j of a block) of the packed upper blocks (a, c), a <= c < n, at
-// a*n - a*(a-1)/2 + (c-a), each plane enriched_cluster_packed_blocks(n) long (padded); then
-// D_f (xi1 and xi2 parts) for f < n. Where the element is planar
+// Shapes: rest data, cluster after cluster, enriched_cluster_rest_size doubles in all; per
+// cluster of element e (n = enriched_basis_count(batch, e)), enriched_cluster_rest_stride
+// (batch, e) doubles: 9 planes (entry i*3+j of a block) of the packed upper blocks (a, c),
+// a <= c < n, at a*n - a*(a-1)/2 + (c-a), each plane enriched_cluster_packed_blocks(n) long
+// (padded); then D_f (xi1 and xi2 parts) for f < n. Where the element is planar
 // (enriched_element_planar_frame), a block is sum_ab g_ab E_a E_b^T + g_T T T^T in its
 // frame (membrane rows in the plane, bending rows along T), so 5 planes hold g_11, g_12,
 // g_21, g_22, g_T (x^T B y for the frame pairs) instead of 9: 5/9 of the memory and of the
