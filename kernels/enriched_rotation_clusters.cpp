@@ -245,16 +245,30 @@ EnrichedRotationClusters concatenate(const std::vector<ElementClusters>& element
   return out;
 }
 
-// Where each cluster's rest data starts (#clusters + 1; the last: the size of them all).
-std::vector<std::int64_t> rest_starts(const EnrichedElementBatch& batch, const EnrichedRotationClusters& clusters) {
-  std::vector<std::int64_t> start(1, 0);
-  for (std::int64_t e = 0; e < batch.count; ++e) {
-    const std::int64_t stride = enriched_cluster_rest_stride(batch, e);
-    for (std::int64_t c = clusters.element_start[e]; c < clusters.element_start[e + 1]; ++c)
-      start.push_back(start.back() + stride);
-  }
-  return start;
+int rest_planes(bool planar) { return planar ? 5 : 9; }
+// Doubles of one cluster's rest data: the planes of packed blocks, then D_f.
+std::int64_t rest_stride(bool planar, int n) {
+  return rest_planes(planar) * enriched_cluster_packed_blocks(n) + 2 * static_cast<std::int64_t>(n);
 }
+
+// The rest data's layout, each element's planarity tested once per call: per element
+// whether it is planar and its frame (enriched_element_planar_frame), per cluster where its
+// rest data starts (#clusters + 1; the last: the size of them all).
+struct RestLayout {
+  std::vector<char> planar;
+  std::vector<double> frames;  // 9 per element
+  std::vector<std::int64_t> start;
+
+  RestLayout(const EnrichedElementBatch& batch, const EnrichedRotationClusters& clusters)
+      : planar(static_cast<std::size_t>(batch.count)), frames(9 * static_cast<std::size_t>(batch.count)), start(1, 0) {
+    for (std::int64_t e = 0; e < batch.count; ++e) {
+      planar[e] = enriched_element_planar_frame(batch, e, &frames[9 * e]);
+      const std::int64_t stride = rest_stride(planar[e], enriched_basis_count(batch, e));
+      for (std::int64_t c = clusters.element_start[e]; c < clusters.element_start[e + 1]; ++c)
+        start.push_back(start.back() + stride);
+    }
+  }
+};
 
 // Mean-tangent weights D_f = sum_q w_q dN_f(q) of one cluster (2 per function, W slots).
 void tangent_weights(const EnrichedElementBatch& b, const EnrichedQuadrature& quad, std::int64_t e,
@@ -344,16 +358,15 @@ std::int64_t enriched_cluster_packed_blocks(int functions) {
 
 int enriched_cluster_rest_planes(const EnrichedElementBatch& batch, std::int64_t e) {
   double frame[9];
-  return enriched_element_planar_frame(batch, e, frame) ? 5 : 9;
+  return rest_planes(enriched_element_planar_frame(batch, e, frame));
 }
 
 std::int64_t enriched_cluster_rest_stride(const EnrichedElementBatch& batch, std::int64_t e) {
-  const int n = enriched_basis_count(batch, e);
-  return enriched_cluster_rest_planes(batch, e) * enriched_cluster_packed_blocks(n) + 2 * static_cast<std::int64_t>(n);
+  return rest_stride(enriched_cluster_rest_planes(batch, e) == 5, enriched_basis_count(batch, e));
 }
 
 std::int64_t enriched_cluster_rest_size(const EnrichedElementBatch& batch, const EnrichedRotationClusters& clusters) {
-  return rest_starts(batch, clusters).back();
+  return RestLayout(batch, clusters).start.back();
 }
 
 EnrichedRotationClusters enriched_rotation_clusters(const EnrichedElementBatch& batch,
@@ -394,24 +407,22 @@ EnrichedRotationClusters enriched_rotation_clusters_reference(const EnrichedElem
 
 void enriched_cluster_rest_stiffness(const EnrichedElementBatch& batch, const EnrichedQuadrature& quadrature,
                                      const EnrichedRotationClusters& clusters, double* rest, Execution execution) {
-  const std::vector<std::int64_t> rest_start = rest_starts(batch, clusters);
+  const RestLayout layout(batch, clusters);
+  const std::vector<char>& planar = layout.planar;
   std::vector<std::int64_t> element_of(static_cast<std::size_t>(clusters.count()));
-  std::vector<char> planar(static_cast<std::size_t>(batch.count));
-  for (std::int64_t e = 0; e < batch.count; ++e) {
-    planar[e] = enriched_cluster_rest_planes(batch, e) == 5;
+  for (std::int64_t e = 0; e < batch.count; ++e)
     for (std::int64_t c = clusters.element_start[e]; c < clusters.element_start[e + 1]; ++c) element_of[c] = e;
-  }
   // Clusters differ much in cost (tip blocks hold few points): handed out dynamically;
   // each writes only its own rest data, so the result does not depend on the threads.
   auto cluster = [&](std::int64_t c) {
     const std::int64_t e = element_of[c];
     const int n = enriched_basis_count(batch, e);
-    const int planes = planar[e] ? 5 : 9;
+    const int planes = rest_planes(planar[e]);
     const std::int64_t plane = enriched_cluster_packed_blocks(n);
     const std::int64_t* points = clusters.points.data() + clusters.point_start[c];
     const std::int64_t count = clusters.point_start[c + 1] - clusters.point_start[c];
     static thread_local std::vector<double> K;
-    double* out = rest + rest_start[c];
+    double* out = rest + layout.start[c];
     enriched_element_point_set_stiffness(batch, quadrature, e, points, count, K, out + planes * plane);
     std::fill(out, out + planes * plane, 0.0);
     const std::size_t N3 = 3 * static_cast<std::size_t>(n);
@@ -433,14 +444,14 @@ void enriched_cluster_rest_stiffness(const EnrichedElementBatch& batch, const En
 
 void enriched_cluster_rotations(const EnrichedElementBatch& batch, const EnrichedRotationClusters& clusters,
                                 const double* rest, const double* current, double* rotations, Execution execution) {
-  const std::vector<std::int64_t> rest_start = rest_starts(batch, clusters);
+  const RestLayout layout(batch, clusters);
   forall(
       batch.count,
       [&](std::int64_t e) {
-        const std::int64_t weights = enriched_cluster_rest_planes(batch, e) *
-                                     enriched_cluster_packed_blocks(enriched_basis_count(batch, e));
+        const std::int64_t weights =
+            rest_planes(layout.planar[e]) * enriched_cluster_packed_blocks(enriched_basis_count(batch, e));
         for (std::int64_t c = clusters.element_start[e]; c < clusters.element_start[e + 1]; ++c)
-          cluster_rotation(batch, e, rest + rest_start[c] + weights, current, rotations + 9 * c);
+          cluster_rotation(batch, e, rest + layout.start[c] + weights, current, rotations + 9 * c);
       },
       execution);
 }
@@ -450,10 +461,10 @@ void enriched_element_clustered_stiffness(const EnrichedElementBatch& batch, con
                                           double* forces, Execution execution) {
   const int W = batch.width;
   const int npe = nodes_per_element(batch.type);
-  const std::vector<std::int64_t> rest_start = rest_starts(batch, clusters);
-  std::vector<char> planar(static_cast<std::size_t>(batch.count));
-  std::vector<double> frames(9 * static_cast<std::size_t>(batch.count));
-  for (std::int64_t e = 0; e < batch.count; ++e) planar[e] = enriched_element_planar_frame(batch, e, &frames[9 * e]);
+  const RestLayout layout(batch, clusters);
+  const std::vector<char>& planar = layout.planar;
+  const std::vector<double>& frames = layout.frames;
+  const std::vector<std::int64_t>& rest_start = layout.start;
   const std::int64_t widest = static_cast<std::int64_t>(W) * (W + 1) / 2;
   const std::int64_t tiles = (widest + cluster_tile_blocks - 1) / cluster_tile_blocks;
   // Blocks: one work item per tile of an element's packed upper blocks; every cluster adds
