@@ -11,6 +11,7 @@
 #include <omp.h>
 
 #include "dgtex/enrichment_span.h"
+#include "dgtex/kernels/forall.h"
 #include "dgtex/stage_timer.h"
 #include "dgtex/surface_point.h"
 #include "dgtex/texel_storage.h"
@@ -157,14 +158,17 @@ CutManager::CutManager(const Mesh& mesh, const Topology& topology, const std::ve
   paths_.resize(cuts_.size());
   std::vector<std::exception_ptr> failures(cuts_.size());
   const SurfacePointSearch search(mesh);
-#pragma omp parallel for schedule(dynamic, 1) if (count > 1 && !omp_in_parallel())
-  for (int c = 0; c < count; ++c) {
-    try {
-      paths_[c] = trace_cut_path(mesh, search, adjacency_, cuts_[c], resolution_, "cuts[" + std::to_string(c) + "]");
-    } catch (...) {
-      failures[c] = std::current_exception();
-    }
-  }
+  kernels::forall_dynamic(
+      count,
+      [&](std::int64_t c) {
+        try {
+          const std::string where = "cuts[" + std::to_string(c) + "]";
+          paths_[c] = trace_cut_path(mesh, search, adjacency_, cuts_[c], resolution_, where);
+        } catch (...) {
+          failures[c] = std::current_exception();
+        }
+      },
+      count > 1 && !omp_in_parallel() ? kernels::Execution::parallel : kernels::Execution::serial);
   for (const std::exception_ptr& failure : failures)
     if (failure) std::rethrow_exception(failure);
   // Boundaries closer than half a texel (of a mean-sized element) are merged.
@@ -397,13 +401,9 @@ bool CutManager::update(double time) {
       failures[k] = std::current_exception();
     }
   };
-  if (concurrent) {
-    const int count = static_cast<int>(jobs.size());
-#pragma omp parallel for schedule(dynamic, 1)
-    for (int k = 0; k < count; ++k) solve_job(static_cast<std::size_t>(k));
-  } else {
-    for (std::size_t k = 0; k < jobs.size(); ++k) solve_job(k);
-  }
+  kernels::forall_dynamic(
+      static_cast<std::int64_t>(jobs.size()), [&](std::int64_t k) { solve_job(static_cast<std::size_t>(k)); },
+      concurrent ? kernels::Execution::parallel : kernels::Execution::serial);
   for (const std::exception_ptr& failure : failures)
     if (failure) std::rethrow_exception(failure);
   last_.solve_ms = ms_since(solve_start);
