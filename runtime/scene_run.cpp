@@ -8,6 +8,7 @@
 
 #include "dgtex/basis_projection.h"
 #include "dgtex/crease_enrichment.h"
+#include "dgtex/kernels/threads_busy_beside.h"
 #include "dgtex/model_error.h"
 #include "dgtex/scene_model.h"
 #include "dgtex/topology.h"
@@ -69,6 +70,7 @@ void SceneRun::solve_static() { simulation_->solve_static(); }
 
 void SceneRun::step() {
   const double next = time_ + dynamics_.time_step;
+  const kernels::ScopedThreadsBusyBeside beside(&cut_update_threads_);
   try {
     if (cuts_) {
       const bool changed = bring_cuts_to(next);
@@ -115,9 +117,14 @@ void SceneRun::start_next_cut_update(double time) {
       omp_get_max_threads() < 2)
     return;
   next_cut_update_time_ = time;
+  cut_update_threads_.store(1, std::memory_order_release);
   try {
     next_cut_update_ = std::async(std::launch::async, [this, time] {
-      omp_set_num_threads(1);  // serial kernels: the shell step has the OpenMP team
+      omp_set_num_threads(1);  // serial kernels: the shell step has the other threads
+      struct Done {
+        std::atomic<int>& threads;
+        ~Done() { threads.store(0, std::memory_order_release); }
+      } done_with_the_thread{cut_update_threads_};
       const auto start = std::chrono::steady_clock::now();
       CutUpdate done;
       done.changed = cuts_->update(time);
@@ -126,6 +133,7 @@ void SceneRun::start_next_cut_update(double time) {
     });
   } catch (const std::system_error&) {
     // No thread to be had: the next step updates the cuts itself.
+    cut_update_threads_.store(0, std::memory_order_release);
   }
 }
 

@@ -13,6 +13,7 @@
 #include "dgtex/kernels/enriched_element_rest_integrals.h"
 #include "dgtex/kernels/polar_decomposition.h"
 #include "dgtex/kernels/shell_point.h"
+#include "dgtex/kernels/threads_busy_beside.h"
 #include "dgtex/mesh_validation.h"
 #include "dgtex/model_error.h"
 #include "enriched_sub_batch.h"
@@ -1156,7 +1157,7 @@ std::vector<std::vector<double>> ShellModel::moments_of_fields(const ShellModel&
       };
       // Plain elements have a handful of points: no parallel region for them.
       const bool parallel = count > block;
-      const std::int64_t slices = parallel ? std::max(1, omp_get_max_threads()) : 1;
+      const std::int64_t slices = parallel ? kernels::parallel_team_size() : 1;
       // Then w N_A g_c summed per basis function: each of `slices` items takes a run of the
       // element's basis functions (its global nodes are distinct) and adds, for every field,
       // point after point into a local copy of their sums: the same additions in the same

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "cholmod_lock.h"
+#include "dgtex/kernels/threads_busy_beside.h"
 #include "dense_cholesky.h"
 
 namespace dgtex {
@@ -293,7 +294,7 @@ void SparseCholesky::solve_single_precision(const std::vector<double>& b, std::v
   };
   // Forward, L y = P b: the subtrees, then their updates of the top rows in task order,
   // then the top supernodes. Backward, L^T z = y, in the reverse order.
-#pragma omp parallel for schedule(dynamic, 1) if (n_ >= parallel_solve_size)
+#pragma omp parallel for schedule(dynamic, 1) if (n_ >= parallel_solve_size) num_threads(kernels::parallel_team_size())
   for (int task = 0; task < tasks; ++task)
     for (int s = schedule.task_first[task]; s <= schedule.task_last[task]; ++s)
       forward(s, m.gathered[task], m.top_updates.data() + static_cast<std::size_t>(task) * schedule.top_rows);
@@ -303,7 +304,7 @@ void SparseCholesky::solve_single_precision(const std::vector<double>& b, std::v
         y[k] -= m.top_updates[static_cast<std::size_t>(task) * schedule.top_rows + schedule.top_slot[k]];
   for (int s : schedule.top) forward(s, m.top_scratch, nullptr);
   for (auto s = schedule.top.rbegin(); s != schedule.top.rend(); ++s) backward(*s, m.top_scratch);
-#pragma omp parallel for schedule(dynamic, 1) if (n_ >= parallel_solve_size)
+#pragma omp parallel for schedule(dynamic, 1) if (n_ >= parallel_solve_size) num_threads(kernels::parallel_team_size())
   for (int task = 0; task < tasks; ++task)
     for (int s = schedule.task_last[task]; s >= schedule.task_first[task]; --s) backward(s, m.gathered[task]);
   x.resize(n_);

@@ -28,6 +28,7 @@
 // Not thread-safe; each call uses all OpenMP threads itself.
 // SceneRun owns the mesh, topology, model, cut manager and simulation; it keeps a reference
 // to the Scene (which must outlive it). Units: those of the scene (SI: m, kg, s, N).
+#include <atomic>
 #include <future>
 #include <memory>
 #include <vector>
@@ -114,6 +115,9 @@ class SceneRun {
   // The next step's cut update while it runs beside a step (after cuts_: it refers to it,
   // so it is destroyed, i.e. waited for, first).
   std::future<CutUpdate> next_cut_update_;
+  // Threads that update holds (1 while it runs): the step's parallel loops leave them out
+  // (kernels/threads_busy_beside.h).
+  std::atomic<int> cut_update_threads_{0};
   double next_cut_update_time_ = 0;
 };
 

@@ -7,11 +7,14 @@
 // thread, ~9 on two): max(F, A) instead of F + A / T on T threads, a gain while
 // F > A (1 - 1/T). Both tasks must be independent (no shared writes); the results do not
 // depend on how they overlap. The first exception thrown by either task (first's, if both
-// throw) is rethrown after both have finished.
+// throw) is rethrown after both have finished. Threads busy beside the caller already
+// (threads_busy_beside.h) count as unavailable.
 #include <chrono>
 #include <exception>
 
 #include <omp.h>
+
+#include "dgtex/kernels/threads_busy_beside.h"
 
 namespace dgtex {
 
@@ -29,7 +32,7 @@ SideBySideTimes run_side_by_side(First&& first, Second&& second) {
   SideBySideTimes times;
   const Clock::time_point start = Clock::now();
   std::exception_ptr errors[2];
-  if (omp_get_max_threads() < 2) {
+  if (kernels::parallel_team_size() < 2) {
     try {
       first();
     } catch (...) {

@@ -7,9 +7,12 @@
 // Conventions of every dgtex::kernels header: arrays (structure of arrays) belong to the
 // caller; *Batch / *View structs only point into them and must outlive the call; a kernel
 // keeps nothing and has no global state, so calls on distinct outputs are thread-safe.
-// Execution::parallel uses all OpenMP threads of the calling thread, Execution::serial one;
-// both give the same result (bitwise where documented).
+// Execution::parallel uses the OpenMP threads of the calling thread (less those busy beside
+// it, threads_busy_beside.h), Execution::serial one; both give the same result (bitwise where
+// documented).
 #include <cstdint>
+
+#include "dgtex/kernels/threads_busy_beside.h"
 
 namespace dgtex::kernels {
 
@@ -18,7 +21,7 @@ enum class Execution { serial, parallel };
 template <class Body>
 void forall(std::int64_t n, Body&& body, Execution execution = Execution::parallel) {
   if (execution == Execution::parallel) {
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) num_threads(parallel_team_size())
     for (std::int64_t i = 0; i < n; ++i) body(i);
   } else {
     for (std::int64_t i = 0; i < n; ++i) body(i);
@@ -31,7 +34,7 @@ void forall(std::int64_t n, Body&& body, Execution execution = Execution::parall
 template <class Body>
 void forall_dynamic(std::int64_t n, Body&& body, Execution execution = Execution::parallel) {
   if (execution == Execution::parallel) {
-#pragma omp parallel for schedule(dynamic, 1)
+#pragma omp parallel for schedule(dynamic, 1) num_threads(parallel_team_size())
     for (std::int64_t i = 0; i < n; ++i) body(i);
   } else {
     for (std::int64_t i = 0; i < n; ++i) body(i);
@@ -46,7 +49,7 @@ template <class First, class Second>
 void forall_then(std::int64_t n1, First&& first, std::int64_t n2, Second&& second,
                  Execution execution = Execution::parallel) {
   if (execution == Execution::parallel) {
-#pragma omp parallel
+#pragma omp parallel num_threads(parallel_team_size())
     {
 #pragma omp for schedule(static)
       for (std::int64_t i = 0; i < n1; ++i) first(i);

@@ -1,0 +1,122 @@
+// Parallel loops of a thread with work running beside it (dgtex/kernels/threads_busy_beside.h):
+// forall, forall_dynamic, forall_then and run_side_by_side leave out the threads that work
+// holds, take them back once the count drops, and a scope restores the thread's previous
+// setting. SceneRun's overlapped cut updates, which set the count, keep the plain bits
+// (test_scene_run_overlap).
+#include <gtest/gtest.h>
+
+#include <omp.h>
+
+#include <algorithm>
+#include <atomic>
+#include <thread>
+#include <vector>
+
+#include "dgtex/kernels/forall.h"
+#include "dgtex/side_by_side.h"
+
+using namespace dgtex;
+
+namespace {
+
+// The largest team any iteration of each loop kind ran in.
+struct Teams {
+  int forall = 0, dynamic = 0, then = 0;
+};
+
+Teams loop_teams() {
+  constexpr std::int64_t n = 64;
+  std::vector<int> forall_team(n), dynamic_team(n), then_team(2 * n);
+  kernels::forall(n, [&](std::int64_t i) { forall_team[i] = omp_get_num_threads(); });
+  kernels::forall_dynamic(n, [&](std::int64_t i) { dynamic_team[i] = omp_get_num_threads(); });
+  kernels::forall_then(
+      n, [&](std::int64_t i) { then_team[i] = omp_get_num_threads(); }, n,
+      [&](std::int64_t i) { then_team[n + i] = omp_get_num_threads(); });
+  Teams teams;
+  for (int t : forall_team) teams.forall = std::max(teams.forall, t);
+  for (int t : dynamic_team) teams.dynamic = std::max(teams.dynamic, t);
+  for (int t : then_team) teams.then = std::max(teams.then, t);
+  return teams;
+}
+
+class ThreadsBusyBeside : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    saved_ = omp_get_max_threads();
+    omp_set_num_threads(3);
+  }
+  void TearDown() override { omp_set_num_threads(saved_); }
+  int saved_ = 1;
+};
+
+}  // namespace
+
+TEST_F(ThreadsBusyBeside, LoopsLeaveOutTheThreadsBusyBesideTheCaller) {
+  ASSERT_EQ(kernels::threads_busy_beside, nullptr);
+  EXPECT_EQ(kernels::parallel_team_size(), 3);
+  EXPECT_EQ(loop_teams().forall, 3);
+  std::atomic<int> busy{1};
+  {
+    const kernels::ScopedThreadsBusyBeside beside(&busy);
+    EXPECT_EQ(kernels::parallel_team_size(), 2);
+    const Teams teams = loop_teams();
+    EXPECT_EQ(teams.forall, 2);
+    EXPECT_EQ(teams.dynamic, 2);
+    EXPECT_EQ(teams.then, 2);
+    busy = 5;  // more than the caller has: it keeps one thread
+    EXPECT_EQ(kernels::parallel_team_size(), 1);
+    EXPECT_EQ(loop_teams().forall, 1);
+    busy = 0;  // the side work is done: the whole team again
+    const Teams again = loop_teams();
+    EXPECT_EQ(again.forall, 3);
+    EXPECT_EQ(again.dynamic, 3);
+    EXPECT_EQ(again.then, 3);
+  }
+  EXPECT_EQ(kernels::threads_busy_beside, nullptr);
+}
+
+TEST_F(ThreadsBusyBeside, ScopesNestAndStayWithTheirThread) {
+  std::atomic<int> outer{1}, inner{2};
+  const kernels::ScopedThreadsBusyBeside a(&outer);
+  {
+    const kernels::ScopedThreadsBusyBeside b(&inner);
+    EXPECT_EQ(kernels::parallel_team_size(), 1);
+    // Another thread sees nothing of this thread's setting.
+    int other = 0;
+    std::thread([&] {
+      omp_set_num_threads(3);
+      other = kernels::parallel_team_size();
+    }).join();
+    EXPECT_EQ(other, 3);
+  }
+  EXPECT_EQ(kernels::threads_busy_beside, &outer);
+  EXPECT_EQ(kernels::parallel_team_size(), 2);
+}
+
+TEST_F(ThreadsBusyBeside, SideWorkThatFinishesHandsItsThreadBack) {
+  // As in SceneRun: the count is 1 while a thread works beside the loops, and that thread
+  // lowers it as it finishes.
+  std::atomic<int> busy{1};
+  const kernels::ScopedThreadsBusyBeside beside(&busy);
+  std::thread side([&] { busy.store(0, std::memory_order_release); });
+  side.join();
+  EXPECT_EQ(loop_teams().forall, 3);
+}
+
+TEST_F(ThreadsBusyBeside, SideBySideRunsInTurnWhenOnlyOneThreadIsFree) {
+  omp_set_num_threads(2);
+  const std::thread::id caller = std::this_thread::get_id();
+  std::thread::id first_ran_on, second_ran_on;
+  std::atomic<int> busy{1};
+  {
+    const kernels::ScopedThreadsBusyBeside beside(&busy);
+    run_side_by_side([&] { first_ran_on = std::this_thread::get_id(); },
+                     [&] { second_ran_on = std::this_thread::get_id(); });
+  }
+  EXPECT_EQ(first_ran_on, caller);
+  EXPECT_EQ(second_ran_on, caller);
+  // Nothing busy: the second task runs on a thread of its own.
+  run_side_by_side([&] { first_ran_on = std::this_thread::get_id(); },
+                   [&] { second_ran_on = std::this_thread::get_id(); });
+  EXPECT_NE(first_ran_on, second_ran_on);
+}
