@@ -185,6 +185,13 @@ int CutManager::total_segments() const {
   return n;
 }
 
+bool CutManager::complete() const {
+  if (!updated_once_) return false;
+  for (std::size_t c = 0; c < boundaries_.size(); ++c)
+    if (visible_cut_length(cuts_[c], boundaries_[c].back(), time_) < boundaries_[c].back()) return false;
+  return true;
+}
+
 void CutManager::rasterize_visible(const std::vector<VisibleCutSegment>& visible,
                                    std::vector<std::vector<std::pair<int, CutRaster>>>& rasters) {
   walls_.clear();

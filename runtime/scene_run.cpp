@@ -112,9 +112,11 @@ void SceneRun::start_next_cut_update(double time) {
   // Not past the scene's last step, and not where this thread has one OpenMP thread only
   // (a batch of scenes with a thread each, or a 1-thread measurement). Not beside the first
   // step either: its first projection and shell step touch their memory for the first
-  // time, and an update beside them made chad's first step 43 -> 58 ms.
+  // time, and an update beside them made chad's first step 43 -> 58 ms. Nor once every cut
+  // is complete: the update would change nothing (the static cuts of the accordion and
+  // fracture from the start), and its thread would only hold the step's loops to one thread.
   if (!options_.overlap_cut_updates || steps_ == 0 || steps_ + 1 >= scene_.analysis.steps ||
-      omp_get_max_threads() < 2)
+      omp_get_max_threads() < 2 || cuts_->complete())
     return;
   next_cut_update_time_ = time;
   cut_update_threads_.store(1, std::memory_order_release);

@@ -97,12 +97,16 @@ TEST(CutsProgressive, CutGrowsMonotonicallyWithTime) {
   o.new_cut_length = 1.0;
   CutManager m(mesh, build_topology(mesh), {cut}, o);
   const double length = m.paths()[0].length();
+  EXPECT_FALSE(m.complete());  // not before the first update
   EXPECT_FALSE(m.update(0.0));  // nothing yet
   EXPECT_TRUE(m.functions().empty());
+  EXPECT_FALSE(m.complete());
   double last_length = 0;
   std::size_t last_functions = 0, last_edges = 0;
   for (double t = 0.6; t < 0.5 + length + 0.5; t += 0.1) {
     m.update(t);
+    // Complete once the whole path shows; SceneRun then stops overlapping cut updates.
+    EXPECT_EQ(m.complete(), t - 0.5 >= length) << "t = " << t;
     double visible = 0;
     std::size_t edges = 0;
     for (const auto& s : m.function_segments()) visible += s.end - s.begin;
@@ -117,6 +121,20 @@ TEST(CutsProgressive, CutGrowsMonotonicallyWithTime) {
     last_length = visible, last_functions = m.functions().size(), last_edges = edges;
   }
   EXPECT_EQ(static_cast<int>(last_functions), static_cast<int>(std::ceil(length)));
+  EXPECT_FALSE(m.update(0.5 + length + 1.0));  // complete: a later update changes nothing
+}
+
+TEST(CutsProgressive, UnscheduledCutIsCompleteAfterTheFirstUpdate) {
+  const Mesh mesh = make_rectangle(3, 2, 3, 2, ElementType::quad8);
+  Cut late = points_cut({{0, 0.5, 0}, {1.4, 0.6, 0}});
+  late.has_schedule = true;
+  late.start_time = 1.0;  // appears whole at t = 1
+  CutManager m(mesh, build_topology(mesh), {points_cut({{0, 1.2, 0}, {1.4, 1.1, 0}}), late}, cholmod_enrichment(16));
+  EXPECT_FALSE(m.complete());
+  EXPECT_TRUE(m.update(0.0));
+  EXPECT_FALSE(m.complete());  // the late cut is still hidden
+  EXPECT_TRUE(m.update(1.0));
+  EXPECT_TRUE(m.complete());
 }
 
 TEST(CutsProgressive, CrossingCutIsSplitButTJunctionIsNot) {

@@ -151,6 +151,37 @@ TEST(FactorReuse, ResultIsBitwiseIndependentOfThreadCountAcrossRefactorisations)
   omp_set_num_threads(2);
 }
 
+TEST(FactorReuse, DenseFactorisationsInTurnGiveTheSameBitsAtAnyThreadCount) {
+  // Pending dense factorisations run before the assembly, not beside it (step()); the
+  // steps must still meet the bound, refactorise, and not depend on the thread count.
+  const BottomHeldCylinder c(8, 4);
+  ASSERT_TRUE(c.factored_densely());
+  std::vector<double> load(c.model->num_dofs(), 0.0);
+  const double g[3] = {4000, 0, 0};  // sideways: the cylinder swings and its K rotates
+  c.model->add_gravity(g, load);
+  DynamicsOptions options;
+  options.time_step = 1e-2;
+  options.corotational = true;
+  FactorReuseOptions often;
+  often.refactor_after_iterations = 1;
+  std::vector<double> reference;
+  for (int threads : {1, 2, 4}) {
+    omp_set_num_threads(threads);
+    ShellSimulation sim(*c.model, c.fixed, load);
+    sim.set_solver_options(often);
+    for (int s = 0; s < 10; ++s) {
+      sim.step(options);
+      EXPECT_LE(sim.solver_statistics().last_relative_residual, often.relative_tolerance);
+    }
+    EXPECT_GT(sim.solver_statistics().factorizations, 2) << threads << " threads";
+    std::printf("%d threads: %ld factorisations, %ld PCG iterations\n", threads,
+                sim.solver_statistics().factorizations, sim.solver_statistics().iterations);
+    if (reference.empty()) reference = sim.displacement();
+    EXPECT_EQ(sim.displacement(), reference) << threads << " threads";
+  }
+  omp_set_num_threads(2);
+}
+
 TEST(FactorReuse, StalePreconditionerIsReplacedAndTheBoundStillHolds) {
   CylinderSystem cylinder;
   CompressedCylinder& c = cylinder.c;
@@ -271,6 +302,7 @@ TEST(FactorReuse, WholePatternFactorisationIsAlsoLeftForBesideTheAssembly) {
   EXPECT_LE(solver.statistics().last_relative_residual, options.relative_tolerance);
   EXPECT_EQ(solver.statistics().factorizations, 1);
   ASSERT_TRUE(solver.factorization_pending());
+  EXPECT_FALSE(solver.dense_factorization_pending());  // CHOLMOD's: left for beside the assembly
   solver.factorize_pending();
   EXPECT_FALSE(solver.factorization_pending());
   EXPECT_EQ(solver.statistics().factorizations, 2);
@@ -331,6 +363,8 @@ TEST(FactorReuse, LargeDenseSystemsRefactoriseSooner) {
     ASSERT_LE(iterations, options.refactor_after_iterations);
     EXPECT_LE(solver.statistics().last_relative_residual, options.relative_tolerance);
     EXPECT_EQ(solver.factorization_pending(), iterations > threshold) << "threshold " << threshold;
+    // A dense factor's: ShellSimulation::step runs it in turn, before the assembly.
+    EXPECT_EQ(solver.dense_factorization_pending(), solver.factorization_pending()) << "threshold " << threshold;
   }
 }
 

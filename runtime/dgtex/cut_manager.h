@@ -104,6 +104,9 @@ class CutManager {
   const std::vector<std::vector<std::pair<int, kernels::CutRaster>>>& rasters() const { return function_rasters_; }
   const CutUpdateStats& last_update() const { return last_; }
   double time() const { return time_; }
+  // Every cut wholly visible at time(): no later update changes anything (false before the
+  // first update).
+  bool complete() const;
 
   // Writes DIR/enrichment.vdb (DIR created if missing): field "enrichment_NNN" for function
   // NNN (texel (i, j) of element e's tile in slot of e, see texel_storage.h) and field
