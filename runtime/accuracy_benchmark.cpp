@@ -1,17 +1,14 @@
-// Reporting of the speed-against-accuracy sweeps: machine description, JSON and Markdown.
+// Reporting of the speed-against-accuracy sweeps: JSON and Markdown (the machine: benchmark_machine.h).
 #include "dgtex/accuracy_benchmark.h"
 #include "dgtex/stage_timer.h"
 
-#include <omp.h>
 #include <time.h>
 
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
-#include <fstream>
 #include <nlohmann/json.hpp>
 #include <sstream>
-#include <thread>
 
 namespace dgtex {
 
@@ -28,21 +25,6 @@ std::vector<std::string> AccuracyChart::series() const {
   for (const AccuracyPoint& p : points)
     if (std::find(out.begin(), out.end(), p.series) == out.end()) out.push_back(p.series);
   return out;
-}
-
-std::string describe_machine() {
-  std::string model = "unknown CPU";
-  std::ifstream cpuinfo("/proc/cpuinfo");
-  for (std::string line; std::getline(cpuinfo, line);)
-    if (line.rfind("model name", 0) == 0) {
-      const auto colon = line.find(':');
-      if (colon != std::string::npos) model = line.substr(line.find_first_not_of(" \t", colon + 1));
-      break;
-    }
-  std::ostringstream out;
-  out << model << ", " << std::thread::hardware_concurrency() << " cores, " << omp_get_max_threads()
-      << (omp_get_max_threads() == 1 ? " thread" : " threads");
-  return out.str();
 }
 
 std::string accuracy_charts_json(const std::vector<AccuracyChart>& charts, const std::string& machine,

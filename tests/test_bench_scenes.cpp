@@ -56,6 +56,10 @@ TEST(BenchScenes, JsonHasEveryRequestedSceneWithRequiredKeysAndThesisRatios) {
   ASSERT_EQ(r.exit_code, 0) << r.stderr_text;
   const nlohmann::json j = read_json(dir / "out.json");
   ASSERT_EQ(j["scenes"].size(), 2u);
+  // The machine, and its speed probe before each scene and at the end.
+  EXPECT_NE(j["machine"].get<std::string>().find(" cores, "), std::string::npos);
+  EXPECT_GT(j["machine_probe_ms_at_end"].get<double>(), 0);
+  for (const nlohmann::json& s : j["scenes"]) EXPECT_GT(s["machine_probe_ms"].get<double>(), 0);
   EXPECT_EQ(j["scenes"][0]["name"], "spiral1");
   EXPECT_EQ(j["scenes"][1]["name"], "cylinder_buckling");
   for (const nlohmann::json& s : j["scenes"]) {

@@ -16,6 +16,7 @@
 
 #include "commands.h"
 #include "dgtex/accuracy_benchmark.h"
+#include "dgtex/benchmark_machine.h"
 #include "gnuplot_chart.h"
 
 namespace dgtex::cli {

@@ -5,6 +5,7 @@
 #include <omp.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -16,6 +17,7 @@
 
 #include "commands.h"
 #include "gnuplot_chart.h"
+#include "dgtex/benchmark_machine.h"
 #include "dgtex/mesh_error.h"
 #include "dgtex/model_error.h"
 #include "dgtex/scene_benchmark.h"
@@ -258,7 +260,10 @@ int bench_scenes_command(int argc, char** argv) {
   }
 
   std::vector<SceneBenchResult> results;
-  nlohmann::json all = {{"steps", steps},
+  const std::string machine = describe_machine();
+  std::vector<double> probes_ms;  // before each scene, and after the last
+  nlohmann::json all = {{"machine", machine},
+                        {"steps", steps},
                         {"threads", omp_get_max_threads()},
                         {"overlap_cut_updates", !inline_cut_updates},
                         {"omp_wait_policy", omp_wait_policy_name()},
@@ -272,6 +277,7 @@ int bench_scenes_command(int argc, char** argv) {
       double elapsed_ms = 0;
       SceneRunOptions run_options;
       run_options.overlap_cut_updates = !inline_cut_updates;
+      probes_ms.push_back(machine_probe_ms());
       SceneBenchResult r = run_scene_benchmark(
           scene, entry.name, steps,
           [&](int step, int total) {
@@ -284,6 +290,7 @@ int bench_scenes_command(int argc, char** argv) {
         std::fprintf(stderr, "%sbench scenes: %s: %d steps, %.1f steps/s, peak step %.1f ms, %.1f s\n", tty ? "\r" : "",
                      entry.name.c_str(), r.steps, r.steps_per_second(), r.peak_step_ms(), elapsed_ms / 1e3);
       all["scenes"].push_back(scene_json(r));
+      all["scenes"].back()["machine_probe_ms"] = probes_ms.back();
       results.push_back(std::move(r));
       if (!json_path.empty()) write_text(json_path, all.dump(2) + "\n", "--json");
     } catch (const SceneError& e) {
@@ -303,12 +310,19 @@ int bench_scenes_command(int argc, char** argv) {
       return 1;
     }
   }
+  // The host's speed at the end too: a probe that moved during the run says the machine did.
+  probes_ms.push_back(machine_probe_ms());
+  all["machine_probe_ms_at_end"] = probes_ms.back();
+  const auto [fastest, slowest] = std::minmax_element(probes_ms.begin(), probes_ms.end());
   const std::string tables = markdown_tables(results);
   const std::string step_count =
       steps > 0 ? std::to_string(steps) + " steps per scene" : "each scene's own analysis.steps";
-  std::printf("dgtex bench scenes: %d OpenMP threads, %s, cut updates %s (ms per step; ratio = Table 5.1 / ours)\n\n%s",
-              omp_get_max_threads(), step_count.c_str(), inline_cut_updates ? "inline" : "overlapped", tables.c_str());
+  std::printf("dgtex bench scenes: %s; %s, cut updates %s; machine probe %.1f-%.1f ms (one core, lower is "
+              "faster). Times in ms per step; ratio = Table 5.1 / ours.\n\n%s",
+              machine.c_str(), step_count.c_str(), inline_cut_updates ? "inline" : "overlapped", *fastest, *slowest,
+              tables.c_str());
   try {
+    if (!json_path.empty()) write_text(json_path, all.dump(2) + "\n", "--json");
     if (!markdown_path.empty()) write_text(markdown_path, tables, "--markdown");
   } catch (const std::exception& e) {
     std::fprintf(stderr, "dgtex bench scenes: %s\n", e.what());

@@ -129,9 +129,6 @@ struct RotationAccuracyOptions {
 // not dynamic and corotated; what load_scene and SceneRun throw for a bad scene.
 AccuracyChart run_rotation_accuracy(const RotationAccuracyOptions& options, const AccuracyProgress& progress = {});
 
-// "MODEL NAME, N cores" from /proc/cpuinfo (or "unknown CPU"), plus the OpenMP threads.
-std::string describe_machine();
-
 // {"charts": [{"name", "title", "time_label", "error_label", "points": [{"series", "label",
 // "ms", "error", extra...}]}], "machine", "command"} as JSON text.
 std::string accuracy_charts_json(const std::vector<AccuracyChart>& charts, const std::string& machine,

@@ -1,0 +1,52 @@
+#include "dgtex/benchmark_machine.h"
+
+#include <omp.h>
+
+#include <algorithm>
+#include <chrono>
+#include <fstream>
+#include <limits>
+#include <sstream>
+#include <stdexcept>
+#include <thread>
+
+namespace dgtex {
+
+std::string describe_machine() {
+  std::string model = "unknown CPU";
+  std::ifstream cpuinfo("/proc/cpuinfo");
+  for (std::string line; std::getline(cpuinfo, line);)
+    if (line.rfind("model name", 0) == 0) {
+      const auto colon = line.find(':');
+      if (colon != std::string::npos) model = line.substr(line.find_first_not_of(" \t", colon + 1));
+      break;
+    }
+  std::ostringstream out;
+  out << model << ", " << std::thread::hardware_concurrency() << " cores, " << omp_get_max_threads()
+      << (omp_get_max_threads() == 1 ? " thread" : " threads");
+  return out.str();
+}
+
+double machine_probe_ms(int repeats) {
+  if (repeats < 1) throw std::invalid_argument("machine_probe_ms: repeats must be >= 1, got " + std::to_string(repeats));
+  constexpr int chains = 16;
+  constexpr long rounds = (1L << 25) / chains;
+  // Volatile inputs and output: the compiler can neither fold the chains nor drop them.
+  volatile double factor_in = 1.0000001, offset_in = 1e-9, sink = 0;
+  double best = std::numeric_limits<double>::infinity();
+  for (int r = 0; r < repeats; ++r) {
+    const double factor = factor_in, offset = offset_in;
+    double a[chains];
+    for (int k = 0; k < chains; ++k) a[k] = k;
+    const auto start = std::chrono::steady_clock::now();
+    for (long i = 0; i < rounds; ++i)
+      for (int k = 0; k < chains; ++k) a[k] = a[k] * factor + offset;
+    best = std::min(best, std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count());
+    double sum = 0;
+    for (int k = 0; k < chains; ++k) sum += a[k];
+    sink = sink + sum;
+  }
+  return best;
+}
+
+}  // namespace dgtex

@@ -1,0 +1,19 @@
+#pragma once
+// The machine a benchmark ran on, for its report: what it is, and how fast it ran then.
+// The same build can run at very different speeds on machines of one kind, and on one
+// machine from day to day (session 32's 2-core host ran every scene ~2.5x slower than
+// session 31's), so a figure is only comparable with one taken beside the same yardstick.
+#include <string>
+
+namespace dgtex {
+
+// "MODEL NAME, N cores" from /proc/cpuinfo (or "unknown CPU"), plus the OpenMP threads.
+std::string describe_machine();
+
+// Milliseconds that the calling thread takes for a fixed arithmetic workload held in
+// registers (2^25 multiply-adds in 16 independent chains): the best of `repeats` runs.
+// No memory traffic and no other thread, so it shows the speed of one core as the host
+// gives it now (lower is faster). Throws std::invalid_argument for repeats < 1.
+double machine_probe_ms(int repeats = 3);
+
+}  // namespace dgtex

@@ -1,0 +1,32 @@
+// The machine line and speed probe of the benchmark reports (dgtex/benchmark_machine.h).
+#include <gtest/gtest.h>
+#include <omp.h>
+
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+#include "dgtex/benchmark_machine.h"
+
+using namespace dgtex;
+
+TEST(BenchmarkMachine, DescriptionNamesTheCoresAndThreads) {
+  const int saved = omp_get_max_threads();
+  omp_set_num_threads(1);
+  const std::string one = describe_machine();
+  omp_set_num_threads(3);
+  const std::string three = describe_machine();
+  omp_set_num_threads(saved);
+  EXPECT_NE(one.find(" cores, 1 thread"), std::string::npos) << one;
+  EXPECT_NE(three.find(" cores, 3 threads"), std::string::npos) << three;
+}
+
+TEST(BenchmarkMachine, ProbeTimesItsWorkloadAndRejectsNoRuns) {
+  // 2^25 multiply-adds: well above the clock's resolution on any machine, below a second
+  // on any that runs the test suite in its time limit (about 10 ms on the 2-core machine).
+  const double ms = machine_probe_ms(1);
+  EXPECT_TRUE(std::isfinite(ms));
+  EXPECT_GT(ms, 0.1);
+  EXPECT_LT(ms, 2000.0);
+  EXPECT_THROW(machine_probe_ms(0), std::invalid_argument);
+}
