@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cstdio>
 #include <fstream>
 #include <limits>
 #include <sstream>
@@ -47,6 +48,12 @@ double machine_probe_ms(int repeats) {
     sink = sink + sum;
   }
   return best;
+}
+
+std::string describe_machine_and_probe() {
+  char probe[64];
+  std::snprintf(probe, sizeof probe, ", one-core probe %.1f ms", machine_probe_ms());
+  return describe_machine() + probe;
 }
 
 }  // namespace dgtex

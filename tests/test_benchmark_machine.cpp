@@ -29,4 +29,8 @@ TEST(BenchmarkMachine, ProbeTimesItsWorkloadAndRejectsNoRuns) {
   EXPECT_GT(ms, 0.1);
   EXPECT_LT(ms, 2000.0);
   EXPECT_THROW(machine_probe_ms(0), std::invalid_argument);
+  // The charts' heading: the description, then the probe.
+  const std::string heading = describe_machine_and_probe();
+  EXPECT_EQ(heading.rfind(describe_machine() + ", one-core probe ", 0), 0u) << heading;
+  EXPECT_EQ(heading.substr(heading.size() - 3), " ms") << heading;
 }

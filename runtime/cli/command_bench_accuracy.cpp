@@ -133,7 +133,7 @@ int bench_accuracy_command(int argc, char** argv) {
     plate.clock = quadrature.clock = texture.clock = tolerance.clock = rotation.clock = which;
     omp_set_num_threads(threads);
     std::filesystem::create_directories(out_dir);
-    const std::string machine = describe_machine();
+    const std::string machine = describe_machine_and_probe();
     const auto start = std::chrono::steady_clock::now();
     const AccuracyProgress progress = [&](const std::string& line) {
       const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

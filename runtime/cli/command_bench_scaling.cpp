@@ -193,7 +193,7 @@ int bench_scaling_command(int argc, char** argv) {
     }
   const std::set<std::string> chosen(families.begin(), families.end());
   // The chart's heading: the machine (before any run changes the thread count) and command.
-  const std::string about = describe_machine() + ", OMP_WAIT_POLICY=" + omp_wait_policy_name() + "\n" +
+  const std::string about = describe_machine_and_probe() + ", OMP_WAIT_POLICY=" + omp_wait_policy_name() + "\n" +
                             bench_command_line(argc, argv);
   if (batch_scenes.empty()) batch_scenes = {cut_scene_path, scene_path};
   const int max_threads = *std::max_element(threads.begin(), threads.end());

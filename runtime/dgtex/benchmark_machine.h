@@ -16,4 +16,7 @@ std::string describe_machine();
 // gives it now (lower is faster). Throws std::invalid_argument for repeats < 1.
 double machine_probe_ms(int repeats = 3);
 
+// describe_machine() and ", one-core probe X ms" (machine_probe_ms now): a chart's heading.
+std::string describe_machine_and_probe();
+
 }  // namespace dgtex
