@@ -107,7 +107,12 @@ TEST(BenchScenes, JsonHasEveryRequestedSceneWithRequiredKeysAndThesisRatios) {
   EXPECT_TRUE(j["scenes"][1]["table_5_1"].is_null());
   EXPECT_TRUE(j["scenes"][1]["ratio_to_table_5_1"].is_null());
   EXPECT_EQ(j["scenes"][1]["counts"]["enrichments"], 0);
-  EXPECT_TRUE(fs::file_size(dir / "out.md") > 0);
+  // The Markdown file starts with the same heading as the printed tables: machine and probe.
+  std::ifstream markdown(dir / "out.md");
+  std::string heading;
+  std::getline(markdown, heading);
+  EXPECT_EQ(heading.rfind("dgtex bench scenes: " + j["machine"].get<std::string>() + ";", 0), 0u) << heading;
+  EXPECT_NE(heading.find("machine probe "), std::string::npos) << heading;
 }
 
 TEST(BenchScenes, CountsMatchTheReportOfDgtexRun) {
