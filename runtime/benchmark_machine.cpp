@@ -51,6 +51,18 @@ double machine_probe_ms(int repeats) {
   return best;
 }
 
+std::string probe_drift_warning(const std::vector<double>& probes_ms, double tolerance) {
+  if (probes_ms.size() < 2) return {};
+  const auto [fastest, slowest] = std::minmax_element(probes_ms.begin(), probes_ms.end());
+  if (*slowest <= (1 + tolerance) * *fastest) return {};
+  char text[256];
+  std::snprintf(text, sizeof text,
+                "the machine's speed changed during the run: the one-core probe took %.1f-%.1f ms (more than %.0f %% "
+                "apart); compare these figures with care",
+                *fastest, *slowest, 100 * tolerance);
+  return text;
+}
+
 std::string describe_machine_and_probe() {
   char probe[64];
   std::snprintf(probe, sizeof probe, ", one-core probe %.1f ms", machine_probe_ms());

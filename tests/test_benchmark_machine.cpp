@@ -5,6 +5,7 @@
 #include <cmath>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include "dgtex/benchmark_machine.h"
 
@@ -33,4 +34,14 @@ TEST(BenchmarkMachine, ProbeTimesItsWorkloadAndRejectsNoRuns) {
   const std::string heading = describe_machine_and_probe();
   EXPECT_EQ(heading.rfind(describe_machine() + ", one-core probe ", 0), 0u) << heading;
   EXPECT_EQ(heading.substr(heading.size() - 3), " ms") << heading;
+}
+
+TEST(BenchmarkMachine, DriftWarningOnlyWhenProbesMoveBeyondTheTolerance) {
+  EXPECT_EQ(probe_drift_warning({}), "");
+  EXPECT_EQ(probe_drift_warning({10.0}), "");
+  EXPECT_EQ(probe_drift_warning({10.0, 12.5, 11.0}), "");  // 25 % apart: at the tolerance
+  const std::string moved = probe_drift_warning({10.0, 12.6, 11.0});
+  EXPECT_NE(moved.find("10.0-12.6 ms"), std::string::npos) << moved;
+  EXPECT_EQ(probe_drift_warning({10.0, 14.0}, 0.5), "");
+  EXPECT_NE(probe_drift_warning({18.7, 10.6}), "");  // session 32: beside a build, then idle
 }

@@ -323,6 +323,8 @@ int bench_scenes_command(int argc, char** argv) {
                 "Times in ms per step; ratio = Table 5.1 / ours.\n\n",
                 machine.c_str(), step_count.c_str(), inline_cut_updates ? "inline" : "overlapped", *fastest, *slowest);
   std::printf("%s%s", heading, tables.c_str());
+  const std::string drift = probe_drift_warning(probes_ms);
+  if (!drift.empty()) std::fprintf(stderr, "dgtex bench scenes: warning: %s\n", drift.c_str());
   try {
     if (!json_path.empty()) write_text(json_path, all.dump(2) + "\n", "--json");
     if (!markdown_path.empty()) write_text(markdown_path, heading + tables, "--markdown");

@@ -4,6 +4,7 @@
 // machine from day to day (session 32's 2-core host ran every scene ~2.5x slower than
 // session 31's), so a figure is only comparable with one taken beside the same yardstick.
 #include <string>
+#include <vector>
 
 namespace dgtex {
 
@@ -15,6 +16,12 @@ std::string describe_machine();
 // No memory traffic and no other thread, so it shows the speed of one core as the host
 // gives it now (lower is faster). Throws std::invalid_argument for repeats < 1.
 double machine_probe_ms(int repeats = 3);
+
+// A warning when probes taken during one benchmark run differ by more than `tolerance`
+// (0.25: the slowest more than 25 % above the fastest): the host's speed changed under the
+// run, so its figures do not compare with each other or with another run. Empty otherwise
+// (also for fewer than two probes).
+std::string probe_drift_warning(const std::vector<double>& probes_ms, double tolerance = 0.25);
 
 // describe_machine() and ", one-core probe X ms" (machine_probe_ms now): a chart's heading.
 std::string describe_machine_and_probe();
