@@ -17,7 +17,6 @@
 
 #include "commands.h"
 #include "gnuplot_chart.h"
-#include "dgtex/accuracy_benchmark.h"
 #include "dgtex/benchmark_machine.h"
 #include "dgtex/mesh_error.h"
 #include "dgtex/model_error.h"
