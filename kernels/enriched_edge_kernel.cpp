@@ -62,6 +62,12 @@ void side_global_nodes(const EnrichedEdgeBatch& b, int element, int* out) {
   for (int a = 0; a < W; ++a) out[a] = a < npe ? b.connectivity[static_cast<std::int64_t>(element) * npe + a] : -1;
 }
 
+// A side's basis count: its enriched element's, else the element's standard functions.
+int side_basis_count(const EnrichedEdgeBatch& b, int element) {
+  const std::int64_t enriched = b.enriched_index[element];
+  return enriched >= 0 ? enriched_basis_count(*b.elements, enriched) : nodes_per_element(b.type);
+}
+
 
 // One side of an edge point as the stiffness passes read it: its rest frame and tangent and
 // the first derivatives of its local basis, from a Side just evaluated or from the records
@@ -224,10 +230,13 @@ void edge_stiffness(const EnrichedEdgeBatch& b, const EdgeQuadrature& quad, std:
   // Compact numbering of the used local slots: side 0's functions, then side 1's.
   Side side_data[2];
   int counts[2] = {0, 0};
+  for (int s = 0; s < sides; ++s) counts[s] = side_basis_count(b, ed[2 * s]);
+  const int m = counts[0] + counts[1];
   // K = sum_q ds penalty G_q G_q^T: rows sqrt(ds penalty) G_q, summed by blocked products.
+  // An edge whose points all lie on a cut (drop_cut_edge_points) has none: K stays null and
+  // its blocks are written as 0.
   std::unique_ptr<GramAccumulator> K;
-  std::vector<double> G, f;
-  int m = 0;
+  std::vector<double> G(3 * static_cast<std::size_t>(m)), f(3 * static_cast<std::size_t>(m), 0.0);
   std::vector<int> global;
   if (current) {
     global.resize(static_cast<std::size_t>(nb));
@@ -250,13 +259,7 @@ void edge_stiffness(const EnrichedEdgeBatch& b, const EdgeQuadrature& quad, std:
         side_view[1] = view_of(side_data[1]);
       }
     }
-    if (q == quad.start[e]) {
-      for (int s = 0; s < sides; ++s) counts[s] = side_view[s].count;
-      m = counts[0] + counts[1];
-      K = std::make_unique<GramAccumulator>(3 * m, quad.start[e + 1] - quad.start[e]);
-      f.assign(3 * m, 0.0);
-      G.resize(3 * m);
-    }
+    if (!K) K = std::make_unique<GramAccumulator>(3 * m, quad.start[e + 1] - quad.start[e]);
     const SideView& plus = side_view[0];
     const double ds = std::sqrt(dot3(plus.tangent, plus.tangent)) * wt;
     double tau[3] = {plus.tangent[0], plus.tangent[1], plus.tangent[2]};
@@ -328,7 +331,7 @@ void edge_stiffness(const EnrichedEdgeBatch& b, const EdgeQuadrature& quad, std:
       for (int r = 0; r < 3; ++r)
         for (int c = 0; c < 3; ++c) {
           const int I = 3 * i + r, J = 3 * j + c;
-          blk[r * 3 + c] = (*K)(I, J);
+          blk[r * 3 + c] = K ? (*K)(I, J) : 0.0;
         }
     }
   if (forces) {
@@ -382,15 +385,13 @@ void enriched_edge_rest_sides(const EnrichedEdgeBatch& batch, const EdgeQuadratu
   // Sizes first (a side's count is its element's basis count, the same at every point).
   out.counts.assign(2 * static_cast<std::size_t>(batch.count), 0);
   out.offset.assign(static_cast<std::size_t>(batch.count) + 1, 0);
-  const int npe = nodes_per_element(batch.type);
   for (std::int64_t e = 0; e < batch.count; ++e) {
     const int* ed = batch.edges + 4 * e;
     std::int64_t record = 0;
     for (int s = 0; s < 2; ++s) {
       const int element = ed[2 * s];
       if (element < 0) continue;
-      const std::int64_t enriched = batch.enriched_index[element];
-      const int count = enriched >= 0 ? enriched_basis_count(*batch.elements, enriched) : npe;
+      const int count = side_basis_count(batch, element);
       out.counts[2 * e + s] = count;
       record += side_record_size(count);
     }
