@@ -122,6 +122,7 @@ std::atomic<bool> poison_unzeroed{false};
 SkipCachedBlockZeroing::SkipCachedBlockZeroing() { skip_cached_zeroing = true; }
 SkipCachedBlockZeroing::~SkipCachedBlockZeroing() { skip_cached_zeroing = false; }
 void set_poison_unzeroed_blocks(bool poison) noexcept { poison_unzeroed = poison; }
+bool poison_unzeroed_blocks() noexcept { return poison_unzeroed; }
 
 std::size_t cached_block_bytes() noexcept {
   BlockCache& c = cache();

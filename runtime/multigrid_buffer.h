@@ -51,8 +51,10 @@ class SkipCachedBlockZeroing {
 std::size_t cached_block_bytes() noexcept;
 void release_cached_blocks() noexcept;
 // Test hook: with poisoning on, the blocks that SkipCachedBlockZeroing leaves unzeroed are
-// filled with NaN instead, so a read before the first write shows up in results.
+// filled with NaN instead, so a read before the first write shows up in results (also the
+// arrays of dgtex/scratch_array.h).
 void set_poison_unzeroed_blocks(bool poison) noexcept;
+bool poison_unzeroed_blocks() noexcept;
 
 template <class T>
 struct ZeroedBlockAllocator {

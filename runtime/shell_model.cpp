@@ -681,7 +681,7 @@ void ShellModel::assemble_stiffness(const double* current, std::vector<double>& 
     w.edge_rotations.resize(static_cast<size_t>(nedges) * gb.quadrature_points * 9);
     kernels::shell_edge_rotations(gb, current, w.edge_rotations.data(), execution);
   }
-  w.element_blocks.resize(static_cast<size_t>(ne) * npe * npe * 9);
+  double* const element_blocks = w.element_blocks.resize(static_cast<size_t>(ne) * npe * npe * 9);
   if (forces) {
     w.element_forces.resize(static_cast<size_t>(ne) * npe * 3);
     w.edge_forces.resize(static_cast<size_t>(nedges) * 2 * npe * 3);
@@ -697,7 +697,7 @@ void ShellModel::assemble_stiffness(const double* current, std::vector<double>& 
       kernels::shell_element_rest_rows(eb, w.element_rest_rows.data(), execution);
     }
     kernels::shell_element_stiffness_cached(eb, w.element_rest_rows.data(), current ? w.element_rotations.data() : nullptr,
-                                            w.element_blocks.data(), forces ? w.element_forces.data() : nullptr,
+                                            element_blocks, forces ? w.element_forces.data() : nullptr,
                                             execution);
     const size_t rest_size = static_cast<size_t>(nedges) * gb.quadrature_points * kernels::shell_edge_rest_row_stride(gb);
     if (w.edge_rest_rows.size() != rest_size) {
@@ -709,7 +709,7 @@ void ShellModel::assemble_stiffness(const double* current, std::vector<double>& 
                                 w.edge_factors.data(), forces ? w.edge_forces.data() : nullptr, execution);
     blocks.resize(assembly_.num_blocks() * 9);
     assembly_.assemble_symmetric_matrix(
-        {{w.element_blocks.data(), 0}, {w.edge_factors.data(), kernels::shell_edge_factor_rank(gb)}}, blocks.data(),
+        {{element_blocks, 0}, {w.edge_factors.data(), kernels::shell_edge_factor_rank(gb)}}, blocks.data(),
         parallel);
     if (corrective) {
       corrective->assign(num_dofs(), 0.0);
@@ -718,12 +718,12 @@ void ShellModel::assemble_stiffness(const double* current, std::vector<double>& 
     }
     return;
   }
-  kernels::shell_element_stiffness(eb, current ? w.element_rotations.data() : nullptr, w.element_blocks.data(),
+  kernels::shell_element_stiffness(eb, current ? w.element_rotations.data() : nullptr, element_blocks,
                                    forces ? w.element_forces.data() : nullptr, execution);
-  w.edge_blocks.resize(static_cast<size_t>(nedges) * 4 * npe * npe * 9);
-  kernels::shell_edge_stiffness_merged(gb, current ? w.edge_rotations.data() : nullptr, w.edge_blocks.data(),
+  double* const edge_blocks = w.edge_blocks.resize(static_cast<size_t>(nedges) * 4 * npe * npe * 9);
+  kernels::shell_edge_stiffness_merged(gb, current ? w.edge_rotations.data() : nullptr, edge_blocks,
                                        forces ? w.edge_forces.data() : nullptr, execution);
-  std::vector<const double*> matrix_locals = {w.element_blocks.data(), w.edge_blocks.data()};
+  std::vector<const double*> matrix_locals = {element_blocks, edge_blocks};
   std::vector<const double*> vector_locals = {forces ? w.element_forces.data() : nullptr,
                                               forces ? w.edge_forces.data() : nullptr};
 
@@ -740,8 +740,9 @@ void ShellModel::assemble_stiffness(const double* current, std::vector<double>& 
     const kernels::EnrichedQuadrature element_quad{element_qp_start_.data(), element_qp_.data()};
     const kernels::EdgeQuadrature edge_quad{edge_qp_start_.data(), edge_qp_.data()};
     const int W = width_;
-    w.enriched_blocks.resize(static_cast<size_t>(num_enriched_elements()) * W * W * 9);
-    w.enriched_edge_blocks.resize(static_cast<size_t>(num_enriched_edges()) * 4 * W * W * 9);
+    double* const enriched_blocks = w.enriched_blocks.resize(static_cast<size_t>(num_enriched_elements()) * W * W * 9);
+    double* const enriched_edge_blocks =
+        w.enriched_edge_blocks.resize(static_cast<size_t>(num_enriched_edges()) * 4 * W * W * 9);
     if (forces) {
       w.enriched_forces.resize(static_cast<size_t>(num_enriched_elements()) * W * 3);
       w.enriched_edge_forces.resize(static_cast<size_t>(num_enriched_edges()) * 2 * W * 3);
@@ -780,24 +781,24 @@ void ShellModel::assemble_stiffness(const double* current, std::vector<double>& 
       kernels::enriched_cluster_rotations(xb, w.clusters, w.cluster_rest.get(), current, w.cluster_rotations.data(),
                                           execution);
       kernels::enriched_element_clustered_stiffness(xb, w.clusters, w.cluster_rest.get(), w.cluster_rotations.data(),
-                                                    w.enriched_blocks.data(),
+                                                    enriched_blocks,
                                                     forces ? w.enriched_forces.data() : nullptr, execution);
     } else if (current)
-      kernels::enriched_element_corotated_stiffness(xb, element_quad, current, w.enriched_blocks.data(),
+      kernels::enriched_element_corotated_stiffness(xb, element_quad, current, enriched_blocks,
                                                     forces ? w.enriched_forces.data() : nullptr, execution);
     else
-      kernels::enriched_element_stiffness(xb, element_quad, nullptr, w.enriched_blocks.data(), nullptr, execution);
+      kernels::enriched_element_stiffness(xb, element_quad, nullptr, enriched_blocks, nullptr, execution);
     // Edges: each point's rotation formed in the stiffness pass, the sides' rest data (frames,
     // basis derivatives) evaluated once per basis.
     if (current) {
       if (w.edge_rest_sides.offset.empty()) kernels::enriched_edge_rest_sides(xg, edge_quad, w.edge_rest_sides, execution);
       kernels::enriched_edge_corotated_stiffness(xg, edge_quad, w.edge_rest_sides, current,
-                                                 w.enriched_edge_blocks.data(),
+                                                 enriched_edge_blocks,
                                                  forces ? w.enriched_edge_forces.data() : nullptr, execution);
     } else
-      kernels::enriched_edge_stiffness(xg, edge_quad, nullptr, w.enriched_edge_blocks.data(),
+      kernels::enriched_edge_stiffness(xg, edge_quad, nullptr, enriched_edge_blocks,
                                        forces ? w.enriched_edge_forces.data() : nullptr, execution);
-    matrix_locals.insert(matrix_locals.end(), {w.enriched_blocks.data(), w.enriched_edge_blocks.data()});
+    matrix_locals.insert(matrix_locals.end(), {enriched_blocks, enriched_edge_blocks});
     vector_locals.insert(vector_locals.end(), {forces ? w.enriched_forces.data() : nullptr,
                                                forces ? w.enriched_edge_forces.data() : nullptr});
   }

@@ -31,6 +31,7 @@
 #include "dgtex/kernels/texel_derivative_tile.h"
 #include "dgtex/element_material_texture.h"
 #include "dgtex/mesh.h"
+#include "dgtex/scratch_array.h"
 #include "dgtex/topology.h"
 
 namespace dgtex {
@@ -264,9 +265,11 @@ class ShellModel {
   // use, cleared by rebuild.
   struct AssemblyWorkspace {
     std::vector<double> gradients, element_rotations, edge_rotations;
-    std::vector<double> element_blocks, edge_blocks, element_forces, edge_forces;
+    std::vector<double> element_forces, edge_forces;
     std::vector<double> element_rest_rows, edge_rest_rows, edge_factors;
-    std::vector<double> enriched_blocks, enriched_edge_blocks, enriched_forces, enriched_edge_forces;
+    std::vector<double> enriched_forces, enriched_edge_forces;
+    // The local blocks: no zero-filling, so the pages of padding slots are never touched.
+    detail::ScratchArray element_blocks, edge_blocks, enriched_blocks, enriched_edge_blocks;
     // Rotation clusters (options.rotation_cluster_texels > 0) and their rest sums: built at
     // the first corotated assembly after the enrichment changed (rebuild clears them).
     // The rest sums take up to GBs: zeroed pages straight from the kernel, marked for huge
