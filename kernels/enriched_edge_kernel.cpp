@@ -68,7 +68,6 @@ int side_basis_count(const EnrichedEdgeBatch& b, int element) {
   return enriched >= 0 ? enriched_basis_count(*b.elements, enriched) : nodes_per_element(b.type);
 }
 
-
 // One side of an edge point as the stiffness passes read it: its rest frame and tangent and
 // the first derivatives of its local basis, from a Side just evaluated or from the records
 // of enriched_edge_rest_sides (the same numbers).

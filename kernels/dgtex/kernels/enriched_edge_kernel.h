@@ -9,8 +9,9 @@
 // side element's local basis (enriched_basis.h order; a non-enriched side has just its npe
 // standard functions), W = elements->width. Outputs: blocks #edges x (2W)^2 x 9, forces
 // #edges x 2W x 3, per-point rotations (one 3x3 per edge quadrature point). Only the blocks
-// of used slot pairs are written (the slots enriched_edge_global_nodes does not mark -1);
-// the others are left as they were (BlockAssembly never reads them). Forces: every slot.
+// of used slot pairs are written (the slots enriched_edge_global_nodes does not mark -1;
+// as 0 on an edge without quadrature points); the others are left as they were
+// (BlockAssembly never reads them). Forces: every slot.
 //
 // Edge quadrature (t in [-1, 1], in the plus element's direction): the edge is split into
 // T pieces of equal t-length (each piece lies on one border texel per side, the diagonal
