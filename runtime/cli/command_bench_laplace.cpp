@@ -13,6 +13,7 @@
 
 #include "commands.h"
 #include "gnuplot_chart.h"
+#include "dgtex/benchmark_machine.h"
 #include "dgtex/laplace_benchmark.h"
 #include "dgtex/laplace_domains.h"
 
@@ -80,6 +81,8 @@ int bench_laplace_command(int argc, char** argv) {
     for (int T : sizes)
       if (T < 16) throw std::invalid_argument("--sizes: T = " + std::to_string(T) + " is too small, need >= 16");
 
+    const std::string machine = describe_machine_and_probe();
+    std::printf("machine: %s\n", machine.c_str());
     nlohmann::json cases = nlohmann::json::array();
     std::vector<ChartSeries> chart;
     std::printf("%-10s %5s %9s  %-15s %10s %10s %6s %9s\n", "domain", "T", "unknowns", "solver", "ms", "residual", "iters",
@@ -136,7 +139,8 @@ int bench_laplace_command(int argc, char** argv) {
     if (!json_path.empty()) {
       std::ofstream out(json_path);
       if (!out) throw std::runtime_error("cannot write --json file '" + json_path + "'");
-      out << nlohmann::json{{"tolerance", tolerance},
+      out << nlohmann::json{{"machine", machine},
+                            {"tolerance", tolerance},
                             {"cases", cases},
                             {"speedup_of_multigrid", ratios},
                             {"smoother_bandwidth", {{"size", bandwidth_size},

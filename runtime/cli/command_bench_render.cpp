@@ -15,6 +15,7 @@
 
 #include "commands.h"
 #include "gnuplot_chart.h"
+#include "dgtex/benchmark_machine.h"
 #include "dgtex/render_benchmark.h"
 
 namespace dgtex::cli {
@@ -85,6 +86,8 @@ int bench_render_command(int argc, char** argv) {
   }
   options.partial_cut = !complete_only;
   try {
+    const std::string machine = describe_machine_and_probe();
+    std::printf("machine: %s\n", machine.c_str());
     ShellRenderer renderer;
     const RenderBenchResult r = run_render_benchmark(options, renderer);
     std::printf("dgtex bench render: %d quad8 elements, %s, %d enrichments, T = %d, %d x %d, texel = %.2f px; %s\n",
@@ -128,7 +131,8 @@ int bench_render_command(int argc, char** argv) {
     if (!json_path.empty()) {
       std::ofstream out(json_path);
       if (!out) throw std::runtime_error("cannot write --json file '" + json_path + "'");
-      out << nlohmann::json{{"resolution", r.resolution}, {"width", r.width}, {"height", r.height},
+      out << nlohmann::json{{"machine", machine},
+                            {"resolution", r.resolution}, {"width", r.width}, {"height", r.height},
                             {"texel_pixels", r.texel_pixels}, {"elements", r.elements},
                             {"enrichments", r.enrichments}, {"partial_cut", r.partial_cut}, {"device", r.device},
                             {"tip_radius_texels", kRenderBenchTipRadius}, {"cases", cases},

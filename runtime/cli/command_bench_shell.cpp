@@ -15,6 +15,7 @@
 
 #include "commands.h"
 #include "gnuplot_chart.h"
+#include "dgtex/benchmark_machine.h"
 #include "dgtex/mesh_error.h"
 #include "dgtex/scene_io.h"
 #include "dgtex/shell_benchmark.h"
@@ -117,6 +118,8 @@ int bench_shell_command(int argc, char** argv) {
     for (int t : threads_list)
       if (t < 1 || t > 1024)
         throw std::invalid_argument("--threads-list: " + std::to_string(t) + " threads is out of range, need 1..1024");
+    const std::string machine = describe_machine_and_probe();
+    std::printf("machine: %s\n", machine.c_str());
     std::vector<ShellBenchRun> runs;
     std::vector<double> gemm;
     const auto print_header = [] {
@@ -179,7 +182,8 @@ int bench_shell_command(int argc, char** argv) {
       }
       std::ofstream out(json_path);
       if (!out) throw std::runtime_error("cannot write --json file '" + json_path + "'");
-      out << nlohmann::json{{"scene", scene_path},
+      out << nlohmann::json{{"machine", machine},
+                            {"scene", scene_path},
                             {"steps", steps},
                             {"solver", refactor_every_step ? "refactor_every_step" : "pcg_reused_factor"},
                             {"pcg_relative_tolerance", solver.relative_tolerance},

@@ -1,0 +1,100 @@
+// `dgtex bench laplace` and `dgtex bench shell` from the command line: small runs write the
+// JSON the README describes (the machine with its speed probe, every requested case, solver
+// results that meet their bounds), and bad options exit with 2 and name the problem.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <set>
+#include <string>
+
+#include "cli_test_support.h"
+
+namespace fs = std::filesystem;
+using dgtex::test::fresh_dir;
+using dgtex::test::run_cli;
+
+namespace {
+
+nlohmann::json read_json(const fs::path& path) {
+  std::ifstream in(path);
+  return nlohmann::json::parse(in);
+}
+
+void expect_machine_with_probe(const nlohmann::json& j) {
+  ASSERT_TRUE(j.contains("machine"));
+  EXPECT_NE(j["machine"].get<std::string>().find("one-core probe"), std::string::npos) << j["machine"];
+}
+
+TEST(BenchLaplaceCli, JsonHasEveryCaseAtTheToleranceAndTheMachine) {
+  const fs::path dir = fresh_dir("dgtex_bench_laplace", "json");
+  const fs::path json = dir / "laplace.json";
+  const auto r = run_cli("bench laplace --sizes 32 48 --domains open slit --solvers multigrid cholmod --repeat 1"
+                         " --tolerance 1e-7 --json " + json.string(), dir);
+  ASSERT_EQ(r.exit_code, 0) << r.stderr_text;
+  const nlohmann::json j = read_json(json);
+  expect_machine_with_probe(j);
+  EXPECT_EQ(j["tolerance"], 1e-7);
+  std::set<std::string> seen;
+  for (const auto& c : j["cases"]) {
+    seen.insert(c["domain"].get<std::string>() + "/" + std::to_string(c["size"].get<int>()) + "/" +
+                c["solver"].get<std::string>());
+    EXPECT_LE(c["residual"].get<double>(), 1e-7) << c;
+    EXPECT_GT(c["unknowns"].get<long>(), 0) << c;
+    EXPECT_GT(c["ms"].get<double>(), 0.0) << c;
+  }
+  EXPECT_EQ(seen, (std::set<std::string>{"open/32/multigrid", "open/32/cholmod", "open/48/multigrid",
+                                         "open/48/cholmod", "slit/32/multigrid", "slit/32/cholmod",
+                                         "slit/48/multigrid", "slit/48/cholmod"}));
+  EXPECT_EQ(j["speedup_of_multigrid"].size(), 4u);  // one row per domain and size
+}
+
+TEST(BenchLaplaceCli, BadOptionsExitWithTwoAndNameTheProblem) {
+  const fs::path dir = fresh_dir("dgtex_bench_laplace", "bad");
+  const auto small = run_cli("bench laplace --sizes 8", dir);
+  EXPECT_EQ(small.exit_code, 2);
+  EXPECT_NE(small.stderr_text.find("T = 8 is too small, need >= 16"), std::string::npos) << small.stderr_text;
+  const auto domain = run_cli("bench laplace --domains nowhere", dir);
+  EXPECT_EQ(domain.exit_code, 2);
+  EXPECT_NE(domain.stderr_text.find("unknown Laplace domain 'nowhere'; valid: open"), std::string::npos)
+      << domain.stderr_text;
+}
+
+TEST(BenchShellCli, JsonHasEveryThreadCountTheSameStateAndTheMachine) {
+  const fs::path dir = fresh_dir("dgtex_bench_shell", "json");
+  const fs::path json = dir / "shell.json";
+  const auto r = run_cli("bench shell --scene " + std::string(DGTEX_SOURCE_DIR) +
+                             "/examples/scenes/cylinder_buckling.json --steps 2 --threads-list 1 2 --gemm-size 64"
+                             " --json " + json.string(),
+                         dir);
+  ASSERT_EQ(r.exit_code, 0) << r.stderr_text;
+  const nlohmann::json j = read_json(json);
+  expect_machine_with_probe(j);
+  EXPECT_EQ(j["steps"], 2);
+  EXPECT_EQ(j["omp_wait_policy"], "passive");  // the command restarts itself under it
+  EXPECT_EQ(j["identical_across_threads"], true);
+  ASSERT_EQ(j["cases"].size(), 2u);
+  EXPECT_EQ(j["cases"][0]["threads"], 1);
+  EXPECT_EQ(j["cases"][1]["threads"], 2);
+  for (const auto& c : j["cases"]) {
+    EXPECT_GT(c["assembly_ms"]["mean"].get<double>(), 0.0) << c;
+    EXPECT_LE(c["step_ms"]["mean"].get<double>(), c["step_ms"]["max"].get<double>()) << c;
+    EXPECT_GE(c["factorizations"].get<long>(), 1) << c;  // from rest: the first step factorises
+  }
+  EXPECT_EQ(j["counts"]["elements"], 961);  // the cylinder scene's mesh
+  EXPECT_EQ(j["speedups"].size(), 1u);
+}
+
+TEST(BenchShellCli, BadOptionsExitWithTwoAndNameTheProblem) {
+  const fs::path dir = fresh_dir("dgtex_bench_shell", "bad");
+  const auto threads = run_cli("bench shell --threads-list 0", dir);
+  EXPECT_EQ(threads.exit_code, 2);
+  EXPECT_NE(threads.stderr_text.find("--threads-list: 0 threads is out of range, need 1..1024"), std::string::npos)
+      << threads.stderr_text;
+  const auto scene = run_cli("bench shell --scene " + (dir / "missing.json").string(), dir);
+  EXPECT_EQ(scene.exit_code, 2);
+  EXPECT_NE(scene.stderr_text.find("missing.json"), std::string::npos) << scene.stderr_text;
+}
+
+}  // namespace
