@@ -234,7 +234,8 @@ void edge_stiffness(const EnrichedEdgeBatch& b, const EdgeQuadrature& quad, std:
   // K = sum_q ds penalty G_q G_q^T: rows sqrt(ds penalty) G_q, summed by blocked products.
   // An edge whose points all lie on a cut (drop_cut_edge_points) has none: K stays null and
   // its blocks are written as 0.
-  std::unique_ptr<GramAccumulator> K;
+  const std::int64_t points = quad.start[e + 1] - quad.start[e];
+  std::unique_ptr<GramAccumulator> K = points > 0 ? std::make_unique<GramAccumulator>(3 * m, points) : nullptr;
   std::vector<double> G(3 * static_cast<std::size_t>(m)), f(3 * static_cast<std::size_t>(m), 0.0);
   std::vector<int> global;
   if (current) {
@@ -258,7 +259,6 @@ void edge_stiffness(const EnrichedEdgeBatch& b, const EdgeQuadrature& quad, std:
         side_view[1] = view_of(side_data[1]);
       }
     }
-    if (!K) K = std::make_unique<GramAccumulator>(3 * m, quad.start[e + 1] - quad.start[e]);
     const SideView& plus = side_view[0];
     const double ds = std::sqrt(dot3(plus.tangent, plus.tangent)) * wt;
     double tau[3] = {plus.tangent[0], plus.tangent[1], plus.tangent[2]};
