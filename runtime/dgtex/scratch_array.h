@@ -2,14 +2,15 @@
 // Internal (ShellModel's assembly workspace): an array of doubles whose entries are
 // unspecified until written, for kernel outputs of which the kernels write every entry that
 // is read later.
-// Why: the enriched local blocks are padded to the widest basis of the model, and their
-// padding slots are neither written nor read (fracture: 39 MB of enriched edge blocks, 23 %
-// of it used, because one element of 205 has 20 basis functions and most have 7-12). As a
-// std::vector every page was faulted in and zero-filled at each new model (every basis
-// change); here the memory comes from malloc untouched, so the pages that hold only padding
-// are never faulted in. Fracture's first assembly, after the accordion and the slinky in one
-// process: 70 -> 42-48 ms (2-core machine, session 34, three alternations); huge-page blocks
-// from the block cache, which zero whole 2 MiB pages, sat in between.
+// Why: the enriched local blocks are padded to the widest basis of the model, and the edge
+// blocks' padding slots are neither written nor read (fracture: 39 MB of enriched edge
+// blocks, 23 % of it used, because one element of 205 has 20 basis functions and most have
+// 7-12; the element kernels write their padding as 0). As a std::vector every page was
+// faulted in and zero-filled at each new model (every basis change); here the memory comes
+// from malloc untouched, so pages that hold only edge-block padding are never faulted in.
+// Fracture's first assembly, after the accordion and the slinky in one process: 70 -> 42-48
+// ms (2-core machine, session 34, three alternations); huge-page blocks from the block
+// cache, which zero whole 2 MiB pages, sat in between.
 #include <cstddef>
 #include <cstdlib>
 #include <memory>

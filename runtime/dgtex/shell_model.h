@@ -268,7 +268,7 @@ class ShellModel {
     std::vector<double> element_forces, edge_forces;
     std::vector<double> element_rest_rows, edge_rest_rows, edge_factors;
     std::vector<double> enriched_forces, enriched_edge_forces;
-    // The local blocks: no zero-filling, so the pages of padding slots are never touched.
+    // The local blocks: no zero-filling, so pages of enriched edge-block padding are never touched.
     detail::ScratchArray element_blocks, edge_blocks, enriched_blocks, enriched_edge_blocks;
     // Rotation clusters (options.rotation_cluster_texels > 0) and their rest sums: built at
     // the first corotated assembly after the enrichment changed (rebuild clears them).
