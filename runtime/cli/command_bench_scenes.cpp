@@ -211,12 +211,9 @@ std::string markdown_tables(const std::vector<SceneBenchResult>& results) {
     if (row) {
       const StageRatios q = ratios(*row, r);
       const std::optional<std::vector<Target>> missed = missed_targets(*row, r);
-      std::string verdict = "- (partial run)";
-      if (missed && missed->empty()) verdict = "yes";
-      if (missed && !missed->empty()) {
-        verdict = "no: ";
-        for (std::size_t k = 0; k < missed->size(); ++k) verdict += (k ? ", " : "") + std::string((*missed)[k].label);
-      }
+      std::string verdict = !missed ? "- (partial run)" : missed->empty() ? "yes" : "no: ";
+      for (std::size_t k = 0; missed && k < missed->size(); ++k)
+        verdict += (k ? ", " : "") + std::string((*missed)[k].label);
       out << format("%g", row->enrichment_ms) << " / " << format("%g", row->assembly_ms) << " / "
           << format("%g", row->solve_ms) << " | " << format("%.3g", q.enrichment) << " / " << format("%.3g", q.assembly)
           << " / " << format("%.3g", q.solve) << " | " << verdict << " |\n";
