@@ -21,8 +21,9 @@
 // 27-29 -> 33-36 steps/s; examples/bench_scenes_history.md, session 13). Only where the
 // calling thread has more than one OpenMP thread, from the second step on, while another
 // step of the scene (analysis.steps) follows, while some cut has still to grow
-// (CutManager::complete), and where a thread can be started (else the plain order). While the update runs, this step's
-// parallel loops take one thread fewer (dgtex/kernels/threads_busy_beside.h). The results
+// (CutManager::complete), and where a thread can be started (else the plain order). While
+// the update runs, this step's parallel loops take one thread fewer
+// (dgtex/kernels/threads_busy_beside.h). The results
 // are bitwise those of the plain order (every kernel's result is independent of the thread
 // count). Stage times then overlap: "enrichment" is the update's own wall time, counted in
 // the step that uses it, and the other stages include the slowdown of sharing the cores.
