@@ -59,6 +59,24 @@ TEST(BenchLaplaceCli, BadOptionsExitWithTwoAndNameTheProblem) {
   EXPECT_EQ(domain.exit_code, 2);
   EXPECT_NE(domain.stderr_text.find("unknown Laplace domain 'nowhere'; valid: open"), std::string::npos)
       << domain.stderr_text;
+  // Past the largest texture a scene takes, the texel arrays would fail to allocate.
+  const auto large = run_cli("bench laplace --sizes 5000", dir);
+  EXPECT_EQ(large.exit_code, 2);
+  EXPECT_NE(large.stderr_text.find("T = 5000 is too large, need <= 4096"), std::string::npos) << large.stderr_text;
+  const auto tolerance = run_cli("bench laplace --tolerance 0", dir);
+  EXPECT_EQ(tolerance.exit_code, 2);
+  EXPECT_NE(tolerance.stderr_text.find("--tolerance: 0 is out of range; a relative residual in (0, 1)"),
+            std::string::npos)
+      << tolerance.stderr_text;
+  const auto repeat = run_cli("bench laplace --repeat 0", dir);
+  EXPECT_EQ(repeat.exit_code, 2);
+  EXPECT_NE(repeat.stderr_text.find("--repeat: Value 0 not in range 1 to 2147483647"), std::string::npos)
+      << repeat.stderr_text;
+  const auto chart = run_cli("bench laplace --chart " + (dir / "stderr.txt" / "chart.svg").string(), dir);
+  EXPECT_EQ(chart.exit_code, 2);
+  EXPECT_NE(chart.stderr_text.find("--chart: '" + (dir / "stderr.txt").string() + "' is not a folder"),
+            std::string::npos)
+      << chart.stderr_text;
 }
 
 TEST(BenchShellCli, JsonHasEveryThreadCountTheSameStateAndTheMachine) {

@@ -244,4 +244,22 @@ TEST(BenchScenes, BadInputExitsWithTwoAndNamesTheProblem) {
   EXPECT_EQ(static_scene.exit_code, 2);
   EXPECT_NE(static_scene.stderr_text.find("static"), std::string::npos) << static_scene.stderr_text;
   EXPECT_THROW(run_scene_benchmark(load_scene(kScenes + "/spiral1.json"), "spiral1", -1), std::invalid_argument);
+  // Output paths that cannot be written are refused before the first scene runs, not
+  // after minutes of work; a negative step count names the integers --steps takes.
+  const Result json_folder = run_cli(
+      "bench scenes --scene-dir " + kScenes + " --scenes spiral1 --steps 1 --json " + (dir / "no" / "r.json").string(),
+      dir);
+  EXPECT_EQ(json_folder.exit_code, 2);
+  EXPECT_NE(json_folder.stderr_text.find("--json: folder '" + (dir / "no").string() + "' does not exist"),
+            std::string::npos)
+      << json_folder.stderr_text;
+  EXPECT_EQ(json_folder.stderr_text.find("spiral1"), std::string::npos) << json_folder.stderr_text;
+  const Result markdown_folder = run_cli("bench scenes --scene-dir " + kScenes + " --markdown " + dir.string(), dir);
+  EXPECT_EQ(markdown_folder.exit_code, 2);
+  EXPECT_NE(markdown_folder.stderr_text.find("is a folder; give a file name"), std::string::npos)
+      << markdown_folder.stderr_text;
+  const Result steps = run_cli("bench scenes --steps -1", dir);
+  EXPECT_EQ(steps.exit_code, 2);
+  EXPECT_NE(steps.stderr_text.find("--steps: Value -1 not in range 0 to 2147483647"), std::string::npos)
+      << steps.stderr_text;
 }

@@ -106,4 +106,17 @@ TEST(CliRun, BadInputExitsWithCodeTwoAndOneLine) {
   expect_rejected("clusters", accordion.dump(), "enrichment.rotation_cluster_texels");
 }
 
+TEST(CliRun, AnOutputFolderThatCannotBeCreatedIsRefusedBeforeTheScene) {
+  const fs::path dir = fresh_dir("out_under_file");
+  std::ofstream(dir / "file") << "not a folder";
+  // The scene is not read first: the accordion's set-up would take seconds.
+  const fs::path out = dir / "file" / "out";
+  const Result r =
+      run_dgtex(std::string(DGTEX_SOURCE_DIR) + "/examples/scenes/accordion.json --out " + out.string(), dir);
+  EXPECT_EQ(r.exit_code, 2) << r.stderr_text;
+  EXPECT_NE(r.stderr_text.find("--out: '" + (dir / "file").string() + "' is not a folder"), std::string::npos)
+      << r.stderr_text;
+  EXPECT_FALSE(fs::exists(out));
+}
+
 }  // namespace

@@ -80,6 +80,10 @@ TEST(RenderCli, BadInputExitsWithTwo) {
   EXPECT_EQ(r.exit_code, 2);
   r = run_cli("", "'" + saved_plate() + "' --out '" + out + "' --width 0");
   EXPECT_EQ(r.exit_code, 2);
+  const std::string state = saved_plate();
+  r = run_cli("", "'" + state + "' --out '" + state + "/out'");  // the state file is no folder
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("--out: '" + state + "' is not a folder"), std::string::npos) << r.err;
 }
 
 // With glvnd pointed at a vendor file that does not exist no EGL implementation loads:

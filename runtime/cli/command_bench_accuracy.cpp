@@ -9,15 +9,16 @@
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
 #include <sstream>
 #include <string>
 #include <vector>
 
 #include "commands.h"
+#include "count_option.h"
 #include "dgtex/accuracy_benchmark.h"
 #include "dgtex/benchmark_machine.h"
 #include "gnuplot_chart.h"
+#include "output_paths.h"
 
 namespace dgtex::cli {
 namespace {
@@ -95,8 +96,10 @@ int bench_accuracy_command(int argc, char** argv) {
   app.add_option("--format", format, "chart format: png or svg")->capture_default_str()->check(CLI::IsMember({"png", "svg"}));
   app.add_option("--clock", clock, "cpu (process CPU time; robust on a shared machine with 1 thread) or wall")
       ->capture_default_str()->check(CLI::IsMember({"cpu", "wall"}));
-  app.add_option("--threads", threads, "OpenMP threads for every sweep")->capture_default_str()->check(CLI::PositiveNumber);
-  app.add_option("--repeat", repeat, "runs per cheap case; the best time counts")->capture_default_str()->check(CLI::PositiveNumber);
+  app.add_option("--threads", threads, "OpenMP threads for every sweep")->capture_default_str()->check(thread_count());
+  app.add_option("--repeat", repeat, "runs per cheap case; the best time counts")
+      ->capture_default_str()
+      ->check(at_least_one());
   app.add_option("--plate-divisions", plate.divisions, "plate meshes n x n (even n)")->delimiter(',')->capture_default_str();
   app.add_option("--quadrature-resolution", quadrature.resolution, "texels per element side T of the quadrature sweep")
       ->capture_default_str();
@@ -132,7 +135,7 @@ int bench_accuracy_command(int argc, char** argv) {
     const AccuracyClock which = clock == "cpu" ? AccuracyClock::cpu : AccuracyClock::wall;
     plate.clock = quadrature.clock = texture.clock = tolerance.clock = rotation.clock = which;
     omp_set_num_threads(threads);
-    std::filesystem::create_directories(out_dir);
+    create_output_folder(out_dir, "--out");
     const std::string machine = describe_machine_and_probe();
     const auto start = std::chrono::steady_clock::now();
     const AccuracyProgress progress = [&](const std::string& line) {
@@ -150,14 +153,8 @@ int bench_accuracy_command(int argc, char** argv) {
       if (name == "rotation") results.push_back(run_rotation_accuracy(rotation, progress));
     }
     const std::filesystem::path dir(out_dir);
-    {
-      std::ofstream json(dir / "accuracy.json");
-      json << accuracy_charts_json(results, machine, command);
-      if (!json) throw std::runtime_error("cannot write " + (dir / "accuracy.json").string());
-      std::ofstream md(dir / "accuracy.md");
-      md << accuracy_charts_markdown(results, machine, command);
-      if (!md) throw std::runtime_error("cannot write " + (dir / "accuracy.md").string());
-    }
+    write_output_file((dir / "accuracy.json").string(), accuracy_charts_json(results, machine, command), "--out");
+    write_output_file((dir / "accuracy.md").string(), accuracy_charts_markdown(results, machine, command), "--out");
     int failed = 0;
     for (const AccuracyChart& chart : results) {
       const std::string path = (dir / ("accuracy_" + chart.name + "." + format)).string();

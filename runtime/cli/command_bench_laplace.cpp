@@ -4,7 +4,6 @@
 #include <algorithm>
 #include <cstdio>
 #include <cstdlib>
-#include <fstream>
 #include <iostream>
 #include <nlohmann/json.hpp>
 #include <sstream>
@@ -12,10 +11,12 @@
 #include <vector>
 
 #include "commands.h"
+#include "count_option.h"
 #include "gnuplot_chart.h"
 #include "dgtex/benchmark_machine.h"
 #include "dgtex/laplace_benchmark.h"
 #include "dgtex/laplace_domains.h"
+#include "output_paths.h"
 
 namespace dgtex::cli {
 namespace {
@@ -60,11 +61,14 @@ int bench_laplace_command(int argc, char** argv) {
   app.add_option("--sizes", sizes, "texels per element side T")->delimiter(',');
   app.add_option("--domains", domains, "open, slit, spiral, accordion, chad, one_ring")->delimiter(',');
   app.add_option("--solvers", solvers, "multigrid, multigrid_robust, cholmod, cholmod_solve, eigen_ichol_cg, boomeramg")->delimiter(',');
-  app.add_option("--json", json_path, "write the results as JSON");
-  app.add_option("--chart", chart_path, "write residual against time (SVG, or PNG if FILE ends in .png)");
+  app.add_option("--json", json_path, "write the results as JSON")->check(writable_file());
+  app.add_option("--chart", chart_path, "write residual against time (SVG, or PNG if FILE ends in .png)")
+      ->check(writable_file());
   app.add_option("--chart-domain", chart_domain, "domain of the chart")->capture_default_str();
   app.add_option("--chart-size", chart_size, "size T of the chart")->capture_default_str();
-  app.add_option("--repeat", repeat, "runs per case; the best time counts")->capture_default_str()->check(CLI::PositiveNumber);
+  app.add_option("--repeat", repeat, "runs per case; the best time counts")
+      ->capture_default_str()
+      ->check(at_least_one());
   app.add_option("--tolerance", tolerance, "relative residual to reach")->capture_default_str();
   app.add_option("--max-other-unknowns", max_other_unknowns,
                  "skip solvers other than multigrid above this many unknowns")->capture_default_str();
@@ -78,8 +82,18 @@ int bench_laplace_command(int argc, char** argv) {
     std::vector<LaplaceBenchSolver> solver_list;
     for (const std::string& d : domains) domain_list.push_back(parse_laplace_domain(d));
     for (const std::string& s : solvers) solver_list.push_back(parse_laplace_bench_solver(s));
-    for (int T : sizes)
+    for (int T : sizes) {
       if (T < 16) throw std::invalid_argument("--sizes: T = " + std::to_string(T) + " is too small, need >= 16");
+      // The largest texture a scene takes (enrichment.texture_resolution); beyond it the
+      // texel arrays of one domain pass tens of gigabytes.
+      if (T > 4096) throw std::invalid_argument("--sizes: T = " + std::to_string(T) + " is too large, need <= 4096");
+    }
+    if (!(tolerance > 0 && tolerance < 1)) {
+      char message[128];
+      std::snprintf(message, sizeof message, "--tolerance: %g is out of range; a relative residual in (0, 1)",
+                    tolerance);
+      throw std::invalid_argument(message);
+    }
 
     const std::string machine = describe_machine_and_probe();
     std::printf("machine: %s\n", machine.c_str());
@@ -137,17 +151,15 @@ int bench_laplace_command(int argc, char** argv) {
     std::printf("smoother (red-black sweep, T=%d): %.2f GB/s; array copy: %.2f GB/s; ratio %.0f%%\n", bandwidth_size,
                 bw.smoother_gb_per_s, bw.copy_gb_per_s, 100.0 * bw.smoother_gb_per_s / bw.copy_gb_per_s);
     if (!json_path.empty()) {
-      std::ofstream out(json_path);
-      if (!out) throw std::runtime_error("cannot write --json file '" + json_path + "'");
-      out << nlohmann::json{{"machine", machine},
-                            {"tolerance", tolerance},
-                            {"cases", cases},
-                            {"speedup_of_multigrid", ratios},
-                            {"smoother_bandwidth", {{"size", bandwidth_size},
-                                                    {"smoother_gb_per_s", bw.smoother_gb_per_s},
-                                                    {"copy_gb_per_s", bw.copy_gb_per_s}}}}
-                 .dump(2)
-          << "\n";
+      const nlohmann::json results{{"machine", machine},
+                                   {"tolerance", tolerance},
+                                   {"cases", cases},
+                                   {"speedup_of_multigrid", ratios},
+                                   {"smoother_bandwidth",
+                                    {{"size", bandwidth_size},
+                                     {"smoother_gb_per_s", bw.smoother_gb_per_s},
+                                     {"copy_gb_per_s", bw.copy_gb_per_s}}}};
+      write_output_file(json_path, results.dump(2) + "\n", "--json");
     }
     if (!chart_path.empty()) {
       if (chart.empty())

@@ -7,7 +7,6 @@
 #include <algorithm>
 #include <cstdio>
 #include <cstdlib>
-#include <fstream>
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <string>
@@ -17,6 +16,7 @@
 #include "gnuplot_chart.h"
 #include "dgtex/benchmark_machine.h"
 #include "dgtex/render_benchmark.h"
+#include "output_paths.h"
 
 namespace dgtex::cli {
 namespace {
@@ -77,8 +77,9 @@ int bench_render_command(int argc, char** argv) {
       ->check(CLI::Range(1, 1000));
   bool complete_only = false;
   app.add_flag("--complete-cut-only", complete_only, "leave out the partial cut (and its tip)");
-  app.add_option("--json", json_path, "write the results as JSON");
-  app.add_option("--chart", chart_path, "write error against triangles (PNG if FILE ends in .png, else SVG)");
+  app.add_option("--json", json_path, "write the results as JSON")->check(writable_file());
+  app.add_option("--chart", chart_path, "write error against triangles (PNG if FILE ends in .png, else SVG)")
+      ->check(writable_file());
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -129,16 +130,19 @@ int bench_render_command(int argc, char** argv) {
       target["met"] = false;
     }
     if (!json_path.empty()) {
-      std::ofstream out(json_path);
-      if (!out) throw std::runtime_error("cannot write --json file '" + json_path + "'");
-      out << nlohmann::json{{"machine", machine},
-                            {"resolution", r.resolution}, {"width", r.width}, {"height", r.height},
-                            {"texel_pixels", r.texel_pixels}, {"elements", r.elements},
-                            {"enrichments", r.enrichments}, {"partial_cut", r.partial_cut}, {"device", r.device},
-                            {"tip_radius_texels", kRenderBenchTipRadius}, {"cases", cases},
-                            {"target", target}}
-                 .dump(2)
-          << "\n";
+      const nlohmann::json results{{"machine", machine},
+                                   {"resolution", r.resolution},
+                                   {"width", r.width},
+                                   {"height", r.height},
+                                   {"texel_pixels", r.texel_pixels},
+                                   {"elements", r.elements},
+                                   {"enrichments", r.enrichments},
+                                   {"partial_cut", r.partial_cut},
+                                   {"device", r.device},
+                                   {"tip_radius_texels", kRenderBenchTipRadius},
+                                   {"cases", cases},
+                                   {"target", target}};
+      write_output_file(json_path, results.dump(2) + "\n", "--json");
     }
     if (!chart_path.empty() && !write_chart(chart_path, r))
       std::fprintf(stderr, "dgtex bench render: gnuplot failed to write '%s' (is gnuplot installed?)\n",

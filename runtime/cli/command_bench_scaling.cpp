@@ -8,7 +8,6 @@
 #include <algorithm>
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
 #include <nlohmann/json.hpp>
 #include <set>
 #include <sstream>
@@ -16,12 +15,14 @@
 #include <vector>
 
 #include "commands.h"
+#include "count_option.h"
 #include "gnuplot_chart.h"
 #include "dgtex/benchmark_machine.h"
 #include "dgtex/mesh_error.h"
 #include "dgtex/model_error.h"
 #include "dgtex/scaling_benchmark.h"
 #include "dgtex/scene_io.h"
+#include "output_paths.h"
 
 namespace dgtex::cli {
 namespace {
@@ -137,12 +138,6 @@ bool write_chart(const std::string& path, const std::vector<KernelScaling>& kern
   });
 }
 
-void write_text(const std::string& path, const std::string& text, const char* what) {
-  std::ofstream out(path);
-  out << text;
-  if (!out) throw std::runtime_error(std::string("cannot write ") + what + " file '" + path + "'");
-}
-
 }  // namespace
 
 int bench_scaling_command(int argc, char** argv) {
@@ -167,18 +162,23 @@ int bench_scaling_command(int argc, char** argv) {
                  "what to time: enrichment_solve, assembly, polar_decomposition, factorization, scene_step, batch")
       ->delimiter(',')
       ->capture_default_str();
-  app.add_option("--repeats", repeats, "kernel timings: best of this many runs")->capture_default_str()->check(CLI::PositiveNumber);
-  app.add_option("--steps", steps, "scene_step: timed steps per thread count")->capture_default_str()->check(CLI::PositiveNumber);
+  app.add_option("--repeats", repeats, "kernel timings: best of this many runs")
+      ->capture_default_str()
+      ->check(at_least_one());
+  app.add_option("--steps", steps, "scene_step: timed steps per thread count")
+      ->capture_default_str()
+      ->check(at_least_one());
   app.add_option("--polar-count", polar_count, "polar_decomposition: matrices per batch")
       ->capture_default_str()
-      ->check(CLI::PositiveNumber);
+      ->check(at_least_one());
   app.add_option("--batch-scenes", batch_scenes, "batch: scene files (default: --cut-scene and --scene)")->delimiter(',');
   app.add_option("--batch-runs", batch_runs, "batch: independent runs K (default: the largest thread count)")
-      ->check(CLI::PositiveNumber);
-  app.add_option("--batch-steps", batch_steps, "batch: steps per run")->capture_default_str()->check(CLI::PositiveNumber);
-  app.add_option("--json", json_path, "write the results as JSON");
-  app.add_option("--markdown", markdown_path, "write the Markdown tables to FILE too");
-  app.add_option("--chart", chart_path, "chart with gnuplot (PNG if FILE ends in .png, else SVG)");
+      ->check(at_least_one());
+  app.add_option("--batch-steps", batch_steps, "batch: steps per run")->capture_default_str()->check(at_least_one());
+  app.add_option("--json", json_path, "write the results as JSON")->check(writable_file());
+  app.add_option("--markdown", markdown_path, "write the Markdown tables to FILE too")->check(writable_file());
+  app.add_option("--chart", chart_path, "chart with gnuplot (PNG if FILE ends in .png, else SVG)")
+      ->check(writable_file());
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -272,7 +272,7 @@ int bench_scaling_command(int argc, char** argv) {
   std::printf("dgtex bench scaling: %d cores, OMP_WAIT_POLICY=%s (kernels: best of %d, ms)\n\n%s", omp_get_num_procs(),
               omp_wait_policy_name().c_str(), repeats, tables.c_str());
   try {
-    if (!markdown_path.empty()) write_text(markdown_path, tables, "--markdown");
+    if (!markdown_path.empty()) write_output_file(markdown_path, tables, "--markdown");
     if (!json_path.empty()) {
       nlohmann::json j = {{"cores", omp_get_num_procs()},
                           {"threads", threads},
@@ -282,7 +282,7 @@ int bench_scaling_command(int argc, char** argv) {
                           {"batch", nlohmann::json::array()}};
       for (const KernelScaling& k : kernels) j["kernels"].push_back(kernel_json(k));
       for (const BatchThroughput& b : batches) j["batch"].push_back(batch_json(b));
-      write_text(json_path, j.dump(2) + "\n", "--json");
+      write_output_file(json_path, j.dump(2) + "\n", "--json");
     }
   } catch (const std::exception& e) {
     std::fprintf(stderr, "dgtex bench scaling: %s\n", e.what());

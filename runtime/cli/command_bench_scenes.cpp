@@ -8,7 +8,6 @@
 #include <algorithm>
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
 #include <nlohmann/json.hpp>
 #include <numeric>
 #include <optional>
@@ -17,12 +16,14 @@
 #include <vector>
 
 #include "commands.h"
+#include "count_option.h"
 #include "gnuplot_chart.h"
 #include "dgtex/benchmark_machine.h"
 #include "dgtex/mesh_error.h"
 #include "dgtex/model_error.h"
 #include "dgtex/scene_benchmark.h"
 #include "dgtex/scene_io.h"
+#include "output_paths.h"
 
 namespace dgtex::cli {
 namespace {
@@ -224,12 +225,6 @@ std::string markdown_tables(const std::vector<SceneBenchResult>& results) {
   return out.str();
 }
 
-void write_text(const std::string& path, const std::string& text, const char* what) {
-  std::ofstream out(path);
-  out << text;
-  if (!out) throw std::runtime_error(std::string("cannot write ") + what + " file '" + path + "'");
-}
-
 }  // namespace
 
 int bench_scenes_command(int argc, char** argv) {
@@ -250,10 +245,11 @@ int bench_scenes_command(int argc, char** argv) {
                  "time steps per scene from rest (0: the scene's own analysis.steps, the whole run; Table 5.1 "
                  "averages over whole runs, so the targets are judged only then)")
       ->capture_default_str()
-      ->check(CLI::NonNegativeNumber);
-  app.add_option("--threads", threads, "OpenMP threads (default: all cores)")->check(CLI::Range(1, 1024));
-  app.add_option("--json", json_path, "write the results as JSON (rewritten after every scene)");
-  app.add_option("--markdown", markdown_path, "write the Markdown tables to FILE too");
+      ->check(zero_or_more());
+  app.add_option("--threads", threads, "OpenMP threads (default: all cores)")->check(thread_count());
+  app.add_option("--json", json_path, "write the results as JSON (rewritten after every scene)")
+      ->check(writable_file());
+  app.add_option("--markdown", markdown_path, "write the Markdown tables to FILE too")->check(writable_file());
   app.add_flag("--inline-cut-updates", inline_cut_updates,
                "update the cuts at the start of each step instead of beside the previous step's projection and "
                "shell step (SceneRunOptions::overlap_cut_updates)");
@@ -310,7 +306,7 @@ int bench_scenes_command(int argc, char** argv) {
       all["scenes"].push_back(scene_json(r));
       all["scenes"].back()["machine_probe_ms"] = probes_ms.back();
       results.push_back(std::move(r));
-      if (!json_path.empty()) write_text(json_path, all.dump(2) + "\n", "--json");
+      if (!json_path.empty()) write_output_file(json_path, all.dump(2) + "\n", "--json");
     } catch (const SceneError& e) {
       std::fprintf(stderr, "\ndgtex bench scenes: %s\n", e.what());
       return 2;
@@ -344,8 +340,8 @@ int bench_scenes_command(int argc, char** argv) {
   const std::string drift = probe_drift_warning(probes_ms);
   if (!drift.empty()) std::fprintf(stderr, "dgtex bench scenes: warning: %s\n", drift.c_str());
   try {
-    if (!json_path.empty()) write_text(json_path, all.dump(2) + "\n", "--json");
-    if (!markdown_path.empty()) write_text(markdown_path, heading + tables, "--markdown");
+    if (!json_path.empty()) write_output_file(json_path, all.dump(2) + "\n", "--json");
+    if (!markdown_path.empty()) write_output_file(markdown_path, heading + tables, "--markdown");
   } catch (const std::exception& e) {
     std::fprintf(stderr, "dgtex bench scenes: %s\n", e.what());
     return 1;

@@ -7,18 +7,19 @@
 #include <algorithm>
 #include <cstdio>
 #include <cstdlib>
-#include <fstream>
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <string>
 #include <vector>
 
 #include "commands.h"
+#include "count_option.h"
 #include "gnuplot_chart.h"
 #include "dgtex/benchmark_machine.h"
 #include "dgtex/mesh_error.h"
 #include "dgtex/scene_io.h"
 #include "dgtex/shell_benchmark.h"
+#include "output_paths.h"
 
 namespace dgtex::cli {
 namespace {
@@ -71,11 +72,14 @@ int bench_shell_command(int argc, char** argv) {
   bool refactor_every_step = false;
   FactorReuseOptions solver;
   app.add_option("--scene", scene_path, "dynamic scene (JSON)")->capture_default_str();
-  app.add_option("--steps", steps, "time steps per case (from rest)")->capture_default_str()->check(CLI::PositiveNumber);
+  app.add_option("--steps", steps, "time steps per case (from rest)")->capture_default_str()->check(at_least_one());
   app.add_option("--threads-list", threads_list, "OpenMP thread counts, one case each")->delimiter(',')->capture_default_str();
-  app.add_option("--json", json_path, "write the results as JSON");
-  app.add_option("--chart", chart_path, "write ms per step (SVG, or PNG if FILE ends in .png) with gnuplot");
-  app.add_option("--gemm-size", gemm_size, "n of the n x n Eigen GEMM reference")->capture_default_str()->check(CLI::PositiveNumber);
+  app.add_option("--json", json_path, "write the results as JSON")->check(writable_file());
+  app.add_option("--chart", chart_path, "write ms per step (SVG, or PNG if FILE ends in .png) with gnuplot")
+      ->check(writable_file());
+  app.add_option("--gemm-size", gemm_size, "n of the n x n Eigen GEMM reference")
+      ->capture_default_str()
+      ->check(at_least_one());
   app.add_option("--tolerance", solver.relative_tolerance, "PCG relative residual bound per step")->capture_default_str();
   app.add_option("--refactor-after", solver.refactor_after_iterations,
                  "refactorise when a step needed more PCG iterations than this")->capture_default_str();
@@ -180,27 +184,27 @@ int bench_shell_command(int argc, char** argv) {
                          {"factorize_ms_total", r.factorize_ms},
                          {"precondition_ms_total", r.precondition_ms}});
       }
-      std::ofstream out(json_path);
-      if (!out) throw std::runtime_error("cannot write --json file '" + json_path + "'");
-      out << nlohmann::json{{"machine", machine},
-                            {"scene", scene_path},
-                            {"steps", steps},
-                            {"solver", refactor_every_step ? "refactor_every_step" : "pcg_reused_factor"},
-                            {"pcg_relative_tolerance", solver.relative_tolerance},
-                            {"omp_wait_policy", omp_wait_policy_name()},
-                            {"refactor_after_iterations", solver.refactor_after_iterations},
-                            {"preconditioner", preconditioner},
-                            {"overlap_factorization", solver.overlap_factorization},
-                            {"counts", {{"elements", first.elements}, {"nodes", first.nodes}, {"free_dofs", first.free_dofs},
-                                        {"quadrature_points", first.quadrature_points},
-                                        {"factor_nonzeros", first.factor_nonzeros}}},
-                            {"assembly_flops", first.assembly_flops},
-                            {"gemm_size", gemm_size},
-                            {"cases", cases},
-                            {"speedups", speedups},
-                            {"identical_across_threads", identical}}
-                 .dump(2)
-          << "\n";
+      const nlohmann::json results{{"machine", machine},
+                                   {"scene", scene_path},
+                                   {"steps", steps},
+                                   {"solver", refactor_every_step ? "refactor_every_step" : "pcg_reused_factor"},
+                                   {"pcg_relative_tolerance", solver.relative_tolerance},
+                                   {"omp_wait_policy", omp_wait_policy_name()},
+                                   {"refactor_after_iterations", solver.refactor_after_iterations},
+                                   {"preconditioner", preconditioner},
+                                   {"overlap_factorization", solver.overlap_factorization},
+                                   {"counts",
+                                    {{"elements", first.elements},
+                                     {"nodes", first.nodes},
+                                     {"free_dofs", first.free_dofs},
+                                     {"quadrature_points", first.quadrature_points},
+                                     {"factor_nonzeros", first.factor_nonzeros}}},
+                                   {"assembly_flops", first.assembly_flops},
+                                   {"gemm_size", gemm_size},
+                                   {"cases", cases},
+                                   {"speedups", speedups},
+                                   {"identical_across_threads", identical}};
+      write_output_file(json_path, results.dump(2) + "\n", "--json");
     }
     if (!chart_path.empty() && !write_chart(chart_path, runs))
       std::fprintf(stderr, "dgtex bench shell: gnuplot failed to write '%s' (is gnuplot installed?)\n", chart_path.c_str());

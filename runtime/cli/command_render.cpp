@@ -14,6 +14,7 @@
 #include "dgtex/png_io.h"
 #include "dgtex/shell_renderer.h"
 #include "dgtex/shell_state.h"
+#include "output_paths.h"
 
 namespace dgtex::cli {
 
@@ -23,7 +24,7 @@ int render_command(int argc, char** argv) {
   RenderSettings settings;
   std::vector<double> position, target, up, background;
   app.add_option("STATE", state_path, "state file written by dgtex run (binary, see dgtex/shell_state.h)")->required();
-  app.add_option("--out", out_dir, "output folder (created if missing)")->required();
+  app.add_option("--out", out_dir, "output folder (created if missing)")->required()->check(creatable_folder());
   app.add_option("--width", settings.width, "image width in pixels")->capture_default_str()->check(CLI::Range(1, 16384));
   app.add_option("--height", settings.height, "image height in pixels")->capture_default_str()->check(CLI::Range(1, 16384));
   app.add_option("--shading", shading, "flat (one colour per element) or smooth (normals averaged at nodes)")
@@ -66,8 +67,8 @@ int render_command(int argc, char** argv) {
   }
 
   try {
-    std::filesystem::create_directories(out_dir);
     ShellRenderer renderer;
+    create_output_folder(out_dir, "--out");
     const Image image = renderer.render(state, settings);
     const std::string frame = (std::filesystem::path(out_dir) / "frame.png").string();
     write_png(frame, image);

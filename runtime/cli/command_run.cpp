@@ -10,6 +10,7 @@
 #include <omp.h>
 
 #include "commands.h"
+#include "count_option.h"
 #include "dgtex/cut_surface_export.h"
 #include "dgtex/frame_writer.h"
 #include "dgtex/mesh_error.h"
@@ -18,6 +19,7 @@
 #include "dgtex/scene_io.h"
 #include "dgtex/scene_run.h"
 #include "dgtex/surface_point.h"
+#include "output_paths.h"
 
 namespace dgtex::cli {
 namespace {
@@ -50,8 +52,8 @@ int run_command(int argc, char** argv) {
   int threads = 0;
   bool quiet = false;
   app.add_option("scene", scene_path, "scene file (JSON)")->required();
-  app.add_option("--out", out_dir, "output folder (created if missing)")->required();
-  app.add_option("--threads", threads, "OpenMP threads (default: all cores)")->check(CLI::Range(1, 1024));
+  app.add_option("--out", out_dir, "output folder (created if missing)")->required()->check(creatable_folder());
+  app.add_option("--threads", threads, "OpenMP threads (default: all cores)")->check(thread_count());
   app.add_flag("--quiet", quiet, "no progress line");
   bool no_render = false, cut_surface_obj = false, save_textures = false;
   app.add_flag("--no-render", no_render, "write no PNG frames even if the scene has a render block");
@@ -101,7 +103,7 @@ int run_command(int argc, char** argv) {
     if (png_frames) png_frames->write(run->state(), index);
   };
   try {
-    fs::create_directories(out / "frames");
+    create_output_folder((out / "frames").string(), "--out");
     if (!scene.analysis.is_dynamic()) {
       run->solve_static();
       if (png_frames) png_frames->write(run->state(), 0);

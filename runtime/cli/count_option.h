@@ -1,0 +1,18 @@
+#pragma once
+// Range checks for integer options. CLI11's PositiveNumber reports a refused 0 as "not in
+// range 0.000000 to 1797...(309 digits)"; these name the integers an option takes.
+#include <CLI/CLI.hpp>
+#include <limits>
+
+namespace dgtex::cli {
+
+// A count of one or more (runs, steps, repeats): "Value 0 not in range 1 to 2147483647".
+inline CLI::Range at_least_one() { return CLI::Range(1, std::numeric_limits<int>::max()); }
+
+// A count that may be zero where zero means "the default" (bench scenes' --steps).
+inline CLI::Range zero_or_more() { return CLI::Range(0, std::numeric_limits<int>::max()); }
+
+// OpenMP thread counts, as `dgtex run --threads` takes them.
+inline CLI::Range thread_count() { return CLI::Range(1, 1024); }
+
+}  // namespace dgtex::cli

@@ -1,0 +1,26 @@
+#pragma once
+// The files and folders a command writes. Commands run for seconds to many minutes and
+// write their results at the end, so a path they could not write is refused when the
+// options are read, before the work, and the write itself names the option it came from.
+#include <CLI/CLI.hpp>
+#include <string>
+
+namespace dgtex::cli {
+
+// Accepts a path whose folder exists and may be written to, and which is not itself a
+// folder or a read-only file. An empty value passes (the option was not given).
+CLI::Validator writable_file();
+
+// Accepts an existing folder that may be written to, or a path whose nearest existing
+// part is such a folder (the command creates the rest when it writes). Nothing is created
+// here: a run that fails later leaves no empty output folder behind.
+CLI::Validator creatable_folder();
+
+// Creates FOLDER and its parents (nothing when it exists); throws std::invalid_argument naming
+// OPTION ("--out"), the folder and why it cannot be created.
+void create_output_folder(const std::string& folder, const char* option);
+
+// Writes TEXT to PATH; throws std::runtime_error naming OPTION ("--json") and the path.
+void write_output_file(const std::string& path, const std::string& text, const char* option);
+
+}  // namespace dgtex::cli
