@@ -2,6 +2,7 @@
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -66,12 +67,20 @@ int run_command(int argc, char** argv) {
     return app.exit(e) == 0 ? 0 : 2;
   }
   if (threads > 0) omp_set_num_threads(threads);
+  const bool progress = !quiet && isatty(fileno(stderr));
 
   Scene scene;
   std::unique_ptr<SceneRun> run;
   try {
     scene = load_scene(scene_path);
+    // The set-up (cut tracing, the first enrichment solves, the model) can take minutes
+    // at a high texture_resolution: say so, then how long it took.
+    const auto setup_start = std::chrono::steady_clock::now();
+    if (progress) std::fprintf(stderr, "dgtex run: setting up the mesh, cuts and enrichment functions\n");
     run = std::make_unique<SceneRun>(scene);
+    if (progress)
+      std::fprintf(stderr, "dgtex run: set up in %.1f s\n",
+                   std::chrono::duration<double>(std::chrono::steady_clock::now() - setup_start).count());
   } catch (const SceneError& e) {
     std::fprintf(stderr, "dgtex run: %s\n", e.what());
     return 2;
@@ -109,7 +118,6 @@ int run_command(int argc, char** argv) {
       if (png_frames) png_frames->write(run->state(), 0);
     } else {
       const int every = scene.render ? scene.render->every_steps : 10;
-      const bool progress = !quiet && isatty(fileno(stderr));
       write_frame(0);
       for (int step = 1; step <= scene.analysis.steps; ++step) {
         run->step();
