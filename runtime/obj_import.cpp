@@ -25,6 +25,10 @@ double parse_coordinate(const std::string& token, const std::string& path, int l
   const double value = std::strtod(token.c_str(), &end);
   if (token.empty() || *end != '\0' || !std::isfinite(value))
     throw MeshError(where(path, line) + ": vertex coordinate '" + token + "' is not a finite number");
+  // As for the scene's numbers: beyond this, element areas (squares of lengths) overflow.
+  if (std::abs(value) > 1e30)
+    throw MeshError(where(path, line) + ": vertex coordinate '" + token +
+                    "' is out of range; magnitudes up to 1e30 are accepted");
   return value;
 }
 

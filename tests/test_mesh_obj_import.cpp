@@ -115,6 +115,8 @@ TEST(ObjImport, MalformedLinesNameTheLine) {
   EXPECT_CONTAINS(load_error_of_text("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 0 1 2\n"), "refers to vertex 0");
   EXPECT_CONTAINS(load_error_of_text("v 0 0\n"), ".obj:1: vertex needs three coordinates");
   EXPECT_CONTAINS(load_error_of_text("v 0 0 zero\n"), ".obj:1: vertex coordinate 'zero'");
+  // 1e300 would pass as finite, and the area Jacobian would overflow to inf downstream.
+  EXPECT_CONTAINS(load_error_of_text("v 1e300 0 0\n"), ".obj:1: vertex coordinate '1e300' is out of range");
   EXPECT_CONTAINS(load_error_of_text("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 x/1\n"), ".obj:4: face corner 'x/1'");
   EXPECT_CONTAINS(load_error_of_text("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 2\n"), ".obj:4: face repeats vertex 2");
   EXPECT_CONTAINS(load_error_of_text("# nothing\nv 0 0 0\n"), "no faces");
