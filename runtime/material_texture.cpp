@@ -2,6 +2,7 @@
 
 #include <map>
 #include <string>
+#include <utility>
 
 #include "dgtex/png_io.h"
 #include "dgtex/scene_io.h"
@@ -10,6 +11,8 @@ namespace dgtex {
 
 std::vector<ElementMaterialTexture> scene_material_textures(const Scene& scene, const Mesh& mesh) {
   std::map<int, ElementMaterialTexture> per_element;
+  // Which texture set each (element, field): a second one would silently replace the first.
+  std::map<std::pair<int, MaterialTexture::Field>, size_t> setter;
   const int ne = mesh.num_elements();
   for (size_t i = 0; i < scene.material_textures.size(); ++i) {
     const MaterialTexture& t = scene.material_textures[i];
@@ -55,6 +58,12 @@ std::vector<ElementMaterialTexture> scene_material_textures(const Scene& scene, 
                              std::to_string(m.height) + " material texture",
                          "\"" + t.image + "\"", "textures of one element must have the same size");
       }
+      if (const auto [first, fresh_field] = setter.try_emplace({e, t.field}, i); !fresh_field)
+        throw SceneError(scene.source_name, path + ".elements[" + std::to_string(k) + "]",
+                         "element " + std::to_string(e) + " already has a " +
+                             (t.field == MaterialTexture::Field::thickness ? "thickness" : "youngs_modulus") +
+                             " texture from material_textures[" + std::to_string(first->second) + "]",
+                         std::to_string(e), "one texture per field and element");
       (t.field == MaterialTexture::Field::thickness ? m.thickness : m.youngs_modulus) = values;
     }
   }

@@ -37,6 +37,14 @@ Image read_png(const std::string& path) {
     png_image_free(&png);
     throw std::runtime_error("cannot read PNG '" + path + "': " + message);
   }
+  // A header may claim any size up to 2^31 per side; refuse what no texture needs rather
+  // than fail to allocate it (or allocate gigabytes).
+  if (png.width > kMaxPngSide || png.height > kMaxPngSide) {
+    const std::string size = std::to_string(png.width) + " x " + std::to_string(png.height);
+    png_image_free(&png);
+    throw std::runtime_error("cannot read PNG '" + path + "': " + size + " pixels; at most " +
+                             std::to_string(kMaxPngSide) + " x " + std::to_string(kMaxPngSide) + " are read");
+  }
   png.format = PNG_FORMAT_RGBA;
   Image image(static_cast<int>(png.width), static_cast<int>(png.height));
   if (!png_image_finish_read(&png, nullptr, image.rgba.data(), 0, nullptr)) {

@@ -318,6 +318,14 @@ TEST_F(MaterialTextureScene, RejectsBadInputsWithTheJsonPath) {
             "material_textures[0].elements[1]");
   EXPECT_EQ(error_path(R"([{"image": "step.png", "range": [1, 2]}])"), "material_textures[0].field");
   EXPECT_EQ(error_path(R"({"field": "thickness"})"), "material_textures");
+  // A second texture of one field on an element would replace the first without a word;
+  // the other field on the same element is fine.
+  EXPECT_EQ(error_path(R"([{"field": "thickness", "image": "step.png", "range": [1, 2], "elements": [0, 2]},
+                           {"field": "thickness", "image": "step.png", "range": [3, 4], "elements": [1, 2]}])"),
+            "material_textures[1].elements[1]");
+  EXPECT_EQ(error_path(R"([{"field": "thickness", "image": "step.png", "range": [1, 2]},
+                           {"field": "youngs_modulus", "image": "step.png", "range": [1e5, 2e6]}])"),
+            "(accepted)");
   EXPECT_EQ(error_path(R"([{"field": "youngs_modulus", "image": "step.png", "range": [1e5, 2e6]}])"), "(accepted)");
 }
 

@@ -10,7 +10,11 @@ namespace dgtex {
 // Writes an 8-bit RGBA PNG.
 void write_png(const std::string& path, const Image& image);
 
-// Reads any PNG (grey, palette, RGB, 16-bit, ...) converted to 8-bit RGBA.
+// Largest width or height read_png accepts (16384 x 16384 RGBA is 1 GiB).
+inline constexpr unsigned kMaxPngSide = 16384;
+
+// Reads any PNG (grey, palette, RGB, 16-bit, ...) converted to 8-bit RGBA. Throws for a
+// damaged file and for one wider or taller than kMaxPngSide.
 Image read_png(const std::string& path);
 
 }  // namespace dgtex
