@@ -15,6 +15,7 @@
 
 #include "dgtex/frame_writer.h"
 #include "dgtex/png_io.h"
+#include "dgtex/shell_state.h"
 #include "render_fixtures.h"
 
 namespace dgtex {
@@ -143,6 +144,38 @@ TEST(RenderRunFrames, NoRenderBlockOrNoRenderFlagWritesNoPng) {
   EXPECT_TRUE(png_files(dir / "b" / "frames").empty());
   std::ifstream in(dir / "b" / "report.json");
   EXPECT_FALSE(nlohmann::json::parse(in)["timings_ms"].contains("render"));
+}
+
+// --save-state writes the final state; `dgtex render` of it with the scene's camera, size
+// and background draws bitwise the run's last frame (same renderer, state saved exactly:
+// f64 positions and displacements, the f32 textures as they are held).
+TEST(RenderRunFrames, SavedFinalStateRendersToTheLastFrame) {
+  const fs::path dir = test_dir();
+  const std::string cut = R"(, "cuts": [{"points": [[0.6, 0, 0], [0.6, 0.15, 0]]}], "enrichment": {"texture_resolution": 32})";
+  std::ofstream(dir / "scene.json") << strip_scene(kDynamic, kRenderBlock + cut);
+  const fs::path out = dir / "out";
+  const CliResult r =
+      run_dgtex("", "'" + (dir / "scene.json").string() + "' --out '" + out.string() + "' --save-state", dir);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  ShellState uncut = load_state((out / "final.state").string());
+  ASSERT_FALSE(uncut.enrichments.empty());  // the cut's textures travel
+  uncut.enrichments.clear();
+  save_state((dir / "uncut.state").string(), uncut);
+  const auto render = [&](const fs::path& state, const fs::path& folder) {
+    const std::string command = "'" + std::string(DGTEX_CLI) + "' render '" + state.string() + "' --out '" +
+                                folder.string() +
+                                "' --width 96 --height 64 --background 0.2 0.4 0.6 --camera-position 0.5 -1.5 1.0"
+                                " --camera-target 0.5 0.1 -0.1 >/dev/null 2>&1";
+    EXPECT_EQ(std::system(command.c_str()), 0) << command;
+    return read_png((folder / "frame.png").string());
+  };
+  const Image last = read_png((out / "frames" / "frame_00007.png").string());
+  const Image rendered = render(out / "final.state", dir / "again");
+  EXPECT_EQ(rendered.width, last.width);
+  EXPECT_EQ(rendered.height, last.height);
+  EXPECT_TRUE(rendered.rgba == last.rgba) << "the rendered state differs from the run's final frame";
+  // The comparison sees the cut: without its enrichments the same state draws differently.
+  EXPECT_FALSE(render(dir / "uncut.state", dir / "uncut").rgba == last.rgba);
 }
 
 // glvnd pointed at a vendor file that does not exist loads no EGL implementation.

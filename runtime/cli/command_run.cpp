@@ -19,6 +19,7 @@
 #include "dgtex/model_error.h"
 #include "dgtex/scene_io.h"
 #include "dgtex/scene_run.h"
+#include "dgtex/shell_state.h"
 #include "dgtex/surface_point.h"
 #include "output_paths.h"
 
@@ -56,9 +57,11 @@ int run_command(int argc, char** argv) {
   app.add_option("--out", out_dir, "output folder (created if missing)")->required()->check(creatable_folder());
   app.add_option("--threads", threads, "OpenMP threads (default: all cores)")->check(thread_count());
   app.add_flag("--quiet", quiet, "no progress line");
-  bool no_render = false, cut_surface_obj = false, save_textures = false;
+  bool no_render = false, cut_surface_obj = false, save_textures = false, save_final_state = false;
   app.add_flag("--no-render", no_render, "write no PNG frames even if the scene has a render block");
   app.add_flag("--obj", cut_surface_obj, "also write the final cut surface (split along cuts) to DIR/cut_surface.obj");
+  app.add_flag("--save-state", save_final_state,
+               "write the final state (mesh, displacement, enrichments) to DIR/final.state for dgtex render");
   app.add_flag("--save-textures", save_textures,
                "write the enrichment textures and cut walls of the final state to DIR/textures/enrichment.vdb");
   try {
@@ -137,6 +140,7 @@ int run_command(int argc, char** argv) {
     write_vtu((out / "deformed.vtu").string(), mesh, run->displacement().data());
     if (cut_surface_obj) export_cut_surface_obj((out / "cut_surface.obj").string(), run->state());
     if (save_textures && run->cuts()) run->cuts()->save_textures((out / "textures").string());
+    if (save_final_state) save_state((out / "final.state").string(), run->state());
   } catch (const ModelError& e) {
     std::fprintf(stderr, "dgtex run: %s: %s\n", scene_path.c_str(), e.what());
     return 2;
