@@ -51,8 +51,10 @@ class Writer {
 
 class Reader {
  public:
-  explicit Reader(const std::string& path) : path_(path), in_(path, std::ios::binary) {
+  explicit Reader(const std::string& path) : path_(path), in_(path, std::ios::binary | std::ios::ate) {
     if (!in_) throw std::runtime_error("cannot open state file '" + path + "' (missing or unreadable)");
+    file_bytes_ = static_cast<std::uint64_t>(in_.tellg());
+    in_.seekg(0);
   }
   template <class T>
   T value(const char* what) {
@@ -63,6 +65,11 @@ class Reader {
   template <class T>
   void array(std::vector<T>& v, std::uint64_t n, const char* what) {
     if (n > kMaxCount) fail(std::string(what) + " has an implausible size " + std::to_string(n));
+    // A damaged count must not allocate gigabytes that the file cannot hold.
+    const std::uint64_t remaining = file_bytes_ - static_cast<std::uint64_t>(in_.tellg());
+    if (n > remaining / sizeof(T))
+      fail(std::string("truncated or damaged: ") + what + " need " + std::to_string(n * sizeof(T)) + " bytes, " +
+           std::to_string(remaining) + " remain in the file");
     v.resize(n);
     bytes(v.data(), n * sizeof(T), what);
   }
@@ -78,6 +85,7 @@ class Reader {
   }
   std::string path_;
   std::ifstream in_;
+  std::uint64_t file_bytes_ = 0;
 };
 
 }  // namespace

@@ -1,6 +1,7 @@
 // save_state/load_state and PNG round trips, and their error messages.
 #include <gtest/gtest.h>
 
+#include <cstdint>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -71,6 +72,18 @@ TEST(RenderStateIo, ErrorsNameTheFileAndTheProblem) {
   const std::string truncated = error_of([&] { load_state(path); });
   EXPECT_NE(truncated.find(path), std::string::npos);
   EXPECT_NE(truncated.find("truncated"), std::string::npos) << truncated;
+
+  // A damaged node count (bytes 16-23) of 10^9 is refused before 24 GB are allocated for
+  // positions the file cannot hold.
+  save_state(path, test::straight_cut_plate().state);
+  {
+    std::fstream file(path, std::ios::binary | std::ios::in | std::ios::out);
+    const std::uint64_t nodes = 1000000000;
+    file.seekp(16);
+    file.write(reinterpret_cast<const char*>(&nodes), sizeof nodes);
+  }
+  const std::string damaged = error_of([&] { load_state(path); });
+  EXPECT_NE(damaged.find("truncated or damaged: positions need 24000000000 bytes"), std::string::npos) << damaged;
 
   {
     std::ofstream out(path, std::ios::binary);
