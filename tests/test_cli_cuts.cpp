@@ -84,6 +84,21 @@ TEST(CliCuts, CompletelyCutPieceFallsFreelyWhileTheClampedPartHolds) {
   EXPECT_TRUE(fs::exists(dir / "out" / "textures" / "enrichment.vdb"));
 }
 
+TEST(CliCuts, SaveTexturesWithoutCutsSaysSoInsteadOfWritingNothingSilently) {
+  const fs::path dir = fresh_dir("textures_without_cuts");
+  nlohmann::json scene = cut_strip();
+  scene.erase("cuts");
+  scene.erase("enrichment");
+  scene["analysis"]["steps"] = 2;
+  const Result r = run_scene(scene, dir, "--save-textures --no-render");
+  ASSERT_EQ(r.exit_code, 0) << r.stderr_text;
+  EXPECT_NE(r.stderr_text.find("--save-textures writes the textures of cuts, and the scene has none"),
+            std::string::npos)
+      << r.stderr_text;
+  EXPECT_FALSE(fs::exists(dir / "out" / "textures"));
+  EXPECT_TRUE(fs::exists(dir / "out" / "report.json"));
+}
+
 TEST(CliCuts, ProgressiveCutChangesTheBasisEveryStepAndReportsItsStages) {
   const fs::path dir = fresh_dir("progressive");
   nlohmann::json scene = cut_strip();

@@ -9,6 +9,8 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <omp.h>
+#include <string>
+#include <vector>
 
 #include "commands.h"
 #include "count_option.h"
@@ -110,10 +112,13 @@ int run_command(int argc, char** argv) {
     }
   }
   const fs::path out(out_dir);
+  int vtu_frames = 0;
   auto write_frame = [&](int index) {
     write_vtu((out / "frames" / frame_name(index)).string(), mesh, run->displacement().data());
+    ++vtu_frames;
     if (png_frames) png_frames->write(run->state(), index);
   };
+  std::vector<std::string> written;  // for the closing line
   try {
     create_output_folder((out / "frames").string(), "--out");
     if (!scene.analysis.is_dynamic()) {
@@ -138,9 +143,23 @@ int run_command(int argc, char** argv) {
       if (progress) std::fprintf(stderr, "\n");
     }
     write_vtu((out / "deformed.vtu").string(), mesh, run->displacement().data());
-    if (cut_surface_obj) export_cut_surface_obj((out / "cut_surface.obj").string(), run->state());
-    if (save_textures && run->cuts()) run->cuts()->save_textures((out / "textures").string());
-    if (save_final_state) save_state((out / "final.state").string(), run->state());
+    written.push_back("deformed.vtu");
+    if (vtu_frames > 0) written.push_back(std::to_string(vtu_frames) + " VTU frames");
+    if (png_frames) written.push_back(std::to_string(png_frames->frames_written()) + " PNG frames");
+    if (cut_surface_obj) {
+      export_cut_surface_obj((out / "cut_surface.obj").string(), run->state());
+      written.push_back("cut_surface.obj");
+    }
+    if (save_textures && run->cuts()) {
+      run->cuts()->save_textures((out / "textures").string());
+      written.push_back("textures/enrichment.vdb");
+    } else if (save_textures) {
+      std::fprintf(stderr, "dgtex run: note: --save-textures writes the textures of cuts, and the scene has none\n");
+    }
+    if (save_final_state) {
+      save_state((out / "final.state").string(), run->state());
+      written.push_back("final.state");
+    }
   } catch (const ModelError& e) {
     std::fprintf(stderr, "dgtex run: %s: %s\n", scene_path.c_str(), e.what());
     return 2;
@@ -212,7 +231,11 @@ int run_command(int argc, char** argv) {
     std::fprintf(stderr, "dgtex run: cannot write %s\n", report_path.string().c_str());
     return 1;
   }
-  if (!quiet) std::printf("dgtex run: wrote %s and %s\n", report_path.string().c_str(), (out / "deformed.vtu").string().c_str());
+  if (!quiet) {
+    std::string list = scene.output.report;
+    for (const std::string& item : written) list += ", " + item;
+    std::printf("dgtex run: wrote into %s: %s\n", out.string().c_str(), list.c_str());
+  }
   return 0;
 }
 
