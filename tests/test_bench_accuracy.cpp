@@ -187,6 +187,10 @@ TEST(BenchAccuracyArguments, BadValuesAreRejectedWithExitCode2) {
   EXPECT_EQ(WEXITSTATUS(std::system((cli + " bench accuracy --charts plate,bogus --out " + out + " 2>/dev/null").c_str())), 2);
   EXPECT_EQ(WEXITSTATUS(std::system((cli + " bench accuracy --charts plate --plate-divisions 3 --out " + out +
                                      " 2>/dev/null").c_str())), 2);
+  // Past 256 the plate's system and factor outgrow memory: refused up front (a bare
+  // std::bad_alloc and exit code 1 before).
+  EXPECT_EQ(WEXITSTATUS(std::system((cli + " bench accuracy --charts plate --plate-divisions 100000 --out " + out +
+                                     " 2>/dev/null").c_str())), 2);
   EXPECT_EQ(WEXITSTATUS(std::system((cli + " bench accuracy --charts texture --texture-sizes 8 --out " + out +
                                      " 2>/dev/null").c_str())), 2);
   fs::remove_all(out);
