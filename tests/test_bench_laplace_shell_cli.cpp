@@ -79,6 +79,23 @@ TEST(BenchLaplaceCli, BadOptionsExitWithTwoAndNameTheProblem) {
       << chart.stderr_text;
 }
 
+// Chart paths go to gnuplot through a shell and a script that quote names with '...': a
+// folder named with a quote and a space must still get its chart (it got none before).
+TEST(BenchLaplaceCli, ChartPathWithAQuoteAndASpace) {
+  const fs::path work = fresh_dir("dgtex_bench_laplace", "quoted"), folder = work / "it's a folder";
+  fs::create_directories(folder);
+  const fs::path chart = folder / "residual.svg";
+  const auto r = run_cli("bench laplace --sizes 16 --domains slit --solvers multigrid,cholmod --chart-domain slit"
+                         " --chart-size 16 --chart \"" + chart.string() + "\"",
+                         work);
+  ASSERT_EQ(r.exit_code, 0) << r.stderr_text;
+  ASSERT_TRUE(fs::exists(chart)) << r.stderr_text;
+  std::ifstream in(chart);
+  const std::string svg((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  EXPECT_NE(svg.find("<svg"), std::string::npos);
+  EXPECT_NE(svg.find("multigrid"), std::string::npos);  // the legend: the data reached the chart
+}
+
 TEST(BenchShellCli, JsonHasEveryThreadCountTheSameStateAndTheMachine) {
   const fs::path dir = fresh_dir("dgtex_bench_shell", "json");
   const fs::path json = dir / "shell.json";

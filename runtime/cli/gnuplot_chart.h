@@ -8,8 +8,10 @@ namespace dgtex::cli {
 
 // Draws into `path`: PNG if it ends in .png (pngcairo, or the plain png terminal where the
 // gnuplot build lacks cairo), else SVG, width x height pixels. `data` goes to a temporary
-// PATH.dat; `commands(data_file)` returns the settings and plot commands, referring to the
-// data by that file name. The temporary files are removed. False if gnuplot failed.
+// file; `commands(data_file)` returns the settings and plot commands, referring to the data
+// by that file name (plain characters, safe inside '...'). gnuplot draws into a temporary
+// file too, copied to `path` at the end, so any `path` works. The temporary files are
+// removed. False if gnuplot failed or the chart could not be copied to `path`.
 bool draw_gnuplot_chart(const std::string& path, int width, int height, const std::string& data,
                         const std::function<std::string(const std::string& data_file)>& commands);
 
