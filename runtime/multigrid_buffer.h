@@ -55,6 +55,13 @@ void release_cached_blocks() noexcept;
 // arrays of dgtex/scratch_array.h).
 void set_poison_unzeroed_blocks(bool poison) noexcept;
 bool poison_unzeroed_blocks() noexcept;
+// Poisoning on for the life of the object.
+struct PoisonUnzeroedBlocksScope {
+  PoisonUnzeroedBlocksScope() noexcept { set_poison_unzeroed_blocks(true); }
+  ~PoisonUnzeroedBlocksScope() { set_poison_unzeroed_blocks(false); }
+  PoisonUnzeroedBlocksScope(const PoisonUnzeroedBlocksScope&) = delete;
+  PoisonUnzeroedBlocksScope& operator=(const PoisonUnzeroedBlocksScope&) = delete;
+};
 
 template <class T>
 struct ZeroedBlockAllocator {

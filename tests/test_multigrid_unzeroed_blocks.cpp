@@ -15,11 +15,6 @@
 namespace dgtex {
 namespace {
 
-struct PoisonScope {
-  PoisonScope() { detail::set_poison_unzeroed_blocks(true); }
-  ~PoisonScope() { detail::set_poison_unzeroed_blocks(false); }
-};
-
 std::vector<double> solve_twice(const kernels::TexelTile& problem, const LaplaceMultigridOptions& options) {
   kernels::TexelTile tile = problem;
   LaplaceMultigrid multigrid(tile, options);
@@ -34,7 +29,7 @@ std::vector<double> solve_twice(const kernels::TexelTile& problem, const Laplace
 TEST(MultigridFrameZeroedBuffer, GhostFrameIsZeroAndPoisonReachesTheInterior) {
   const std::size_t nx = 130, ny = 97;  // 100 KB: a cached block
   { detail::MultigridBuffer garbage(nx * ny, -3.0); }  // leaves a dirty block in the cache
-  const PoisonScope poison;
+  const detail::PoisonUnzeroedBlocksScope poison;
   const detail::MultigridBuffer v = detail::frame_zeroed_buffer(nx, ny);
   ASSERT_EQ(v.size(), nx * ny);
   int nan_interior = 0;
@@ -60,7 +55,7 @@ TEST_P(MultigridUnzeroedBlocks, PoisonedBlocksGiveTheSameSolution) {
       const std::vector<double> zeroed = solve_twice(problem, options);
       std::vector<double> poisoned;
       {
-        const PoisonScope poison;
+        const detail::PoisonUnzeroedBlocksScope poison;
         poisoned = solve_twice(problem, options);
       }
       for (double v : poisoned) ASSERT_TRUE(std::isfinite(v));

@@ -18,11 +18,6 @@ using namespace dgtex;
 
 namespace {
 
-struct PoisonScope {
-  PoisonScope() { detail::set_poison_unzeroed_blocks(true); }
-  ~PoisonScope() { detail::set_poison_unzeroed_blocks(false); }
-};
-
 TEST(ScratchArray, KeepsItsEntriesWhileTheSizeStaysAndIsPoisonedUnderTheHook) {
   detail::ScratchArray a;
   EXPECT_EQ(a.resize(0), nullptr);
@@ -36,7 +31,7 @@ TEST(ScratchArray, KeepsItsEntriesWhileTheSizeStaysAndIsPoisonedUnderTheHook) {
   EXPECT_EQ(p[n - 1], 1.5);
   a.clear();
   EXPECT_EQ(a.data(), nullptr);
-  const PoisonScope poison;
+  const detail::PoisonUnzeroedBlocksScope poison;
   const double* q = a.resize(n + 1);
   int nan = 0;
   for (std::size_t k = 0; k <= n; ++k) nan += std::isnan(q[k]);
@@ -80,7 +75,7 @@ TEST_P(ShellAssemblyScratchBlocks, PoisonedBlocksGiveTheSameStates) {
   const std::vector<std::vector<double>> leftovers = run(name, steps);
   std::vector<std::vector<double>> poisoned;
   {
-    const PoisonScope poison;
+    const detail::PoisonUnzeroedBlocksScope poison;
     poisoned = run(name, steps);
   }
   ASSERT_EQ(poisoned.size(), leftovers.size());
