@@ -151,7 +151,8 @@ TEST(RenderRunFrames, NoRenderBlockOrNoRenderFlagWritesNoPng) {
 // f64 positions and displacements, the f32 textures as they are held).
 TEST(RenderRunFrames, SavedFinalStateRendersToTheLastFrame) {
   const fs::path dir = test_dir();
-  const std::string cut = R"(, "cuts": [{"points": [[0.6, 0, 0], [0.6, 0.15, 0]]}], "enrichment": {"texture_resolution": 32})";
+  const std::string cut =
+      R"(, "cuts": [{"points": [[0.6, 0, 0], [0.6, 0.15, 0]]}], "enrichment": {"texture_resolution": 32})";
   std::ofstream(dir / "scene.json") << strip_scene(kDynamic, kRenderBlock + cut);
   const fs::path out = dir / "out";
   const CliResult r =

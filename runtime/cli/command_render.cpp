@@ -23,7 +23,9 @@ int render_command(int argc, char** argv) {
   std::string state_path, out_dir, shading = "flat", cut_method = "geometry-shader";
   RenderSettings settings;
   std::vector<double> position, target, up, background;
-  app.add_option("STATE", state_path, "state file written by dgtex run --save-state (DIR/final.state) or save_state() (dgtex/shell_state.h)")->required();
+  app.add_option("STATE", state_path,
+                 "state file written by dgtex run --save-state (DIR/final.state) or save_state() (dgtex/shell_state.h)")
+      ->required();
   app.add_option("--out", out_dir, "output folder (created if missing)")->required()->check(creatable_folder());
   app.add_option("--width", settings.width, "image width in pixels")->capture_default_str()->check(CLI::Range(1, 16384));
   app.add_option("--height", settings.height, "image height in pixels")->capture_default_str()->check(CLI::Range(1, 16384));
