@@ -8,6 +8,7 @@
 // not the expected one or a displacement is not finite or points the wrong way.
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <exception>
 #include <vector>
 
@@ -15,6 +16,7 @@
 #include "dgtex/scene_io.h"
 #include "dgtex/scene_run.h"
 #include "dgtex/surface_point.h"
+#include "dgtex/version.h"
 
 namespace {
 
@@ -97,6 +99,9 @@ int main() {
     // quad8 rectangle: (2 nx + 1)(2 ny + 1) grid points minus the nx ny cell centres.
     const int expected_nodes = (2 * kDivisionsX + 1) * (2 * kDivisionsY + 1) - kDivisionsX * kDivisionsY;
     int failures = 0;
+    std::printf("dgtex %s (found at build time: %s)\n", dgtex::version(), DGTEX_FOUND_VERSION);
+    failures += check(std::strcmp(dgtex::version(), DGTEX_FOUND_VERSION) == 0,
+                      "the library loaded at run time is the version find_package found");
     failures += check(elements == kDivisionsX * kDivisionsY, "element count");
     failures += check(nodes == expected_nodes, "node count");
     failures += check(enrichments >= 1 && model.num_enriched_dofs() > 0, "the cut adds enrichment functions");

@@ -7,6 +7,7 @@
 #include <string>
 
 #include "commands.h"
+#include "dgtex/version.h"
 
 namespace {
 
@@ -22,7 +23,8 @@ void print_usage(std::FILE* to) {
                "  bench scenes [options]       the thesis Table 5.1 scenes: per-step stage timings, steps/s\n"
                "  bench scaling [options]      thread scaling per kernel family, batch throughput\n"
                "  bench accuracy [options]     error against time charts (plate, quadrature, T, tolerance)\n"
-               "Run 'dgtex <command> --help' for the options of one command.\n");
+               "Run 'dgtex <command> --help' for the options of one command; 'dgtex --version' prints the\n"
+               "library's version.\n");
 }
 
 }  // namespace
@@ -36,6 +38,10 @@ int main(int argc, char** argv) {
   if (!std::getenv("OMP_WAIT_POLICY")) {
     setenv("OMP_WAIT_POLICY", "passive", 1);
     execv("/proc/self/exe", argv);  // returns only on failure: then go on as we are
+  }
+  if (argc == 2 && !std::strcmp(argv[1], "--version")) {
+    std::printf("dgtex %s\n", dgtex::version());
+    return 0;
   }
   if (argc < 2 || !std::strcmp(argv[1], "--help") || !std::strcmp(argv[1], "-h")) {
     print_usage(argc < 2 ? stderr : stdout);
