@@ -1,7 +1,7 @@
 # CTest case InstallConsumer.FindPackageBuildRun (registered in cmake/areas/install_consumer.cmake):
 # proves that dgtex links as a runtime from a clean project. Run in script mode (cmake -P):
 #   1. cmake --install <DGTEX_BUILD_DIR> --prefix <WORK_DIR>/prefix, and start the installed
-#      dgtex tool from there,
+#      dgtex tool from there (also a one-step bench of an installed example scene),
 #   2. configure examples/consumer against that prefix only (CMAKE_PREFIX_PATH), check that
 #      find_package(dgtex) found the package there and not some other installed copy,
 #   3. build it, with a translation unit that includes every installed header (-Werror),
@@ -38,6 +38,14 @@ endfunction()
 run_step("install dgtex" ${CMAKE_COMMAND} --install ${DGTEX_BUILD_DIR} --prefix ${prefix})
 # The installed tool must start from the prefix (it finds libdgtex.so through its RUNPATH).
 run_step("installed dgtex --help" ${prefix}/bin/dgtex --help)
+# Outside a checkout the bench commands find the example scenes installed beside the tool.
+execute_process(COMMAND ${prefix}/bin/dgtex bench scenes --scenes spiral1 --steps 1 WORKING_DIRECTORY ${WORK_DIR}
+                RESULT_VARIABLE result OUTPUT_VARIABLE out ERROR_VARIABLE out)
+string(FIND "${out}" "(${prefix}/share/dgtex/scenes/spiral1.json)" at)
+if(NOT result EQUAL 0 OR at EQUAL -1)
+  message(FATAL_ERROR "installed dgtex bench scenes did not use ${prefix}/share/dgtex/scenes (exit ${result}):\n${out}")
+endif()
+message(STATUS "installed dgtex bench scenes: ok (the installed scenes)")
 
 set(configure_args -S ${CONSUMER_SOURCE_DIR} -B ${consumer_build} -G ${GENERATOR}
     -DCMAKE_BUILD_TYPE=Release -DCMAKE_PREFIX_PATH=${prefix} -DCMAKE_CXX_COMPILER=${CXX_COMPILER}

@@ -15,6 +15,7 @@
 
 #include "commands.h"
 #include "count_option.h"
+#include "example_scenes.h"
 #include "dgtex/accuracy_benchmark.h"
 #include "dgtex/benchmark_machine.h"
 #include "gnuplot_chart.h"
@@ -91,6 +92,8 @@ int bench_accuracy_command(int argc, char** argv) {
   TextureAccuracyOptions texture;
   ToleranceAccuracyOptions tolerance;
   RotationAccuracyOptions rotation;
+  tolerance.shell_scene = example_scene("cylinder_buckling.json");
+  rotation.scene = example_scene("accordion.json");
   app.add_option("--charts", charts, "plate, quadrature, texture, tolerance, rotation")->delimiter(',')->capture_default_str();
   app.add_option("--out", out_dir, "output folder (charts, accuracy.json, accuracy.md)")->capture_default_str();
   app.add_option("--format", format, "chart format: png or svg")->capture_default_str()->check(CLI::IsMember({"png", "svg"}));

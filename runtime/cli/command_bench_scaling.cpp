@@ -16,6 +16,7 @@
 
 #include "commands.h"
 #include "count_option.h"
+#include "example_scenes.h"
 #include "gnuplot_chart.h"
 #include "dgtex/benchmark_machine.h"
 #include "dgtex/mesh_error.h"
@@ -147,7 +148,7 @@ int bench_scaling_command(int argc, char** argv) {
                "dgtex bench scaling"};
   std::vector<int> threads;
   for (int t = 1; t <= omp_get_num_procs(); ++t) threads.push_back(t);
-  std::string scene_path = "examples/scenes/cylinder_buckling.json", cut_scene_path = "examples/scenes/chad.json";
+  std::string scene_path = example_scene("cylinder_buckling.json"), cut_scene_path = example_scene("chad.json");
   std::vector<std::string> families = kFamilies, batch_scenes;
   std::string json_path, chart_path, markdown_path;
   int repeats = 3, steps = 5, batch_runs = 0, batch_steps = 5;

@@ -17,6 +17,7 @@
 
 #include "commands.h"
 #include "count_option.h"
+#include "example_scenes.h"
 #include "gnuplot_chart.h"
 #include "dgtex/benchmark_machine.h"
 #include "dgtex/mesh_error.h"
@@ -232,7 +233,7 @@ int bench_scenes_command(int argc, char** argv) {
                "projection, assembly and solve times (mean, max), steps per second, model sizes, ratio to Table 5.1",
                "dgtex bench scenes"};
   std::vector<std::string> scenes = bench_scene_names();
-  std::string scene_dir = "examples/scenes", json_path, markdown_path;
+  std::string scene_dir = example_scene_dir(), json_path, markdown_path;
   int steps = 0, threads = 0;
   bool quiet = false, inline_cut_updates = false;
   app.add_option("--scenes", scenes,

@@ -14,6 +14,7 @@
 
 #include "commands.h"
 #include "count_option.h"
+#include "example_scenes.h"
 #include "gnuplot_chart.h"
 #include "dgtex/benchmark_machine.h"
 #include "dgtex/mesh_error.h"
@@ -66,7 +67,7 @@ int bench_shell_command(int argc, char** argv) {
   CLI::App app{"Time the dynamic shell step of a scene: assembly and solve per step, assembly GFLOP/s against an "
                "Eigen dense GEMM, speed-up over thread counts",
                "dgtex bench shell"};
-  std::string scene_path = "examples/scenes/cylinder_buckling.json", json_path, chart_path;
+  std::string scene_path = example_scene("cylinder_buckling.json"), json_path, chart_path;
   int steps = 30, gemm_size = 512;
   std::vector<int> threads_list = {1, 2};
   bool refactor_every_step = false;
