@@ -72,7 +72,11 @@ int run_command(int argc, char** argv) {
     return app.exit(e) == 0 ? 0 : 2;
   }
   if (threads > 0) omp_set_num_threads(threads);
-  const bool progress = !quiet && isatty(fileno(stderr));
+  // Progress: on a terminal the set-up and one line rewritten every step; into a log (not a
+  // terminal) a step line every 10 s, so that a batch job's log shows the run advancing.
+  const bool terminal = isatty(fileno(stderr));
+  const bool progress = !quiet && terminal;
+  bool progress_line_open = false;  // a rewritten step line waits for its newline
 
   Scene scene;
   std::unique_ptr<SceneRun> run;
@@ -127,20 +131,27 @@ int run_command(int argc, char** argv) {
     } else {
       const int every = scene.render ? scene.render->every_steps : 10;
       write_frame(0);
+      auto last_log_line = std::chrono::steady_clock::now();
       for (int step = 1; step <= scene.analysis.steps; ++step) {
         run->step();
         if (!all_finite(run->displacement()))
           throw ModelError("analysis: the solution diverged at step " + std::to_string(step) + " (time step " +
                            std::to_string(scene.analysis.time_step) + " too large?)");
         if (step % every == 0 || step == scene.analysis.steps) write_frame(step);
-        if (progress) {
+        const auto now = std::chrono::steady_clock::now();
+        const bool log_line = !quiet && !terminal && now - last_log_line >= std::chrono::seconds(10);
+        if (progress || log_line) {
           double ms = 0;
           for (const auto& [stage, stats] : run->timings()) ms += stats.total_ms;
-          std::fprintf(stderr, "\rdgtex run: step %d/%d  t = %.4g  %.1f ms/step  enrichments %d   ", step,
-                       scene.analysis.steps, run->time(), ms / step, static_cast<int>(run->model().enrichments().size()));
+          std::fprintf(stderr, "%sdgtex run: step %d/%d  t = %.4g  %.1f ms/step  enrichments %d%s",
+                       progress ? "\r" : "", step, scene.analysis.steps, run->time(), ms / step,
+                       static_cast<int>(run->model().enrichments().size()), progress ? "   " : "\n");
+          progress_line_open = progress;
+          if (log_line) last_log_line = now;
         }
       }
-      if (progress) std::fprintf(stderr, "\n");
+      if (progress_line_open) std::fprintf(stderr, "\n");
+      progress_line_open = false;
     }
     write_vtu((out / "deformed.vtu").string(), mesh, run->displacement().data());
     written.push_back("deformed.vtu");
@@ -161,10 +172,10 @@ int run_command(int argc, char** argv) {
       written.push_back("final.state");
     }
   } catch (const ModelError& e) {
-    std::fprintf(stderr, "dgtex run: %s: %s\n", scene_path.c_str(), e.what());
+    std::fprintf(stderr, "%sdgtex run: %s: %s\n", progress_line_open ? "\n" : "", scene_path.c_str(), e.what());
     return 2;
   } catch (const std::exception& e) {
-    std::fprintf(stderr, "dgtex run: %s: %s\n", scene_path.c_str(), e.what());
+    std::fprintf(stderr, "%sdgtex run: %s: %s\n", progress_line_open ? "\n" : "", scene_path.c_str(), e.what());
     return 1;
   }
 
