@@ -2,42 +2,28 @@
 // enrichment textures, the enriched shell and the basis change with projection together).
 #include <gtest/gtest.h>
 
-#include <unistd.h>
-
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
-#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <string>
 
+#include "cli_test_support.h"
+
 namespace fs = std::filesystem;
 
 namespace {
 
-struct Result {
-  int exit_code;
-  std::string stderr_text;
-};
+using Result = dgtex::test::CliResult;
 
-fs::path fresh_dir(const std::string& name) {
-  const fs::path dir = fs::temp_directory_path() / ("dgtex_cli_cuts_" + name + "_" + std::to_string(::getpid()));
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  return dir;
-}
+fs::path fresh_dir(const std::string& name) { return dgtex::test::fresh_dir("dgtex_cli_cuts", name); }
 
 Result run_scene(const nlohmann::json& scene, const fs::path& dir, const std::string& extra = "") {
   const fs::path scene_path = dir / "scene.json";
   std::ofstream(scene_path) << scene.dump(1);
-  const fs::path err = dir / "stderr.txt";
-  const std::string command = std::string(DGTEX_CLI) + " run " + scene_path.string() + " --out " +
-                              (dir / "out").string() + " --quiet " + extra + " 2> " + err.string() + " > /dev/null";
-  const int status = std::system(command.c_str());
-  std::ifstream in(err);
-  return {WEXITSTATUS(status), std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>())};
+  return dgtex::test::run_cli("run " + scene_path.string() + " --out " + (dir / "out").string() + " --quiet " + extra,
+                              dir);
 }
 
 nlohmann::json report_of(const fs::path& dir) {

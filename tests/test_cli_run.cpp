@@ -1,40 +1,26 @@
 // End-to-end: the dgtex executable on example scenes and on bad input.
 #include <gtest/gtest.h>
 
-#include <unistd.h>
-
 #include <algorithm>
-#include <cstdio>
-#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <string>
 
+#include "cli_test_support.h"
+
 namespace fs = std::filesystem;
 
 namespace {
 
-struct Result {
-  int exit_code;
-  std::string stderr_text;
-};
+using Result = dgtex::test::CliResult;
 
+// `dgtex run ARGS --quiet`, stderr kept (tests/cli_test_support.h).
 Result run_dgtex(const std::string& args, const fs::path& workdir) {
-  const fs::path err = workdir / "stderr.txt";
-  const std::string command = std::string(DGTEX_CLI) + " run " + args + " --quiet 2> " + err.string() + " > /dev/null";
-  const int status = std::system(command.c_str());
-  std::ifstream in(err);
-  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  return {WEXITSTATUS(status), text};
+  return dgtex::test::run_cli("run " + args + " --quiet", workdir);
 }
 
-fs::path fresh_dir(const std::string& name) {
-  const fs::path dir = fs::temp_directory_path() / ("dgtex_cli_" + name + "_" + std::to_string(::getpid()));
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  return dir;
-}
+fs::path fresh_dir(const std::string& name) { return dgtex::test::fresh_dir("dgtex_cli", name); }
 
 TEST(CliRun, ClampedPlateSceneWritesReportWithinOnePercent) {
   const fs::path dir = fresh_dir("plate");
