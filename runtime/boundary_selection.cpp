@@ -6,8 +6,10 @@ namespace dgtex {
 
 bool point_is_selected(const BoundarySelect& select, const double x[3]) {
   if (select.kind == BoundarySelect::Kind::plane) {
+    // The parser makes the normal a unit vector; one set in code may not be.
     const Vec3& n = select.normal;
-    return std::abs(n[0] * x[0] + n[1] * x[1] + n[2] * x[2] - select.offset) <= select.tolerance;
+    const double length = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+    return std::abs((n[0] * x[0] + n[1] * x[1] + n[2] * x[2]) / length - select.offset) <= select.tolerance;
   }
   for (int i = 0; i < 3; ++i)
     if (!(x[i] >= select.min[i] - select.tolerance && x[i] <= select.max[i] + select.tolerance)) return false;

@@ -33,7 +33,17 @@ std::string one_line(std::string text) {
   return text;
 }
 
+std::string number_text(double x) {
+  std::ostringstream out;
+  out.precision(17);
+  out << x;
+  return out.str();
+}
+
 std::string value_text(const json& value) {
+  // A Scene built in code can hold NaN or infinity, which JSON text would show as null.
+  if (value.is_number_float() && !std::isfinite(value.get<double>()))
+    return std::isnan(value.get<double>()) ? "NaN" : value.get<double>() > 0 ? "Infinity" : "-Infinity";
   std::string text = value.dump(-1, ' ', false, json::error_handler_t::replace);
   constexpr size_t kMaxChars = 80;
   if (text.size() > kMaxChars) {
@@ -42,13 +52,6 @@ std::string value_text(const json& value) {
     text = text.substr(0, cut) + "...";
   }
   return text;
-}
-
-std::string number_text(double x) {
-  std::ostringstream out;
-  out.precision(17);
-  out << x;
-  return out.str();
 }
 
 std::string child(const std::string& path, const std::string& key) { return path.empty() ? key : path + "." + key; }
@@ -848,9 +851,7 @@ json mesh_to_json(const MeshSpec& m) {
   return out;
 }
 
-}  // namespace
-
-std::string scene_to_json_text(const Scene& scene) {
+json scene_to_json(const Scene& scene) {
   json out;
   out["mesh"] = mesh_to_json(scene.mesh);
   const Material& m = scene.material;
@@ -952,7 +953,17 @@ std::string scene_to_json_text(const Scene& scene) {
                      {"background", to_json(r.background)}};
   }
   out["output"] = {{"report", scene.output.report}};
-  return out.dump(2);
+  return out;
+}
+
+}  // namespace
+
+std::string scene_to_json_text(const Scene& scene) { return scene_to_json(scene).dump(2); }
+
+void validate_scene(const Scene& scene) {
+  // Paths in a Scene are already resolved (or, built in code, relative to the working
+  // folder), so the reader resolves nothing again.
+  SceneReader(scene.source_name.empty() ? "scene" : scene.source_name, "").read(scene_to_json(scene));
 }
 
 }  // namespace dgtex

@@ -4,6 +4,7 @@
 #include "dgtex/material_texture.h"
 #include "dgtex/mesh_generators.h"
 #include "dgtex/obj_import.h"
+#include "dgtex/scene_io.h"
 #include "dgtex/scene_mesh_checks.h"
 #include "dgtex/surface_point.h"
 #include "dgtex/topology.h"
@@ -11,6 +12,7 @@
 namespace dgtex {
 
 Mesh build_scene_mesh(const Scene& scene) {
+  validate_scene(scene);
   const MeshSpec& m = scene.mesh;
   const ElementType type = m.element.value_or(ElementType::quad8);
   switch (m.source) {
@@ -24,6 +26,7 @@ Mesh build_scene_mesh(const Scene& scene) {
 }
 
 SceneModel build_scene_model(const Scene& scene, const Mesh& mesh) {
+  validate_scene(scene);
   check_scene_against_mesh(scene, mesh);
   const Topology topology = build_topology(mesh);
   std::vector<char> clamp_node(mesh.num_nodes(), 0);

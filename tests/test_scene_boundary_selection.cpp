@@ -27,10 +27,10 @@ Mesh two_quads() {
   return mesh;
 }
 
-BoundarySelect plane(Vec3 unit_normal, double offset, double tolerance) {
+BoundarySelect plane(Vec3 normal, double offset, double tolerance) {
   BoundarySelect s;
   s.kind = BoundarySelect::Kind::plane;
-  s.normal = unit_normal;
+  s.normal = normal;
   s.offset = offset;
   s.tolerance = tolerance;
   return s;
@@ -96,6 +96,15 @@ TEST(BoundarySelection, ParsedPlaneNormalIsNormalised) {
   ASSERT_EQ(s.boundary.size(), 1u);
   EXPECT_EQ(s.boundary[0].select.normal, (Vec3{0, 1, 0}));
   EXPECT_EQ(select_nodes(two_quads(), s.boundary[0].select), (std::vector<int>{3, 4, 5, 9, 10}));
+}
+
+// A selection set in code (the C++ API) may give any non-zero normal, as a scene file may:
+// the offset is still a distance along the unit normal.
+TEST(BoundarySelection, PlaneNormalSetInCodeNeedNotBeAUnitVector) {
+  const Mesh mesh = two_quads();
+  EXPECT_EQ(select_nodes(mesh, plane({0, 3, 0}, 1, 1e-12)), (std::vector<int>{3, 4, 5, 9, 10}));
+  const double s = 1 / std::sqrt(2.0);
+  EXPECT_EQ(select_nodes(mesh, plane({2, 2, 0}, 1.5 * s, 1e-12)), (std::vector<int>{7, 10, 12}));
 }
 
 TEST(BoundarySelection, PointRuleMatchesNodeRule) {

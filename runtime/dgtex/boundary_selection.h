@@ -9,7 +9,7 @@
 namespace dgtex {
 
 // Indices (ascending) of the nodes of mesh that the selection picks:
-//   plane: |n . x - offset| <= tolerance, with n the selection's unit normal;
+//   plane: |n . x - offset| <= tolerance, with n the selection's normal made a unit vector;
 //   box:   min[i] - tolerance <= x[i] <= max[i] + tolerance for i = 0, 1, 2.
 // Nodes not referenced by any element are never selected. An empty result is not an
 // error here; the caller reports it with the selection's JSON path.

@@ -55,8 +55,8 @@ struct Material {
 struct BoundarySelect {
   enum class Kind { plane, box };
   Kind kind = Kind::plane;
-  Vec3 normal{0, 0, 1};  // plane: unit normal (normalised by the parser; zero is an error)
-  double offset = 0;     // plane: points x with normal . x = offset
+  Vec3 normal{0, 0, 1};  // plane: normal, non-zero (the parser and the selection make it a unit vector)
+  double offset = 0;     // plane: points x with n . x = offset, n the unit normal
   Vec3 min{};            // box: lower corner (min <= max componentwise)
   Vec3 max{};            // box: upper corner
   double tolerance = 1e-6;  // distance a node may lie off the plane / outside the box;

@@ -7,7 +7,7 @@
 //
 // Checks that need the mesh (empty boundary selections, statically unconstrained models,
 // surface points outside the mesh) live in scene_mesh_checks.h.
-// Pure functions returning a Scene by value (thread-safe); load_scene reads one file.
+// Pure functions (thread-safe); load_scene reads one file.
 #include <stdexcept>
 #include <string>
 
@@ -41,6 +41,15 @@ Scene load_scene(const std::string& path);
 // resolves relative paths, so parse_scene(text, "dir/scene.json") behaves like
 // load_scene("dir/scene.json").
 Scene parse_scene(const std::string& json_text, const std::string& source_name);
+
+// Checks a Scene built in code as parse_scene checks a file, and throws the SceneError that
+// the scene's canonical JSON (below) would give: the JSON path names the field
+// (material.poisson_ratio, cuts[0].speed, ...) and the message the value; NaN and infinity
+// are refused like numbers beyond 1e30. Paths (mesh.file, material_textures[i].image) are
+// taken as they stand: a parsed scene's are resolved already, and one built in code gives
+// them relative to the working folder. build_scene_mesh, build_scene_model and SceneRun
+// call it, so a Scene never reaches the simulation unchecked.
+void validate_scene(const Scene& scene);
 
 // The scene as canonical JSON text (every key written, defaults included), which
 // parse_scene reads back into an equal Scene. Used to echo the effective scene.

@@ -18,7 +18,8 @@ struct SceneModel {
   std::vector<double> external_force;  // #dofs
 };
 
-// Throws MeshError (mesh problems) or SceneError (scene/mesh mismatches).
+// Both check the scene first (validate_scene). Throw SceneError (a bad scene, or a scene
+// that does not fit the mesh) or MeshError (mesh problems).
 Mesh build_scene_mesh(const Scene& scene);
 SceneModel build_scene_model(const Scene& scene, const Mesh& mesh);
 

@@ -52,7 +52,8 @@ struct SceneRunOptions {
 
 class SceneRun {
  public:
-  // Builds everything and brings the cuts to time 0; `scene` must outlive the run.
+  // Builds everything and brings the cuts to time 0; `scene` must outlive the run. A
+  // scene built in code is checked as a scene file is (validate_scene).
   // Throws MeshError / SceneError (bad mesh or scene), std::invalid_argument (a cut the
   // mesh cannot take, naming cuts[i]), ModelError (statically unconstrained model).
   explicit SceneRun(const Scene& scene, SceneRunOptions options = {});

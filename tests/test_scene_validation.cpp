@@ -1,0 +1,159 @@
+// A Scene built in code (the C++ API, not a scene file) is checked as a file is:
+// validate_scene, and SceneRun and the scene builders, which call it, refuse a bad value
+// with the SceneError a scene file holding it would give, its JSON path naming the field.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <functional>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "dgtex/scene.h"
+#include "dgtex/scene_io.h"
+#include "dgtex/scene_model.h"
+#include "dgtex/scene_run.h"
+
+namespace {
+
+using namespace dgtex;
+
+// A clamped strip under gravity with a cut from its lower edge, dynamic and corotated, as
+// a program linking dgtex would build it.
+Scene strip_built_in_code() {
+  Scene scene;
+  scene.source_name = "strip (built in code)";
+  scene.mesh.source = MeshSource::rectangle;
+  scene.mesh.element = ElementType::quad8;
+  scene.mesh.size = {0.4, 0.1};
+  scene.mesh.divisions = {4, 1};
+  scene.material = {5e8, 0.3, 0.01, 1000};
+  BoundaryCondition clamp;
+  clamp.select.normal = {1, 0, 0};
+  clamp.fixed = {true, true, true};
+  clamp.clamp = true;
+  scene.boundary.push_back(clamp);
+  Load gravity;
+  gravity.acceleration = {0, 0, -9.81};
+  scene.loads.push_back(gravity);
+  scene.analysis.type = Analysis::Type::dynamic;
+  scene.analysis.time_step = 0.005;
+  scene.analysis.steps = 2;
+  scene.analysis.corotational = true;
+  Cut cut;
+  cut.points = {{0.225, 0, 0}, {0.225, 0.06, 0}};
+  scene.cuts.push_back(cut);
+  scene.enrichment.texture_resolution = 32;
+  return scene;
+}
+
+struct BadValue {
+  const char* what;
+  std::function<void(Scene&)> set;
+  const char* json_path;
+  const char* message_part;  // the value as the message shows it, or the problem
+};
+
+const double kNaN = std::numeric_limits<double>::quiet_NaN();
+const double kInfinity = std::numeric_limits<double>::infinity();
+
+std::vector<BadValue> bad_values() {
+  return {
+      {"E = 0", [](Scene& s) { s.material.youngs_modulus = 0; }, "material.youngs_modulus", "must be positive, got 0"},
+      {"E = NaN", [](Scene& s) { s.material.youngs_modulus = kNaN; }, "material.youngs_modulus", "got NaN"},
+      {"nu = 0.5", [](Scene& s) { s.material.poisson_ratio = 0.5; }, "material.poisson_ratio", "got 0.5"},
+      {"h = 0", [](Scene& s) { s.material.thickness = 0; }, "material.thickness", "must be positive"},
+      {"no density, dynamic", [](Scene& s) { s.material.density = 0; }, "material.density", "dynamic analysis"},
+      {"dt = 0", [](Scene& s) { s.analysis.time_step = 0; }, "analysis.time_step", "must be positive"},
+      {"dt < 0", [](Scene& s) { s.analysis.time_step = -0.005; }, "analysis.time_step", "got -0.005"},
+      {"no steps", [](Scene& s) { s.analysis.steps = 0; }, "analysis.steps", "got 0"},
+      {"negative damping", [](Scene& s) { s.analysis.damping.mass = -1; }, "analysis.damping.mass", "got -1"},
+      {"penalty 0", [](Scene& s) { s.penalty = 0; }, "penalty", "must be positive"},
+      {"no divisions", [](Scene& s) { s.mesh.divisions = {0, 1}; }, "mesh.divisions[0]", "got 0"},
+      {"zero width", [](Scene& s) { s.mesh.size[1] = 0; }, "mesh.size[1]", "must be positive"},
+      {"zero normal", [](Scene& s) { s.boundary[0].select.normal = {0, 0, 0}; }, "boundary[0].select.plane.normal",
+       "zero normal"},
+      {"nothing held", [](Scene& s) { s.boundary[0].fixed = {false, false, false}, s.boundary[0].clamp = false; },
+       "boundary[0].fix", "holds nothing"},
+      {"infinite gravity", [](Scene& s) { s.loads[0].acceleration[2] = -kInfinity; }, "loads[0].acceleration[2]",
+       "got -Infinity"},
+      {"cut of one point", [](Scene& s) { s.cuts[0].points.resize(1); }, "cuts[0].points", "at least 2 points"},
+      {"NaN cut point", [](Scene& s) { s.cuts[0].points[1][1] = kNaN; }, "cuts[0].points[1][1]", "got NaN"},
+      {"cut speed 0", [](Scene& s) { s.cuts[0].has_schedule = true, s.cuts[0].speed = 0.0; }, "cuts[0].speed",
+       "must be positive"},
+      {"T = 33", [](Scene& s) { s.enrichment.texture_resolution = 33; }, "enrichment.texture_resolution",
+       "not a power of two"},
+      {"T = 0", [](Scene& s) { s.enrichment.texture_resolution = 0; }, "enrichment.texture_resolution", "got 0"},
+      {"quadrature tolerance 0", [](Scene& s) { s.enrichment.quadrature_tolerance = 0; },
+       "enrichment.quadrature_tolerance", "must be positive"},
+      {"negative cluster", [](Scene& s) { s.enrichment.rotation_cluster_texels = -1; },
+       "enrichment.rotation_cluster_texels", "got -1"},
+      {"render width 0", [](Scene& s) { s.render = RenderOptions{}, s.render->width = 0; }, "render.width", "got 0"},
+      {"report path", [](Scene& s) { s.output.report = "../report.json"; }, "output.report", "not a plain file name"},
+  };
+}
+
+TEST(SceneValidation, ASceneBuiltInCodeRunsWhenValid) {
+  const Scene scene = strip_built_in_code();
+  EXPECT_NO_THROW(validate_scene(scene));
+  SceneRun run(scene);
+  run.step();
+  EXPECT_EQ(run.steps_taken(), 1);
+  EXPECT_GT(run.model().num_enriched_dofs(), 0);
+}
+
+TEST(SceneValidation, SceneRunRefusesABadValueNamingItsField) {
+  for (const BadValue& bad : bad_values()) {
+    SCOPED_TRACE(bad.what);
+    Scene scene = strip_built_in_code();
+    bad.set(scene);
+    try {
+      SceneRun run(scene);
+      ADD_FAILURE() << "accepted";
+    } catch (const SceneError& e) {
+      EXPECT_EQ(e.json_path(), bad.json_path) << e.what();
+      const std::string message = e.what();
+      EXPECT_EQ(message.rfind("strip (built in code): " + std::string(bad.json_path) + ": ", 0), 0u) << message;
+      EXPECT_NE(message.find(bad.message_part), std::string::npos) << message;
+    }
+  }
+}
+
+// The builders check too, so the benchmarks and programs that build a model without
+// SceneRun get the same errors.
+TEST(SceneValidation, TheSceneBuildersRefuseABadValue) {
+  const Scene good = strip_built_in_code();
+  const Mesh mesh = build_scene_mesh(good);
+  Scene bad = good;
+  bad.material.poisson_ratio = -1;
+  EXPECT_THROW(build_scene_mesh(bad), SceneError);
+  EXPECT_THROW(build_scene_model(bad, mesh), SceneError);
+  EXPECT_NO_THROW(build_scene_model(good, mesh));
+}
+
+TEST(SceneValidation, ASceneWithoutASourceNameIsCalledScene) {
+  Scene scene = strip_built_in_code();
+  scene.source_name.clear();
+  scene.material.thickness = -0.01;
+  try {
+    validate_scene(scene);
+    FAIL() << "accepted";
+  } catch (const SceneError& e) {
+    EXPECT_EQ(std::string(e.what()).rfind("scene: material.thickness: ", 0), 0u) << e.what();
+  }
+}
+
+// What the parser made of a scene file passes again: every example scene as loaded.
+TEST(SceneValidation, EveryExampleSceneAsLoadedPasses) {
+  int scenes = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(DGTEX_SOURCE_DIR "/examples/scenes")) {
+    if (entry.path().extension() != ".json") continue;
+    SCOPED_TRACE(entry.path().string());
+    const Scene scene = load_scene(entry.path().string());
+    EXPECT_NO_THROW(validate_scene(scene));
+    ++scenes;
+  }
+  EXPECT_GE(scenes, 11);
+}
+
+}  // namespace
