@@ -29,32 +29,32 @@ void merge(StageTimings& into, const StageTimings& from) {
 }  // namespace
 
 SceneRun::SceneRun(const Scene& scene, SceneRunOptions options)
-    : scene_(scene), mesh_(build_scene_mesh(scene)), topology_(build_topology(mesh_)), options_(options) {
-  SceneModel built = build_scene_model(scene, mesh_);
+    : scene_(scene), mesh_(build_scene_mesh(scene_)), topology_(build_topology(mesh_)), options_(options) {
+  SceneModel built = build_scene_model(scene_, mesh_);
   model_ = std::move(built.model);
-  if (scene.analysis.is_dynamic()) {
-    dynamics_.time_step = scene.analysis.time_step;
-    dynamics_.corotational = scene.analysis.corotational;
-    dynamics_.mass_damping = scene.analysis.damping.mass;
-    dynamics_.stiffness_damping = scene.analysis.damping.stiffness;
+  if (scene_.analysis.is_dynamic()) {
+    dynamics_.time_step = scene_.analysis.time_step;
+    dynamics_.corotational = scene_.analysis.corotational;
+    dynamics_.mass_damping = scene_.analysis.damping.mass;
+    dynamics_.stiffness_damping = scene_.analysis.damping.stiffness;
   }
-  if (!scene.cuts.empty() || !scene.creases.empty()) {
+  if (!scene_.cuts.empty() || !scene_.creases.empty()) {
     {
       ScopedStage stage(timings_, "enrichment");
-      if (!scene.cuts.empty()) {
-        cuts_ = std::make_unique<CutManager>(mesh_, topology_, scene.cuts, scene.enrichment);
+      if (!scene_.cuts.empty()) {
+        cuts_ = std::make_unique<CutManager>(mesh_, topology_, scene_.cuts, scene_.enrichment);
         cuts_->update(0.0);
       }
-      creases_ = build_crease_functions(mesh_, topology_, scene.creases, scene.enrichment.texture_resolution);
+      creases_ = build_crease_functions(mesh_, topology_, scene_.creases, scene_.enrichment.texture_resolution);
     }
     if (cuts_) model_->set_cut_edge_texels(cuts_->edge_walls().resolution(), cuts_->edge_walls().flags(mesh_.num_elements()));
     model_->set_enrichments(enrichment_functions());
-    built.fixed = scene_fixed_dofs(scene, *model_);
-    built.external_force = scene_external_force(scene, *model_);
+    built.fixed = scene_fixed_dofs(scene_, *model_);
+    built.external_force = scene_external_force(scene_, *model_);
   }
   simulation_ = std::make_unique<ShellSimulation>(*model_, std::move(built.fixed), std::move(built.external_force));
   // A dynamic scene may leave rigid modes free (a falling shell); a static one may not.
-  if (!scene.analysis.is_dynamic()) simulation_->check_statically_constrained();
+  if (!scene_.analysis.is_dynamic()) simulation_->check_statically_constrained();
 }
 
 SceneRun::~SceneRun() { discard_next_cut_update(); }

@@ -76,11 +76,11 @@ int check(bool ok, const char* what) {
 
 int main() {
   try {
-    const dgtex::Scene scene = cut_plate_scene();
     // SceneRun checks the scene as a scene file is checked (dgtex::validate_scene): a bad
     // value throws dgtex::SceneError naming the field, e.g. "material.poisson_ratio".
-    dgtex::SceneRun run(scene);  // `scene` outlives `run`
-    for (int i = 0; i < scene.analysis.steps; ++i) run.step();
+    // It keeps a copy of the scene.
+    dgtex::SceneRun run(cut_plate_scene());
+    while (run.steps_taken() < kSteps) run.step();
 
     const dgtex::ShellModel& model = run.model();
     const double tip_position[3] = {0.4, 0.05, 0};

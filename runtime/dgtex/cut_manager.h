@@ -33,9 +33,9 @@
 //    staircase walks to it from its side), that spur is dropped from both (at most 2
 //    edges), else its texels get contradicting +-1 data and a V's wedge stays attached.
 // CutManager owns its paths, segments, wall tiles and enrichment functions; it keeps a
-// reference to the mesh (the mesh and topology must outlive it). Not thread-safe; the
-// constructor (one cut per thread) and update() use all OpenMP threads. Times in the
-// scene's unit (SI: s), lengths in the mesh's (m).
+// reference to the mesh (which must outlive it; the topology is read by the constructor
+// only). Not thread-safe; the constructor (one cut per thread) and update() use all
+// OpenMP threads. Times in the scene's unit (SI: s), lengths in the mesh's (m).
 #include <cstdint>
 #include <map>
 #include <string>
@@ -75,10 +75,12 @@ struct CutUpdateStats {
 
 class CutManager {
  public:
-  // mesh and topology must outlive the manager. Throws std::invalid_argument for a cut the
+  // The mesh must outlive the manager. Throws std::invalid_argument for a cut the
   // mesh cannot take (messages name cuts[i].points[j]; see trace_cut_path).
   CutManager(const Mesh& mesh, const Topology& topology, const std::vector<Cut>& cuts,
              const EnrichmentOptions& options, CutManagerOptions manager_options = {});
+  // The mesh is kept by reference: a temporary one would dangle.
+  CutManager(Mesh&&, const Topology&, const std::vector<Cut>&, const EnrichmentOptions&, CutManagerOptions = {}) = delete;
 
   // Brings the functions to `time`; true when they changed (added, removed or re-solved).
   bool update(double time);

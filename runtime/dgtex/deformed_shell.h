@@ -29,6 +29,8 @@ class DeformedShell {
  public:
   // Keeps a reference to state (which must outlive this object); validates it.
   explicit DeformedShell(const ShellState& state);
+  // A temporary state (DeformedShell(run.state())) would dangle.
+  explicit DeformedShell(ShellState&&) = delete;
 
   const ShellState& state() const { return state_; }
   // Indices into state.enrichments of the enrichments of one element, in state order.

@@ -28,8 +28,8 @@
 // count). Stage times then overlap: "enrichment" is the update's own wall time, counted in
 // the step that uses it, and the other stages include the slowdown of sharing the cores.
 // Not thread-safe; each call uses all OpenMP threads itself (but the update's, above).
-// SceneRun owns the mesh, topology, model, cut manager and simulation; it keeps a reference
-// to the Scene (which must outlive it). Units: those of the scene (SI: m, kg, s, N).
+// SceneRun owns a copy of the Scene and the mesh, topology, model, cut manager and
+// simulation built from it. Units: those of the scene (SI: m, kg, s, N).
 #include <atomic>
 #include <future>
 #include <memory>
@@ -52,8 +52,9 @@ struct SceneRunOptions {
 
 class SceneRun {
  public:
-  // Builds everything and brings the cuts to time 0; `scene` must outlive the run. A
-  // scene built in code is checked as a scene file is (validate_scene).
+  // Builds everything and brings the cuts to time 0. The run keeps a copy of `scene`
+  // (SceneRun(load_scene(path)) is fine). A scene built in code is checked as a scene file
+  // is (validate_scene).
   // Throws MeshError / SceneError (bad mesh or scene), std::invalid_argument (a cut the
   // mesh cannot take, naming cuts[i]), ModelError (statically unconstrained model).
   explicit SceneRun(const Scene& scene, SceneRunOptions options = {});
@@ -101,7 +102,7 @@ class SceneRun {
   // The cuts' current functions followed by the creases' (fixed) ones.
   std::vector<EnrichmentFunction> enrichment_functions() const;
 
-  const Scene& scene_;
+  const Scene scene_;
   Mesh mesh_;
   Topology topology_;  // the cut manager refers to it
   std::unique_ptr<ShellModel> model_;

@@ -36,6 +36,8 @@ class ShellSimulation {
  public:
   // fixed: #dofs flags; external_force: #dofs.
   ShellSimulation(const ShellModel& model, std::vector<char> fixed, std::vector<double> external_force);
+  // The model is kept by reference: a temporary one would dangle.
+  ShellSimulation(ShellModel&&, std::vector<char>, std::vector<double>) = delete;
 
   // Throws ModelError naming a free rigid-body mode if the constraints (fixed DOFs and
   // clamped edges) leave one.
