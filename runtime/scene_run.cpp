@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <stdexcept>
 #include <system_error>
 
 #include <omp.h>
@@ -69,6 +70,9 @@ std::vector<EnrichmentFunction> SceneRun::enrichment_functions() const {
 void SceneRun::solve_static() { simulation_->solve_static(); }
 
 void SceneRun::step() {
+  if (!scene_.analysis.is_dynamic())
+    throw std::logic_error("SceneRun::step: the scene's analysis is static; call solve_static, or give the scene a "
+                           "dynamic analysis");
   const double next = time_ + dynamics_.time_step;
   const kernels::ScopedThreadsBusyBeside beside(&cut_update_threads_);
   try {

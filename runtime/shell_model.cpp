@@ -16,6 +16,7 @@
 #include "dgtex/kernels/threads_busy_beside.h"
 #include "dgtex/mesh_validation.h"
 #include "dgtex/model_error.h"
+#include "api_argument_checks.h"
 #include "enriched_sub_batch.h"
 #include "multigrid_buffer.h"
 #include "parametric_point_index.h"
@@ -829,6 +830,7 @@ void ShellModel::assemble_stiffness(const double* current, std::vector<double>& 
 }
 
 void ShellModel::add_gravity(const double g[3], std::vector<double>& f) const {
+  detail::check_size("ShellModel::add_gravity", "f", f.size(), "num_dofs()", num_dofs());
   const int npe = mesh_.nodes_per_element();
   const int ne = static_cast<int>(plain_sections_.size());
   for (int e = 0; e < ne; ++e)
@@ -842,6 +844,7 @@ void ShellModel::add_gravity(const double g[3], std::vector<double>& f) const {
 }
 
 void ShellModel::add_area_force(const double q[3], std::vector<double>& f) const {
+  detail::check_size("ShellModel::add_area_force", "f", f.size(), "num_dofs()", num_dofs());
   const int npe = mesh_.nodes_per_element();
   const int ne = static_cast<int>(plain_sections_.size());
   for (int e = 0; e < ne; ++e)
@@ -980,6 +983,8 @@ int ShellModel::basis_at(int element, const double xi[2], int* global, double* v
 }
 
 void ShellModel::add_point_force(int element, const double xi[2], const double force[3], std::vector<double>& f) const {
+  detail::check_size("ShellModel::add_point_force", "f", f.size(), "num_dofs()", num_dofs());
+  detail::check_index("ShellModel::add_point_force", "element", element, "mesh().num_elements()", mesh_.num_elements());
   int global[kernels::max_enriched_basis];
   double values[kernels::max_enriched_basis];
   const int n = basis_at(element, xi, global, values);
@@ -988,6 +993,8 @@ void ShellModel::add_point_force(int element, const double xi[2], const double f
 }
 
 void ShellModel::interpolate(const std::vector<double>& u, int element, const double xi[2], double out[3]) const {
+  detail::check_size("ShellModel::interpolate", "u", u.size(), "num_dofs()", num_dofs());
+  detail::check_index("ShellModel::interpolate", "element", element, "mesh().num_elements()", mesh_.num_elements());
   int global[kernels::max_enriched_basis];
   double values[kernels::max_enriched_basis];
   const int n = basis_at(element, xi, global, values);

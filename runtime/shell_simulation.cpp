@@ -2,16 +2,33 @@
 
 #include <Eigen/Dense>
 #include <cmath>
+#include <cstdio>
+#include <stdexcept>
 #include <string>
 
 #include "dgtex/kernels/forall.h"
 #include "dgtex/model_error.h"
 #include "dgtex/side_by_side.h"
+#include "api_argument_checks.h"
 
 namespace dgtex {
 
+namespace {
+
+// The constructor's #dofs vectors, checked before the members built from them.
+template <class T>
+std::vector<T> checked_size(const char* argument, std::vector<T> values, int dofs) {
+  detail::check_size("ShellSimulation", argument, values.size(), "model.num_dofs()", dofs);
+  return values;
+}
+
+}  // namespace
+
 ShellSimulation::ShellSimulation(const ShellModel& model, std::vector<char> fixed, std::vector<double> external_force)
-    : model_(model), fixed_(std::move(fixed)), f_ext_(std::move(external_force)), system_(model.pattern(), fixed_),
+    : model_(model),
+      fixed_(checked_size("fixed", std::move(fixed), model.num_dofs())),
+      f_ext_(checked_size("external_force", std::move(external_force), model.num_dofs())),
+      system_(model.pattern(), fixed_),
       solver_(model.pattern(), system_, model.mass_blocks()) {
   u_.assign(model.num_dofs(), 0.0);
   v_.assign(model.num_dofs(), 0.0);
@@ -28,6 +45,8 @@ const std::vector<double>& ShellSimulation::linear_stiffness() {
 }
 
 void ShellSimulation::set_state(std::vector<double> u, std::vector<double> v) {
+  detail::check_size("ShellSimulation::set_state", "u", u.size(), "num_dofs()", model_.num_dofs());
+  detail::check_size("ShellSimulation::set_state", "v", v.size(), "num_dofs()", model_.num_dofs());
   u_ = std::move(u);
   v_ = std::move(v);
   previous_v_.clear();
@@ -121,6 +140,11 @@ void ShellSimulation::set_solver_options(const FactorReuseOptions& options) { so
 
 void ShellSimulation::step(const DynamicsOptions& o) {
   const double dt = o.time_step;
+  if (!(dt > 0 && std::isfinite(dt))) {
+    char value[32];
+    std::snprintf(value, sizeof value, "%g", dt);
+    throw std::invalid_argument(std::string("ShellSimulation::step: time_step ") + value + " is not a positive finite time");
+  }
   const int ndofs = model_.num_dofs();
   corrective_.clear();
   const std::vector<double>* K = nullptr;

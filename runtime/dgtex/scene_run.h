@@ -62,7 +62,7 @@ class SceneRun {
 
   // Static analysis: solve K u = f with the cuts present at time 0.
   void solve_static();
-  // One dynamic step of the scene's time step.
+  // One dynamic step of the scene's time step; std::logic_error for a static scene.
   void step();
 
   const Mesh& mesh() const { return mesh_; }

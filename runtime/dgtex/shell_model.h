@@ -169,7 +169,8 @@ class ShellModel {
   const std::vector<double>& mass_blocks() const { return mass_blocks_; }
 
   // Load vectors (#dofs, enriched functions included): body force per unit mass (gravity), force per unit area, and a
-  // point force at a parametric point of an element (distributed by the basis functions).
+  // point force at a parametric point of an element (distributed by the basis functions). A vector of another size
+  // or an element out of range throws std::invalid_argument (so does interpolate).
   void add_gravity(const double acceleration[3], std::vector<double>& f) const;
   void add_area_force(const double force_per_area[3], std::vector<double>& f) const;
   void add_point_force(int element, const double xi[2], const double force[3], std::vector<double>& f) const;

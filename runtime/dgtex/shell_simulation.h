@@ -34,7 +34,7 @@ struct DynamicsOptions {
 
 class ShellSimulation {
  public:
-  // fixed: #dofs flags; external_force: #dofs.
+  // fixed: #dofs flags; external_force: #dofs (std::invalid_argument for other sizes).
   ShellSimulation(const ShellModel& model, std::vector<char> fixed, std::vector<double> external_force);
   // The model is kept by reference: a temporary one would dangle.
   ShellSimulation(ShellModel&&, std::vector<char>, std::vector<double>) = delete;
@@ -44,11 +44,12 @@ class ShellSimulation {
   void check_statically_constrained() const;
   // Throws ModelError "stiffness not positive definite (penalty too low?)" when K is not.
   void solve_static();
+  // std::invalid_argument unless options.time_step is positive and finite.
   void step(const DynamicsOptions& options);
 
   const std::vector<double>& displacement() const { return u_; }
   const std::vector<double>& velocity() const { return v_; }
-  void set_state(std::vector<double> u, std::vector<double> v);
+  void set_state(std::vector<double> u, std::vector<double> v);  // #dofs each, else std::invalid_argument
   double time() const { return time_; }
   const StageTimings& timings() const { return timings_; }
   const FreeDofSystem& system() const { return system_; }

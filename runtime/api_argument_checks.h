@@ -1,0 +1,28 @@
+#pragma once
+// Argument checks of the public runtime classes: a wrong size or index from a program
+// linking dgtex throws std::invalid_argument naming the function, the argument, its value
+// and what is valid, instead of reading or writing out of bounds. O(1); not for kernels.
+#include <cstddef>
+#include <stdexcept>
+#include <string>
+
+namespace dgtex::detail {
+
+// "ShellModel::interpolate: u has 3 entries; expected num_dofs() = 84"
+inline void check_size(const char* function, const char* argument, std::size_t size, const char* expected_name,
+                       std::size_t expected) {
+  if (size == expected) return;
+  throw std::invalid_argument(std::string(function) + ": " + argument + " has " + std::to_string(size) +
+                              " entries; expected " + expected_name + " = " + std::to_string(expected));
+}
+
+// "ShellModel::interpolate: element 99 is out of range; expected 0..15 (num_elements() = 16)"
+inline void check_index(const char* function, const char* argument, long long index, const char* count_name,
+                        long long count) {
+  if (index >= 0 && index < count) return;
+  throw std::invalid_argument(std::string(function) + ": " + argument + " " + std::to_string(index) +
+                              " is out of range; expected 0.." + std::to_string(count - 1) + " (" + count_name +
+                              " = " + std::to_string(count) + ")");
+}
+
+}  // namespace dgtex::detail

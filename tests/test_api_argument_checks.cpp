@@ -1,0 +1,119 @@
+// Wrong sizes and indices from a program linking dgtex throw std::invalid_argument naming
+// the function, the argument and what is valid (runtime/api_argument_checks.h), where they
+// read and wrote out of bounds; stepping a static scene is a std::logic_error.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <functional>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "dgtex/scene.h"
+#include "dgtex/scene_model.h"
+#include "dgtex/scene_run.h"
+#include "dgtex/shell_simulation.h"
+
+namespace {
+
+using namespace dgtex;
+
+// A clamped 4 x 1 quad8 strip under gravity.
+Scene strip(bool dynamic) {
+  Scene scene;
+  scene.source_name = "strip";
+  scene.mesh.source = MeshSource::rectangle;
+  scene.mesh.size = {0.4, 0.1};
+  scene.mesh.divisions = {4, 1};
+  scene.material = {5e8, 0.3, 0.01, 1000};
+  BoundaryCondition clamp;
+  clamp.select.normal = {1, 0, 0};
+  clamp.fixed = {true, true, true};
+  clamp.clamp = true;
+  scene.boundary.push_back(clamp);
+  Load gravity;
+  gravity.acceleration = {0, 0, -9.81};
+  scene.loads.push_back(gravity);
+  if (dynamic) {
+    scene.analysis.type = Analysis::Type::dynamic;
+    scene.analysis.time_step = 0.005;
+    scene.analysis.steps = 2;
+  }
+  return scene;
+}
+
+// Calls `call` and returns the std::invalid_argument message it threw ("" if none).
+std::string invalid_argument_of(const std::function<void()>& call) {
+  try {
+    call();
+  } catch (const std::invalid_argument& e) {
+    return e.what();
+  }
+  return "";
+}
+
+TEST(ApiArgumentChecks, ShellModelLoadsAndInterpolationCheckSizesAndElements) {
+  const Scene scene = strip(true);
+  const Mesh mesh = build_scene_mesh(scene);
+  const SceneModel built = build_scene_model(scene, mesh);
+  const ShellModel& model = *built.model;
+  const int dofs = model.num_dofs();
+  const double xi[2] = {0, 0}, force[3] = {0, 0, 1};
+  std::vector<double> f(dofs, 0.0), short_f(3, 0.0);
+  double out[3];
+
+  EXPECT_EQ(invalid_argument_of([&] { model.interpolate(short_f, 1, xi, out); }),
+            "ShellModel::interpolate: u has 3 entries; expected num_dofs() = " + std::to_string(dofs));
+  EXPECT_EQ(invalid_argument_of([&] { model.interpolate(f, 4, xi, out); }),
+            "ShellModel::interpolate: element 4 is out of range; expected 0..3 (mesh().num_elements() = 4)");
+  EXPECT_NE(invalid_argument_of([&] { model.interpolate(f, -1, xi, out); }), "");
+  EXPECT_NE(invalid_argument_of([&] { model.add_point_force(7, xi, force, f); }), "");
+  EXPECT_NE(invalid_argument_of([&] { model.add_point_force(1, xi, force, short_f); }), "");
+  EXPECT_NE(invalid_argument_of([&] { model.add_gravity(force, short_f); }), "");
+  EXPECT_NE(invalid_argument_of([&] { model.add_area_force(force, short_f); }), "");
+
+  // Valid calls: a unit point force at the centre of element 1 adds up to 1 over its basis.
+  EXPECT_EQ(invalid_argument_of([&] { model.add_point_force(1, xi, force, f); }), "");
+  double total_z = 0;
+  for (int d = 2; d < dofs; d += 3) total_z += f[d];
+  EXPECT_NEAR(total_z, 1.0, 1e-12);
+  EXPECT_EQ(invalid_argument_of([&] { model.interpolate(f, 3, xi, out); }), "");
+}
+
+TEST(ApiArgumentChecks, ShellSimulationChecksItsVectorsAndTimeStep) {
+  const Scene scene = strip(true);
+  const Mesh mesh = build_scene_mesh(scene);
+  const SceneModel built = build_scene_model(scene, mesh);
+  const int dofs = built.model->num_dofs();
+  EXPECT_EQ(invalid_argument_of([&] { ShellSimulation(*built.model, std::vector<char>(5), built.external_force); }),
+            "ShellSimulation: fixed has 5 entries; expected model.num_dofs() = " + std::to_string(dofs));
+  EXPECT_NE(invalid_argument_of([&] { ShellSimulation(*built.model, built.fixed, {}); }), "");
+
+  ShellSimulation simulation(*built.model, built.fixed, built.external_force);
+  EXPECT_NE(invalid_argument_of([&] { simulation.set_state(std::vector<double>(dofs), {}); }), "");
+  DynamicsOptions options;
+  for (double dt : {0.0, -0.005, std::nan("")}) {
+    options.time_step = dt;
+    EXPECT_NE(invalid_argument_of([&] { simulation.step(options); }).find("is not a positive finite time"),
+              std::string::npos)
+        << dt;
+  }
+  options.time_step = 0.005;
+  simulation.step(options);
+  double lowest_z = 0;
+  for (int n = 0; n < mesh.num_nodes(); ++n) lowest_z = std::min(lowest_z, simulation.displacement()[3 * n + 2]);
+  EXPECT_LT(lowest_z, 0);  // gravity pulls the strip down
+}
+
+TEST(ApiArgumentChecks, SteppingAStaticSceneIsALogicError) {
+  SceneRun run(strip(false));
+  EXPECT_THROW(run.step(), std::logic_error);
+  EXPECT_EQ(run.steps_taken(), 0);
+  run.solve_static();
+  SceneRun dynamic(strip(true));
+  dynamic.step();
+  EXPECT_EQ(dynamic.steps_taken(), 1);
+}
+
+}  // namespace
