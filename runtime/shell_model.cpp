@@ -20,6 +20,7 @@
 #include "enriched_sub_batch.h"
 #include "multigrid_buffer.h"
 #include "parametric_point_index.h"
+#include "shell_model_inputs.h"
 
 namespace dgtex {
 
@@ -34,10 +35,8 @@ constexpr std::int64_t max_rotation_cluster_doubles = std::int64_t{1} << 29;
 ShellModel::ShellModel(Mesh mesh, const Topology& topology, std::vector<kernels::ShellSection> sections,
                        const std::vector<int>& clamped_edges, ShellModelOptions options)
     : mesh_(std::move(mesh)), sections_(std::move(sections)), options_(options) {
+  detail::check_shell_model_inputs(mesh_, topology, sections_, clamped_edges, options_);
   const int ne = mesh_.num_elements();
-  if (static_cast<int>(sections_.size()) != ne)
-    throw std::invalid_argument("ShellModel: " + std::to_string(sections_.size()) + " sections for " +
-                                std::to_string(ne) + " elements");
   // h^e = min over adjacent elements of area / perimeter (report eq. 16).
   std::vector<double> size_of_element(ne);
   for (int e = 0; e < ne; ++e) size_of_element[e] = element_area(mesh_, e) / element_perimeter(mesh_, e);

@@ -1,6 +1,7 @@
 // Wrong sizes and indices from a program linking dgtex throw std::invalid_argument naming
 // the function, the argument and what is valid (runtime/api_argument_checks.h), where they
-// read and wrote out of bounds; stepping a static scene is a std::logic_error.
+// read and wrote out of bounds; so do ShellModel's parts (a bad mesh: MeshError). Stepping
+// a static scene is a std::logic_error.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -10,10 +11,13 @@
 #include <string>
 #include <vector>
 
+#include "dgtex/mesh_error.h"
+#include "dgtex/mesh_generators.h"
 #include "dgtex/scene.h"
 #include "dgtex/scene_model.h"
 #include "dgtex/scene_run.h"
 #include "dgtex/shell_simulation.h"
+#include "dgtex/topology.h"
 
 namespace {
 
@@ -104,6 +108,65 @@ TEST(ApiArgumentChecks, ShellSimulationChecksItsVectorsAndTimeStep) {
   double lowest_z = 0;
   for (int n = 0; n < mesh.num_nodes(); ++n) lowest_z = std::min(lowest_z, simulation.displacement()[3 * n + 2]);
   EXPECT_LT(lowest_z, 0);  // gravity pulls the strip down
+}
+
+// ShellModel built from parts of a program's own: each bad part is named before it is read.
+TEST(ApiArgumentChecks, ShellModelChecksItsMeshTopologySectionsAndOptions) {
+  const Mesh mesh = make_rectangle(1, 1, 2, 2, ElementType::quad8);
+  const Topology topology = build_topology(mesh);
+  kernels::ShellSection steel{2e11, 0.3, 0.01, 7800};
+  const std::vector<kernels::ShellSection> sections(4, steel);
+  const auto model_error = [&](Mesh m, const Topology& t, std::vector<kernels::ShellSection> s, std::vector<int> clamped,
+                               ShellModelOptions options) {
+    return invalid_argument_of([&] { ShellModel(std::move(m), t, std::move(s), clamped, options); });
+  };
+  EXPECT_EQ(model_error(mesh, topology, sections, {0, 7}, {}), "");
+
+  EXPECT_EQ(model_error(mesh, topology, {steel, steel}, {}, {}),
+            "ShellModel: sections has 2 entries; expected mesh.num_elements() = 4");
+  const auto with_section = [&](const std::function<void(kernels::ShellSection&)>& change) {
+    std::vector<kernels::ShellSection> changed = sections;
+    change(changed[2]);
+    return model_error(mesh, topology, changed, {}, {});
+  };
+  EXPECT_EQ(with_section([](kernels::ShellSection& s) { s.youngs_modulus = -1; }),
+            "ShellModel: sections[2].youngs_modulus is -1; expected a positive finite number");
+  EXPECT_NE(with_section([](kernels::ShellSection& s) { s.poisson_ratio = 0.5; }), "");
+  EXPECT_NE(with_section([](kernels::ShellSection& s) { s.thickness = 0; }), "");
+  EXPECT_NE(with_section([](kernels::ShellSection& s) { s.density = std::nan(""); }), "");
+  EXPECT_EQ(model_error(mesh, topology, sections, {8}, {}),
+            "ShellModel: clamped_edges[0] 8 is out of range; expected 0..7 (topology.boundary_edges.size() = 8)");
+
+  // A topology of another mesh: more edges, or as many but of other elements.
+  EXPECT_NE(model_error(mesh, build_topology(make_rectangle(1, 1, 4, 4, ElementType::quad8)), sections, {}, {})
+                .find("the topology was not built from this mesh"),
+            std::string::npos);
+  Mesh reversed = mesh;  // the same elements, listed in reverse order
+  for (int e = 0; e < 4; ++e)
+    std::copy(mesh.element_nodes(3 - e), mesh.element_nodes(3 - e) + 8, reversed.elements.begin() + 8 * e);
+  EXPECT_NE(model_error(reversed, topology, sections, {}, {}).find("interior_edges[0] (element 0, local edge 1)"),
+            std::string::npos);
+  EXPECT_EQ(model_error(reversed, build_topology(reversed), sections, {}, {}), "");
+
+  const auto with_options = [&](const std::function<void(ShellModelOptions&)>& change) {
+    ShellModelOptions options;
+    change(options);
+    return model_error(mesh, topology, sections, {}, options);
+  };
+  EXPECT_EQ(with_options([](ShellModelOptions& o) { o.penalty = 0; }),
+            "ShellModel: options.penalty is 0; expected a positive finite number");
+  EXPECT_NE(with_options([](ShellModelOptions& o) { o.edge_quadrature_points = 6; }), "");
+  EXPECT_NE(with_options([](ShellModelOptions& o) { o.min_enrichment_mass_ratio = 1; }), "");
+  EXPECT_NE(with_options([](ShellModelOptions& o) { o.rotation_cluster_texels = -1; }), "");
+  EXPECT_NE(with_options([](ShellModelOptions& o) { o.enrichment_quadrature.merge_tolerance = 0; }), "");
+
+  // The mesh itself: what validate_mesh refuses, as a MeshError.
+  Mesh not_finite = mesh;
+  not_finite.positions[4] = std::nan("");
+  EXPECT_THROW(ShellModel(not_finite, topology, sections, {}, {}), MeshError);
+  Mesh bad_index = mesh;
+  bad_index.elements[3] = 999;
+  EXPECT_THROW(ShellModel(bad_index, build_topology(bad_index), sections, {}, {}), MeshError);
 }
 
 TEST(ApiArgumentChecks, SteppingAStaticSceneIsALogicError) {

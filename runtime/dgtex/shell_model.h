@@ -60,6 +60,9 @@ struct ShellModelOptions {
 class ShellModel {
  public:
   // clamped_edges: indices into topology.boundary_edges whose normal is held (clamp).
+  // Checks its inputs first: MeshError for a mesh validate_mesh refuses; std::invalid_argument
+  // for a topology of another mesh, #sections != #elements, a section that is no material,
+  // a clamped edge out of range or an option out of its range, naming the value.
   ShellModel(Mesh mesh, const Topology& topology, std::vector<kernels::ShellSection> sections,
              const std::vector<int>& clamped_edges, ShellModelOptions options);
 
