@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <exception>
 #include <filesystem>
@@ -231,6 +232,7 @@ void CutManager::rasterize_visible(const std::vector<VisibleCutSegment>& visible
 }
 
 bool CutManager::update(double time) {
+  if (!std::isfinite(time)) throw std::invalid_argument("CutManager::update: time " + std::to_string(time) + " is not finite");
   const auto start = std::chrono::steady_clock::now();
   last_ = CutUpdateStats{};
   time_ = time;

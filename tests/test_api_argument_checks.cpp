@@ -1,7 +1,8 @@
 // Wrong sizes and indices from a program linking dgtex throw std::invalid_argument naming
 // the function, the argument and what is valid (runtime/api_argument_checks.h), where they
-// read and wrote out of bounds; so do ShellModel's parts (a bad mesh: MeshError). Stepping
-// a static scene is a std::logic_error.
+// read and wrote out of bounds; so do ShellModel's parts (a bad mesh: MeshError) and a
+// time that is not finite for CutManager::update. Stepping a static scene is a
+// std::logic_error.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -11,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "dgtex/cut_manager.h"
 #include "dgtex/mesh_error.h"
 #include "dgtex/mesh_generators.h"
 #include "dgtex/scene.h"
@@ -167,6 +169,18 @@ TEST(ApiArgumentChecks, ShellModelChecksItsMeshTopologySectionsAndOptions) {
   Mesh bad_index = mesh;
   bad_index.elements[3] = 999;
   EXPECT_THROW(ShellModel(bad_index, build_topology(bad_index), sections, {}, {}), MeshError);
+}
+
+TEST(ApiArgumentChecks, CutManagerUpdatesToFiniteTimesOnly) {
+  const Mesh mesh = make_rectangle(1, 1, 2, 2, ElementType::quad8);
+  Cut cut;
+  cut.points = {{0, 0.5, 0}, {1, 0.5, 0}};
+  EnrichmentOptions options;
+  options.texture_resolution = 32;
+  CutManager cuts(mesh, build_topology(mesh), {cut}, options);
+  EXPECT_NE(invalid_argument_of([&] { cuts.update(std::nan("")); }).find("is not finite"), std::string::npos);
+  EXPECT_TRUE(cuts.update(0.0));
+  EXPECT_EQ(cuts.functions().size(), 1u);
 }
 
 TEST(ApiArgumentChecks, SteppingAStaticSceneIsALogicError) {

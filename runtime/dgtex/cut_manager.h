@@ -82,7 +82,8 @@ class CutManager {
   // The mesh is kept by reference: a temporary one would dangle.
   CutManager(Mesh&&, const Topology&, const std::vector<Cut>&, const EnrichmentOptions&, CutManagerOptions = {}) = delete;
 
-  // Brings the functions to `time`; true when they changed (added, removed or re-solved).
+  // Brings the functions to `time` (finite, else std::invalid_argument); true when they
+  // changed (added, removed or re-solved).
   bool update(double time);
 
   // One function per visible segment with texel data, in order of first appearance (a
