@@ -20,34 +20,12 @@
 #include "dgtex/scene_run.h"
 #include "dgtex/shell_simulation.h"
 #include "dgtex/topology.h"
+#include "scene_in_code_support.h"
 
 namespace {
 
 using namespace dgtex;
-
-// A clamped 4 x 1 quad8 strip under gravity.
-Scene strip(bool dynamic) {
-  Scene scene;
-  scene.source_name = "strip";
-  scene.mesh.source = MeshSource::rectangle;
-  scene.mesh.size = {0.4, 0.1};
-  scene.mesh.divisions = {4, 1};
-  scene.material = {5e8, 0.3, 0.01, 1000};
-  BoundaryCondition clamp;
-  clamp.select.normal = {1, 0, 0};
-  clamp.fixed = {true, true, true};
-  clamp.clamp = true;
-  scene.boundary.push_back(clamp);
-  Load gravity;
-  gravity.acceleration = {0, 0, -9.81};
-  scene.loads.push_back(gravity);
-  if (dynamic) {
-    scene.analysis.type = Analysis::Type::dynamic;
-    scene.analysis.time_step = 0.005;
-    scene.analysis.steps = 2;
-  }
-  return scene;
-}
+using test::strip_built_in_code;
 
 // Calls `call` and returns the std::invalid_argument message it threw ("" if none).
 std::string invalid_argument_of(const std::function<void()>& call) {
@@ -60,7 +38,7 @@ std::string invalid_argument_of(const std::function<void()>& call) {
 }
 
 TEST(ApiArgumentChecks, ShellModelLoadsAndInterpolationCheckSizesAndElements) {
-  const Scene scene = strip(true);
+  const Scene scene = strip_built_in_code(true, false);
   const Mesh mesh = build_scene_mesh(scene);
   const SceneModel built = build_scene_model(scene, mesh);
   const ShellModel& model = *built.model;
@@ -88,7 +66,7 @@ TEST(ApiArgumentChecks, ShellModelLoadsAndInterpolationCheckSizesAndElements) {
 }
 
 TEST(ApiArgumentChecks, ShellSimulationChecksItsVectorsAndTimeStep) {
-  const Scene scene = strip(true);
+  const Scene scene = strip_built_in_code(true, false);
   const Mesh mesh = build_scene_mesh(scene);
   const SceneModel built = build_scene_model(scene, mesh);
   const int dofs = built.model->num_dofs();
@@ -184,11 +162,11 @@ TEST(ApiArgumentChecks, CutManagerUpdatesToFiniteTimesOnly) {
 }
 
 TEST(ApiArgumentChecks, SteppingAStaticSceneIsALogicError) {
-  SceneRun run(strip(false));
+  SceneRun run(strip_built_in_code(false, false));
   EXPECT_THROW(run.step(), std::logic_error);
   EXPECT_EQ(run.steps_taken(), 0);
   run.solve_static();
-  SceneRun dynamic(strip(true));
+  SceneRun dynamic(strip_built_in_code(true, false));
   dynamic.step();
   EXPECT_EQ(dynamic.steps_taken(), 1);
 }

@@ -13,39 +13,12 @@
 #include "dgtex/scene_io.h"
 #include "dgtex/scene_model.h"
 #include "dgtex/scene_run.h"
+#include "scene_in_code_support.h"
 
 namespace {
 
 using namespace dgtex;
-
-// A clamped strip under gravity with a cut from its lower edge, dynamic and corotated, as
-// a program linking dgtex would build it.
-Scene strip_built_in_code() {
-  Scene scene;
-  scene.source_name = "strip (built in code)";
-  scene.mesh.source = MeshSource::rectangle;
-  scene.mesh.element = ElementType::quad8;
-  scene.mesh.size = {0.4, 0.1};
-  scene.mesh.divisions = {4, 1};
-  scene.material = {5e8, 0.3, 0.01, 1000};
-  BoundaryCondition clamp;
-  clamp.select.normal = {1, 0, 0};
-  clamp.fixed = {true, true, true};
-  clamp.clamp = true;
-  scene.boundary.push_back(clamp);
-  Load gravity;
-  gravity.acceleration = {0, 0, -9.81};
-  scene.loads.push_back(gravity);
-  scene.analysis.type = Analysis::Type::dynamic;
-  scene.analysis.time_step = 0.005;
-  scene.analysis.steps = 2;
-  scene.analysis.corotational = true;
-  Cut cut;
-  cut.points = {{0.225, 0, 0}, {0.225, 0.06, 0}};
-  scene.cuts.push_back(cut);
-  scene.enrichment.texture_resolution = 32;
-  return scene;
-}
+using test::strip_built_in_code;
 
 struct BadValue {
   const char* what;
