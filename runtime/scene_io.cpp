@@ -33,13 +33,6 @@ std::string one_line(std::string text) {
   return text;
 }
 
-std::string number_text(double x) {
-  std::ostringstream out;
-  out.precision(17);
-  out << x;
-  return out.str();
-}
-
 std::string value_text(const json& value) {
   // A Scene built in code can hold NaN or infinity, which JSON text would show as null.
   if (value.is_number_float() && !std::isfinite(value.get<double>()))
@@ -52,6 +45,13 @@ std::string value_text(const json& value) {
     text = text.substr(0, cut) + "...";
   }
   return text;
+}
+
+std::string number_text(double x) {
+  std::ostringstream out;
+  out.precision(17);
+  out << x;
+  return out.str();
 }
 
 std::string child(const std::string& path, const std::string& key) { return path.empty() ? key : path + "." + key; }

@@ -45,8 +45,8 @@ const std::vector<double>& ShellSimulation::linear_stiffness() {
 }
 
 void ShellSimulation::set_state(std::vector<double> u, std::vector<double> v) {
-  detail::check_size("ShellSimulation::set_state", "u", u.size(), "num_dofs()", model_.num_dofs());
-  detail::check_size("ShellSimulation::set_state", "v", v.size(), "num_dofs()", model_.num_dofs());
+  detail::check_size("ShellSimulation::set_state", "u", u.size(), "model.num_dofs()", model_.num_dofs());
+  detail::check_size("ShellSimulation::set_state", "v", v.size(), "model.num_dofs()", model_.num_dofs());
   u_ = std::move(u);
   v_ = std::move(v);
   previous_v_.clear();
