@@ -5,11 +5,12 @@
 #   2. configure examples/consumer against that prefix only (CMAKE_PREFIX_PATH), check that
 #      find_package(dgtex) found the package there and not some other installed copy,
 #   3. build it, with a translation unit that includes every installed header (-Werror),
-#   4. run the cut_plate program (it checks its own results).
+#   4. run the cut_plate program (it checks its own results), and README.md's C++ example
+#      (built beside it from the README's text).
 # Any failing step fails the test with that step's output.
-# Inputs: DGTEX_BUILD_DIR, CONSUMER_SOURCE_DIR, WORK_DIR, GENERATOR, MAKE_PROGRAM,
+# Inputs: DGTEX_BUILD_DIR, SOURCE_DIR, CONSUMER_SOURCE_DIR, WORK_DIR, GENERATOR, MAKE_PROGRAM,
 #         CXX_COMPILER, CXX_COMPILER_LAUNCHER (may be empty).
-foreach(var DGTEX_BUILD_DIR CONSUMER_SOURCE_DIR WORK_DIR GENERATOR CXX_COMPILER)
+foreach(var DGTEX_BUILD_DIR SOURCE_DIR CONSUMER_SOURCE_DIR WORK_DIR GENERATOR CXX_COMPILER)
   if(NOT DEFINED ${var} OR "${${var}}" STREQUAL "")
     message(FATAL_ERROR "install_consumer_test.cmake: -D${var}=... is required")
   endif()
@@ -47,9 +48,29 @@ if(NOT result EQUAL 0 OR at EQUAL -1)
 endif()
 message(STATUS "installed dgtex bench scenes: ok (the installed scenes)")
 
+# README.md's C++ example (the first ```cpp block after "## Using dgtex as a library"),
+# wrapped in a main() with the includes it assumes, built and run from the source tree below.
+file(READ ${SOURCE_DIR}/README.md readme)
+string(FIND "${readme}" "## Using dgtex as a library" section)
+string(SUBSTRING "${readme}" ${section} -1 readme)
+string(FIND "${readme}" "```cpp\n" begin)
+if(section EQUAL -1 OR begin EQUAL -1)
+  message(FATAL_ERROR "no ```cpp example under \"## Using dgtex as a library\" in ${SOURCE_DIR}/README.md")
+endif()
+math(EXPR begin "${begin} + 7")
+string(SUBSTRING "${readme}" ${begin} -1 readme)
+string(FIND "${readme}" "```" end)
+string(SUBSTRING "${readme}" 0 ${end} example)
+string(REGEX MATCHALL "#include <[^>\n]+>" example_includes "${example}")
+string(REGEX REPLACE "#include <[^>\n]+>\n" "" example_body "${example}")
+string(REPLACE ";" "\n" example_includes "${example_includes}")
+file(WRITE ${WORK_DIR}/readme_example.cpp
+     "#include <cstdio>\n${example_includes}\n\nint main() {\n${example_body}  return 0;\n}\n")
+
 set(configure_args -S ${CONSUMER_SOURCE_DIR} -B ${consumer_build} -G ${GENERATOR}
     -DCMAKE_BUILD_TYPE=Release -DCMAKE_PREFIX_PATH=${prefix} -DCMAKE_CXX_COMPILER=${CXX_COMPILER}
-    -DCMAKE_FIND_USE_PACKAGE_REGISTRY=OFF -DDGTEX_CONSUMER_HEADER_CHECK=ON)
+    -DCMAKE_FIND_USE_PACKAGE_REGISTRY=OFF -DDGTEX_CONSUMER_HEADER_CHECK=ON
+    -DDGTEX_CONSUMER_README_EXAMPLE=${WORK_DIR}/readme_example.cpp)
 if(MAKE_PROGRAM)
   list(APPEND configure_args -DCMAKE_MAKE_PROGRAM=${MAKE_PROGRAM})
 endif()
@@ -70,3 +91,10 @@ endif()
 run_step("build consumer" ${CMAKE_COMMAND} --build ${consumer_build})
 run_step("run consumer" ${consumer_build}/cut_plate)
 message("${step_output}")
+# The README example loads examples/scenes/spiral1.json relative to the source tree.
+execute_process(COMMAND ${consumer_build}/readme_example WORKING_DIRECTORY ${SOURCE_DIR}
+                RESULT_VARIABLE result OUTPUT_VARIABLE out ERROR_VARIABLE out)
+if(NOT result EQUAL 0 OR NOT out MATCHES "^u = -?[0-9]")
+  message(FATAL_ERROR "README.md's example failed (exit ${result}):\n${out}")
+endif()
+message(STATUS "README.md's example: ok: ${out}")

@@ -6,6 +6,7 @@ if(DGTEX_BUILD_TESTS AND NOT DGTEX_SANITIZE)
   add_test(NAME InstallConsumer.FindPackageBuildRun
            COMMAND ${CMAKE_COMMAND}
                    -DDGTEX_BUILD_DIR=${PROJECT_BINARY_DIR}
+                   -DSOURCE_DIR=${PROJECT_SOURCE_DIR}
                    -DCONSUMER_SOURCE_DIR=${PROJECT_SOURCE_DIR}/examples/consumer
                    -DWORK_DIR=${PROJECT_BINARY_DIR}/install_consumer
                    -DGENERATOR=${CMAKE_GENERATOR}
