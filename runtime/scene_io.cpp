@@ -904,7 +904,8 @@ json scene_to_json(const Scene& scene) {
       for (const CutSurfacePoint& sp : cut.surface_points)
         c["surface_points"].push_back({{"element", sp.element}, {"xi", {sp.xi[0], sp.xi[1]}}});
     }
-    if (cut.has_schedule) c["start_time"] = cut.start_time;
+    // A Scene built in code may set start_time without has_schedule; the run uses it anyway.
+    if (cut.has_schedule || cut.start_time != 0) c["start_time"] = cut.start_time;
     if (cut.speed) c["speed"] = *cut.speed;
     out["cuts"].push_back(c);
   }

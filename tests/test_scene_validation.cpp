@@ -52,6 +52,7 @@ std::vector<BadValue> bad_values() {
        "got -Infinity"},
       {"cut of one point", [](Scene& s) { s.cuts[0].points.resize(1); }, "cuts[0].points", "at least 2 points"},
       {"NaN cut point", [](Scene& s) { s.cuts[0].points[1][1] = kNaN; }, "cuts[0].points[1][1]", "got NaN"},
+      {"negative start time", [](Scene& s) { s.cuts[0].start_time = -1; }, "cuts[0].start_time", "must not be negative"},
       {"cut speed 0", [](Scene& s) { s.cuts[0].has_schedule = true, s.cuts[0].speed = 0.0; }, "cuts[0].speed",
        "must be positive"},
       {"T = 33", [](Scene& s) { s.enrichment.texture_resolution = 33; }, "enrichment.texture_resolution",
@@ -94,6 +95,20 @@ TEST(SceneValidation, SceneRunRefusesABadValueNamingItsField) {
 
 // The builders check too, so the benchmarks and programs that build a model without
 // SceneRun get the same errors.
+// A start time set in code without has_schedule still delays the cut, so it is checked as
+// a schedule: a static scene cannot have one.
+TEST(SceneValidation, AStartTimeSetInCodeCountsAsASchedule) {
+  Scene scene = strip_built_in_code(false);
+  scene.cuts[0].start_time = 0.5;
+  try {
+    validate_scene(scene);
+    FAIL() << "accepted";
+  } catch (const SceneError& e) {
+    EXPECT_EQ(e.json_path(), "cuts[0].start_time") << e.what();
+    EXPECT_NE(std::string(e.what()).find("needs a dynamic analysis"), std::string::npos) << e.what();
+  }
+}
+
 TEST(SceneValidation, TheSceneBuildersRefuseABadValue) {
   const Scene good = strip_built_in_code();
   const Mesh mesh = build_scene_mesh(good);
