@@ -20,22 +20,14 @@
 #include "dgtex/scene_run.h"
 #include "dgtex/shell_simulation.h"
 #include "dgtex/topology.h"
+#include "exception_message_support.h"
 #include "scene_in_code_support.h"
 
 namespace {
 
 using namespace dgtex;
+using test::message_of;
 using test::strip_built_in_code;
-
-// Calls `call` and returns the std::invalid_argument message it threw ("" if none).
-std::string invalid_argument_of(const std::function<void()>& call) {
-  try {
-    call();
-  } catch (const std::invalid_argument& e) {
-    return e.what();
-  }
-  return "";
-}
 
 TEST(ApiArgumentChecks, ShellModelLoadsAndInterpolationCheckSizesAndElements) {
   const Scene scene = strip_built_in_code(true, false);
@@ -47,22 +39,22 @@ TEST(ApiArgumentChecks, ShellModelLoadsAndInterpolationCheckSizesAndElements) {
   std::vector<double> f(dofs, 0.0), short_f(3, 0.0);
   double out[3];
 
-  EXPECT_EQ(invalid_argument_of([&] { model.interpolate(short_f, 1, xi, out); }),
+  EXPECT_EQ(message_of<std::invalid_argument>([&] { model.interpolate(short_f, 1, xi, out); }),
             "ShellModel::interpolate: u has 3 entries; expected num_dofs() = " + std::to_string(dofs));
-  EXPECT_EQ(invalid_argument_of([&] { model.interpolate(f, 4, xi, out); }),
+  EXPECT_EQ(message_of<std::invalid_argument>([&] { model.interpolate(f, 4, xi, out); }),
             "ShellModel::interpolate: element 4 is out of range; expected 0..3 (mesh().num_elements() = 4)");
-  EXPECT_NE(invalid_argument_of([&] { model.interpolate(f, -1, xi, out); }), "");
-  EXPECT_NE(invalid_argument_of([&] { model.add_point_force(7, xi, force, f); }), "");
-  EXPECT_NE(invalid_argument_of([&] { model.add_point_force(1, xi, force, short_f); }), "");
-  EXPECT_NE(invalid_argument_of([&] { model.add_gravity(force, short_f); }), "");
-  EXPECT_NE(invalid_argument_of([&] { model.add_area_force(force, short_f); }), "");
+  EXPECT_NE(message_of<std::invalid_argument>([&] { model.interpolate(f, -1, xi, out); }), "");
+  EXPECT_NE(message_of<std::invalid_argument>([&] { model.add_point_force(7, xi, force, f); }), "");
+  EXPECT_NE(message_of<std::invalid_argument>([&] { model.add_point_force(1, xi, force, short_f); }), "");
+  EXPECT_NE(message_of<std::invalid_argument>([&] { model.add_gravity(force, short_f); }), "");
+  EXPECT_NE(message_of<std::invalid_argument>([&] { model.add_area_force(force, short_f); }), "");
 
   // Valid calls: a unit point force at the centre of element 1 adds up to 1 over its basis.
-  EXPECT_EQ(invalid_argument_of([&] { model.add_point_force(1, xi, force, f); }), "");
+  EXPECT_EQ(message_of<std::invalid_argument>([&] { model.add_point_force(1, xi, force, f); }), "");
   double total_z = 0;
   for (int d = 2; d < dofs; d += 3) total_z += f[d];
   EXPECT_NEAR(total_z, 1.0, 1e-12);
-  EXPECT_EQ(invalid_argument_of([&] { model.interpolate(f, 3, xi, out); }), "");
+  EXPECT_EQ(message_of<std::invalid_argument>([&] { model.interpolate(f, 3, xi, out); }), "");
 }
 
 TEST(ApiArgumentChecks, ShellSimulationChecksItsVectorsAndTimeStep) {
@@ -70,16 +62,16 @@ TEST(ApiArgumentChecks, ShellSimulationChecksItsVectorsAndTimeStep) {
   const Mesh mesh = build_scene_mesh(scene);
   const SceneModel built = build_scene_model(scene, mesh);
   const int dofs = built.model->num_dofs();
-  EXPECT_EQ(invalid_argument_of([&] { ShellSimulation(*built.model, std::vector<char>(5), built.external_force); }),
+  EXPECT_EQ(message_of<std::invalid_argument>([&] { ShellSimulation(*built.model, std::vector<char>(5), built.external_force); }),
             "ShellSimulation: fixed has 5 entries; expected model.num_dofs() = " + std::to_string(dofs));
-  EXPECT_NE(invalid_argument_of([&] { ShellSimulation(*built.model, built.fixed, {}); }), "");
+  EXPECT_NE(message_of<std::invalid_argument>([&] { ShellSimulation(*built.model, built.fixed, {}); }), "");
 
   ShellSimulation simulation(*built.model, built.fixed, built.external_force);
-  EXPECT_NE(invalid_argument_of([&] { simulation.set_state(std::vector<double>(dofs), {}); }), "");
+  EXPECT_NE(message_of<std::invalid_argument>([&] { simulation.set_state(std::vector<double>(dofs), {}); }), "");
   DynamicsOptions options;
   for (double dt : {0.0, -0.005, std::nan("")}) {
     options.time_step = dt;
-    EXPECT_NE(invalid_argument_of([&] { simulation.step(options); }).find("is not a positive finite time"),
+    EXPECT_NE(message_of<std::invalid_argument>([&] { simulation.step(options); }).find("is not a positive finite time"),
               std::string::npos)
         << dt;
   }
@@ -98,7 +90,7 @@ TEST(ApiArgumentChecks, ShellModelChecksItsMeshTopologySectionsAndOptions) {
   const std::vector<kernels::ShellSection> sections(4, steel);
   const auto model_error = [&](Mesh m, const Topology& t, std::vector<kernels::ShellSection> s, std::vector<int> clamped,
                                ShellModelOptions options) {
-    return invalid_argument_of([&] { ShellModel(std::move(m), t, std::move(s), clamped, options); });
+    return message_of<std::invalid_argument>([&] { ShellModel(std::move(m), t, std::move(s), clamped, options); });
   };
   EXPECT_EQ(model_error(mesh, topology, sections, {0, 7}, {}), "");
 
@@ -156,7 +148,7 @@ TEST(ApiArgumentChecks, CutManagerUpdatesToFiniteTimesOnly) {
   EnrichmentOptions options;
   options.texture_resolution = 32;
   CutManager cuts(mesh, build_topology(mesh), {cut}, options);
-  EXPECT_NE(invalid_argument_of([&] { cuts.update(std::nan("")); }).find("is not finite"), std::string::npos);
+  EXPECT_NE(message_of<std::invalid_argument>([&] { cuts.update(std::nan("")); }).find("is not finite"), std::string::npos);
   EXPECT_TRUE(cuts.update(0.0));
   EXPECT_EQ(cuts.functions().size(), 1u);
 }

@@ -5,11 +5,11 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
-#include <functional>
 #include <string>
 
 #include "dgtex/png_io.h"
 #include "dgtex/shell_state.h"
+#include "exception_message_support.h"
 #include "render_fixtures.h"
 
 namespace dgtex {
@@ -17,15 +17,6 @@ namespace {
 
 std::string temp_path(const std::string& name) {
   return (std::filesystem::path(::testing::TempDir()) / ("dgtex_render_state_io_" + name)).string();
-}
-
-std::string error_of(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const std::exception& e) {
-    return e.what();
-  }
-  return "";
 }
 
 TEST(RenderStateIo, RoundTripIsExact) {
@@ -63,13 +54,13 @@ TEST(RenderStateIo, EmptyDisplacementStaysEmpty) {
 
 TEST(RenderStateIo, ErrorsNameTheFileAndTheProblem) {
   const std::string missing = temp_path("does_not_exist.state");
-  EXPECT_NE(error_of([&] { load_state(missing); }).find(missing), std::string::npos);
+  EXPECT_NE(test::message_of([&] { load_state(missing); }).find(missing), std::string::npos);
 
   const std::string path = temp_path("broken.state");
   save_state(path, test::straight_cut_plate().state);
   const auto size = std::filesystem::file_size(path);
   std::filesystem::resize_file(path, size - 10);
-  const std::string truncated = error_of([&] { load_state(path); });
+  const std::string truncated = test::message_of([&] { load_state(path); });
   EXPECT_NE(truncated.find(path), std::string::npos);
   EXPECT_NE(truncated.find("truncated"), std::string::npos) << truncated;
 
@@ -82,25 +73,25 @@ TEST(RenderStateIo, ErrorsNameTheFileAndTheProblem) {
     file.seekp(16);
     file.write(reinterpret_cast<const char*>(&nodes), sizeof nodes);
   }
-  const std::string damaged = error_of([&] { load_state(path); });
+  const std::string damaged = test::message_of([&] { load_state(path); });
   EXPECT_NE(damaged.find("truncated or damaged: positions need 24000000000 bytes"), std::string::npos) << damaged;
 
   {
     std::ofstream out(path, std::ios::binary);
     out << "not a state file at all";
   }
-  EXPECT_NE(error_of([&] { load_state(path); }).find("bad magic"), std::string::npos);
+  EXPECT_NE(test::message_of([&] { load_state(path); }).find("bad magic"), std::string::npos);
 
   ShellState bad = test::straight_cut_plate().state;
   bad.enrichments[0].element = 7;
-  const std::string invalid = error_of([&] { save_state(path, bad); });
+  const std::string invalid = test::message_of([&] { save_state(path, bad); });
   EXPECT_NE(invalid.find("enrichments[0].element = 7"), std::string::npos) << invalid;
   bad = test::straight_cut_plate().state;
   bad.enrichments[0].values.pop_back();
-  EXPECT_NE(error_of([&] { save_state(path, bad); }).find("enrichments[0].values"), std::string::npos);
+  EXPECT_NE(test::message_of([&] { save_state(path, bad); }).find("enrichments[0].values"), std::string::npos);
   bad = test::straight_cut_plate().state;
   bad.mesh.elements[3] = 1000;
-  EXPECT_NE(error_of([&] { save_state(path, bad); }).find("mesh.elements[3] = 1000"), std::string::npos);
+  EXPECT_NE(test::message_of([&] { save_state(path, bad); }).find("mesh.elements[3] = 1000"), std::string::npos);
   std::remove(path.c_str());
 }
 
@@ -114,10 +105,10 @@ TEST(RenderStateIo, PngRoundTripIsExact) {
   EXPECT_EQ(back.height, 5);
   EXPECT_EQ(back.rgba, image.rgba);
   std::remove(path.c_str());
-  EXPECT_NE(error_of([&] { read_png(path); }).find(path), std::string::npos);
+  EXPECT_NE(test::message_of([&] { read_png(path); }).find(path), std::string::npos);
   Image wrong(3, 3);
   wrong.rgba.pop_back();
-  EXPECT_NE(error_of([&] { write_png(path, wrong); }).find("expected width * height * 4"), std::string::npos);
+  EXPECT_NE(test::message_of([&] { write_png(path, wrong); }).find("expected width * height * 4"), std::string::npos);
 }
 
 TEST(RenderStateIo, PngWiderThanTheLimitIsRefusedBeforeDecoding) {
@@ -129,7 +120,7 @@ TEST(RenderStateIo, PngWiderThanTheLimitIsRefusedBeforeDecoding) {
       0xff, 0x7d, 0xf9, 0x00, 0x00, 0x00, 0x00, 0x49, 0x45, 0x4e, 0x44, 0xae, 0x42, 0x60, 0x82};
   const std::string path = temp_path("wide.png");
   std::ofstream(path, std::ios::binary).write(reinterpret_cast<const char*>(wide), sizeof wide);
-  const std::string message = error_of([&] { read_png(path); });
+  const std::string message = test::message_of([&] { read_png(path); });
   EXPECT_NE(message.find(path + "': 20000 x 1 pixels; at most 16384 x 16384 are read"), std::string::npos) << message;
   std::remove(path.c_str());
 }
