@@ -12,6 +12,7 @@
 #include "dgtex/kernels/threads_busy_beside.h"
 #include "dgtex/model_error.h"
 #include "dgtex/scene_model.h"
+#include "dgtex/texel_memory_estimate.h"
 #include "dgtex/topology.h"
 
 namespace dgtex {
@@ -44,6 +45,12 @@ SceneRun::SceneRun(const Scene& scene, SceneRunOptions options)
       ScopedStage stage(timings_, "enrichment");
       if (!scene_.cuts.empty()) {
         cuts_ = std::make_unique<CutManager>(mesh_, topology_, scene_.cuts, scene_.enrichment);
+        // Before the first tile is allocated: a scene whose texel fields cannot fit is
+        // refused with one line rather than killed by the system later.
+        const bool direct_solves =
+            mesh_.type == ElementType::tri6 || scene_.enrichment.solver == EnrichmentOptions::Solver::cholmod;
+        check_texel_memory(cuts_->full_footprint(), mesh_.type, direct_solves, available_memory_bytes(),
+                           scene_.source_name.empty() ? "scene" : scene_.source_name);
         cuts_->update(0.0);
       }
       creases_ = build_crease_functions(mesh_, topology_, scene_.creases, scene_.enrichment.texture_resolution);

@@ -2,12 +2,14 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cstdint>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <string>
 
 #include "cli_test_support.h"
+#include "dgtex/texel_memory_estimate.h"
 
 namespace fs = std::filesystem;
 
@@ -90,6 +92,18 @@ TEST(CliRun, BadInputExitsWithCodeTwoAndOneLine) {
   accordion["analysis"]["steps"] = 1;
   accordion.erase("render");
   expect_rejected("clusters", accordion.dump(), "enrichment.rotation_cluster_texels");
+}
+
+// fracture.json at T = 4096: at least 370 GB of texel fields (dgtex/texel_memory_estimate.h).
+// Without the check the system killed such a run minutes in; now one line, at once.
+TEST(CliRun, CutsWhoseTexelFieldsCannotFitAreRefusedNamingTheResolution) {
+  if (dgtex::available_memory_bytes() > std::int64_t{300} * 1000 * 1000 * 1000)
+    GTEST_SKIP() << "this machine may have the memory for T = 4096";
+  nlohmann::json fracture;
+  std::ifstream(std::string(DGTEX_SOURCE_DIR) + "/examples/scenes/fracture.json") >> fracture;
+  fracture["enrichment"]["texture_resolution"] = 4096;
+  expect_rejected("texel_memory", fracture.dump(),
+                  "enrichment.texture_resolution: the cuts' texel fields need at least");
 }
 
 TEST(CliRun, AnOutputFolderThatCannotBeCreatedIsRefusedBeforeTheScene) {

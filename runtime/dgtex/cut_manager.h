@@ -65,6 +65,15 @@ struct EnrichmentSegment {
   double begin = 0, end = 0;  // visible arc range (rest length)
 };
 
+// How many T x T texel fields the cuts need once wholly visible (every segment at its full
+// length), known from the traced paths before any tile exists: a scene's enrichment memory
+// grows with this count times T^2 (texel_memory_estimate.h).
+struct CutTexelFootprint {
+  int resolution = 0;                        // T
+  int segments = 0;                          // all segments of all cuts
+  std::int64_t segment_region_elements = 0;  // sum over segments of |Omega_i| (a field each)
+};
+
 struct CutUpdateStats {
   double ms = 0;        // the whole update
   double solve_ms = 0;  // Laplace solves only
@@ -100,6 +109,11 @@ class CutManager {
   // Per cut the segment boundaries 0 = b_0 < ... < b_n = length (all segments, visible or not).
   const std::vector<std::vector<double>>& segment_boundaries() const { return boundaries_; }
   int total_segments() const;
+  // The fields every segment at its full length needs (from the paths; no update needed).
+  // A segment's region Omega_i is taken from the elements its path passes through, which
+  // may count a few more than the update's (fracture at T = 32: 296 against 284; a path
+  // grazing an element leaves no texel data there).
+  CutTexelFootprint full_footprint() const;
   // Walls of all visible cuts in every element they touch (inactive tri6 texels flagged).
   const std::map<int, kernels::TexelTile>& wall_tiles() const { return walls_; }
   const MeshEdgeWalls& edge_walls() const { return edge_walls_; }

@@ -1,0 +1,91 @@
+#include "dgtex/texel_memory_estimate.h"
+
+#include <algorithm>
+#include <cstdio>
+#include <fstream>
+#include <sstream>
+
+#include "dgtex/scene_io.h"
+
+namespace dgtex {
+namespace {
+
+std::int64_t active_texels_per_tile(ElementType type, int resolution) {
+  const std::int64_t t = resolution;
+  return type == ElementType::tri6 ? t * (t + 1) / 2 : t * t;
+}
+
+// "key: value kB" of /proc/meminfo in bytes; -1 when missing.
+std::int64_t meminfo_bytes(const std::string& text, const std::string& key) {
+  const std::size_t at = text.find("\n" + key + ":");
+  if (at == std::string::npos) return -1;
+  long long kib = -1;
+  if (std::sscanf(text.c_str() + at + key.size() + 2, "%lld", &kib) != 1) return -1;
+  return static_cast<std::int64_t>(kib) * 1024;
+}
+
+// A number in a file (a cgroup's limit or usage); -1 for "max", a missing file or text.
+std::int64_t file_number(const char* path) {
+  std::ifstream file(path);
+  long long value = -1;
+  if (!(file >> value)) return -1;
+  return value;
+}
+
+std::string gigabytes(std::int64_t bytes) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.1f GB", static_cast<double>(bytes) / 1e9);
+  return text;
+}
+
+}  // namespace
+
+std::int64_t texel_memory_lower_bound(const CutTexelFootprint& footprint, ElementType type, bool direct_solves) {
+  const std::int64_t texels = footprint.segment_region_elements * active_texels_per_tile(type, footprint.resolution);
+  return texels * (direct_solves ? kDirectSolveBytesPerTexel : kMultigridBytesPerTexel);
+}
+
+std::int64_t available_memory_bytes() {
+  std::ifstream meminfo("/proc/meminfo");
+  if (!meminfo) return -1;
+  std::stringstream text;
+  text << "\n" << meminfo.rdbuf();
+  const std::int64_t available = meminfo_bytes(text.str(), "MemAvailable");
+  if (available < 0) return -1;
+  std::int64_t bytes = available + std::max<std::int64_t>(0, meminfo_bytes(text.str(), "SwapFree"));
+  // A container's limit (the cgroup's) can be far below the host's memory. v1 reports "no
+  // limit" as a number near 2^63.
+  const std::int64_t no_limit = std::int64_t{1} << 60;
+  for (const auto& [limit_file, usage_file] : {std::pair{"/sys/fs/cgroup/memory.max", "/sys/fs/cgroup/memory.current"},
+                                                 std::pair{"/sys/fs/cgroup/memory/memory.limit_in_bytes",
+                                                           "/sys/fs/cgroup/memory/memory.usage_in_bytes"}}) {
+    const std::int64_t limit = file_number(limit_file), usage = file_number(usage_file);
+    if (limit > 0 && limit < no_limit && usage >= 0) bytes = std::min(bytes, std::max<std::int64_t>(0, limit - usage));
+  }
+  return bytes;
+}
+
+void check_texel_memory(const CutTexelFootprint& footprint, ElementType type, bool direct_solves,
+                        std::int64_t available_bytes, const std::string& source_name) {
+  if (available_bytes < 0) return;
+  const std::int64_t needed = texel_memory_lower_bound(footprint, type, direct_solves);
+  if (needed <= available_bytes) return;
+  int fitting = 0;  // the largest power of two below T whose bound fits
+  for (int t = footprint.resolution / 2; t >= 8 && fitting == 0; t /= 2) {
+    CutTexelFootprint smaller = footprint;
+    smaller.resolution = t;
+    if (texel_memory_lower_bound(smaller, type, direct_solves) <= available_bytes) fitting = t;
+  }
+  const std::string problem =
+      "the cuts' texel fields need at least " + gigabytes(needed) + " (" + std::to_string(footprint.segments) +
+      " cut segments over " + std::to_string(footprint.segment_region_elements) + " element regions of " +
+      std::to_string(footprint.resolution) + " x " + std::to_string(footprint.resolution) + " texels, " +
+      std::to_string(direct_solves ? kDirectSolveBytesPerTexel : kMultigridBytesPerTexel) + " bytes a texel with " +
+      (direct_solves ? "direct" : "multigrid") + " Laplace solves), more than the " + gigabytes(available_bytes) +
+      " of memory available";
+  const std::string valid = fitting > 0 ? "expected " + std::to_string(fitting) + " or less (the most that could fit on this machine)"
+                                        : "no texture_resolution fits on this machine; fewer or shorter cuts";
+  throw SceneError(source_name, "enrichment.texture_resolution", problem, std::to_string(footprint.resolution), valid);
+}
+
+}  // namespace dgtex
