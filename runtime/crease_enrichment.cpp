@@ -89,44 +89,65 @@ kernels::TexelTile crease_distance_tile(const Mesh& mesh, int element, int resol
   return tile;
 }
 
-}  // namespace
+// A crease traced across the mesh: its polyline, N_i and Omega_i (sorted).
+struct CreaseRegion {
+  std::vector<Vec3> line;
+  std::vector<int> nodes, elements;
+};
 
-std::vector<EnrichmentFunction> build_crease_functions(const Mesh& mesh, const Topology& topology,
-                                                       const std::vector<Cut>& creases, int resolution) {
-  std::vector<EnrichmentFunction> functions;
-  if (creases.empty()) return functions;
+// Traces every crease (one search for all) and finds its region.
+std::vector<CreaseRegion> crease_regions(const Mesh& mesh, const Topology& topology, const std::vector<Cut>& creases,
+                                         int resolution) {
+  std::vector<CreaseRegion> regions;
+  if (creases.empty()) return regions;
   const ElementAdjacency adjacency(mesh, topology);
   const int npe = mesh.nodes_per_element();
   std::vector<std::vector<int>> node_elements(mesh.num_nodes());
   for (int e = 0; e < mesh.num_elements(); ++e)
     for (int a = 0; a < npe; ++a) node_elements[mesh.element_nodes(e)[a]].push_back(e);
-  const double scale = 1.0 / (4.0 * cut_point_tolerance(mesh));  // 1 / mean element edge length
-  const SurfacePointSearch search(mesh);  // one for all creases
-
+  const SurfacePointSearch search(mesh);
   for (std::size_t c = 0; c < creases.size(); ++c) {
     const std::string name = "creases[" + std::to_string(c) + "]";
     const MeshCutPath path = trace_cut_path(mesh, search, adjacency, creases[c], resolution, name);
-    std::set<int> touched;
-    std::vector<Vec3> line;
-    for (std::size_t v = 0; v < path.vertices.size(); ++v) {
-      const CutPathVertex& p = path.vertices[v];
-      line.push_back(p.position);
-      if (v == 0) continue;
-      const CutPathVertex& q = path.vertices[v - 1];
-      if (q.element == p.element && (q.xi[0] != p.xi[0] || q.xi[1] != p.xi[1])) touched.insert(p.element);
-    }
+    const std::vector<int> touched = elements_passed_through(path.vertices);
     if (touched.empty())
       throw std::invalid_argument(name + ": the crease passes through no element (zero length on the surface)");
     std::set<int> nodes, omega;
     for (int e : touched)
       for (int a = 0; a < npe; ++a) nodes.insert(mesh.element_nodes(e)[a]);
     for (int n : nodes) omega.insert(node_elements[n].begin(), node_elements[n].end());
+    CreaseRegion region;
+    for (const CutPathVertex& v : path.vertices) region.line.push_back(v.position);
+    region.nodes.assign(nodes.begin(), nodes.end());
+    region.elements.assign(omega.begin(), omega.end());
+    regions.push_back(std::move(region));
+  }
+  return regions;
+}
+
+}  // namespace
+
+std::vector<EnrichmentFunction> build_crease_functions(const Mesh& mesh, const Topology& topology,
+                                                       const std::vector<Cut>& creases, int resolution) {
+  const double scale = 1.0 / (4.0 * cut_point_tolerance(mesh));  // 1 / mean element edge length
+  std::vector<EnrichmentFunction> functions;
+  for (const CreaseRegion& region : crease_regions(mesh, topology, creases, resolution)) {
     EnrichmentFunction f;
-    f.enriched_nodes.assign(nodes.begin(), nodes.end());
-    for (int e : omega) f.elements.push_back({e, crease_distance_tile(mesh, e, resolution, line, scale)});
+    f.enriched_nodes = region.nodes;
+    for (int e : region.elements) f.elements.push_back({e, crease_distance_tile(mesh, e, resolution, region.line, scale)});
     functions.push_back(std::move(f));
   }
   return functions;
+}
+
+TexelFootprint crease_footprint(const Mesh& mesh, const Topology& topology, const std::vector<Cut>& creases,
+                                int resolution) {
+  TexelFootprint footprint;
+  for (const CreaseRegion& region : crease_regions(mesh, topology, creases, resolution)) {
+    footprint.region_elements += static_cast<std::int64_t>(region.elements.size());
+    ++footprint.fields;
+  }
+  return footprint;
 }
 
 }  // namespace dgtex

@@ -186,19 +186,16 @@ int CutManager::total_segments() const {
   return n;
 }
 
-CutTexelFootprint CutManager::full_footprint() const {
-  CutTexelFootprint footprint;
-  footprint.resolution = resolution_;
+TexelFootprint CutManager::full_footprint() const {
+  TexelFootprint footprint;
   for (std::size_t c = 0; c < boundaries_.size(); ++c)
     for (std::size_t k = 0; k + 1 < boundaries_[c].size(); ++k) {
-      std::set<int> crossed, omega;
-      for (const CutPathVertex& v : sub_path(paths_[c], boundaries_[c][k], boundaries_[c][k + 1]))
-        crossed.insert(v.element);
-      for (int e : crossed)
+      std::set<int> omega;
+      for (int e : elements_passed_through(sub_path(paths_[c], boundaries_[c][k], boundaries_[c][k + 1])))
         for (int a = 0; a < mesh_.nodes_per_element(); ++a)
           for (int f : node_elements_[mesh_.element_nodes(e)[a]]) omega.insert(f);
-      footprint.segment_region_elements += static_cast<std::int64_t>(omega.size());
-      ++footprint.segments;
+      footprint.region_elements += static_cast<std::int64_t>(omega.size());
+      ++footprint.fields;
     }
   return footprint;
 }

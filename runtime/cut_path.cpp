@@ -404,6 +404,17 @@ std::vector<CutPathVertex> sub_path(const MeshCutPath& path, double a, double b)
   return out;
 }
 
+std::vector<int> elements_passed_through(const std::vector<CutPathVertex>& vertices) {
+  std::vector<int> elements;
+  for (std::size_t v = 1; v < vertices.size(); ++v) {
+    const CutPathVertex &p = vertices[v - 1], &q = vertices[v];
+    if (p.element == q.element && (p.xi[0] != q.xi[0] || p.xi[1] != q.xi[1])) elements.push_back(q.element);
+  }
+  std::sort(elements.begin(), elements.end());
+  elements.erase(std::unique(elements.begin(), elements.end()), elements.end());
+  return elements;
+}
+
 bool insert_path_vertex(MeshCutPath& path, double s, int element) {
   auto& v = path.vertices;
   const double eps = 1e-12 * std::max(1.0, path.length());

@@ -43,16 +43,19 @@ SceneRun::SceneRun(const Scene& scene, SceneRunOptions options)
   if (!scene_.cuts.empty() || !scene_.creases.empty()) {
     {
       ScopedStage stage(timings_, "enrichment");
-      if (!scene_.cuts.empty()) {
+      if (!scene_.cuts.empty())
         cuts_ = std::make_unique<CutManager>(mesh_, topology_, scene_.cuts, scene_.enrichment);
-        // Before the first tile is allocated: a scene whose texel fields cannot fit is
-        // refused with one line rather than killed by the system later.
-        const bool direct_solves =
-            mesh_.type == ElementType::tri6 || scene_.enrichment.solver == EnrichmentOptions::Solver::cholmod;
-        check_texel_memory(cuts_->full_footprint(), mesh_.type, direct_solves, available_memory_bytes(),
-                           scene_.source_name.empty() ? "scene" : scene_.source_name);
-        cuts_->update(0.0);
-      }
+      // Before the first field is allocated: a scene whose texel fields cannot fit is
+      // refused with one line rather than killed by the system later.
+      TexelFields fields;
+      fields.type = mesh_.type;
+      fields.resolution = scene_.enrichment.texture_resolution;
+      fields.direct_solves =
+          mesh_.type == ElementType::tri6 || scene_.enrichment.solver == EnrichmentOptions::Solver::cholmod;
+      if (cuts_) fields.cuts = cuts_->full_footprint();
+      fields.creases = crease_footprint(mesh_, topology_, scene_.creases, fields.resolution);
+      check_texel_memory(fields, available_memory_bytes(), scene_.source_name.empty() ? "scene" : scene_.source_name);
+      if (cuts_) cuts_->update(0.0);
       creases_ = build_crease_functions(mesh_, topology_, scene_.creases, scene_.enrichment.texture_resolution);
     }
     if (cuts_) model_->set_cut_edge_texels(cuts_->edge_walls().resolution(), cuts_->edge_walls().flags(mesh_.num_elements()));

@@ -38,11 +38,14 @@ std::string gigabytes(std::int64_t bytes) {
   return text;
 }
 
+std::string count_of(int n, const std::string& noun) { return std::to_string(n) + " " + noun + (n == 1 ? "" : "s"); }
+
 }  // namespace
 
-std::int64_t texel_memory_lower_bound(const CutTexelFootprint& footprint, ElementType type, bool direct_solves) {
-  const std::int64_t texels = footprint.segment_region_elements * active_texels_per_tile(type, footprint.resolution);
-  return texels * (direct_solves ? kDirectSolveBytesPerTexel : kMultigridBytesPerTexel);
+std::int64_t texel_memory_lower_bound(const TexelFields& fields) {
+  const std::int64_t per_tile = active_texels_per_tile(fields.type, fields.resolution);
+  const std::int64_t cut_bytes = fields.direct_solves ? kDirectSolveBytesPerTexel : kFieldBytesPerTexel;
+  return per_tile * (fields.cuts.region_elements * cut_bytes + fields.creases.region_elements * kFieldBytesPerTexel);
 }
 
 std::int64_t available_memory_bytes() {
@@ -65,27 +68,32 @@ std::int64_t available_memory_bytes() {
   return bytes;
 }
 
-void check_texel_memory(const CutTexelFootprint& footprint, ElementType type, bool direct_solves,
-                        std::int64_t available_bytes, const std::string& source_name) {
+void check_texel_memory(const TexelFields& fields, std::int64_t available_bytes, const std::string& source_name) {
   if (available_bytes < 0) return;
-  const std::int64_t needed = texel_memory_lower_bound(footprint, type, direct_solves);
+  const std::int64_t needed = texel_memory_lower_bound(fields);
   if (needed <= available_bytes) return;
   int fitting = 0;  // the largest power of two below T whose bound fits
-  for (int t = footprint.resolution / 2; t >= 8 && fitting == 0; t /= 2) {
-    CutTexelFootprint smaller = footprint;
+  for (int t = fields.resolution / 2; t >= 8 && fitting == 0; t /= 2) {
+    TexelFields smaller = fields;
     smaller.resolution = t;
-    if (texel_memory_lower_bound(smaller, type, direct_solves) <= available_bytes) fitting = t;
+    if (texel_memory_lower_bound(smaller) <= available_bytes) fitting = t;
   }
-  const std::string problem =
-      "the cuts' texel fields need at least " + gigabytes(needed) + " (" + std::to_string(footprint.segments) +
-      " cut segments over " + std::to_string(footprint.segment_region_elements) + " element regions of " +
-      std::to_string(footprint.resolution) + " x " + std::to_string(footprint.resolution) + " texels, " +
-      std::to_string(direct_solves ? kDirectSolveBytesPerTexel : kMultigridBytesPerTexel) + " bytes a texel with " +
-      (direct_solves ? "direct" : "multigrid") + " Laplace solves), more than the " + gigabytes(available_bytes) +
-      " of memory available";
+  std::string what;
+  if (fields.cuts.fields > 0)
+    what = count_of(fields.cuts.fields, "cut segment") + " (" + std::to_string(fields.cuts.region_elements) +
+           " element regions, " + std::to_string(fields.direct_solves ? kDirectSolveBytesPerTexel : kFieldBytesPerTexel) +
+           " bytes a texel with " + (fields.direct_solves ? "direct" : "multigrid") + " Laplace solves)";
+  if (fields.creases.fields > 0)
+    what += (what.empty() ? "" : " and ") + count_of(fields.creases.fields, "crease") + " (" +
+            std::to_string(fields.creases.region_elements) + " element regions, " +
+            std::to_string(kFieldBytesPerTexel) + " bytes a texel)";
+  const std::string t = std::to_string(fields.resolution);
+  const std::string problem = "the texel fields of " + what + " at " + t + " x " + t + " texels an element need at least " +
+                              gigabytes(needed) + ", more than the " + gigabytes(available_bytes) +
+                              " of memory available";
   const std::string valid = fitting > 0 ? "expected " + std::to_string(fitting) + " or less (the most that could fit on this machine)"
-                                        : "no texture_resolution fits on this machine; fewer or shorter cuts";
-  throw SceneError(source_name, "enrichment.texture_resolution", problem, std::to_string(footprint.resolution), valid);
+                                        : "no texture_resolution fits on this machine; fewer or shorter cuts or creases";
+  throw SceneError(source_name, "enrichment.texture_resolution", problem, t, valid);
 }
 
 }  // namespace dgtex

@@ -103,7 +103,7 @@ TEST(CliRun, CutsWhoseTexelFieldsCannotFitAreRefusedNamingTheResolution) {
   std::ifstream(std::string(DGTEX_SOURCE_DIR) + "/examples/scenes/fracture.json") >> fracture;
   fracture["enrichment"]["texture_resolution"] = 4096;
   expect_rejected("texel_memory", fracture.dump(),
-                  "enrichment.texture_resolution: the cuts' texel fields need at least");
+                  "enrichment.texture_resolution: the texel fields of 5 cut segments");
 }
 
 TEST(CliRun, AnOutputFolderThatCannotBeCreatedIsRefusedBeforeTheScene) {

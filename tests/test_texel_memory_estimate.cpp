@@ -1,7 +1,7 @@
-// A scene whose cut enrichment cannot fit in memory is refused before its first tile is
+// A scene whose enrichment cannot fit in memory is refused before its first texel field is
 // allocated (dgtex/texel_memory_estimate.h): fracture.json at T = 4096 would need hundreds
-// of GB, and the system killed such a run minutes in. The footprint the bound counts comes
-// from the traced paths alone and is checked against the regions the update builds.
+// of GB, and the system killed such a run minutes in. The footprints the bound counts come
+// from the traced cuts and creases alone and are checked against the fields they build.
 #include <gtest/gtest.h>
 
 #include <cstdint>
@@ -9,6 +9,7 @@
 #include <sstream>
 #include <string>
 
+#include "dgtex/crease_enrichment.h"
 #include "dgtex/cut_manager.h"
 #include "dgtex/scene_io.h"
 #include "dgtex/scene_model.h"
@@ -26,82 +27,106 @@ Scene example_scene(const std::string& name) {
   return load_scene(std::string(DGTEX_SOURCE_DIR) + "/examples/scenes/" + name + ".json");
 }
 
-CutTexelFootprint footprint_of(int resolution, std::int64_t segment_region_elements) {
-  CutTexelFootprint footprint;
-  footprint.resolution = resolution;
-  footprint.segment_region_elements = segment_region_elements;
-  footprint.segments = 6;
-  return footprint;
+// fracture.json's cuts at T = 4096 (tri6, direct solves), and a crease.
+TexelFields fracture_like(int resolution) {
+  TexelFields fields;
+  fields.type = ElementType::tri6;
+  fields.resolution = resolution;
+  fields.direct_solves = true;
+  fields.cuts = {6, 284};
+  return fields;
 }
 
-TEST(TexelMemoryEstimate, LowerBoundIsBytesPerActiveTexelOfEverySegmentsRegion) {
-  const CutTexelFootprint footprint = footprint_of(256, 296);
-  EXPECT_EQ(texel_memory_lower_bound(footprint, ElementType::quad8, false), 296LL * 256 * 256 * kMultigridBytesPerTexel);
-  EXPECT_EQ(texel_memory_lower_bound(footprint, ElementType::quad8, true), 296LL * 256 * 256 * kDirectSolveBytesPerTexel);
+TEST(TexelMemoryEstimate, LowerBoundIsBytesPerActiveTexelOfEveryFieldsRegion) {
+  TexelFields fields = fracture_like(256);
   // tri6: the texels with i + j <= T - 1
-  EXPECT_EQ(texel_memory_lower_bound(footprint, ElementType::tri6, true), 296LL * 256 * 257 / 2 * kDirectSolveBytesPerTexel);
-  // no 32-bit overflow at the largest resolution
-  EXPECT_EQ(texel_memory_lower_bound(footprint_of(4096, 296), ElementType::quad8, false),
-            296LL * 4096 * 4096 * kMultigridBytesPerTexel);
+  EXPECT_EQ(texel_memory_lower_bound(fields), 284LL * 256 * 257 / 2 * kDirectSolveBytesPerTexel);
+  fields.type = ElementType::quad8;
+  EXPECT_EQ(texel_memory_lower_bound(fields), 284LL * 256 * 256 * kDirectSolveBytesPerTexel);
+  fields.direct_solves = false;
+  EXPECT_EQ(texel_memory_lower_bound(fields), 284LL * 256 * 256 * kFieldBytesPerTexel);
+  fields.creases = {1, 24};  // creases count as fields without a solve
+  EXPECT_EQ(texel_memory_lower_bound(fields), (284LL + 24) * 256 * 256 * kFieldBytesPerTexel);
+  fields.resolution = 4096;  // no 32-bit overflow
+  EXPECT_EQ(texel_memory_lower_bound(fields), (284LL + 24) * 4096 * 4096 * kFieldBytesPerTexel);
 }
 
-// The counts come from the elements the paths pass through; the update's own regions
-// (functions' Omega_i) may be a few elements fewer where a path only grazes an element.
+// The counts come from the paths alone; the update's own regions (its functions' Omega_i)
+// can hold an element less where a path grazes one (fracture 290 against 284, slinky 48
+// against 47): an over-count of at most a few per cent, inside the bound's margin (64 bytes
+// a texel against >= 84 measured).
 TEST(TexelMemoryEstimate, FootprintMatchesTheRegionsOfTheWholeCuts) {
   for (const std::string name : {"chad", "spiral6", "slinky", "fracture"}) {
     SCOPED_TRACE(name);
     const Scene scene = example_scene(name);
     const Mesh mesh = build_scene_mesh(scene);
     CutManager cuts(mesh, build_topology(mesh), scene.cuts, scene.enrichment);
-    const CutTexelFootprint footprint = cuts.full_footprint();
+    const TexelFootprint footprint = cuts.full_footprint();
     cuts.update(1e9);  // every cut whole
     ASSERT_TRUE(cuts.complete());
     std::int64_t region_elements = 0;
     for (const EnrichmentFunction& function : cuts.functions())
       region_elements += static_cast<std::int64_t>(function.elements.size());
-    EXPECT_EQ(footprint.resolution, scene.enrichment.texture_resolution);
-    EXPECT_EQ(footprint.segments, cuts.total_segments());
-    EXPECT_EQ(static_cast<int>(cuts.functions().size()), footprint.segments);  // each segment has a function here
-    EXPECT_GE(footprint.segment_region_elements, region_elements);
-    EXPECT_LE(footprint.segment_region_elements, region_elements * 105 / 100);
+    EXPECT_EQ(footprint.fields, cuts.total_segments());
+    EXPECT_EQ(static_cast<int>(cuts.functions().size()), footprint.fields);  // each segment has a function here
+    EXPECT_GE(footprint.region_elements, region_elements);
+    EXPECT_LE(footprint.region_elements, region_elements * 103 / 100);
   }
 }
 
-TEST(TexelMemoryEstimate, TooLittleMemoryIsASceneErrorNamingTheResolution) {
-  const CutTexelFootprint footprint = footprint_of(4096, 296);
-  const std::int64_t needed = texel_memory_lower_bound(footprint, ElementType::tri6, true);
-  EXPECT_NO_THROW(check_texel_memory(footprint, ElementType::tri6, true, needed, "f.json"));
-  EXPECT_NO_THROW(check_texel_memory(footprint, ElementType::tri6, true, -1, "f.json"));  // unknown: no check
+TEST(TexelMemoryEstimate, CreaseFootprintCountsTheTilesOfItsFunctions) {
+  const Scene scene = example_scene("crease");
+  Mesh mesh = build_scene_mesh(scene);
+  Scene finer = scene;  // 8 x 8 elements, the crease inside a column of them
+  finer.mesh.divisions = {8, 8};
+  finer.creases[0].points = {{0.45, 0, 0}, {0.45, 1, 0}};
+  for (const Scene& s : {scene, finer}) {
+    mesh = build_scene_mesh(s);
+    const Topology topology = build_topology(mesh);
+    const TexelFootprint footprint = crease_footprint(mesh, topology, s.creases, 32);
+    const std::vector<EnrichmentFunction> functions = build_crease_functions(mesh, topology, s.creases, 32);
+    ASSERT_EQ(footprint.fields, static_cast<int>(functions.size()));
+    EXPECT_EQ(footprint.region_elements, static_cast<std::int64_t>(functions[0].elements.size()));
+  }
+  EXPECT_EQ(crease_footprint(mesh, build_topology(mesh), finer.creases, 32).region_elements, 24);  // 3 columns of 8
+}
 
-  // 1 GB: T = 256 needs 296 x 32896 x 160 B = 1.56 GB, T = 128 0.39 GB.
+TEST(TexelMemoryEstimate, TooLittleMemoryIsASceneErrorNamingTheResolution) {
+  TexelFields fields = fracture_like(4096);
+  const std::int64_t needed = texel_memory_lower_bound(fields);
+  EXPECT_NO_THROW(check_texel_memory(fields, needed, "f.json"));
+  EXPECT_NO_THROW(check_texel_memory(fields, -1, "f.json"));  // unknown: no check
+
+  // 1 GB: T = 256 needs 284 x 32896 x 160 B = 1.49 GB, T = 128 0.38 GB.
   try {
-    check_texel_memory(footprint, ElementType::tri6, true, 1000000000, "f.json");
+    check_texel_memory(fields, 1000000000, "f.json");
     FAIL() << "no SceneError";
   } catch (const SceneError& e) {
     EXPECT_EQ(e.json_path(), "enrichment.texture_resolution");
-    const std::string message = e.what();
-    EXPECT_EQ(message.rfind("f.json: enrichment.texture_resolution: the cuts' texel fields need at least 397.4 GB "
-                            "(6 cut segments over 296 element regions of 4096 x 4096 texels, 160 bytes a texel "
-                            "with direct Laplace solves), more than the 1.0 GB of memory available",
-                            0),
-              0u)
-        << message;
-    EXPECT_NE(message.find("got 4096; expected 128 or less (the most that could fit on this machine)"),
-              std::string::npos)
-        << message;
+    EXPECT_EQ(std::string(e.what()),
+              "f.json: enrichment.texture_resolution: the texel fields of 6 cut segments (284 element regions, 160 "
+              "bytes a texel with direct Laplace solves) at 4096 x 4096 texels an element need at least 381.3 GB, "
+              "more than the 1.0 GB of memory available, got 4096; expected 128 or less (the most that could fit on "
+              "this machine)");
   }
-  const std::string none = message_of<SceneError>(
-      [&] { check_texel_memory(footprint, ElementType::quad8, false, 1000, "f.json"); });
-  EXPECT_NE(none.find("64 bytes a texel with multigrid Laplace solves"), std::string::npos) << none;
-  EXPECT_NE(none.find("no texture_resolution fits on this machine; fewer or shorter cuts"), std::string::npos) << none;
+  fields.type = ElementType::quad8;
+  fields.direct_solves = false;
+  fields.creases = {1, 24};
+  const std::string none = message_of<SceneError>([&] { check_texel_memory(fields, 1000, "f.json"); });
+  EXPECT_NE(none.find("the texel fields of 6 cut segments (284 element regions, 64 bytes a texel with multigrid "
+                      "Laplace solves) and 1 crease (24 element regions, 64 bytes a texel) at 4096 x 4096"),
+            std::string::npos)
+      << none;
+  EXPECT_NE(none.find("got 4096; no texture_resolution fits on this machine; fewer or shorter cuts or creases"),
+            std::string::npos)
+      << none;
 }
 
 TEST(TexelMemoryEstimate, AvailableMemoryIsPositiveAndAtMostWhatTheMachineHas) {
   std::ifstream meminfo("/proc/meminfo");
   if (!meminfo) GTEST_SKIP() << "no /proc/meminfo";
-  std::string key;
+  std::string key, unit;
   long long kib = 0, total = 0;
-  std::string unit;
   while (meminfo >> key >> kib) {
     if (key == "MemTotal:" || key == "SwapTotal:") total += kib * 1024;
     std::getline(meminfo, unit);
@@ -118,13 +143,34 @@ TEST(TexelMemoryEstimate, SceneRunRefusesCutsThatCannotFitBeforeItsFirstUpdate) 
   scene.enrichment.texture_resolution = 4096;
   const Mesh mesh = build_scene_mesh(scene);
   const CutManager cuts(mesh, build_topology(mesh), scene.cuts, scene.enrichment);
-  const std::int64_t needed = texel_memory_lower_bound(cuts.full_footprint(), mesh.type, true);
+  TexelFields fields = fracture_like(4096);
+  fields.cuts = cuts.full_footprint();
+  const std::int64_t needed = texel_memory_lower_bound(fields);
   if (available_memory_bytes() >= needed) GTEST_SKIP() << "this machine has the memory for T = 4096";
   const std::string message = message_of<SceneError>([&] { SceneRun run(scene); });
-  EXPECT_NE(message.find("fracture.json: enrichment.texture_resolution: the cuts' texel fields need at least"),
+  EXPECT_NE(message.find("fracture.json: enrichment.texture_resolution: the texel fields of " +
+                         std::to_string(fields.cuts.fields) + " cut segments"),
             std::string::npos)
       << message;
   EXPECT_NE(message.find("got 4096; expected"), std::string::npos) << message;
+}
+
+// The same for a crease (no cuts): 16 x 16 elements, the crease through a column of 16,
+// 48 regions, at least 51.5 GB at T = 4096.
+TEST(TexelMemoryEstimate, SceneRunRefusesCreasesThatCannotFitBeforeBuildingThem) {
+  Scene scene = example_scene("crease");
+  scene.mesh.divisions = {16, 16};
+  scene.creases[0].points = {{0.47, 0, 0}, {0.47, 1, 0}};
+  scene.enrichment.texture_resolution = 4096;
+  TexelFields fields;
+  fields.resolution = 4096;
+  fields.creases = {1, 48};
+  if (available_memory_bytes() >= texel_memory_lower_bound(fields)) GTEST_SKIP() << "this machine has the memory";
+  const std::string message = message_of<SceneError>([&] { SceneRun run(scene); });
+  EXPECT_NE(message.find("crease.json: enrichment.texture_resolution: the texel fields of 1 crease (48 element "
+                         "regions, 64 bytes a texel) at 4096 x 4096 texels an element need at least 51.5 GB"),
+            std::string::npos)
+      << message;
 }
 
 }  // namespace

@@ -32,6 +32,7 @@
 #include "dgtex/enrichment_function.h"
 #include "dgtex/mesh.h"
 #include "dgtex/scene.h"
+#include "dgtex/texel_memory_estimate.h"
 #include "dgtex/topology.h"
 
 namespace dgtex {
@@ -41,5 +42,10 @@ namespace dgtex {
 // trace_cut_path) or one that passes through no element with positive length.
 std::vector<EnrichmentFunction> build_crease_functions(const Mesh& mesh, const Topology& topology,
                                                        const std::vector<Cut>& creases, int resolution);
+
+// The fields build_crease_functions would make (one per crease, a tile on each element of
+// its Omega_i), from the traced creases alone (texel_memory_estimate.h). Throws as it does.
+TexelFootprint crease_footprint(const Mesh& mesh, const Topology& topology, const std::vector<Cut>& creases,
+                                int resolution);
 
 }  // namespace dgtex

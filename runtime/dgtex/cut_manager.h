@@ -48,6 +48,7 @@
 #include "dgtex/mesh.h"
 #include "dgtex/mesh_texel_laplace.h"
 #include "dgtex/scene.h"
+#include "dgtex/texel_memory_estimate.h"
 #include "dgtex/topology.h"
 
 namespace dgtex {
@@ -63,15 +64,6 @@ struct EnrichmentSegment {
   int cut = -1;      // index into the scene's cuts
   int segment = -1;  // segment index along that cut
   double begin = 0, end = 0;  // visible arc range (rest length)
-};
-
-// How many T x T texel fields the cuts need once wholly visible (every segment at its full
-// length), known from the traced paths before any tile exists: a scene's enrichment memory
-// grows with this count times T^2 (texel_memory_estimate.h).
-struct CutTexelFootprint {
-  int resolution = 0;                        // T
-  int segments = 0;                          // all segments of all cuts
-  std::int64_t segment_region_elements = 0;  // sum over segments of |Omega_i| (a field each)
 };
 
 struct CutUpdateStats {
@@ -109,11 +101,11 @@ class CutManager {
   // Per cut the segment boundaries 0 = b_0 < ... < b_n = length (all segments, visible or not).
   const std::vector<std::vector<double>>& segment_boundaries() const { return boundaries_; }
   int total_segments() const;
-  // The fields every segment at its full length needs (from the paths; no update needed).
-  // A segment's region Omega_i is taken from the elements its path passes through, which
-  // may count a few more than the update's (fracture at T = 32: 296 against 284; a path
-  // grazing an element leaves no texel data there).
-  CutTexelFootprint full_footprint() const;
+  // The fields of every segment at its full length (texel_memory_estimate.h), from the
+  // paths alone, before any update: Omega_i from the elements the segment's path passes
+  // through with positive length. The update's E_i are those holding texel data, which
+  // can lack an element the path grazes (fracture at T = 32: 290 here against 284).
+  TexelFootprint full_footprint() const;
   // Walls of all visible cuts in every element they touch (inactive tri6 texels flagged).
   const std::map<int, kernels::TexelTile>& wall_tiles() const { return walls_; }
   const MeshEdgeWalls& edge_walls() const { return edge_walls_; }

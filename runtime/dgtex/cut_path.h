@@ -86,6 +86,10 @@ void element_surface_point(const Mesh& mesh, int element, const double xi[2], Ve
 // their element, vertices at exactly a or b are kept).
 std::vector<CutPathVertex> sub_path(const MeshCutPath& path, double a, double b);
 
+// The elements holding a piece of positive length of the path (consecutive vertices in the
+// element at different xi), sorted; an element the path only touches at a point is not one.
+std::vector<int> elements_passed_through(const std::vector<CutPathVertex>& vertices);
+
 // Inserts a vertex at arc length s on the path's segment inside `element` (no change if a
 // vertex of that element is already there, within 1e-12 of the length). Returns false if
 // the path has no segment in `element` at s.
