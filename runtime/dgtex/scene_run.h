@@ -55,9 +55,10 @@ class SceneRun {
   // Builds everything and brings the cuts to time 0. The run keeps a copy of `scene`
   // (SceneRun(load_scene(path)) is fine). A scene built in code is checked as a scene file
   // is (validate_scene).
-  // Throws MeshError / SceneError (bad mesh or scene; also cuts whose texel fields cannot
-  // fit in the memory available, dgtex/texel_memory_estimate.h), std::invalid_argument (a
-  // cut the mesh cannot take, naming cuts[i]), ModelError (statically unconstrained model).
+  // Throws MeshError / SceneError (bad mesh or scene; also cuts and creases whose texel
+  // fields cannot fit in the memory available, dgtex/texel_memory_estimate.h),
+  // std::invalid_argument (a cut or crease the mesh cannot take, naming cuts[i] or
+  // creases[i]), ModelError (statically unconstrained model).
   explicit SceneRun(const Scene& scene, SceneRunOptions options = {});
   ~SceneRun();
 

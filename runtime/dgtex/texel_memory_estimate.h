@@ -1,7 +1,7 @@
 #pragma once
 // Will a scene's enrichment fit in memory? Its texel fields grow with T^2 times the elements
 // around the cuts and creases (per cut segment and per crease, a T x T field on every
-// element of its region Omega_i): fracture.json's 280 segment regions take 1.9 GB at
+// element of its region Omega_i): fracture.json's ~280 segment regions take 1.9 GB at
 // T = 256 and 8.9 GB at 512, and at T = 1024 the process outgrew a 23 GB machine and the
 // system killed it, minutes in and without a word. SceneRun checks a lower bound of that
 // memory before the first field is allocated and refuses such a scene with one line (a
