@@ -47,6 +47,11 @@ AccuracyChart run_rotation_accuracy(const RotationAccuracyOptions& options, cons
   const Scene base = load_scene(options.scene);
   if (!base.analysis.is_dynamic() || !base.analysis.corotational)
     throw std::invalid_argument("rotation accuracy: " + options.scene + " is not a dynamic corotated scene");
+  // Clusters group the points of enriched elements only: without cuts every block size
+  // gives the per-point run itself (error 0, which the log-scale chart cannot draw).
+  if (base.cuts.empty())
+    throw std::invalid_argument("rotation accuracy: " + options.scene +
+                                " has no cuts; rotation clusters group the quadrature points of cut elements");
   AccuracyChart chart;
   chart.name = "rotation";
   chart.title = "rotation clusters of enriched elements against time";

@@ -17,10 +17,13 @@ struct CliResult {
   std::string stderr_text;
 };
 
-// Runs `dgtex ARGS` (stdout discarded), keeping stderr in WORKDIR/stderr.txt.
-inline CliResult run_cli(const std::string& args, const std::filesystem::path& workdir) {
+// Runs `dgtex ARGS` (stdout discarded), keeping stderr in WORKDIR/stderr.txt; ENVIRONMENT
+// ("NAME=value ...", shell words) is set for that command only.
+inline CliResult run_cli(const std::string& args, const std::filesystem::path& workdir,
+                         const std::string& environment = "") {
   const std::filesystem::path err = workdir / "stderr.txt";
-  const std::string command = std::string(DGTEX_CLI) + " " + args + " 2> " + err.string() + " > /dev/null";
+  const std::string command =
+      environment + " " + std::string(DGTEX_CLI) + " " + args + " 2> " + err.string() + " > /dev/null";
   const int status = std::system(command.c_str());
   std::ifstream in(err);
   return {WEXITSTATUS(status), std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>())};

@@ -193,6 +193,11 @@ TEST(BenchAccuracyArguments, BadValuesAreRejectedWithExitCode2) {
                                      " 2>/dev/null").c_str())), 2);
   EXPECT_EQ(WEXITSTATUS(std::system((cli + " bench accuracy --charts texture --texture-sizes 8 --out " + out +
                                      " 2>/dev/null").c_str())), 2);
+  // Rotation clusters need cuts: a scene without gave error 0 everywhere, and the log-scale
+  // chart then failed as if gnuplot were missing (exit code 1).
+  EXPECT_EQ(WEXITSTATUS(std::system((cli + " bench accuracy --charts rotation --rotation-scene " + DGTEX_SOURCE_DIR +
+                                     "/examples/scenes/cylinder_buckling.json --out " + out + " 2>/dev/null").c_str())),
+            2);
   fs::remove_all(out);
 }
 

@@ -121,6 +121,33 @@ TEST(BenchShellCli, JsonHasEveryThreadCountTheSameStateAndTheMachine) {
   EXPECT_EQ(j["speedups"].size(), 1u);
 }
 
+// A chart gnuplot cannot draw ends the command with exit code 1 and the reason: gnuplot
+// missing from PATH, or gnuplot's own error line (all said "is gnuplot installed?" before,
+// and bench shell, laplace and render exited 0 without their chart).
+TEST(BenchShellCli, AChartGnuplotCannotDrawExitsWithOneAndSaysWhy) {
+  const fs::path dir = fresh_dir("dgtex_bench_shell", "chart");
+  const fs::path bin = dir / "bin";
+  fs::create_directories(bin);
+  const std::string args = "bench shell --scene " + std::string(DGTEX_SOURCE_DIR) +
+                           "/examples/scenes/cylinder_buckling.json --steps 1 --threads-list 1 --gemm-size 16 --chart " +
+                           (dir / "chart.png").string();
+  const auto missing = run_cli(args, dir, "PATH=" + bin.string());
+  EXPECT_EQ(missing.exit_code, 1) << missing.stderr_text;
+  EXPECT_NE(missing.stderr_text.find("no chart '" + (dir / "chart.png").string() +
+                                     "': gnuplot is not installed (Debian: apt-get install gnuplot-nox)"),
+            std::string::npos)
+      << missing.stderr_text;
+  // A gnuplot that fails as the real one does on a script it cannot plot.
+  std::ofstream(bin / "gnuplot") << "#!/bin/sh\necho '    plot x' >&2\necho '         ^' >&2\n"
+                                    "echo \"\\\"$1\\\", line 9: all points y value undefined!\" >&2\nexit 1\n";
+  fs::permissions(bin / "gnuplot", fs::perms::owner_all);
+  const auto failing = run_cli(args, dir, "PATH=" + bin.string());
+  EXPECT_EQ(failing.exit_code, 1) << failing.stderr_text;
+  EXPECT_NE(failing.stderr_text.find("': gnuplot failed: line 9: all points y value undefined!"), std::string::npos)
+      << failing.stderr_text;
+  EXPECT_FALSE(fs::exists(dir / "chart.png"));
+}
+
 TEST(BenchShellCli, BadOptionsExitWithTwoAndNameTheProblem) {
   const fs::path dir = fresh_dir("dgtex_bench_shell", "bad");
   const auto threads = run_cli("bench shell --threads-list 0", dir);

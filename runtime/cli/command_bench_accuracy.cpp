@@ -25,8 +25,8 @@ namespace dgtex::cli {
 namespace {
 
 // Error against time per series; reference points (error 0) become dashed vertical lines.
-bool write_chart(const std::string& path, const AccuracyChart& chart, const std::string& machine,
-                 const std::string& command) {
+std::string write_chart(const std::string& path, const AccuracyChart& chart, const std::string& machine,
+                        const std::string& command) {
   const std::vector<std::string> series = chart.series();
   std::ostringstream data;
   for (const std::string& s : series) {
@@ -161,10 +161,11 @@ int bench_accuracy_command(int argc, char** argv) {
     int failed = 0;
     for (const AccuracyChart& chart : results) {
       const std::string path = (dir / ("accuracy_" + chart.name + "." + format)).string();
-      if (write_chart(path, chart, machine, command))
+      const std::string failure = write_chart(path, chart, machine, command);
+      if (failure.empty()) {
         std::printf("chart: %s\n", path.c_str());
-      else {
-        std::fprintf(stderr, "dgtex bench accuracy: gnuplot could not draw %s (is gnuplot installed?)\n", path.c_str());
+      } else {
+        std::fprintf(stderr, "dgtex bench accuracy: no chart %s: %s\n", path.c_str(), failure.c_str());
         ++failed;
       }
     }

@@ -27,7 +27,7 @@ struct ChartSeries {
 };
 
 // Residual against time, one line per solver (PNG if the path ends in .png, else SVG).
-bool write_chart(const std::string& path, const std::string& title, const std::vector<ChartSeries>& series) {
+std::string write_chart(const std::string& path, const std::string& title, const std::vector<ChartSeries>& series) {
   std::ostringstream data;
   for (const ChartSeries& s : series) {
     data << "# " << s.solver << "\n";
@@ -165,8 +165,11 @@ int bench_laplace_command(int argc, char** argv) {
       if (chart.empty())
         std::fprintf(stderr, "dgtex bench laplace: no chart: --chart-domain %s / --chart-size %d is not among the cases\n",
                      chart_domain.c_str(), chart_size);
-      else if (!write_chart(chart_path, chart_domain + ", T = " + std::to_string(chart_size), chart))
-        std::fprintf(stderr, "dgtex bench laplace: gnuplot failed to write '%s' (is gnuplot installed?)\n", chart_path.c_str());
+      else if (const std::string failure = write_chart(chart_path, chart_domain + ", T = " + std::to_string(chart_size), chart);
+               !failure.empty()) {
+        std::fprintf(stderr, "dgtex bench laplace: no chart '%s': %s\n", chart_path.c_str(), failure.c_str());
+        return 1;
+      }
     }
   } catch (const std::invalid_argument& e) {
     std::fprintf(stderr, "dgtex bench laplace: %s\n", e.what());

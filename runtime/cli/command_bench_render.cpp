@@ -25,7 +25,7 @@ constexpr double kErrorFloor = 0.05;  // texels; zero errors are drawn here on t
 
 // Error (texels) against triangles drawn, one line per method, the 1-texel target and
 // 1/16 of the per-texel triangles as guides. PNG if the path ends in .png, else SVG.
-bool write_chart(const std::string& path, const RenderBenchResult& r) {
+std::string write_chart(const std::string& path, const RenderBenchResult& r) {
   const std::vector<std::string> series = {"per-texel", "geometry-shader", "drop-triangles", "kill-pixels"};
   double per_texel_triangles = 0;
   std::ostringstream data;
@@ -144,9 +144,10 @@ int bench_render_command(int argc, char** argv) {
                                    {"target", target}};
       write_output_file(json_path, results.dump(2) + "\n", "--json");
     }
-    if (!chart_path.empty() && !write_chart(chart_path, r))
-      std::fprintf(stderr, "dgtex bench render: gnuplot failed to write '%s' (is gnuplot installed?)\n",
-                   chart_path.c_str());
+    if (const std::string failure = chart_path.empty() ? "" : write_chart(chart_path, r); !failure.empty()) {
+      std::fprintf(stderr, "dgtex bench render: no chart '%s': %s\n", chart_path.c_str(), failure.c_str());
+      return 1;
+    }
   } catch (const std::invalid_argument& e) {
     std::fprintf(stderr, "dgtex bench render: %s\n", e.what());
     return 2;

@@ -94,8 +94,8 @@ std::string markdown_tables(const std::vector<int>& threads, const std::vector<K
 
 // Left: speed-up over the first thread count per family (and the ideal); right: scenes
 // per second, solo against batch. `about` (machine, command) heads the chart.
-bool write_chart(const std::string& path, const std::vector<KernelScaling>& kernels,
-                 const std::vector<BatchThroughput>& batches, const std::string& about) {
+std::string write_chart(const std::string& path, const std::vector<KernelScaling>& kernels,
+                        const std::vector<BatchThroughput>& batches, const std::string& about) {
   std::ostringstream data;
   for (const KernelScaling& k : kernels) {
     data << "# " << k.family << "\n";
@@ -287,8 +287,9 @@ int bench_scaling_command(int argc, char** argv) {
     std::fprintf(stderr, "dgtex bench scaling: %s\n", e.what());
     return 1;
   }
-  if (!chart_path.empty() && !write_chart(chart_path, kernels, batches, about)) {
-    std::fprintf(stderr, "dgtex bench scaling: gnuplot failed to write '%s' (is gnuplot installed?)\n", chart_path.c_str());
+  if (const std::string failure = chart_path.empty() ? "" : write_chart(chart_path, kernels, batches, about);
+      !failure.empty()) {
+    std::fprintf(stderr, "dgtex bench scaling: no chart '%s': %s\n", chart_path.c_str(), failure.c_str());
     return 1;
   }
   return 0;

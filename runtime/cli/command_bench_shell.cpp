@@ -39,7 +39,7 @@ nlohmann::json stage_json(const StageStatistics& s, const std::vector<double>& p
 }
 
 // Milliseconds per step (assembly and solve, one line per thread count) with gnuplot.
-bool write_chart(const std::string& path, const std::vector<ShellBenchRun>& runs) {
+std::string write_chart(const std::string& path, const std::vector<ShellBenchRun>& runs) {
   std::ostringstream data;
   for (const ShellBenchRun& r : runs) {
     data << "# threads " << r.threads << "\n";
@@ -207,8 +207,10 @@ int bench_shell_command(int argc, char** argv) {
                                    {"identical_across_threads", identical}};
       write_output_file(json_path, results.dump(2) + "\n", "--json");
     }
-    if (!chart_path.empty() && !write_chart(chart_path, runs))
-      std::fprintf(stderr, "dgtex bench shell: gnuplot failed to write '%s' (is gnuplot installed?)\n", chart_path.c_str());
+    if (const std::string failure = chart_path.empty() ? "" : write_chart(chart_path, runs); !failure.empty()) {
+      std::fprintf(stderr, "dgtex bench shell: no chart '%s': %s\n", chart_path.c_str(), failure.c_str());
+      return 1;
+    }
   } catch (const SceneError& e) {
     std::fprintf(stderr, "dgtex bench shell: %s\n", e.what());
     return 2;

@@ -1,5 +1,6 @@
 #include "gnuplot_chart.h"
 
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include <atomic>
@@ -7,13 +8,14 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <string>
 
 namespace fs = std::filesystem;
 
 namespace dgtex::cli {
 
-bool draw_gnuplot_chart(const std::string& path, int width, int height, const std::string& data,
-                        const std::function<std::string(const std::string& data_file)>& commands) {
+std::string draw_gnuplot_chart(const std::string& path, int width, int height, const std::string& data,
+                               const std::function<std::string(const std::string& data_file)>& commands) {
   // gnuplot and the shell see only temporary names of plain characters: the scripts quote
   // file names with '...', which a name holding a quote would break. The chart is then
   // copied to PATH.
@@ -21,20 +23,38 @@ bool draw_gnuplot_chart(const std::string& path, int width, int height, const st
   const fs::path stem = fs::temp_directory_path() /
                         ("dgtex_chart_" + std::to_string(::getpid()) + "_" + std::to_string(charts++));
   const std::string data_path = stem.string() + ".dat", script_path = stem.string() + ".gp";
-  const std::string image_path = stem.string() + ".image";
+  const std::string image_path = stem.string() + ".image", errors_path = stem.string() + ".err";
   std::ofstream(data_path) << data;
   const bool png = path.size() > 4 && path.substr(path.size() - 4) == ".png";
   const std::string size = " size " + std::to_string(width) + "," + std::to_string(height);
   const std::string body = "set output '" + image_path + "'\n" + commands(data_path) + "\n";
+  int status = 0;
   auto run = [&](const std::string& terminal) {
     std::ofstream(script_path) << "set terminal " << terminal << size << "\n" << body;
-    return std::system(("gnuplot '" + script_path + "' 2>/dev/null").c_str()) == 0;
+    status = std::system(("gnuplot '" + script_path + "' 2>'" + errors_path + "'").c_str());
+    return status == 0;
   };
   const bool drawn = png ? (run("pngcairo") || run("png")) : run("svg");
-  std::error_code copied, ignored;
-  if (drawn) fs::copy_file(image_path, path, fs::copy_options::overwrite_existing, copied);
-  for (const std::string& temporary : {script_path, data_path, image_path}) fs::remove(temporary, ignored);
-  return drawn && !copied;
+  std::string failure;
+  if (!drawn && WIFEXITED(status) && WEXITSTATUS(status) == 127) {
+    failure = "gnuplot is not installed (Debian: apt-get install gnuplot-nox)";
+  } else if (!drawn) {
+    // gnuplot's last message line names the script line and the problem.
+    std::ifstream errors(errors_path);
+    std::string line, last;
+    while (std::getline(errors, line))
+      if (line.find_first_not_of(" \t^") != std::string::npos) last = line;
+    const std::string script_prefix = "\"" + script_path + "\", ";
+    if (last.rfind(script_prefix, 0) == 0) last = last.substr(script_prefix.size());
+    failure = "gnuplot failed" + (last.empty() ? std::string() : ": " + last);
+  } else {
+    std::error_code copied;
+    fs::copy_file(image_path, path, fs::copy_options::overwrite_existing, copied);
+    if (copied) failure = "cannot write it: " + copied.message();
+  }
+  std::error_code ignored;
+  for (const std::string& temporary : {script_path, data_path, image_path, errors_path}) fs::remove(temporary, ignored);
+  return failure;
 }
 
 std::string gnuplot_quoted(const std::string& text) {

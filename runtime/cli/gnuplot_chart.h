@@ -11,8 +11,10 @@ namespace dgtex::cli {
 // file; `commands(data_file)` returns the settings and plot commands, referring to the data
 // by that file name (plain characters, safe inside '...'). gnuplot draws into a temporary
 // file too, copied to `path` at the end, so any `path` works. The temporary files are
-// removed. False if gnuplot failed or the chart could not be copied to `path`.
-bool draw_gnuplot_chart(const std::string& path, int width, int height, const std::string& data,
+// removed. Returns "" when the chart was drawn, else why not: gnuplot is not installed,
+// gnuplot's own error (e.g. "line 9: all points y value undefined!"), or the copy to
+// `path` failed.
+std::string draw_gnuplot_chart(const std::string& path, int width, int height, const std::string& data,
                         const std::function<std::string(const std::string& data_file)>& commands);
 
 // A gnuplot double-quoted string (newlines become line breaks there).
