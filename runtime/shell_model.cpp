@@ -355,7 +355,8 @@ void ShellModel::install_enrichments(std::vector<EnrichmentFunction> functions, 
     if (static_cast<int>(per_element[e].size()) > kernels::max_enrichments_per_element)
       throw std::invalid_argument("enrichment: element " + std::to_string(e) + " carries " +
                                   std::to_string(per_element[e].size()) + " enrichment functions; at most " +
-                                  std::to_string(kernels::max_enrichments_per_element) + " are supported");
+                                  std::to_string(kernels::max_enrichments_per_element) +
+                                  " are supported (fewer cuts through and around the element, or a finer mesh)");
     enriched_index_[e] = static_cast<int>(enriched_elements_.size());
     enriched_elements_.push_back(e);
     for (const ElementEnrichment& ee : per_element[e]) {

@@ -11,10 +11,12 @@
 #include <random>
 
 #include "cut_test_support.h"
+#include "scene_in_code_support.h"
 #include "dgtex/cut_manager.h"
 #include "dgtex/harmonic_enrichment.h"
 #include "dgtex/kernels/multigrid_unknowns.h"
 #include "dgtex/mesh_generators.h"
+#include "dgtex/scene_run.h"
 #include "dgtex/texel_storage.h"
 #include "dgtex/topology.h"
 
@@ -274,5 +276,29 @@ TEST(CutsEnrichment, RandomCompleteCutsAreExactHeavisides) {
         EXPECT_GT(plus, 0);
         EXPECT_GT(minus, 0);
       }
+  }
+}
+
+// An element carries at most kernels::max_enrichments_per_element (31) functions: 32 cuts
+// side by side in one element are refused with the element, the count, the limit and what
+// to change, not run. Each function also lives on the neighbours of its element (Omega_i):
+// element 1, the first of them, is named.
+TEST(CutsEnrichment, MoreFunctionsOnAnElementThanSupportedAreRefusedNamingTheLimit) {
+  Scene scene = test::strip_built_in_code(false, true);
+  scene.cuts.clear();
+  scene.enrichment.texture_resolution = 128;
+  for (int k = 0; k < 32; ++k) {  // 4 texels apart in element 2 (0.2 <= x <= 0.3)
+    const double x = 0.2 + 0.1 * (k + 0.5) / 32;
+    Cut cut;
+    cut.points = {{x, 0, 0}, {x, 0.05, 0}};
+    scene.cuts.push_back(cut);
+  }
+  try {
+    SceneRun run(scene);
+    FAIL() << "no error";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_EQ(std::string(e.what()),
+              "enrichment: element 1 carries 32 enrichment functions; at most 31 are supported (fewer cuts through "
+              "and around the element, or a finer mesh)");
   }
 }
