@@ -106,6 +106,24 @@ TEST(CliRun, CutsWhoseTexelFieldsCannotFitAreRefusedNamingTheResolution) {
                   "enrichment.texture_resolution: the texel fields of 5 cut segments");
 }
 
+// A progressive cut whose new function is one too many on an element is met in a step:
+// exit code 2 and the step, like any scene problem (it was exit code 1 without the step).
+TEST(CliRun, AProgressiveCutsFunctionTooManyOnAnElementNamesTheStep) {
+  nlohmann::json scene = nlohmann::json::parse(R"({
+    "mesh": {"generator": "rectangle", "size": [0.4, 0.1], "divisions": [4, 1], "element": "quad8"},
+    "material": {"youngs_modulus": 5e8, "poisson_ratio": 0.3, "thickness": 0.01, "density": 1000},
+    "boundary": [{"select": {"plane": {"normal": [1, 0, 0], "offset": 0}}, "fix": ["x", "y", "z"], "clamp": true}],
+    "loads": [{"type": "gravity", "acceleration": [0, 0, -9.81]}],
+    "analysis": {"type": "dynamic", "time_step": 0.005, "steps": 40},
+    "enrichment": {"texture_resolution": 128}})");
+  for (int k = 0; k < 32; ++k) {  // side by side in element 2, one starting each step
+    const double x = 0.2 + 0.1 * (k + 0.5) / 32;
+    scene["cuts"].push_back({{"points", {{x, 0, 0}, {x, 0.05, 0}}}, {"start_time", 0.005 * k}});
+  }
+  expect_rejected("too_many_functions", scene.dump(),
+                  "step 31 (to t = 0.155): enrichment: element 1 carries 32 enrichment functions; at most 31");
+}
+
 TEST(CliRun, AnOutputFolderThatCannotBeCreatedIsRefusedBeforeTheScene) {
   const fs::path dir = fresh_dir("out_under_file");
   std::ofstream(dir / "file") << "not a folder";

@@ -42,6 +42,12 @@ std::string frame_name(int index) {
   return buffer;
 }
 
+std::string short_number(double x) {
+  char buffer[32];
+  std::snprintf(buffer, sizeof buffer, "%.6g", x);
+  return buffer;
+}
+
 bool all_finite(const std::vector<double>& v) {
   for (double x : v)
     if (!std::isfinite(x)) return false;
@@ -133,7 +139,12 @@ int run_command(int argc, char** argv) {
       write_frame(0);
       auto last_log_line = std::chrono::steady_clock::now();
       for (int step = 1; step <= scene.analysis.steps; ++step) {
-        run->step();
+        try {
+          run->step();
+        } catch (const std::invalid_argument& e) {  // the scene, met in a step: a progressive cut's new function
+          throw ModelError("step " + std::to_string(step) + " (to t = " + short_number(step * scene.analysis.time_step) +
+                           "): " + e.what());
+        }
         if (!all_finite(run->displacement()))
           throw ModelError("analysis: the solution diverged at step " + std::to_string(step) + " (time step " +
                            std::to_string(scene.analysis.time_step) + " too large?)");
