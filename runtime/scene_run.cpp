@@ -12,6 +12,7 @@
 #include "dgtex/kernels/threads_busy_beside.h"
 #include "dgtex/model_error.h"
 #include "dgtex/scene_model.h"
+#include "dgtex/scene_texel_fields.h"
 #include "dgtex/texel_memory_estimate.h"
 #include "dgtex/topology.h"
 
@@ -47,14 +48,8 @@ SceneRun::SceneRun(const Scene& scene, SceneRunOptions options)
         cuts_ = std::make_unique<CutManager>(mesh_, topology_, scene_.cuts, scene_.enrichment);
       // Before the first field is allocated: a scene whose texel fields cannot fit is
       // refused with one line rather than killed by the system later.
-      TexelFields fields;
-      fields.type = mesh_.type;
-      fields.resolution = scene_.enrichment.texture_resolution;
-      fields.direct_solves =
-          mesh_.type == ElementType::tri6 || scene_.enrichment.solver == EnrichmentOptions::Solver::cholmod;
-      if (cuts_) fields.cuts = cuts_->full_footprint();
-      fields.creases = crease_footprint(mesh_, topology_, scene_.creases, fields.resolution);
-      check_texel_memory(fields, available_memory_bytes(), scene_.source_name.empty() ? "scene" : scene_.source_name);
+      check_texel_memory(scene_texel_fields(scene_, mesh_, topology_, cuts_.get()), available_memory_bytes(),
+                         scene_.source_name.empty() ? "scene" : scene_.source_name);
       if (cuts_) cuts_->update(0.0);
       creases_ = build_crease_functions(mesh_, topology_, scene_.creases, scene_.enrichment.texture_resolution);
     }

@@ -13,6 +13,7 @@
 #include "dgtex/scene_io.h"
 #include "dgtex/scene_model.h"
 #include "dgtex/scene_run.h"
+#include "dgtex/scene_texel_fields.h"
 #include "dgtex/texel_memory_estimate.h"
 #include "dgtex/topology.h"
 #include "exception_message_support.h"
@@ -120,6 +121,38 @@ TEST(TexelMemoryEstimate, TooLittleMemoryIsASceneErrorNamingTheResolution) {
   EXPECT_NE(none.find("got 4096; no texture_resolution fits on this machine; fewer or shorter cuts or creases"),
             std::string::npos)
       << none;
+}
+
+// Between half the memory and all of it the scene runs, with a caution first (runs measured
+// up to 4x the bound): fracture at T = 1024 passed the check and was still killed.
+TEST(TexelMemoryEstimate, ACautionAboveHalfTheMemoryAvailable) {
+  const TexelFields fields = fracture_like(1024);
+  const std::int64_t needed = texel_memory_lower_bound(fields);  // 23.8 GB
+  EXPECT_EQ(texel_memory_caution(fields, 2 * needed), "");
+  EXPECT_EQ(texel_memory_caution(fields, -1), "");
+  EXPECT_EQ(texel_memory_caution(fields, 25000000000),
+            "enrichment.texture_resolution 1024: the texel fields need at least 23.8 GB of the 25.0 GB of memory "
+            "available, and runs measured 1.3-4x that bound; the run may be killed for memory (a lower "
+            "texture_resolution is safer)");
+  EXPECT_NO_THROW(check_texel_memory(fields, 25000000000, "f.json"));  // a caution, not a refusal
+}
+
+// What SceneRun checks, from the scene alone: fracture's cuts on tri6 (direct solves), a
+// crease on quad8, nothing for a scene without either.
+TEST(TexelMemoryEstimate, SceneTexelFieldsFromTheSceneAlone) {
+  const TexelFields fracture = scene_texel_fields(example_scene("fracture"));
+  EXPECT_EQ(fracture.type, ElementType::tri6);
+  EXPECT_EQ(fracture.resolution, 32);
+  EXPECT_TRUE(fracture.direct_solves);
+  EXPECT_EQ(fracture.cuts.fields, 6);
+  EXPECT_EQ(fracture.cuts.region_elements, 290);
+  EXPECT_EQ(fracture.creases.fields, 0);
+  const TexelFields crease = scene_texel_fields(example_scene("crease"));
+  EXPECT_FALSE(crease.direct_solves);
+  EXPECT_EQ(crease.cuts.fields, 0);
+  EXPECT_EQ(crease.creases.fields, 1);
+  EXPECT_EQ(crease.creases.region_elements, 1);
+  EXPECT_EQ(texel_memory_lower_bound(scene_texel_fields(example_scene("cylinder_buckling"))), 0);
 }
 
 TEST(TexelMemoryEstimate, AvailableMemoryIsPositiveAndAtMostWhatTheMachineHas) {
