@@ -130,6 +130,7 @@ TEST(TexelMemoryEstimate, ACautionAboveHalfTheMemoryAvailable) {
   const std::int64_t needed = texel_memory_lower_bound(fields);  // 23.8 GB
   EXPECT_EQ(texel_memory_caution(fields, 2 * needed), "");
   EXPECT_EQ(texel_memory_caution(fields, -1), "");
+  EXPECT_EQ(texel_memory_caution(fields, needed - 1), "");  // refused by check_texel_memory instead
   EXPECT_EQ(texel_memory_caution(fields, 25000000000),
             "enrichment.texture_resolution 1024: the texel fields need at least 23.8 GB of the 25.0 GB of memory "
             "available, and runs measured 1.3-4x that bound; the run may be killed for memory (a lower "

@@ -58,9 +58,10 @@ std::int64_t available_memory_bytes();
 void check_texel_memory(const TexelFields& fields, std::int64_t available_bytes, const std::string& source_name);
 
 // A caution for a scene that passes the check but comes near the limit: runs measured
-// 1.3-4x the bound, so above half the memory available it may still be killed. Returns ""
-// below that (or with available_bytes < 0), else one sentence naming the bound, the memory
-// and the remedy, for `dgtex run` to print before its set-up.
+// 1.3-4x the bound, so above half the memory available it may still be killed. One
+// sentence naming the bound, the memory and the remedy, for `dgtex run` to print before its
+// set-up, when the bound lies between half the memory available and all of it; else ""
+// (also with available_bytes < 0).
 std::string texel_memory_caution(const TexelFields& fields, std::int64_t available_bytes);
 
 }  // namespace dgtex
