@@ -12,7 +12,6 @@
 #include "dgtex/kernels/threads_busy_beside.h"
 #include "dgtex/model_error.h"
 #include "dgtex/scene_model.h"
-#include "dgtex/scene_texel_fields.h"
 #include "dgtex/texel_memory_estimate.h"
 #include "dgtex/topology.h"
 
@@ -27,6 +26,18 @@ void merge(StageTimings& into, const StageTimings& from) {
     s.max_ms = std::max(s.max_ms, stats.max_ms);
     s.count += stats.count;
   }
+}
+
+// The texel fields the scene's cuts and creases will hold, from the traced paths
+// (cuts: nullptr without cuts).
+TexelFields texel_fields(const Scene& scene, const Mesh& mesh, const Topology& topology, const CutManager* cuts) {
+  TexelFields fields;
+  fields.type = mesh.type;
+  fields.resolution = scene.enrichment.texture_resolution;
+  fields.direct_solves = mesh.type == ElementType::tri6 || scene.enrichment.solver == EnrichmentOptions::Solver::cholmod;
+  if (cuts) fields.cuts = cuts->full_footprint();
+  fields.creases = crease_footprint(mesh, topology, scene.creases, fields.resolution);
+  return fields;
 }
 
 }  // namespace
@@ -48,8 +59,10 @@ SceneRun::SceneRun(const Scene& scene, SceneRunOptions options)
         cuts_ = std::make_unique<CutManager>(mesh_, topology_, scene_.cuts, scene_.enrichment);
       // Before the first field is allocated: a scene whose texel fields cannot fit is
       // refused with one line rather than killed by the system later.
-      check_texel_memory(scene_texel_fields(scene_, mesh_, topology_, cuts_.get()), available_memory_bytes(),
-                         scene_.source_name.empty() ? "scene" : scene_.source_name);
+      const TexelFields fields = texel_fields(scene_, mesh_, topology_, cuts_.get());
+      const std::int64_t available = available_memory_bytes();
+      check_texel_memory(fields, available, scene_.source_name.empty() ? "scene" : scene_.source_name);
+      if (options_.before_texel_fields) options_.before_texel_fields(fields, available);
       if (cuts_) cuts_->update(0.0);
       creases_ = build_crease_functions(mesh_, topology_, scene_.creases, scene_.enrichment.texture_resolution);
     }

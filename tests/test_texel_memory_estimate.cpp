@@ -13,7 +13,6 @@
 #include "dgtex/scene_io.h"
 #include "dgtex/scene_model.h"
 #include "dgtex/scene_run.h"
-#include "dgtex/scene_texel_fields.h"
 #include "dgtex/texel_memory_estimate.h"
 #include "dgtex/topology.h"
 #include "exception_message_support.h"
@@ -138,22 +137,41 @@ TEST(TexelMemoryEstimate, ACautionAboveHalfTheMemoryAvailable) {
   EXPECT_NO_THROW(check_texel_memory(fields, 25000000000, "f.json"));  // a caution, not a refusal
 }
 
-// What SceneRun checks, from the scene alone: fracture's cuts on tri6 (direct solves), a
-// crease on quad8, nothing for a scene without either.
-TEST(TexelMemoryEstimate, SceneTexelFieldsFromTheSceneAlone) {
-  const TexelFields fracture = scene_texel_fields(example_scene("fracture"));
+// The fields SceneRun checks, handed to SceneRunOptions::before_texel_fields (where
+// `dgtex run` prints its caution) with the memory available: fracture's cuts on tri6
+// (direct solves), a crease on quad8, no call for a scene without either.
+TexelFields fields_seen_by_scene_run(const std::string& name, int& calls) {
+  TexelFields seen;
+  SceneRunOptions options;
+  options.before_texel_fields = [&](const TexelFields& fields, std::int64_t available) {
+    seen = fields;
+    ++calls;
+    if (available >= 0) {
+      EXPECT_LE(texel_memory_lower_bound(fields), available);  // called after the check passed
+    }
+  };
+  SceneRun run(example_scene(name), options);
+  return seen;
+}
+
+TEST(TexelMemoryEstimate, SceneRunHandsItsFieldsToTheCallerBeforeAllocatingThem) {
+  int calls = 0;
+  const TexelFields fracture = fields_seen_by_scene_run("fracture", calls);
+  EXPECT_EQ(calls, 1);
   EXPECT_EQ(fracture.type, ElementType::tri6);
   EXPECT_EQ(fracture.resolution, 32);
   EXPECT_TRUE(fracture.direct_solves);
   EXPECT_EQ(fracture.cuts.fields, 6);
   EXPECT_EQ(fracture.cuts.region_elements, 290);
   EXPECT_EQ(fracture.creases.fields, 0);
-  const TexelFields crease = scene_texel_fields(example_scene("crease"));
+  const TexelFields crease = fields_seen_by_scene_run("crease", calls);
+  EXPECT_EQ(calls, 2);
   EXPECT_FALSE(crease.direct_solves);
   EXPECT_EQ(crease.cuts.fields, 0);
   EXPECT_EQ(crease.creases.fields, 1);
   EXPECT_EQ(crease.creases.region_elements, 1);
-  EXPECT_EQ(texel_memory_lower_bound(scene_texel_fields(example_scene("cylinder_buckling"))), 0);
+  EXPECT_EQ(texel_memory_lower_bound(fields_seen_by_scene_run("cylinder_buckling", calls)), 0);
+  EXPECT_EQ(calls, 2);
 }
 
 TEST(TexelMemoryEstimate, AvailableMemoryIsPositiveAndAtMostWhatTheMachineHas) {

@@ -21,7 +21,6 @@
 #include "dgtex/model_error.h"
 #include "dgtex/scene_io.h"
 #include "dgtex/scene_run.h"
-#include "dgtex/scene_texel_fields.h"
 #include "dgtex/shell_state.h"
 #include "dgtex/surface_point.h"
 #include "dgtex/texel_memory_estimate.h"
@@ -90,15 +89,18 @@ int run_command(int argc, char** argv) {
   std::unique_ptr<SceneRun> run;
   try {
     scene = load_scene(scene_path);
-    // Near the memory limit the set-up can run for minutes before the system kills it:
-    // say so first (a scene that cannot fit at all is refused by SceneRun below).
-    const std::string caution = texel_memory_caution(scene_texel_fields(scene), available_memory_bytes());
-    if (!caution.empty()) std::fprintf(stderr, "dgtex run: warning: %s: %s\n", scene_path.c_str(), caution.c_str());
     // The set-up (cut tracing, the first enrichment solves, the model) can take minutes
     // at a high texture_resolution: say so, then how long it took.
     const auto setup_start = std::chrono::steady_clock::now();
     if (progress) std::fprintf(stderr, "dgtex run: setting up the mesh, cuts and enrichment functions\n");
-    run = std::make_unique<SceneRun>(scene);
+    // Near the memory limit the set-up can run for minutes before the system kills it: say
+    // so before the fields are allocated (a scene that cannot fit at all is refused).
+    SceneRunOptions run_options;
+    run_options.before_texel_fields = [&](const TexelFields& fields, std::int64_t available) {
+      const std::string caution = texel_memory_caution(fields, available);
+      if (!caution.empty()) std::fprintf(stderr, "dgtex run: warning: %s: %s\n", scene_path.c_str(), caution.c_str());
+    };
+    run = std::make_unique<SceneRun>(scene, run_options);
     if (progress)
       std::fprintf(stderr, "dgtex run: set up in %.1f s\n",
                    std::chrono::duration<double>(std::chrono::steady_clock::now() - setup_start).count());

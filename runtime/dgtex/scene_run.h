@@ -31,6 +31,8 @@
 // SceneRun owns a copy of the Scene and the mesh, topology, model, cut manager and
 // simulation built from it. Units: those of the scene (SI: m, kg, s, N).
 #include <atomic>
+#include <cstdint>
+#include <functional>
 #include <future>
 #include <memory>
 #include <vector>
@@ -42,12 +44,17 @@
 #include "dgtex/shell_simulation.h"
 #include "dgtex/shell_state.h"
 #include "dgtex/stage_timer.h"
+#include "dgtex/texel_memory_estimate.h"
 #include "dgtex/topology.h"
 
 namespace dgtex {
 
 struct SceneRunOptions {
   bool overlap_cut_updates = true;  // the next step's cut update beside this step (above)
+  // Called once in the set-up of a scene with cuts or creases, after the memory check has
+  // passed and before any texel field is allocated, with the fields counted and the memory
+  // available (-1: unknown); `dgtex run` prints texel_memory_caution from it.
+  std::function<void(const TexelFields& fields, std::int64_t available_bytes)> before_texel_fields;
 };
 
 class SceneRun {
