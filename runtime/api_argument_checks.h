@@ -3,10 +3,18 @@
 // linking dgtex throws std::invalid_argument naming the function, the argument, its value
 // and what is valid, instead of reading or writing out of bounds. O(1); not for kernels.
 #include <cstddef>
+#include <cstdio>
 #include <stdexcept>
 #include <string>
 
 namespace dgtex::detail {
+
+// A value in a message, "%g" ("-0.005", "nan", "inf").
+inline std::string short_number(double x) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%g", x);
+  return text;
+}
 
 // "ShellModel::interpolate: u has 3 entries; expected num_dofs() = 84"
 inline void check_size(const char* function, const char* argument, std::size_t size, const char* expected_name,

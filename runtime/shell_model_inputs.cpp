@@ -1,7 +1,6 @@
 #include "shell_model_inputs.h"
 
 #include <cmath>
-#include <cstdio>
 #include <stdexcept>
 #include <string>
 
@@ -12,14 +11,8 @@
 namespace dgtex::detail {
 namespace {
 
-std::string number(double x) {
-  char text[32];
-  std::snprintf(text, sizeof text, "%g", x);
-  return text;
-}
-
 [[noreturn]] void refuse(const std::string& what, double value, const std::string& valid) {
-  throw std::invalid_argument("ShellModel: " + what + " is " + number(value) + "; expected " + valid);
+  throw std::invalid_argument("ShellModel: " + what + " is " + short_number(value) + "; expected " + valid);
 }
 
 // Each edge must name elements of this mesh and the nodes of their local edge.

@@ -2,7 +2,6 @@
 
 #include <Eigen/Dense>
 #include <cmath>
-#include <cstdio>
 #include <stdexcept>
 #include <string>
 
@@ -140,11 +139,9 @@ void ShellSimulation::set_solver_options(const FactorReuseOptions& options) { so
 
 void ShellSimulation::step(const DynamicsOptions& o) {
   const double dt = o.time_step;
-  if (!(dt > 0 && std::isfinite(dt))) {
-    char value[32];
-    std::snprintf(value, sizeof value, "%g", dt);
-    throw std::invalid_argument(std::string("ShellSimulation::step: time_step ") + value + " is not a positive finite time");
-  }
+  if (!(dt > 0 && std::isfinite(dt)))
+    throw std::invalid_argument("ShellSimulation::step: time_step " + detail::short_number(dt) +
+                                " is not a positive finite time");
   const int ndofs = model_.num_dofs();
   corrective_.clear();
   const std::vector<double>* K = nullptr;
