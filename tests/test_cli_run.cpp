@@ -1,12 +1,18 @@
 // End-to-end: the dgtex executable on example scenes and on bad input.
 #include <gtest/gtest.h>
 
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
 #include <algorithm>
+#include <chrono>
 #include <cstdint>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <thread>
 
 #include "cli_test_support.h"
 #include "dgtex/texel_memory_estimate.h"
@@ -135,6 +141,99 @@ TEST(CliRun, AnOutputFolderThatCannotBeCreatedIsRefusedBeforeTheScene) {
   EXPECT_NE(r.stderr_text.find("--out: '" + (dir / "file").string() + "' is not a folder"), std::string::npos)
       << r.stderr_text;
   EXPECT_FALSE(fs::exists(out));
+}
+
+// The demo cantilever without frames to draw, for STEPS steps, writing a VTU frame every 10.
+fs::path cantilever_scene(const fs::path& dir, int steps) {
+  nlohmann::json scene;
+  std::ifstream(std::string(DGTEX_SOURCE_DIR) + "/examples/scenes/demo_cantilever.json") >> scene;
+  scene["analysis"]["steps"] = steps;
+  scene.erase("render");
+  const fs::path path = dir / ("cantilever_" + std::to_string(steps) + ".json");
+  std::ofstream(path) << scene.dump();
+  return path;
+}
+
+// Starts `dgtex run SCENE --out OUT --quiet` (stderr into DIR/stderr.txt), waits until FILE
+// exists, sends SIGNAL and returns the exit code (-1 if the run did not end within a minute).
+int run_and_interrupt(const fs::path& scene, const fs::path& out, const fs::path& file, int signal_number,
+                      const fs::path& dir) {
+  const pid_t pid = ::fork();
+  if (pid == 0) {
+    const std::string err = (dir / "stderr.txt").string();
+    if (!std::freopen(err.c_str(), "w", stderr)) ::_exit(127);
+    ::execl(DGTEX_CLI, DGTEX_CLI, "run", scene.c_str(), "--out", out.c_str(), "--quiet", static_cast<char*>(nullptr));
+    ::_exit(127);
+  }
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::minutes(1);
+  while (!fs::exists(file) && std::chrono::steady_clock::now() < deadline)
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  ::kill(pid, signal_number);
+  int status = 0;
+  while (::waitpid(pid, &status, WNOHANG) == 0) {
+    if (std::chrono::steady_clock::now() > deadline) {
+      ::kill(pid, SIGKILL);
+      ::waitpid(pid, &status, 0);
+      return -1;
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+// A long run stopped by Ctrl-C or a batch system's time limit keeps what it has: the
+// frame and mesh of the step it reached and a report saying so, with exit code 128 + signal.
+TEST(CliRun, AnInterruptedRunWritesTheStepItReachedAndSaysSo) {
+  const fs::path dir = fresh_dir("interrupted");
+  const fs::path scene = cantilever_scene(dir, 1000000);  // hours of steps
+  for (const int signal_number : {SIGINT, SIGTERM}) {
+    const fs::path out = dir / ("out_" + std::to_string(signal_number));
+    const int code = run_and_interrupt(scene, out, out / "frames" / "frame_00020.vtu", signal_number, dir);
+    std::ifstream err(dir / "stderr.txt");
+    const std::string stderr_text((std::istreambuf_iterator<char>(err)), std::istreambuf_iterator<char>());
+    ASSERT_EQ(code, 128 + signal_number) << stderr_text;
+    const std::string name = signal_number == SIGINT ? "SIGINT" : "SIGTERM";
+    EXPECT_NE(stderr_text.find("interrupted by " + name + " at step "), std::string::npos) << stderr_text;
+    std::ifstream in(out / "report.json");
+    const nlohmann::json report = nlohmann::json::parse(in);
+    EXPECT_EQ(report["completed"], false);
+    EXPECT_EQ(report["interrupted_by"], name);
+    const int steps = report["steps_completed"];
+    EXPECT_GE(steps, 20);
+    EXPECT_LT(steps, 1000000);
+    EXPECT_NEAR(report["time"].get<double>(), steps * 0.005, 1e-9);
+    EXPECT_EQ(report["timings_ms"]["assembly"]["calls"], steps);
+    char frame[32];
+    std::snprintf(frame, sizeof frame, "frame_%05d.vtu", steps);
+    EXPECT_TRUE(fs::exists(out / "frames" / frame)) << frame;
+    EXPECT_TRUE(fs::exists(out / "deformed.vtu"));
+  }
+}
+
+// A run into a folder an earlier run wrote: none of the earlier run's frames or report stay
+// beside the new run's (a shorter run's folder showed the longer run's last frames).
+TEST(CliRun, ARunRemovesTheOutputsOfAnEarlierRunIntoItsFolder) {
+  const fs::path dir = fresh_dir("earlier_outputs");
+  const fs::path out = dir / "out";
+  ASSERT_EQ(run_dgtex(cantilever_scene(dir, 30).string() + " --out " + out.string(), dir).exit_code, 0);
+  ASSERT_TRUE(fs::exists(out / "frames" / "frame_00030.vtu"));
+  std::ofstream(out / "frames" / "frame_00040.png") << "a frame";
+  std::ofstream(out / "frames" / "notes.txt") << "not dgtex's";
+  std::ofstream(out / "final.state") << "an earlier state";
+  const Result r = dgtex::test::run_cli("run " + cantilever_scene(dir, 10).string() + " --out " + out.string(), dir);
+  ASSERT_EQ(r.exit_code, 0) << r.stderr_text;
+  EXPECT_NE(r.stderr_text.find("removed 8 files of an earlier run from " + out.string()), std::string::npos)
+      << r.stderr_text;  // frames 0, 10, 20, 30 and 40, the report, deformed.vtu, final.state
+  EXPECT_TRUE(fs::exists(out / "frames" / "frame_00010.vtu"));
+  EXPECT_FALSE(fs::exists(out / "frames" / "frame_00020.vtu"));
+  EXPECT_FALSE(fs::exists(out / "frames" / "frame_00030.vtu"));
+  EXPECT_FALSE(fs::exists(out / "frames" / "frame_00040.png"));
+  EXPECT_FALSE(fs::exists(out / "final.state"));
+  EXPECT_TRUE(fs::exists(out / "frames" / "notes.txt"));
+  std::ifstream in(out / "report.json");
+  const nlohmann::json report = nlohmann::json::parse(in);
+  EXPECT_EQ(report["completed"], true);
+  EXPECT_EQ(report["steps_completed"], 10);
 }
 
 }  // namespace

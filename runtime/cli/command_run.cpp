@@ -24,6 +24,7 @@
 #include "dgtex/shell_state.h"
 #include "dgtex/surface_point.h"
 #include "dgtex/texel_memory_estimate.h"
+#include "interrupt_request.h"
 #include "output_paths.h"
 
 namespace dgtex::cli {
@@ -137,8 +138,13 @@ int run_command(int argc, char** argv) {
     if (png_frames) png_frames->write(run->state(), index);
   };
   std::vector<std::string> written;  // for the closing line
+  int steps_completed = 0;
+  int interrupted_by = 0;  // the signal that ended a dynamic run early
   try {
     create_output_folder((out / "frames").string(), "--out");
+    const int removed = remove_earlier_run_outputs(out_dir, scene.output.report);
+    if (removed > 0 && !quiet)
+      std::fprintf(stderr, "dgtex run: removed %d files of an earlier run from %s\n", removed, out_dir.c_str());
     if (!scene.analysis.is_dynamic()) {
       run->solve_static();
       if (png_frames) png_frames->write(run->state(), 0);
@@ -146,6 +152,7 @@ int run_command(int argc, char** argv) {
       const int every = scene.render ? scene.render->every_steps : 10;
       write_frame(0);
       auto last_log_line = std::chrono::steady_clock::now();
+      const InterruptRequest interrupt;
       for (int step = 1; step <= scene.analysis.steps; ++step) {
         try {
           run->step();
@@ -156,7 +163,9 @@ int run_command(int argc, char** argv) {
         if (!all_finite(run->displacement()))
           throw ModelError("analysis: the solution diverged at step " + std::to_string(step) + " (time step " +
                            std::to_string(scene.analysis.time_step) + " too large?)");
-        if (step % every == 0 || step == scene.analysis.steps) write_frame(step);
+        steps_completed = step;
+        const bool stop_early = interrupt.signal() != 0 && step < scene.analysis.steps;
+        if (step % every == 0 || step == scene.analysis.steps || stop_early) write_frame(step);
         const auto now = std::chrono::steady_clock::now();
         const bool log_line = !quiet && !terminal && now - last_log_line >= std::chrono::seconds(10);
         if (progress || log_line) {
@@ -167,6 +176,10 @@ int run_command(int argc, char** argv) {
                        static_cast<int>(run->model().enrichments().size()), progress ? "   " : "\n");
           progress_line_open = progress;
           if (log_line) last_log_line = now;
+        }
+        if (stop_early) {
+          interrupted_by = interrupt.signal();
+          break;
         }
       }
       if (progress_line_open) std::fprintf(stderr, "\n");
@@ -204,6 +217,9 @@ int run_command(int argc, char** argv) {
   nlohmann::json report;
   report["scene"] = scene_path;
   report["analysis"] = scene.analysis.is_dynamic() ? "dynamic" : "static";
+  report["completed"] = interrupted_by == 0;
+  if (scene.analysis.is_dynamic()) report["steps_completed"] = steps_completed;
+  if (interrupted_by != 0) report["interrupted_by"] = signal_name(interrupted_by);
   const std::int64_t lower = sim.system().nonzeros();
   report["counts"] = {{"elements", mesh.num_elements()},
                       {"nodes", mesh.num_nodes()},
@@ -265,6 +281,12 @@ int run_command(int argc, char** argv) {
     std::string list = scene.output.report;
     for (const std::string& item : written) list += ", " + item;
     std::printf("dgtex run: wrote into %s: %s\n", out.string().c_str(), list.c_str());
+  }
+  if (interrupted_by != 0) {
+    std::fprintf(stderr, "dgtex run: %s: interrupted by %s at step %d of %d (t = %s); the results are that step's\n",
+                 scene_path.c_str(), signal_name(interrupted_by), steps_completed, scene.analysis.steps,
+                 short_number(run->time()).c_str());
+    return 128 + interrupted_by;  // the shell's convention for a process ended by a signal
   }
   return 0;
 }

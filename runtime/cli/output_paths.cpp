@@ -6,6 +6,7 @@
 #include <fstream>
 #include <stdexcept>
 #include <system_error>
+#include <vector>
 
 namespace fs = std::filesystem;
 
@@ -58,6 +59,45 @@ void create_output_folder(const std::string& folder, const char* option) {
   if (error)
     throw std::invalid_argument(std::string(option) + " " + folder + ": cannot create the folder (" + error.message() +
                                 ")");
+}
+
+namespace {
+
+// frame_ and at least five digits, then .vtu or .png: the names dgtex run gives its frames.
+bool is_frame_file_name(const std::string& name) {
+  const std::string prefix = "frame_";
+  if (name.size() < prefix.size() + 5 + 4 || name.compare(0, prefix.size(), prefix) != 0) return false;
+  const std::string extension = name.substr(name.size() - 4);
+  if (extension != ".vtu" && extension != ".png") return false;
+  for (std::size_t i = prefix.size(); i < name.size() - 4; ++i)
+    if (name[i] < '0' || name[i] > '9') return false;
+  return true;
+}
+
+bool remove_file(const fs::path& path) {
+  std::error_code error;
+  if (!fs::is_regular_file(path, error)) return false;
+  const bool removed = fs::remove(path, error);
+  if (error)
+    throw std::runtime_error("cannot remove '" + path.string() + "' of an earlier run (" + error.message() + ")");
+  return removed;
+}
+
+}  // namespace
+
+int remove_earlier_run_outputs(const std::string& folder, const std::string& report_name) {
+  const fs::path out(folder);
+  int removed = 0;
+  for (const char* name : {"deformed.vtu", "cut_surface.obj", "final.state", "textures/enrichment.vdb"})
+    removed += remove_file(out / name);
+  removed += remove_file(out / report_name);
+  std::vector<fs::path> frames;  // listed first: removing while iterating may skip entries
+  std::error_code error;
+  if (fs::is_directory(out / "frames", error))
+    for (const fs::directory_entry& entry : fs::directory_iterator(out / "frames"))
+      if (is_frame_file_name(entry.path().filename().string())) frames.push_back(entry.path());
+  for (const fs::path& frame : frames) removed += remove_file(frame);
+  return removed;
 }
 
 void write_output_file(const std::string& path, const std::string& text, const char* option) {
