@@ -1,4 +1,4 @@
-// `dgtex render STATE --out DIR`: success, bad input (exit 2) and no EGL (exit 1 with
+// `dgtex render STATE --out DIR|FILE.png`: success, bad input (exit 2) and no EGL (exit 1 with
 // the documented one-line message).
 #include <gtest/gtest.h>
 #include <sys/wait.h>
@@ -64,6 +64,27 @@ TEST(RenderCli, RendersAStateToFramePng) {
   EXPECT_EQ(image.width, 96);
   EXPECT_EQ(image.height, 64);
   EXPECT_NE(r.out.find("frame.png"), std::string::npos);
+}
+
+// `--out NAME.png` is the image itself (it was a folder NAME.png holding frame.png); an
+// existing folder of that name still gets its frame.png.
+TEST(RenderCli, AnOutEndingInPngNamesTheImage) {
+  const fs::path dir = work_dir() / "png_out";
+  fs::remove_all(dir);
+  const fs::path image = dir / "new" / "spiral.PNG";
+  CliResult r = run_cli("", "'" + saved_plate() + "' --out '" + image.string() + "' --width 40 --height 30");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  ASSERT_TRUE(fs::is_regular_file(image));
+  EXPECT_EQ(read_png(image.string()).width, 40);
+  EXPECT_NE(r.out.find("wrote " + image.string() + " (40 x 30;"), std::string::npos) << r.out;
+  const fs::path folder = dir / "folder.png";
+  fs::create_directories(folder);
+  r = run_cli("", "'" + saved_plate() + "' --out '" + folder.string() + "' --width 40 --height 30");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_TRUE(fs::is_regular_file(folder / "frame.png"));
+  r = run_cli("", "'" + saved_plate() + "' --out '" + (dir / "new" / "spiral.PNG" / "x.png").string() + "'");
+  EXPECT_EQ(r.exit_code, 2);  // under a file
+  EXPECT_NE(r.err.find("'" + image.string() + "' is not a folder"), std::string::npos) << r.err;
 }
 
 TEST(RenderCli, BadInputExitsWithTwo) {

@@ -1,10 +1,12 @@
-// dgtex render STATE --out DIR: renders a saved shell state (dgtex/shell_state.h) to
-// DIR/frame.png through a headless EGL context.
+// dgtex render STATE --out DIR|FILE.png: renders a saved shell state (dgtex/shell_state.h)
+// to DIR/frame.png, or to FILE.png, through a headless EGL context.
 // Exit codes: 0 success; 2 bad arguments or an unreadable/invalid state file; 1 no
 // OpenGL context (one line on stderr: "dgtex render: no OpenGL 3.3+ core context through
 // EGL (tried: ...)") or another rendering failure.
 #include <CLI/CLI.hpp>
 
+#include <algorithm>
+#include <cctype>
 #include <cstdio>
 #include <filesystem>
 #include <string>
@@ -18,15 +20,47 @@
 
 namespace dgtex::cli {
 
+namespace {
+
+// --out names a folder (the image is its frame.png) or, ending in .png and not an existing
+// folder, the image itself: `--out spiral.png` writes spiral.png, not spiral.png/frame.png.
+std::filesystem::path image_path(const std::string& out) {
+  const std::filesystem::path path(out);
+  std::string extension = path.extension().string();
+  std::transform(extension.begin(), extension.end(), extension.begin(), [](unsigned char c) { return std::tolower(c); });
+  std::error_code error;
+  if (extension == ".png" && !std::filesystem::is_directory(path, error)) return path;
+  return path / "frame.png";
+}
+
+// The image's folder must exist or be creatable, and an existing image be writable.
+CLI::Validator writable_image() {
+  return CLI::Validator(
+      [](std::string& value) -> std::string {
+        const std::filesystem::path image = image_path(value);
+        std::string folder = image.has_parent_path() ? image.parent_path().string() : ".";
+        if (std::string why = creatable_folder()(folder); !why.empty()) return why;
+        std::string file = image.string();
+        std::error_code error;
+        return std::filesystem::exists(image, error) ? writable_file()(file) : "";
+      },
+      "DIR|FILE.png");
+}
+
+}  // namespace
+
 int render_command(int argc, char** argv) {
-  CLI::App app{"Render a saved shell state to OUT/frame.png (headless, EGL)", "dgtex render"};
+  CLI::App app{"Render a saved shell state to OUT/frame.png, or to OUT when it ends in .png (headless, EGL)",
+               "dgtex render"};
   std::string state_path, out_dir, shading = "flat", cut_method = "geometry-shader";
   RenderSettings settings;
   std::vector<double> position, target, up, background;
   app.add_option("STATE", state_path,
                  "state file written by dgtex run --save-state (DIR/final.state) or save_state() (dgtex/shell_state.h)")
       ->required();
-  app.add_option("--out", out_dir, "output folder (created if missing)")->required()->check(creatable_folder());
+  app.add_option("--out", out_dir, "output folder (created if missing) for frame.png, or the image's own name, FILE.png")
+      ->required()
+      ->check(writable_image());
   app.add_option("--width", settings.width, "image width in pixels")->capture_default_str()->check(CLI::Range(1, 16384));
   app.add_option("--height", settings.height, "image height in pixels")->capture_default_str()->check(CLI::Range(1, 16384));
   app.add_option("--shading", shading, "flat (one colour per element) or smooth (normals averaged at nodes)")
@@ -70,9 +104,10 @@ int render_command(int argc, char** argv) {
 
   try {
     ShellRenderer renderer;
-    create_output_folder(out_dir, "--out");
+    const std::filesystem::path frame_path = image_path(out_dir);
+    if (frame_path.has_parent_path()) create_output_folder(frame_path.parent_path().string(), "--out");
     const Image image = renderer.render(state, settings);
-    const std::string frame = (std::filesystem::path(out_dir) / "frame.png").string();
+    const std::string frame = frame_path.string();
     write_png(frame, image);
     std::printf("dgtex render: wrote %s (%d x %d; upload %.1f ms, shader setup %.1f ms, draw %.1f ms; %s)\n",
                 frame.c_str(), image.width, image.height, renderer.last_upload_ms(), renderer.last_setup_ms(),
