@@ -16,7 +16,7 @@ void print_usage(std::FILE* to) {
                "usage: dgtex <command> [options]\n"
                "commands:\n"
                "  run SCENE.json --out DIR     simulate a scene, write report, meshes and images\n"
-               "  render STATE --out DIR       render a saved state to PNG\n"
+               "  render STATE --out DIR|PNG   render a saved state to PNG\n"
                "  bench laplace [options]      Laplace solvers on texel domains (multigrid, CHOLMOD, ...)\n"
                "  bench shell [options]        shell assembly and solve throughput\n"
                "  bench render [options]       cut-boundary error against triangles drawn, frame times\n"
