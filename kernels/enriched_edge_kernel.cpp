@@ -186,8 +186,14 @@ void current_normal(const SideView& s, const int* global, const double* current,
 
 // R = Cur Rest^T of one point: the edge frame (tangent, averaged normal) from rest to
 // current, each side's current normal from its whole basis (global: the edge's 2W slots).
+// A clamped boundary edge (no minus side) keeps R = I: its prescribed normal is fixed in
+// space (shell_edge_rotations says why).
 void edge_point_rotation(const SideView& plus, const SideView* minus, const int* global, int W,
                          const double* current, double* R) {
+  if (!minus) {
+    for (int i = 0; i < 9; ++i) R[i] = i % 4 == 0 ? 1.0 : 0.0;
+    return;
+  }
   double rest[9], cur[9], tangent[3], n_plus[3], n_minus[3], unused[3];
   edge_frame(plus.tangent, plus.t0, minus ? minus->t0 : nullptr, rest);
   current_normal(plus, global, current, tangent, n_plus);

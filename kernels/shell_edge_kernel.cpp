@@ -375,12 +375,21 @@ void shell_edge_rotations(const EdgeBatch& b, const double* current, double* rot
       [&](std::int64_t e) {
         const int* ed = b.edges + 4 * e;
         const bool interior = ed[2] >= 0;
+        if (!interior) {
+          // A clamped boundary edge holds the normal at its prescribed rest value, fixed in
+          // space: turning the clamp's terms with the element's own frame would let the
+          // element rotate about the edge at no cost (a clamped cantilever hinged, and even
+          // under a small load it sagged 4x the linear deflection). R = I.
+          for (int q = 0; q < rule.count; ++q)
+            for (int i = 0; i < 9; ++i) rotations[(e * rule.count + q) * 9 + i] = i % 4 == 0 ? 1.0 : 0.0;
+          return;
+        }
         const int npe = nodes_per_element(b.type);
         for (int q = 0; q < rule.count; ++q) {
           // Shape values once per side; the rest and current frames share them.
           fast_rows::SurfaceFrame rest_side[2], current_side[2];
           double dxi_plus[2] = {0, 0};
-          for (int side = 0; side < (interior ? 2 : 1); ++side) {
+          for (int side = 0; side < 2; ++side) {
             double xi[2], dxi[2];
             local_edge_point(b.type, ed[2 * side + 1], side == 0 ? rule.t[q] : -rule.t[q], xi, dxi);
             if (side == 0) dxi_plus[0] = dxi[0], dxi_plus[1] = dxi[1];
@@ -395,7 +404,7 @@ void shell_edge_rotations(const EdgeBatch& b, const double* current, double* rot
             const fast_rows::SurfaceFrame* sides = k == 0 ? rest_side : current_side;
             double tangent[3];
             for (int d = 0; d < 3; ++d) tangent[d] = sides[0].a1[d] * dxi_plus[0] + sides[0].a2[d] * dxi_plus[1];
-            edge_frame(tangent, sides[0].t0, interior ? sides[1].t0 : nullptr, k == 0 ? rest : cur);
+            edge_frame(tangent, sides[0].t0, sides[1].t0, k == 0 ? rest : cur);
           }
           // R = Cur * Rest^T maps the rest frame onto the current one.
           double* R = rotations + (e * rule.count + q) * 9;

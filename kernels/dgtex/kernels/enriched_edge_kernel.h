@@ -94,7 +94,8 @@ void enriched_edge_corotated_stiffness(const EnrichedEdgeBatch& batch, const Edg
                                        double* blocks, double* forces, Execution execution = Execution::parallel);
 
 // Rotation of the edge frame (tangent, averaged normal) from rest to current, the current
-// frame taken from each side's whole basis. current: #(nodes + virtual nodes) x 3.
+// frame taken from each side's whole basis; the identity on clamped boundary edges (as
+// shell_edge_rotations). current: #(nodes + virtual nodes) x 3.
 void enriched_edge_rotations(const EnrichedEdgeBatch& batch, const EdgeQuadrature& quadrature,
                              const double* current, double* rotations, Execution execution = Execution::parallel);
 

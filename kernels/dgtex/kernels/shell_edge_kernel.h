@@ -91,7 +91,9 @@ void shell_edge_blocks_from_factors(const EdgeBatch& batch, const double* factor
 // equal to it to round-off (~1e-15 relative), not bitwise.
 void shell_edge_stiffness_reference(const EdgeBatch& batch, const double* rotations, double* blocks, double* forces);
 
-// Rotation of the edge frame (tangent, averaged normal) from rest to current positions.
+// Rotation of the edge frame (tangent, averaged normal) from rest to current positions on
+// interior edges; the identity on clamped boundary edges, whose prescribed normal is fixed in
+// space (a rotation there would let the clamped element turn about the edge at no cost).
 void shell_edge_rotations(const EdgeBatch& batch, const double* current_positions, double* rotations,
                           Execution execution = Execution::parallel);
 
