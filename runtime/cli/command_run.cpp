@@ -24,6 +24,7 @@
 #include "dgtex/shell_state.h"
 #include "dgtex/surface_point.h"
 #include "dgtex/texel_memory_estimate.h"
+#include "api_argument_checks.h"
 #include "interrupt_request.h"
 #include "output_paths.h"
 
@@ -41,12 +42,6 @@ nlohmann::json stage_json(const StageTimings& timings, const std::string& stage)
 std::string frame_name(int index) {
   char buffer[32];
   std::snprintf(buffer, sizeof buffer, "frame_%05d.vtu", index);
-  return buffer;
-}
-
-std::string short_number(double x) {
-  char buffer[32];
-  std::snprintf(buffer, sizeof buffer, "%.6g", x);
   return buffer;
 }
 
@@ -157,7 +152,7 @@ int run_command(int argc, char** argv) {
         try {
           run->step();
         } catch (const std::invalid_argument& e) {  // the scene, met in a step: a progressive cut's new function
-          throw ModelError("step " + std::to_string(step) + " (to t = " + short_number(step * scene.analysis.time_step) +
+          throw ModelError("step " + std::to_string(step) + " (to t = " + detail::short_number(step * scene.analysis.time_step) +
                            "): " + e.what());
         }
         if (!all_finite(run->displacement()))
@@ -285,7 +280,7 @@ int run_command(int argc, char** argv) {
   if (interrupted_by != 0) {
     std::fprintf(stderr, "dgtex run: %s: interrupted by %s at step %d of %d (t = %s); the results are that step's\n",
                  scene_path.c_str(), signal_name(interrupted_by), steps_completed, scene.analysis.steps,
-                 short_number(run->time()).c_str());
+                 detail::short_number(run->time()).c_str());
     return 128 + interrupted_by;  // the shell's convention for a process ended by a signal
   }
   return 0;
