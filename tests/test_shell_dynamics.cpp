@@ -65,12 +65,17 @@ double rigid_rotation_force(ShellModel& model, bool corotational) {
 }
 
 TEST(Dynamics, CorotationGivesNoForceUnderRigidRotation) {
-  const Mesh mesh = make_rectangle(1, 0.5, 4, 2, ElementType::quad8);
-  auto model = make_model(mesh, Material{}, 1.0);  // elements and interior edges only
-  const double corotated = rigid_rotation_force(*model, true), linear = rigid_rotation_force(*model, false);
-  std::printf("rigid rotation by 1 rad: |f| / max|K| corotated %.3e, linear %.3e\n", corotated, linear);
-  EXPECT_LT(corotated, 1e-12);
-  EXPECT_GT(linear, 1e-2);
+  // Flat and curved (kinked edges between the elements of a coarse cylinder), quad8 and tri6.
+  for (ElementType type : {ElementType::quad8, ElementType::tri6})
+    for (bool curved : {false, true}) {
+      const Mesh mesh = curved ? make_cylinder(0.5, 1.0, -60, 60, 3, 2, type) : make_rectangle(1, 0.5, 4, 2, type);
+      auto model = make_model(mesh, Material{}, 1.0);  // elements and interior edges only
+      const double corotated = rigid_rotation_force(*model, true), linear = rigid_rotation_force(*model, false);
+      std::printf("%s %s, rigid rotation by 1 rad: |f| / max|K| corotated %.3e, linear %.3e\n",
+                  type == ElementType::quad8 ? "quad8" : "tri6", curved ? "cylinder" : "plate", corotated, linear);
+      EXPECT_LT(corotated, 1e-12);
+      EXPECT_GT(linear, 1e-2);
+    }
 }
 
 // A clamped edge holds its normal fixed in space, so turning the clamped shell about the edge
