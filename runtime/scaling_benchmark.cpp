@@ -63,11 +63,28 @@ std::string scene_label(const Scene& scene) { return scene.source_name.empty() ?
 
 }  // namespace
 
+void check_scaling_scene(const Scene& scene, const std::string& family) {
+  const std::string name = "scene '" + scene_label(scene) + "'";
+  if (family == "enrichment_solve" || family == "enriched_assembly") {
+    if (scene.cuts.empty())
+      throw std::invalid_argument(name + " has no cuts; the " +
+                                  (family == "enrichment_solve" ? "enrichment solve" : "enriched assembly") +
+                                  " needs \"cuts\"");
+  } else if (family == "factorization" || family == "scene_step" || family == "batch") {
+    if (!scene.analysis.is_dynamic())
+      throw std::invalid_argument(name + " is static; " +
+                                  (family == "factorization" ? "the factorization needs a dynamic scene (its time step)"
+                                   : family == "scene_step"  ? "whole steps need a dynamic scene"
+                                                             : "the batch needs a dynamic scene"));
+  } else {
+    throw std::invalid_argument("check_scaling_scene: unknown family '" + family + "'");
+  }
+}
+
 KernelScaling scale_enrichment_solve(const Scene& cut_scene, const std::vector<int>& threads, int repeats) {
   check_threads(threads);
   check_repeats(repeats);
-  if (cut_scene.cuts.empty())
-    throw std::invalid_argument("scene '" + scene_label(cut_scene) + "' has no cuts; the enrichment solve needs \"cuts\"");
+  check_scaling_scene(cut_scene, "enrichment_solve");
   const Mesh mesh = build_scene_mesh(cut_scene);
   const Topology topology = build_topology(mesh);
   const double time = end_time(cut_scene);
@@ -97,8 +114,7 @@ KernelScaling scale_assembly(const Scene& scene, bool complete_cuts, const std::
   SceneModel built = build_scene_model(scene, mesh);
   ShellModel& model = *built.model;
   if (complete_cuts) {
-    if (scene.cuts.empty())
-      throw std::invalid_argument("scene '" + scene_label(scene) + "' has no cuts; the enriched assembly needs \"cuts\"");
+    check_scaling_scene(scene, "enriched_assembly");
     const Topology topology = build_topology(mesh);
     CutManager cuts(mesh, topology, scene.cuts, scene.enrichment);
     cuts.update(end_time(scene));
@@ -162,8 +178,7 @@ KernelScaling scale_polar_decomposition(std::int64_t count, const std::vector<in
 KernelScaling scale_factorization(const Scene& scene, const std::vector<int>& threads, int repeats) {
   check_threads(threads);
   check_repeats(repeats);
-  if (!scene.analysis.is_dynamic())
-    throw std::invalid_argument("scene '" + scene_label(scene) + "' is static; the factorization needs a dynamic scene (its time step)");
+  check_scaling_scene(scene, "factorization");
   const Mesh mesh = build_scene_mesh(scene);
   SceneModel built = build_scene_model(scene, mesh);
   const ShellModel& model = *built.model;
@@ -208,8 +223,7 @@ KernelScaling scale_factorization(const Scene& scene, const std::vector<int>& th
 KernelScaling scale_scene_steps(const Scene& scene, int steps, const std::vector<int>& threads) {
   check_threads(threads);
   if (steps < 1) throw std::invalid_argument("scene steps = " + std::to_string(steps) + ", need >= 1");
-  if (!scene.analysis.is_dynamic())
-    throw std::invalid_argument("scene '" + scene_label(scene) + "' is static; whole steps need a dynamic scene");
+  check_scaling_scene(scene, "scene_step");
   KernelScaling k;
   k.family = "scene_step";
   k.threads = threads;
@@ -232,8 +246,7 @@ BatchThroughput measure_batch_throughput(const Scene& scene, int runs, int steps
   if (runs < 1) throw std::invalid_argument("batch runs = " + std::to_string(runs) + ", need >= 1");
   if (steps < 1) throw std::invalid_argument("batch steps = " + std::to_string(steps) + ", need >= 1");
   if (solo_threads < 1) throw std::invalid_argument("solo threads = " + std::to_string(solo_threads) + ", need >= 1");
-  if (!scene.analysis.is_dynamic())
-    throw std::invalid_argument("scene '" + scene_label(scene) + "' is static; the batch needs a dynamic scene");
+  check_scaling_scene(scene, "batch");
   auto simulate = [&] {
     SceneRun run(scene);
     for (int s = 0; s < steps; ++s) run.step();

@@ -1,11 +1,13 @@
 // dgtex bench scaling (dgtex/scaling_benchmark.h): kernel results do not depend on the
 // thread count, independent scenes run at once in one process end where a run alone ends,
-// and the command writes its JSON (every family, every thread count) and its chart.
+// the command writes its JSON (every family, every thread count) and its chart, and refuses
+// a scene a chosen family cannot use before any family runs.
 #include <gtest/gtest.h>
 
 #include <omp.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -98,6 +100,31 @@ TEST(BenchScaling, ConcurrentRunsWithCholmodEndExactlyWhereARunAloneEnds) {
     EXPECT_EQ(b.max_relative_difference, 0.0) << name;
   }
   omp_set_num_threads(2);
+}
+
+// A scene a chosen family cannot use is refused before any family runs, naming the scene
+// once: a static --scene was refused only when the factorization came, after the enrichment
+// solve, both assemblies and a million polar decompositions, as "dgtex bench scaling: X:
+// scene 'X' is static; ...".
+TEST(BenchScaling, AScenesAFamilyCannotUseIsRefusedBeforeAnyFamilyRuns) {
+  const fs::path dir = fresh_dir("refused");
+  const std::string plate = kScenes + "/clamped_plate.json";
+  const struct {
+    std::string arguments, message;
+  } cases[] = {
+      {"--scene " + plate, "scene '" + plate + "' is static; the factorization needs a dynamic scene"},
+      {"--cut-scene " + plate, "scene '" + plate + "' has no cuts; the enrichment solve needs \"cuts\""},
+      {"--families assembly --cut-scene " + plate, "scene '" + plate + "' has no cuts; the enriched assembly needs"},
+      {"--families batch --batch-scenes " + kScenes + "/spiral1.json," + plate,
+       "scene '" + plate + "' is static; the batch needs a dynamic scene"},
+  };
+  for (const auto& c : cases) {
+    const Result r = run_cli("bench scaling " + c.arguments, dir);
+    EXPECT_EQ(r.exit_code, 2) << c.arguments;
+    // One line (no family's progress line before it), the scene named once.
+    EXPECT_EQ(r.stderr_text.rfind("dgtex bench scaling: " + c.message, 0), 0u) << r.stderr_text;
+    EXPECT_EQ(std::count(r.stderr_text.begin(), r.stderr_text.end(), '\n'), 1) << r.stderr_text;
+  }
 }
 
 TEST(BenchScaling, CommandWritesJsonForEveryThreadCountAndAChart) {

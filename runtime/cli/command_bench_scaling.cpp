@@ -208,10 +208,28 @@ int bench_scaling_command(int argc, char** argv) {
     const bool need_scene = chosen.count("assembly") || chosen.count("factorization") || chosen.count("scene_step");
     const bool need_cut_scene = chosen.count("enrichment_solve") || chosen.count("assembly") || chosen.count("scene_step");
     Scene scene, cut_scene;
+    std::vector<Scene> batch;
     current = scene_path;
     if (need_scene) scene = load_scene(scene_path);
     current = cut_scene_path;
     if (need_cut_scene) cut_scene = load_scene(cut_scene_path);
+    if (chosen.count("batch"))
+      for (const std::string& path : batch_scenes) {
+        current = path;
+        batch.push_back(load_scene(path));
+      }
+    // A scene a chosen family cannot use is refused before any family runs (they take minutes).
+    try {
+      if (chosen.count("enrichment_solve")) check_scaling_scene(cut_scene, "enrichment_solve");
+      if (chosen.count("assembly")) check_scaling_scene(cut_scene, "enriched_assembly");
+      if (chosen.count("factorization")) check_scaling_scene(scene, "factorization");
+      if (chosen.count("scene_step"))
+        for (const Scene* s : {&cut_scene, &scene}) check_scaling_scene(*s, "scene_step");
+      for (const Scene& s : batch) check_scaling_scene(s, "batch");
+    } catch (const std::invalid_argument& e) {  // the message names the scene
+      std::fprintf(stderr, "dgtex bench scaling: %s\n", e.what());
+      return 2;
+    }
     auto note = [](const std::string& what) { std::fprintf(stderr, "bench scaling: %s ...\n", what.c_str()); };
     if (chosen.count("enrichment_solve")) {
       note("enrichment solve, " + cut_scene_path);
@@ -242,13 +260,10 @@ int bench_scaling_command(int argc, char** argv) {
         kernels.push_back(scale_scene_steps(*s, steps, threads));
       }
     }
-    if (chosen.count("batch")) {
-      for (const std::string& path : batch_scenes) {
-        current = path;
-        note("batch throughput, " + path);
-        const Scene s = load_scene(path);
-        batches.push_back(measure_batch_throughput(s, batch_runs, batch_steps, max_threads));
-      }
+    for (const Scene& s : batch) {
+      current = s.source_name;
+      note("batch throughput, " + current);
+      batches.push_back(measure_batch_throughput(s, batch_runs, batch_steps, max_threads));
     }
   } catch (const SceneError& e) {
     std::fprintf(stderr, "dgtex bench scaling: %s\n", e.what());

@@ -34,6 +34,12 @@ struct KernelScaling {
   bool identical_across_threads = true;
 };
 
+// What a family needs of its scene: "enrichment_solve" and "enriched_assembly" need cuts;
+// "factorization", "scene_step" and "batch" a dynamic analysis. Throws std::invalid_argument
+// naming the scene (its source_name) and the family where the scene lacks it. The families
+// check it themselves; a tool calls it first, to refuse a scene before any family runs.
+void check_scaling_scene(const Scene& scene, const std::string& family);
+
 // Time of the complete cuts' enrichment update (CutManager from scratch, update at the
 // scene's end time). Throws std::invalid_argument for a scene without cuts.
 KernelScaling scale_enrichment_solve(const Scene& cut_scene, const std::vector<int>& threads, int repeats);
