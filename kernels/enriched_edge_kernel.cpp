@@ -195,10 +195,10 @@ void edge_point_rotation(const SideView& plus, const SideView* minus, const int*
     return;
   }
   double rest[9], cur[9], tangent[3], n_plus[3], n_minus[3], unused[3];
-  edge_frame(plus.tangent, plus.t0, minus ? minus->t0 : nullptr, rest);
+  edge_frame(plus.tangent, plus.t0, minus->t0, rest);
   current_normal(plus, global, current, tangent, n_plus);
-  if (minus) current_normal(*minus, global + W, current, unused, n_minus);
-  edge_frame(tangent, n_plus, minus ? n_minus : nullptr, cur);
+  current_normal(*minus, global + W, current, unused, n_minus);
+  edge_frame(tangent, n_plus, n_minus, cur);
   for (int i = 0; i < 3; ++i)
     for (int j = 0; j < 3; ++j)
       R[i * 3 + j] = cur[i * 3 + 0] * rest[j * 3 + 0] + cur[i * 3 + 1] * rest[j * 3 + 1] + cur[i * 3 + 2] * rest[j * 3 + 2];

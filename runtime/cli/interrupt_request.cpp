@@ -3,7 +3,6 @@
 #include <unistd.h>
 
 #include <csignal>
-#include <cstdio>
 
 namespace dgtex::cli {
 namespace {
@@ -39,12 +38,6 @@ InterruptRequest::~InterruptRequest() {
 
 int InterruptRequest::signal() const { return received_signal; }
 
-const char* signal_name(int signal) {
-  if (signal == SIGINT) return "SIGINT";
-  if (signal == SIGTERM) return "SIGTERM";
-  static thread_local char buffer[32];
-  std::snprintf(buffer, sizeof buffer, "signal %d", signal);
-  return buffer;
-}
+const char* signal_name(int signal) { return signal == SIGINT ? "SIGINT" : "SIGTERM"; }
 
 }  // namespace dgtex::cli

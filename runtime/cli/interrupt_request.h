@@ -16,7 +16,7 @@ class InterruptRequest {
   int signal() const;
 };
 
-// "SIGINT", "SIGTERM", else "signal N".
+// "SIGINT" or "SIGTERM" (the two signals InterruptRequest catches).
 const char* signal_name(int signal);
 
 }  // namespace dgtex::cli
