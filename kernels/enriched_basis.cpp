@@ -20,14 +20,15 @@ inline void texel_coordinates(ElementType type, int t, double xi1, double xi2, d
   }
 }
 
-// Whether texel (i, j) and its neighbour (i + di, j + dj) (one unit step) are connected.
+// Whether texel (i, j) and its neighbour (i + di, j + dj) (one unit step) are connected
+// (no wall or crease between them).
 inline bool reachable(ElementType type, int t, const std::uint8_t* flags, int i, int j, int di, int dj) {
   const int ni = i + di, nj = j + dj;
   if (!texel_in_domain(type, t, flags, ni, nj)) return false;
-  if (di == 1) return !(flags[j * t + i] & wall_east);
-  if (di == -1) return !(flags[nj * t + ni] & wall_east);
-  if (dj == 1) return !(flags[j * t + i] & wall_north);
-  return !(flags[nj * t + ni] & wall_north);
+  if (di == 1) return !(flags[j * t + i] & stencil_barrier_east);
+  if (di == -1) return !(flags[nj * t + ni] & stencil_barrier_east);
+  if (dj == 1) return !(flags[j * t + i] & stencil_barrier_north);
+  return !(flags[nj * t + ni] & stencil_barrier_north);
 }
 
 // First and second difference of the texel values along one axis (rule of the header).

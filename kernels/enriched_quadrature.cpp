@@ -118,8 +118,8 @@ struct ElementInputs {
         std::uint8_t f = 0;
         for (int k = 0; k < texture_count; ++k) f |= textures[k].flags[j * t + i];
         const bool out = (f & inactive) || (tri && i + j > t - 1);
-        counts[i + 1] = {counts[i].outside + (out ? 1 : 0), counts[i].east + ((f & wall_east) ? 1 : 0),
-                         counts[i].north + ((f & wall_north) ? 1 : 0)};
+        counts[i + 1] = {counts[i].outside + (out ? 1 : 0), counts[i].east + ((f & stencil_barrier_east) ? 1 : 0),
+                         counts[i].north + ((f & stencil_barrier_north) ? 1 : 0)};
       }
     }
   }
@@ -129,7 +129,7 @@ struct ElementInputs {
     for (int j = 0; j < t; ++j) {
       std::uint8_t f = 0;
       for (int k = 0; k < texture_count; ++k) f |= textures[k].flags[j * t + i];
-      east[j + 1] = east[j] + ((f & wall_east) ? 1 : 0);
+      east[j + 1] = east[j] + ((f & stencil_barrier_east) ? 1 : 0);
     }
   }
   static int count(const std::unique_ptr<int[]>& prefix, int t, int line, int begin, int length) {

@@ -47,8 +47,8 @@ struct CellBuilder {
       for (int i = 0; i < t; ++i) {
         std::uint8_t f = 0;
         for (int k = 0; k < texture_count; ++k) f |= textures[k].flags[j * t + i];
-        north_prefix[j * (t + 1) + i + 1] = north_prefix[j * (t + 1) + i] + ((f & wall_north) ? 1 : 0);
-        east_prefix[i * (t + 1) + j + 1] = east_prefix[i * (t + 1) + j] + ((f & wall_east) ? 1 : 0);
+        north_prefix[j * (t + 1) + i + 1] = north_prefix[j * (t + 1) + i] + ((f & stencil_barrier_north) ? 1 : 0);
+        east_prefix[i * (t + 1) + j + 1] = east_prefix[i * (t + 1) + j] + ((f & stencil_barrier_east) ? 1 : 0);
       }
   }
   // Walls on the line between rows j and j + 1 over columns [i0, i0 + w), and between
@@ -100,8 +100,8 @@ struct CellBuilder {
           const std::uint8_t* flags = textures[k].flags;
           if (!texel_in_domain(type, t, flags, i, j)) return false;
           const std::uint8_t f = flags[j * t + i];
-          if ((f & wall_east) && in_cell(i + 1, j, i0, j0, w, h, triangle)) return false;
-          if ((f & wall_north) && in_cell(i, j + 1, i0, j0, w, h, triangle)) return false;
+          if ((f & stencil_barrier_east) && in_cell(i + 1, j, i0, j0, w, h, triangle)) return false;
+          if ((f & stencil_barrier_north) && in_cell(i, j + 1, i0, j0, w, h, triangle)) return false;
           if (!agrees(field(k, ri, rj), field(k, i, j), i - ri, j - rj, size, options.merge_tolerance)) return false;
         }
       }

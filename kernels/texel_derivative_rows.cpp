@@ -42,10 +42,10 @@ struct Tile {
       auto texel = [&](int i) {
         if (!row[i]) return std::uint8_t(0);
         std::uint8_t c = in_domain;
-        if (i + 1 < t && row[i + 1] && !(f[i] & wall_east)) c |= reach_east;
-        if (i > 0 && row[i - 1] && !(f[i - 1] & wall_east)) c |= reach_west;
-        if (above && above[i] && !(f[i] & wall_north)) c |= reach_north;
-        if (below && below[i] && !(f[i - t] & wall_north)) c |= reach_south;
+        if (i + 1 < t && row[i + 1] && !(f[i] & stencil_barrier_east)) c |= reach_east;
+        if (i > 0 && row[i - 1] && !(f[i - 1] & stencil_barrier_east)) c |= reach_west;
+        if (above && above[i] && !(f[i] & stencil_barrier_north)) c |= reach_north;
+        if (below && below[i] && !(f[i - t] & stencil_barrier_north)) c |= reach_south;
         return c;
       };
       // The same bits without branches (0/1 products) for the texels that have all four
@@ -54,10 +54,10 @@ struct Tile {
         const std::uint8_t* fs = f - t;
         for (int i = 1; i + 1 < t; ++i) {
           const int in = row[i];
-          const int east = in & row[i + 1] & ((f[i] & wall_east) == 0);
-          const int west = in & row[i - 1] & ((f[i - 1] & wall_east) == 0);
-          const int north = in & above[i] & ((f[i] & wall_north) == 0);
-          const int south = in & below[i] & ((fs[i] & wall_north) == 0);
+          const int east = in & row[i + 1] & ((f[i] & stencil_barrier_east) == 0);
+          const int west = in & row[i - 1] & ((f[i - 1] & stencil_barrier_east) == 0);
+          const int north = in & above[i] & ((f[i] & stencil_barrier_north) == 0);
+          const int south = in & below[i] & ((fs[i] & stencil_barrier_north) == 0);
           b[i] = static_cast<std::uint8_t>(in * in_domain | east * reach_east | west * reach_west | north * reach_north |
                                            south * reach_south);
         }

@@ -1,23 +1,29 @@
 #pragma once
 // Creases (thesis §5.6, Fig. 5.21): the shell stays C0 across a crease line but its slope
-// may jump there. Each scene crease becomes one EnrichmentFunction WITHOUT walls whose
-// texture H is the distance from the crease line divided by the mesh's mean element edge
-// length (so H = O(1)): H has a kink along the crease, and the enriched basis
-// (H - H(xi^a)) N^a (enrichment_function.h) then represents displacement fields whose
-// first derivatives jump across the crease.
+// may jump there (a hinge). Each scene crease becomes one EnrichmentFunction WITHOUT walls
+// whose texture H has a kink along the crease, so that the enriched basis
+// (H - H(xi^a)) N^a (enrichment_function.h) represents displacement fields whose first
+// derivatives jump across it. On the elements the crease passes through, H is the ridge
+// sum_b |d_b| N^b - |d| of the distance d from the crease line (divided by the mesh's mean
+// element edge length, so H = O(1)): zero at the nodes and on the element edges the crease
+// does not cross. The other elements of Omega_i get H = 0, so no element carries a ramp its
+// basis cannot follow. The crease's texel edges carry kink bits (texel_grid.h): the texel
+// rule's differences stay on one side, so the kink is not a curvature spike.
 //
 // What is built, per crease:
 //   - the crease is traced across the mesh like a cut (trace_cut_path, same point forms and
 //     validation, messages name creases[i]);
 //   - N_i: the nodes of every element the crease passes through (a segment of positive
 //     length inside it); Omega_i: every element incident to one of those nodes (one ring);
-//   - per element of Omega_i, a fast-marching distance (kernels/fast_marching.h) in the
-//     element's own parameter space scaled by its metric at the element centre (texel
-//     steps |dx/dxi1| dxi and |dx/dxi2| dxi: an affine, orthogonal approximation). Seeds,
-//     with the exact 3D distance to the crease polyline (the traced path's rest points):
-//     the texels within 1.5 texels of the crease, and every texel on the tile's border, so
-//     neighbouring elements agree along their shared edge (H is C0 across elements up to
-//     the half-texel offset of the texel centres from the edge).
+//   - per element the crease passes through, a fast-marching distance
+//     (kernels/fast_marching.h) in the element's own parameter space scaled by its metric
+//     at the element centre (texel steps |dx/dxi1| dxi and |dx/dxi2| dxi: an affine,
+//     orthogonal approximation). Seeds, with the exact 3D distance to the crease polyline
+//     (the traced path's rest points): the texels within 1.5 texels of the crease, and
+//     every texel on the tile's border, so neighbouring elements agree along their shared
+//     edge (H is C0 across elements up to the half-texel offset of the texel centres from
+//     the edge); then the ridge of it, with the nodes' exact distances, and the kink bits
+//     on the texel edges the crease's path rasterises to (as a cut's walls would be).
 // Limits: on a flat mesh the result is the exact Euclidean (= geodesic) distance up to the
 // first-order fast-marching error O(texel) away from the seeds. On a curved mesh the seeds
 // use the chordal 3D distance, which underestimates the geodesic one by O(kappa^2 d^3), and

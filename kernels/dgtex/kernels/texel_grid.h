@@ -6,6 +6,10 @@
 // and (i+1, j) is cut; wall_north the edge between (i, j) and (i, j+1). A wall on the tile
 // border means a zero-Neumann boundary there. inactive texels lie outside the domain
 // (e.g. the upper half of a tri6 element's square). dirichlet texels hold a fixed value.
+// A crease lies on texel edges too (kink_east, kink_north): the values stay continuous
+// across it, but the texel rule's finite differences (enriched_basis.h) and the enriched
+// quadrature's cells do not cross it, as for a wall, so the crease is a kink of the field
+// and not a one-texel spike of its curvature.
 // TexelTile is a value type that owns its flags and values. Positions in texel units.
 #include <cstddef>
 #include <cstdint>
@@ -18,7 +22,13 @@ enum TexelFlags : std::uint8_t {
   wall_north = 1u << 1,
   dirichlet = 1u << 2,
   inactive = 1u << 3,
+  kink_east = 1u << 4,
+  kink_north = 1u << 5,
 };
+
+// The edges that finite differences and quadrature cells do not cross: walls and kinks.
+constexpr std::uint8_t stencil_barrier_east = wall_east | kink_east;
+constexpr std::uint8_t stencil_barrier_north = wall_north | kink_north;
 
 struct TexelTile {
   int width = 0;
