@@ -95,9 +95,7 @@ struct CreaseRegion {
   std::vector<Vec3> line;
   std::vector<int> nodes, elements;
   // The elements the crease folds inside (sorted): its path rasterises to texel edges
-  // there, not only to the element's border. Empty when the crease runs along element edges
-  // only: it then keeps the plain distance texture on the one ring of the elements it
-  // touches (no ridge, which would be zero there, and no hinge: see README "Creases").
+  // there, not only to the element's border.
   std::vector<int> crossed;
 };
 
@@ -190,9 +188,16 @@ std::vector<CreaseRegion> crease_regions(const Mesh& mesh, const Topology& topol
           region.crossed.push_back(e);
           break;
         }
+    // Along mesh edges the ridge is zero and the DG edge terms keep the slope continuous: a
+    // crease there would not fold (and its distance texture made a 2 x 2 plate's stiffness
+    // singular). Refused, with the remedy.
+    if (region.crossed.empty())
+      throw std::invalid_argument(name + ": the crease runs along element edges only, where it cannot fold (the edge "
+                                         "terms keep the slope continuous there); a crease folds inside elements: "
+                                         "move it off the mesh lines, e.g. by a tenth of an element");
     std::sort(region.crossed.begin(), region.crossed.end());
     std::set<int> nodes, omega;
-    for (int e : region.crossed.empty() ? touched : region.crossed)
+    for (int e : region.crossed)
       for (int a = 0; a < npe; ++a) nodes.insert(mesh.element_nodes(e)[a]);
     for (int n : nodes) omega.insert(node_elements[n].begin(), node_elements[n].end());
     for (const CutPathVertex& v : path.vertices) region.line.push_back(v.position);
@@ -214,10 +219,6 @@ std::vector<EnrichmentFunction> build_crease_functions(const Mesh& mesh, const T
     EnrichmentFunction f;
     f.enriched_nodes = region.nodes;
     for (int e : region.elements) {
-      if (region.crossed.empty()) {  // along element edges only: the distance itself
-        f.elements.push_back({e, crease_distance_tile(mesh, e, resolution, region.line, scale)});
-        continue;
-      }
       if (!std::binary_search(region.crossed.begin(), region.crossed.end(), e)) {
         f.elements.push_back({e, kernels::make_element_tile(mesh.type, resolution)});  // H = 0: see make_ridge
         continue;
