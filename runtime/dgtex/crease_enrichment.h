@@ -45,7 +45,8 @@ namespace dgtex {
 
 // One function per crease, in order. resolution: texels per element side (T, as for cuts).
 // Throws std::invalid_argument naming creases[i] for a crease the mesh cannot take (see
-// trace_cut_path) or one that passes through no element with positive length.
+// trace_cut_path), one that passes through no element with positive length, or one that
+// runs along element edges only (it could not fold there; the message gives the remedy).
 std::vector<EnrichmentFunction> build_crease_functions(const Mesh& mesh, const Topology& topology,
                                                        const std::vector<Cut>& creases, int resolution);
 
