@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iterator>
 #include <limits>
 #include <set>
 #include <stdexcept>
@@ -89,14 +90,15 @@ kernels::TexelTile crease_distance_tile(const Mesh& mesh, int element, int resol
   return tile;
 }
 
-// A crease traced across the mesh: its path, its polyline, N_i and Omega_i (sorted).
+// A crease traced across the mesh: its polyline, N_i and Omega_i (sorted).
 struct CreaseRegion {
-  MeshCutPath path;
   std::vector<Vec3> line;
   std::vector<int> nodes, elements;
   // The elements the crease folds inside (sorted): its path rasterises to texel edges
-  // there, not only to the element's border.
+  // there, not only to the element's border; per element, those edges (kink_edges[k] for
+  // crossed[k]).
   std::vector<int> crossed;
+  std::vector<std::vector<kernels::CutLatticeEdge>> kink_edges;
 };
 
 // The path's runs in `element`, rasterised to texel edges as a cut's would be (`scratch`: a
@@ -150,17 +152,13 @@ void make_ridge(const Mesh& mesh, int element, int resolution, const std::vector
     }
 }
 
-// Marks the crease's texel edges inside `tile` (element `element`) as kinks, where a cut
-// would set its walls, so the texel rule's differences stay on one side.
-void mark_crease_kinks(const Mesh& mesh, int element, int resolution, const MeshCutPath& path,
-                       kernels::TexelTile& tile) {
-  kernels::TexelTile scratch = kernels::make_element_tile(mesh.type, resolution);
-  for (const kernels::CutRaster& raster : crease_rasters(mesh, element, resolution, path, scratch))
-    for (const kernels::CutLatticeEdge& edge : raster.edges) {
-      if (!separates_texels(edge)) continue;
-      const int a = std::min(edge.left_texel, edge.right_texel), b = std::max(edge.left_texel, edge.right_texel);
-      tile.flags[a] |= b == a + 1 ? kernels::kink_east : kernels::kink_north;  // b is a's east or north neighbour
-    }
+// Marks the crease's texel edges inside an element's tile as kinks, where a cut would set
+// its walls, so the texel rule's differences stay on one side.
+void mark_crease_kinks(const std::vector<kernels::CutLatticeEdge>& edges, kernels::TexelTile& tile) {
+  for (const kernels::CutLatticeEdge& edge : edges) {
+    const int a = std::min(edge.left_texel, edge.right_texel), b = std::max(edge.left_texel, edge.right_texel);
+    tile.flags[a] |= b == a + 1 ? kernels::kink_east : kernels::kink_north;  // b is a's east or north neighbour
+  }
 }
 
 // Traces every crease (one search for all) and finds its region.
@@ -182,12 +180,14 @@ std::vector<CreaseRegion> crease_regions(const Mesh& mesh, const Topology& topol
     if (touched.empty())
       throw std::invalid_argument(name + ": the crease passes through no element (zero length on the surface)");
     CreaseRegion region;
-    for (int e : touched)
+    for (int e : touched) {  // sorted: so is crossed
+      std::vector<kernels::CutLatticeEdge> inside;
       for (const kernels::CutRaster& raster : crease_rasters(mesh, e, resolution, path, scratch))
-        if (std::any_of(raster.edges.begin(), raster.edges.end(), separates_texels)) {
-          region.crossed.push_back(e);
-          break;
-        }
+        std::copy_if(raster.edges.begin(), raster.edges.end(), std::back_inserter(inside), separates_texels);
+      if (inside.empty()) continue;
+      region.crossed.push_back(e);
+      region.kink_edges.push_back(std::move(inside));
+    }
     // Along mesh edges the ridge is zero and the DG edge terms keep the slope continuous: a
     // crease there would not fold (and its distance texture made a 2 x 2 plate's stiffness
     // singular). Refused, with the remedy.
@@ -195,13 +195,11 @@ std::vector<CreaseRegion> crease_regions(const Mesh& mesh, const Topology& topol
       throw std::invalid_argument(name + ": the crease runs along element edges only, where it cannot fold (the edge "
                                          "terms keep the slope continuous there); a crease folds inside elements: "
                                          "move it off the mesh lines, e.g. by a tenth of an element");
-    std::sort(region.crossed.begin(), region.crossed.end());
     std::set<int> nodes, omega;
     for (int e : region.crossed)
       for (int a = 0; a < npe; ++a) nodes.insert(mesh.element_nodes(e)[a]);
     for (int n : nodes) omega.insert(node_elements[n].begin(), node_elements[n].end());
     for (const CutPathVertex& v : path.vertices) region.line.push_back(v.position);
-    region.path = path;
     region.nodes.assign(nodes.begin(), nodes.end());
     region.elements.assign(omega.begin(), omega.end());
     regions.push_back(std::move(region));
@@ -219,13 +217,14 @@ std::vector<EnrichmentFunction> build_crease_functions(const Mesh& mesh, const T
     EnrichmentFunction f;
     f.enriched_nodes = region.nodes;
     for (int e : region.elements) {
-      if (!std::binary_search(region.crossed.begin(), region.crossed.end(), e)) {
+      const auto crossed = std::lower_bound(region.crossed.begin(), region.crossed.end(), e);
+      if (crossed == region.crossed.end() || *crossed != e) {
         f.elements.push_back({e, kernels::make_element_tile(mesh.type, resolution)});  // H = 0: see make_ridge
         continue;
       }
       kernels::TexelTile tile = crease_distance_tile(mesh, e, resolution, region.line, scale);
       make_ridge(mesh, e, resolution, region.line, scale, tile);
-      mark_crease_kinks(mesh, e, resolution, region.path, tile);
+      mark_crease_kinks(region.kink_edges[crossed - region.crossed.begin()], tile);
       f.elements.push_back({e, std::move(tile)});
     }
     functions.push_back(std::move(f));
