@@ -184,9 +184,13 @@ const char* kPlate = R"({
   CREASES
 })";
 
-Scene plate_scene(const std::string& creases) {
+// The plate with these creases (JSON text after the enrichment block) on n x n quad8.
+Scene plate_scene(const std::string& creases, int n = 1) {
   std::string text = kPlate;
   text.replace(text.find("CREASES"), 7, creases);
+  const std::string divisions = R"("divisions": [1, 1])";
+  text.replace(text.find(divisions), divisions.size(),
+               "\"divisions\": [" + std::to_string(n) + ", " + std::to_string(n) + "]");
   return parse_scene(text, "plate.json");
 }
 
@@ -246,12 +250,7 @@ TEST(Creases, PlateRotatesAboutTheCrease) {
 TEST(Creases, AStraightCreaseIsAHingeOnEveryMesh) {
   const double P = 6e-4, D = kernels::bending_rigidity(1e6, 0.3, 0.01), hinge = P * 0.125 / (3 * D);
   for (int n : {1, 3, 5}) {
-    std::string text = kPlate;
-    text.replace(text.find("CREASES"), 7, R"(, "creases": [{"points": [[0.5, 0, 0], [0.5, 1, 0]]}])");
-    const std::string divisions = R"("divisions": [1, 1])";
-    text.replace(text.find(divisions), divisions.size(),
-                 "\"divisions\": [" + std::to_string(n) + ", " + std::to_string(n) + "]");
-    SceneRun run(parse_scene(text, "plate.json"));
+    SceneRun run(plate_scene(R"(, "creases": [{"points": [[0.5, 0, 0], [0.5, 1, 0]]}])", n));
     run.solve_static();
     auto z = [&](double x) {
       const double at[3] = {x, 0.5, 0};
@@ -276,12 +275,8 @@ TEST(Creases, AStraightCreaseIsAHingeOnEveryMesh) {
 // little softer: no hinge).
 TEST(Creases, ACreaseAlongElementEdgesOnlyIsRefusedWithARemedy) {
   for (const char* points : {"[[0.5, 0, 0], [0.5, 1, 0]]", "[[0.5, 0, 0], [0.5, 0.6, 0]]"}) {
-    std::string text = kPlate;
-    text.replace(text.find("CREASES"), 7, std::string(R"(, "creases": [{"points": )") + points + "}]");
-    const std::string divisions = R"("divisions": [1, 1])";
-    text.replace(text.find(divisions), divisions.size(), R"("divisions": [4, 4])");
     try {
-      SceneRun run(parse_scene(text, "plate.json"));
+      SceneRun run(plate_scene(std::string(R"(, "creases": [{"points": )") + points + "}]", 4));
       ADD_FAILURE() << points << ": accepted";
     } catch (const std::invalid_argument& e) {
       EXPECT_NE(std::string(e.what()).find("creases[0]: the crease runs along element edges only"), std::string::npos)
@@ -290,11 +285,7 @@ TEST(Creases, ACreaseAlongElementEdgesOnlyIsRefusedWithARemedy) {
     }
   }
   // Moved off the mesh line by a tenth of an element, it folds (a hinge at x = 0.525).
-  std::string text = kPlate;
-  text.replace(text.find("CREASES"), 7, R"(, "creases": [{"points": [[0.525, 0, 0], [0.525, 1, 0]]}])");
-  const std::string divisions = R"("divisions": [1, 1])";
-  text.replace(text.find(divisions), divisions.size(), R"("divisions": [4, 4])");
-  SceneRun run(parse_scene(text, "plate.json"));
+  SceneRun run(plate_scene(R"(, "creases": [{"points": [[0.525, 0, 0], [0.525, 1, 0]]}])", 4));
   EXPECT_NO_THROW(run.solve_static());
 }
 

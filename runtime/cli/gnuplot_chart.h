@@ -15,7 +15,7 @@ namespace dgtex::cli {
 // gnuplot's own error (e.g. "line 9: all points y value undefined!"), or the copy to
 // `path` failed.
 std::string draw_gnuplot_chart(const std::string& path, int width, int height, const std::string& data,
-                        const std::function<std::string(const std::string& data_file)>& commands);
+                               const std::function<std::string(const std::string& data_file)>& commands);
 
 // A gnuplot double-quoted string (newlines become line breaks there).
 std::string gnuplot_quoted(const std::string& text);
