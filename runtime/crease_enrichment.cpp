@@ -90,17 +90,6 @@ kernels::TexelTile crease_distance_tile(const Mesh& mesh, int element, int resol
   return tile;
 }
 
-// A crease traced across the mesh: its polyline, N_i and Omega_i (sorted).
-struct CreaseRegion {
-  std::vector<Vec3> line;
-  std::vector<int> nodes, elements;
-  // The elements the crease folds inside (sorted): its path rasterises to texel edges
-  // there, not only to the element's border; per element, those edges (kink_edges[k] for
-  // crossed[k]).
-  std::vector<int> crossed;
-  std::vector<std::vector<kernels::CutLatticeEdge>> kink_edges;
-};
-
 // The path's runs in `element`, rasterised to texel edges as a cut's would be (`scratch`: a
 // tile of the element's layout that takes the rasteriser's wall marks).
 std::vector<kernels::CutRaster> crease_rasters(const Mesh& mesh, int element, int resolution, const MeshCutPath& path,
@@ -161,11 +150,12 @@ void mark_crease_kinks(const std::vector<kernels::CutLatticeEdge>& edges, kernel
   }
 }
 
-// Traces every crease (one search for all) and finds its region.
-std::vector<CreaseRegion> crease_regions(const Mesh& mesh, const Topology& topology, const std::vector<Cut>& creases,
-                                         int resolution) {
-  std::vector<CreaseRegion> regions;
-  if (creases.empty()) return regions;
+}  // namespace
+
+std::vector<TracedCrease> trace_creases(const Mesh& mesh, const Topology& topology, const std::vector<Cut>& creases,
+                                        int resolution) {
+  std::vector<TracedCrease> traced;
+  if (creases.empty()) return traced;
   const ElementAdjacency adjacency(mesh, topology);
   const int npe = mesh.nodes_per_element();
   std::vector<std::vector<int>> node_elements(mesh.num_nodes());
@@ -179,7 +169,8 @@ std::vector<CreaseRegion> crease_regions(const Mesh& mesh, const Topology& topol
     const std::vector<int> touched = elements_passed_through(path.vertices);
     if (touched.empty())
       throw std::invalid_argument(name + ": the crease passes through no element (zero length on the surface)");
-    CreaseRegion region;
+    TracedCrease region;
+    region.resolution = resolution;
     for (int e : touched) {  // sorted: so is crossed
       std::vector<kernels::CutLatticeEdge> inside;
       for (const kernels::CutRaster& raster : crease_rasters(mesh, e, resolution, path, scratch))
@@ -202,18 +193,16 @@ std::vector<CreaseRegion> crease_regions(const Mesh& mesh, const Topology& topol
     for (const CutPathVertex& v : path.vertices) region.line.push_back(v.position);
     region.nodes.assign(nodes.begin(), nodes.end());
     region.elements.assign(omega.begin(), omega.end());
-    regions.push_back(std::move(region));
+    traced.push_back(std::move(region));
   }
-  return regions;
+  return traced;
 }
 
-}  // namespace
-
-std::vector<EnrichmentFunction> build_crease_functions(const Mesh& mesh, const Topology& topology,
-                                                       const std::vector<Cut>& creases, int resolution) {
+std::vector<EnrichmentFunction> build_crease_functions(const Mesh& mesh, const std::vector<TracedCrease>& creases) {
   const double scale = 1.0 / (4.0 * cut_point_tolerance(mesh));  // 1 / mean element edge length
   std::vector<EnrichmentFunction> functions;
-  for (const CreaseRegion& region : crease_regions(mesh, topology, creases, resolution)) {
+  for (const TracedCrease& region : creases) {
+    const int resolution = region.resolution;
     EnrichmentFunction f;
     f.enriched_nodes = region.nodes;
     for (int e : region.elements) {
@@ -232,10 +221,14 @@ std::vector<EnrichmentFunction> build_crease_functions(const Mesh& mesh, const T
   return functions;
 }
 
-TexelFootprint crease_footprint(const Mesh& mesh, const Topology& topology, const std::vector<Cut>& creases,
-                                int resolution) {
+std::vector<EnrichmentFunction> build_crease_functions(const Mesh& mesh, const Topology& topology,
+                                                       const std::vector<Cut>& creases, int resolution) {
+  return build_crease_functions(mesh, trace_creases(mesh, topology, creases, resolution));
+}
+
+TexelFootprint crease_footprint(const std::vector<TracedCrease>& creases) {
   TexelFootprint footprint;
-  for (const CreaseRegion& region : crease_regions(mesh, topology, creases, resolution)) {
+  for (const TracedCrease& region : creases) {
     footprint.region_elements += static_cast<std::int64_t>(region.elements.size());
     ++footprint.fields;
   }

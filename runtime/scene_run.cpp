@@ -30,13 +30,14 @@ void merge(StageTimings& into, const StageTimings& from) {
 
 // The texel fields the scene's cuts and creases will hold, from the traced paths
 // (cuts: nullptr without cuts).
-TexelFields texel_fields(const Scene& scene, const Mesh& mesh, const Topology& topology, const CutManager* cuts) {
+TexelFields texel_fields(const Scene& scene, const Mesh& mesh, const CutManager* cuts,
+                         const std::vector<TracedCrease>& creases) {
   TexelFields fields;
   fields.type = mesh.type;
   fields.resolution = scene.enrichment.texture_resolution;
   fields.direct_solves = mesh.type == ElementType::tri6 || scene.enrichment.solver == EnrichmentOptions::Solver::cholmod;
   if (cuts) fields.cuts = cuts->full_footprint();
-  fields.creases = crease_footprint(mesh, topology, scene.creases, fields.resolution);
+  fields.creases = crease_footprint(creases);
   return fields;
 }
 
@@ -59,12 +60,14 @@ SceneRun::SceneRun(const Scene& scene, SceneRunOptions options)
         cuts_ = std::make_unique<CutManager>(mesh_, topology_, scene_.cuts, scene_.enrichment);
       // Before the first field is allocated: a scene whose texel fields cannot fit is
       // refused with one line rather than killed by the system later.
-      const TexelFields fields = texel_fields(scene_, mesh_, topology_, cuts_.get());
+      const std::vector<TracedCrease> creases =
+          trace_creases(mesh_, topology_, scene_.creases, scene_.enrichment.texture_resolution);
+      const TexelFields fields = texel_fields(scene_, mesh_, cuts_.get(), creases);
       const std::int64_t available = available_memory_bytes();
       check_texel_memory(fields, available, scene_.source_name.empty() ? "scene" : scene_.source_name);
       if (options_.before_texel_fields) options_.before_texel_fields(fields, available);
       if (cuts_) cuts_->update(0.0);
-      creases_ = build_crease_functions(mesh_, topology_, scene_.creases, scene_.enrichment.texture_resolution);
+      creases_ = build_crease_functions(mesh_, creases);
     }
     if (cuts_) model_->set_cut_edge_texels(cuts_->edge_walls().resolution(), cuts_->edge_walls().flags(mesh_.num_elements()));
     model_->set_enrichments(enrichment_functions());

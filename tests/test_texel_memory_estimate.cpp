@@ -82,13 +82,13 @@ TEST(TexelMemoryEstimate, CreaseFootprintCountsTheTilesOfItsFunctions) {
   finer.creases[0].points = {{0.45, 0, 0}, {0.45, 1, 0}};
   for (const Scene& s : {scene, finer}) {
     mesh = build_scene_mesh(s);
-    const Topology topology = build_topology(mesh);
-    const TexelFootprint footprint = crease_footprint(mesh, topology, s.creases, 32);
-    const std::vector<EnrichmentFunction> functions = build_crease_functions(mesh, topology, s.creases, 32);
+    const std::vector<TracedCrease> traced = trace_creases(mesh, build_topology(mesh), s.creases, 32);
+    const TexelFootprint footprint = crease_footprint(traced);
+    const std::vector<EnrichmentFunction> functions = build_crease_functions(mesh, traced);
     ASSERT_EQ(footprint.fields, static_cast<int>(functions.size()));
     EXPECT_EQ(footprint.region_elements, static_cast<std::int64_t>(functions[0].elements.size()));
   }
-  EXPECT_EQ(crease_footprint(mesh, build_topology(mesh), finer.creases, 32).region_elements, 24);  // 3 columns of 8
+  EXPECT_EQ(crease_footprint(trace_creases(mesh, build_topology(mesh), finer.creases, 32)).region_elements, 24);  // 3 columns of 8
 }
 
 TEST(TexelMemoryEstimate, TooLittleMemoryIsASceneErrorNamingTheResolution) {

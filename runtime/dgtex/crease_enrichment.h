@@ -31,11 +31,12 @@
 // crossing a creased element does not split the crease's enrichment. Creases are static
 // (no start_time/speed). A crease tip inside an element gives distance-to-endpoint (a cone),
 // so the slope jump fades out around the tip as the kink does.
-// Pure function: returns the EnrichmentFunctions by value (keeps nothing; thread-safe).
+// Pure functions: return their results by value (keep nothing; thread-safe).
 // H is dimensionless (distance / mean edge length); lengths in the mesh's unit (SI: m).
 #include <vector>
 
 #include "dgtex/enrichment_function.h"
+#include "dgtex/kernels/cut_rasterization.h"
 #include "dgtex/mesh.h"
 #include "dgtex/scene.h"
 #include "dgtex/texel_memory_estimate.h"
@@ -43,16 +44,35 @@
 
 namespace dgtex {
 
-// One function per crease, in order. resolution: texels per element side (T, as for cuts).
+// A scene crease traced across the mesh: what build_crease_functions needs from the trace.
+// Kept between the texel memory check and the build, so each crease is traced once.
+struct TracedCrease {
+  int resolution = 0;           // T, texels per element side, the kinks were rasterised at
+  std::vector<Vec3> line;       // the traced path's rest points
+  std::vector<int> nodes;       // N_i (sorted)
+  std::vector<int> elements;    // Omega_i (sorted)
+  std::vector<int> crossed;     // the elements the crease folds inside (sorted)
+  // Per crossed element (kink_edges[k] for crossed[k]): the texel edges its path
+  // rasterises to inside the element, as a cut's walls would be.
+  std::vector<std::vector<kernels::CutLatticeEdge>> kink_edges;
+};
+
+// One trace per crease, in order. resolution: texels per element side (T, as for cuts).
 // Throws std::invalid_argument naming creases[i] for a crease the mesh cannot take (see
 // trace_cut_path), one that passes through no element with positive length, or one that
 // runs along element edges only (it could not fold there; the message gives the remedy).
+std::vector<TracedCrease> trace_creases(const Mesh& mesh, const Topology& topology, const std::vector<Cut>& creases,
+                                        int resolution);
+
+// One function per traced crease, in order.
+std::vector<EnrichmentFunction> build_crease_functions(const Mesh& mesh, const std::vector<TracedCrease>& creases);
+
+// trace_creases, then build_crease_functions; throws as trace_creases does.
 std::vector<EnrichmentFunction> build_crease_functions(const Mesh& mesh, const Topology& topology,
                                                        const std::vector<Cut>& creases, int resolution);
 
-// The fields build_crease_functions would make (one per crease, a tile on each element of
-// its Omega_i), from the traced creases alone (texel_memory_estimate.h). Throws as it does.
-TexelFootprint crease_footprint(const Mesh& mesh, const Topology& topology, const std::vector<Cut>& creases,
-                                int resolution);
+// The fields build_crease_functions makes from the traced creases (one per crease, a tile on
+// each element of its Omega_i; texel_memory_estimate.h).
+TexelFootprint crease_footprint(const std::vector<TracedCrease>& creases);
 
 }  // namespace dgtex
