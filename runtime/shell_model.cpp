@@ -20,17 +20,12 @@
 #include "enriched_sub_batch.h"
 #include "multigrid_buffer.h"
 #include "parametric_point_index.h"
+#include "rotation_cluster_memory.h"
 #include "shell_model_inputs.h"
 
 namespace dgtex {
 
 using kernels::Execution;
-
-namespace {
-// Rotation clusters' rest sums beyond this (4 GiB) are refused: ~0.8 MB per cluster for the
-// accordion's 150 functions, so blocks of 8 texels there already take 1.2 GB.
-constexpr std::int64_t max_rotation_cluster_doubles = std::int64_t{1} << 29;
-}  // namespace
 
 ShellModel::ShellModel(Mesh mesh, const Topology& topology, std::vector<kernels::ShellSection> sections,
                        const std::vector<int>& clamped_edges, ShellModelOptions options)
@@ -759,12 +754,9 @@ void ShellModel::assemble_stiffness(const double* current, std::vector<double>& 
         const int tip_block = std::max(1, options_.rotation_cluster_texels / 4);
         w.clusters = kernels::enriched_rotation_clusters(xb, element_quad, options_.rotation_cluster_texels, tip_block);
         const std::int64_t size = kernels::enriched_cluster_rest_size(xb, w.clusters);
-        if (size > max_rotation_cluster_doubles)
-          throw ModelError("rotation clusters of " + std::to_string(options_.rotation_cluster_texels) +
-                                   " texels: " + std::to_string(w.clusters.count()) + " clusters would take " +
-                                   std::to_string(size * 8 >> 20) + " MiB of rest sums (limit " +
-                                   std::to_string(max_rotation_cluster_doubles * 8 >> 20) +
-                                   " MiB); use larger blocks (enrichment.rotation_cluster_texels) or 0 (per point)");
+        detail::check_rotation_cluster_memory(size * static_cast<std::int64_t>(sizeof(double)),
+                                              detail::rotation_cluster_memory_available(),
+                                              options_.rotation_cluster_texels, w.clusters.count());
         // A progressive cut's next model needs a slightly different size; the block cache
         // hands it the block of an earlier model that serves it (spiral6 at B = 16: ~23 MB a
         // step, otherwise fresh pages faulted in every step). The kernel writes every entry,

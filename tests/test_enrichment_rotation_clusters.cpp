@@ -15,9 +15,13 @@
 
 #include "dgtex/kernels/cut_rasterization.h"
 #include "dgtex/kernels/enriched_rotation_clusters.h"
+#include "dgtex/model_error.h"
+#include "dgtex/texel_memory_estimate.h"
 #include "dgtex/topology.h"
 #include "cut_element_fixture.h"
 #include "enrichment_test_support.h"
+#include "multigrid_buffer.h"         // internal (runtime/)
+#include "rotation_cluster_memory.h"  // internal (runtime/)
 #include "shell_test_support.h"
 
 using namespace dgtex;
@@ -343,6 +347,26 @@ TEST(EnrichedRotationClusters, ModelRebuildsThemWhenTheEnrichmentChanges) {
       EXPECT_LE(max_difference(f, fref), 1e-9 * max_abs(fref)) << where;
     }
   }
+}
+
+TEST(EnrichedRotationClusters, RestSumsLargerThanTheMemoryAvailableAreRefusedNamingTheKey) {
+  constexpr std::int64_t MiB = std::int64_t{1} << 20;
+  EXPECT_NO_THROW(detail::check_rotation_cluster_memory(645 * MiB, 645 * MiB, 8, 1416));
+  EXPECT_NO_THROW(detail::check_rotation_cluster_memory(645 * MiB, -1, 8, 1416));  // nothing known: no check
+  try {
+    detail::check_rotation_cluster_memory(645 * MiB, 645 * MiB - 1, 8, 1416);
+    FAIL() << "645 MiB of rest sums accepted with 1 byte less available";
+  } catch (const ModelError& e) {
+    const std::string what = e.what();
+    for (const char* part : {"enrichment.rotation_cluster_texels = 8", "1416 rotation clusters", "645 MiB of rest sums",
+                             "the 644 MiB of memory available", "larger blocks or 0"})
+      EXPECT_NE(what.find(part), std::string::npos) << part << " not in: " << what;
+  }
+  // The bound the model uses: this machine's memory (Linux: /proc/meminfo) plus the blocks
+  // the process keeps for reuse.
+  if (available_memory_bytes() < 0) GTEST_SKIP() << "/proc/meminfo cannot be read here";
+  EXPECT_GE(detail::rotation_cluster_memory_available(), static_cast<std::int64_t>(detail::cached_block_bytes()));
+  EXPECT_GT(detail::rotation_cluster_memory_available(), 0);
 }
 
 }  // namespace

@@ -162,7 +162,8 @@ class ShellModel {
   // Global stiffness blocks (pattern().num_blocks() x 9). With a current state (#dofs:
   // current node positions, then the current enriched DOF values), the model is corotated
   // per quadrature point (enriched elements: per rotation cluster where
-  // options().rotation_cluster_texels > 0; ModelError if their rest sums would pass 4 GiB)
+  // options().rotation_cluster_texels > 0; ModelError if their rest sums would not fit in
+  // the memory available)
   // and `corrective` (#dofs) receives the right-hand-side term of report eq. 48; without,
   // it is the linear model.
   void assemble_stiffness(const double* current_positions, std::vector<double>& blocks,
