@@ -9,33 +9,47 @@
 namespace dgtex::kernels {
 namespace {
 
-// Emits the quadtree cells of texels [i0, i1) x [j0, j1) in a fixed order.
-void emit_cells(const MaterialTextureView& t, const ShellSection& base, int i0, int i1, int j0, int j1,
-                std::vector<double>& points, std::vector<ShellSection>& sections) {
+// Visits the uniform quadtree cells of texels [i0, i1) x [j0, j1) in a fixed order:
+// visit(i0, i1, j0, j1) for each cell whose texels all share E and h.
+template <class Visit>
+void for_each_uniform_cell(const MaterialTextureView& t, int i0, int i1, int j0, int j1, Visit&& visit) {
   const double e0 = t.youngs_modulus[j0 * t.width + i0], h0 = t.thickness[j0 * t.width + i0];
   bool uniform = true;
   for (int j = j0; j < j1 && uniform; ++j)
     for (int i = i0; i < i1 && uniform; ++i)
       uniform = t.youngs_modulus[j * t.width + i] == e0 && t.thickness[j * t.width + i] == h0;
-  if (!uniform) {
-    const int im = i1 - i0 > 1 ? (i0 + i1) / 2 : i1;
-    const int jm = j1 - j0 > 1 ? (j0 + j1) / 2 : j1;
-    for (int jj = 0; jj < 2; ++jj)
-      for (int ii = 0; ii < 2; ++ii) {
-        const int a0 = ii ? im : i0, a1 = ii ? i1 : im, b0 = jj ? jm : j0, b1 = jj ? j1 : jm;
-        if (a0 < a1 && b0 < b1) emit_cells(t, base, a0, a1, b0, b1, points, sections);
-      }
+  if (uniform) {
+    visit(i0, i1, j0, j1);
     return;
   }
-  // Cell in xi: [x0, x1] x [y0, y1]; the whole element maps with mid 0, half 1 exactly.
-  const double x0 = -1 + 2.0 * i0 / t.width, x1 = -1 + 2.0 * i1 / t.width;
-  const double y1 = 1 - 2.0 * j0 / t.height, y0 = 1 - 2.0 * j1 / t.height;
-  const double mx = 0.5 * (x0 + x1), hx = 0.5 * (x1 - x0), my = 0.5 * (y0 + y1), hy = 0.5 * (y1 - y0);
+  const int im = i1 - i0 > 1 ? (i0 + i1) / 2 : i1;
+  const int jm = j1 - j0 > 1 ? (j0 + j1) / 2 : j1;
+  for (int jj = 0; jj < 2; ++jj)
+    for (int ii = 0; ii < 2; ++ii) {
+      const int a0 = ii ? im : i0, a1 = ii ? i1 : im, b0 = jj ? jm : j0, b1 = jj ? j1 : jm;
+      if (a0 < a1 && b0 < b1) for_each_uniform_cell(t, a0, a1, b0, b1, visit);
+    }
+}
+
+void check_texture(const MaterialTextureView& t) {
+  if (t.width < 1 || t.height < 1) throw std::invalid_argument("material textures: empty texture");
+}
+
+// Appends the element rule mapped onto each uniform cell (points, sections).
+void emit_cells(const MaterialTextureView& t, const ShellSection& base, std::vector<double>& points,
+                std::vector<ShellSection>& sections) {
   const QuadratureRule rule = element_quadrature(ElementType::quad8);
-  for (int q = 0; q < rule.count; ++q) {
-    points.insert(points.end(), {mx + hx * rule.xi1[q], my + hy * rule.xi2[q], rule.weight[q] * hx * hy});
-    sections.push_back({e0, base.poisson_ratio, h0, base.density});
-  }
+  for_each_uniform_cell(t, 0, t.width, 0, t.height, [&](int i0, int i1, int j0, int j1) {
+    // Cell in xi: [x0, x1] x [y0, y1]; the whole element maps with mid 0, half 1 exactly.
+    const double x0 = -1 + 2.0 * i0 / t.width, x1 = -1 + 2.0 * i1 / t.width;
+    const double y1 = 1 - 2.0 * j0 / t.height, y0 = 1 - 2.0 * j1 / t.height;
+    const double mx = 0.5 * (x0 + x1), hx = 0.5 * (x1 - x0), my = 0.5 * (y0 + y1), hy = 0.5 * (y1 - y0);
+    const double e0 = t.youngs_modulus[j0 * t.width + i0], h0 = t.thickness[j0 * t.width + i0];
+    for (int q = 0; q < rule.count; ++q) {
+      points.insert(points.end(), {mx + hx * rule.xi1[q], my + hy * rule.xi2[q], rule.weight[q] * hx * hy});
+      sections.push_back({e0, base.poisson_ratio, h0, base.density});
+    }
+  });
 }
 
 inline void apply_plane_stress(double nu, double scale, const double in[3], double out[3]) {
@@ -123,15 +137,26 @@ void element_stiffness(const PointSectionBatch& b, std::int64_t e, const double*
 
 }  // namespace
 
+std::int64_t material_texture_point_count(const MaterialTextureView& texture) {
+  check_texture(texture);
+  std::int64_t cells = 0;
+  for_each_uniform_cell(texture, 0, texture.width, 0, texture.height, [&](int, int, int, int) { ++cells; });
+  return cells * element_quadrature(ElementType::quad8).count;
+}
+
 void material_texture_quadrature(ElementType type, std::int64_t count, const MaterialTextureView* textures,
                                  const ShellSection* base, std::vector<std::int64_t>& start,
                                  std::vector<double>& points, std::vector<ShellSection>& sections) {
   if (type != ElementType::quad8) throw std::invalid_argument("material textures: only quad8 elements are supported");
+  // Counted first, so the arrays are allocated once at their size: growing them doubled
+  // the memory of a texture whose texels all differ (~120 instead of 56 bytes a point).
+  std::int64_t total = static_cast<std::int64_t>(sections.size());
+  for (std::int64_t e = 0; e < count; ++e) total += material_texture_point_count(textures[e]);
+  points.reserve(3 * static_cast<std::size_t>(total));
+  sections.reserve(static_cast<std::size_t>(total));
   if (start.empty()) start.push_back(0);
   for (std::int64_t e = 0; e < count; ++e) {
-    const MaterialTextureView& t = textures[e];
-    if (t.width < 1 || t.height < 1) throw std::invalid_argument("material textures: empty texture");
-    emit_cells(t, base[e], 0, t.width, 0, t.height, points, sections);
+    emit_cells(textures[e], base[e], points, sections);
     start.push_back(static_cast<std::int64_t>(sections.size()));
   }
 }

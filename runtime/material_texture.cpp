@@ -4,6 +4,7 @@
 #include <string>
 #include <utility>
 
+#include "dgtex/kernels/material_texture_kernel.h"
 #include "dgtex/png_io.h"
 #include "dgtex/scene_io.h"
 
@@ -70,6 +71,33 @@ std::vector<ElementMaterialTexture> scene_material_textures(const Scene& scene, 
   std::vector<ElementMaterialTexture> out;
   for (auto& [e, m] : per_element) out.push_back(std::move(m));
   return out;
+}
+
+static_assert(kMaterialBytesPerPoint == 3 * sizeof(double) + sizeof(kernels::ShellSection),
+              "a point: (xi1, xi2, weight) and its section");
+
+std::int64_t material_texture_quadrature_bytes(const std::vector<ElementMaterialTexture>& textures) {
+  std::int64_t points = 0;
+  for (const ElementMaterialTexture& t : textures)
+    points += kernels::material_texture_point_count({t.width, t.height, t.youngs_modulus.data(), t.thickness.data()});
+  return points * kMaterialBytesPerPoint;
+}
+
+void check_material_texture_memory(const std::vector<ElementMaterialTexture>& textures, std::int64_t available_bytes,
+                                   const std::string& source_name) {
+  if (available_bytes < 0) return;
+  const std::int64_t needed = material_texture_quadrature_bytes(textures);
+  if (needed <= available_bytes) return;
+  std::int64_t texels = 0;
+  for (const ElementMaterialTexture& t : textures) texels += static_cast<std::int64_t>(t.width) * t.height;
+  const auto megabytes = [](std::int64_t bytes) { return std::to_string(bytes >> 20) + " MiB"; };
+  throw SceneError(source_name, "material_textures",
+                   "the quadrature of " + std::to_string(textures.size()) + " textured elements (" +
+                       std::to_string(texels) + " texels, " + std::to_string(needed / kMaterialBytesPerPoint) +
+                       " points: a 3 x 3 rule on each cell of equal texels) needs " + megabytes(needed) +
+                       ", more than the " + megabytes(available_bytes) + " of memory available",
+                   "", "smaller images, textures on fewer elements, or images with larger regions of one value (each "
+                       "region of equal texels is integrated as one cell)");
 }
 
 }  // namespace dgtex

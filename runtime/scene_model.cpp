@@ -1,5 +1,7 @@
 #include "dgtex/scene_model.h"
 
+#include <utility>
+
 #include "dgtex/boundary_selection.h"
 #include "dgtex/material_texture.h"
 #include "dgtex/mesh_generators.h"
@@ -7,6 +9,7 @@
 #include "dgtex/scene_io.h"
 #include "dgtex/scene_mesh_checks.h"
 #include "dgtex/surface_point.h"
+#include "dgtex/texel_memory_estimate.h"
 #include "dgtex/topology.h"
 
 namespace dgtex {
@@ -48,7 +51,12 @@ SceneModel build_scene_model(const Scene& scene, const Mesh& mesh) {
   options.rotation_cluster_texels = scene.enrichment.rotation_cluster_texels;
   SceneModel out;
   out.model = std::make_unique<ShellModel>(mesh, topology, sections, clamped, options);
-  if (!scene.material_textures.empty()) out.model->set_material_textures(scene_material_textures(scene, mesh));
+  if (!scene.material_textures.empty()) {
+    std::vector<ElementMaterialTexture> textures = scene_material_textures(scene, mesh);
+    check_material_texture_memory(textures, available_memory_bytes(),
+                                  scene.source_name.empty() ? "scene" : scene.source_name);
+    out.model->set_material_textures(std::move(textures));
+  }
   out.fixed = scene_fixed_dofs(scene, *out.model);
   out.external_force = scene_external_force(scene, *out.model);
   return out;

@@ -3,6 +3,7 @@
 // material_texture_kernel.h.
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -91,6 +92,56 @@ TEST(MaterialTextureQuadrature, UniformIsTheStandardRuleAndStepsSplit) {
   }
   EXPECT_NEAR(area, 4.0, 1e-14);
   EXPECT_NEAR(integral_h, 4.0 * (15 * 0.02 + 0.03) / 16, 1e-15);
+}
+
+TEST(MaterialTextureQuadrature, PointCountIsTheRulesPointsPerTexture) {
+  // Textures from uniform to every texel different, odd sizes included: the count that
+  // sizes the model's arrays and its memory check is what the quadrature emits.
+  std::mt19937 random(7);
+  const kernels::ShellSection base{1e6, 0.3, 0.01, 1000};
+  for (const auto& [w, h, levels] : std::vector<std::array<int, 3>>{{1, 1, 1}, {4, 4, 1}, {5, 3, 2}, {16, 16, 3},
+                                                                     {33, 17, 256}}) {
+    std::uniform_int_distribution<int> level(0, levels - 1);
+    std::vector<double> E(static_cast<size_t>(w) * h), thickness(E.size());
+    for (size_t i = 0; i < E.size(); ++i) E[i] = 1e6 * (1 + level(random)), thickness[i] = 0.01 * (1 + level(random));
+    const kernels::MaterialTextureView view{w, h, E.data(), thickness.data()};
+    std::vector<std::int64_t> start;
+    std::vector<double> points;
+    std::vector<kernels::ShellSection> sections;
+    kernels::material_texture_quadrature(ElementType::quad8, 1, &view, &base, start, points, sections);
+    EXPECT_EQ(kernels::material_texture_point_count(view), start[1]) << w << " x " << h << ", " << levels << " levels";
+    EXPECT_EQ(points.capacity(), points.size());  // allocated once, at its size
+    if (levels == 256) {
+      EXPECT_EQ(start[1], 9 * w * h);  // every texel its own cell
+    }
+  }
+}
+
+TEST(MaterialTextureModel, QuadratureLargerThanTheMemoryAvailableIsRefusedNamingTheKey) {
+  std::vector<ElementMaterialTexture> textures{uniform_texture(0, 64, 64, 1e6, 0.01),
+                                               uniform_texture(2, 8, 8, 1e6, 0.01)};
+  for (int i = 0; i < 64; ++i) textures[1].thickness[i] = 0.01 + 1e-4 * i;  // 64 texels, all different
+  const std::int64_t points = 9 + 9 * 64;
+  EXPECT_EQ(material_texture_quadrature_bytes(textures), points * kMaterialBytesPerPoint);
+  // What the model then holds: exactly those points.
+  auto model = make_model(make_rectangle(3, 1, 3, 1, ElementType::quad8), Material{}, 1.0);
+  model->set_material_textures(textures);
+  EXPECT_EQ(model->num_textured_quadrature_points(), points);
+
+  const std::int64_t needed = points * kMaterialBytesPerPoint;
+  EXPECT_NO_THROW(check_material_texture_memory(textures, needed, "plate.json"));
+  EXPECT_NO_THROW(check_material_texture_memory(textures, -1, "plate.json"));  // nothing known: no check
+  try {
+    check_material_texture_memory(textures, needed - 1, "plate.json");
+    FAIL() << "accepted with one byte too few";
+  } catch (const SceneError& e) {
+    EXPECT_EQ(e.json_path(), "material_textures");
+    const std::string what = e.what();
+    for (const std::string& part : {std::string("plate.json"), std::string("2 textured elements"),
+                                   std::string("4160 texels"), std::to_string(points) + " points",
+                                   std::string("memory available"), std::string("smaller images")})
+      EXPECT_NE(what.find(part), std::string::npos) << part << " not in: " << what;
+  }
 }
 
 TEST(MaterialTextureKernel, ParallelEqualsSerialBitwise) {

@@ -3,8 +3,10 @@
 // chosen elements, from grayscale/RGB images of the scene ("material_textures").
 // Texture layout per element: kernels/material_texture_kernel.h (the image covers the
 // element's parameter square, row 0 at xi2 = +1; nearest-texel values).
-// Functions that read the scene's images and return value types (nothing kept;
-// thread-safe). Young's modulus in Pa, thickness in m (the scene's consistent units).
+// Functions that read the scene's images and return value types, or check them (nothing
+// kept; thread-safe). Young's modulus in Pa, thickness in m (the scene's consistent units).
+#include <cstdint>
+#include <string>
 #include <vector>
 
 #include "dgtex/element_material_texture.h"
@@ -20,5 +22,24 @@ namespace dgtex {
 // textures of one element with different image sizes. Sorted by element; empty without
 // material textures.
 std::vector<ElementMaterialTexture> scene_material_textures(const Scene& scene, const Mesh& mesh);
+
+// Bytes a quadrature point of a textured element takes in the model: its (xi1, xi2, weight)
+// and its section (material_texture_kernel.h). A whole static run measures the same: a
+// 2 x 2 plate with 512 x 512 texels an element, all different (9.4 M points), peaks at
+// 579 MB, with uniform textures of that size (36 points) at 63 MB: 56.0 bytes a point.
+inline constexpr std::int64_t kMaterialBytesPerPoint = 56;
+
+// The memory the model's quadrature of these textures takes: kMaterialBytesPerPoint times
+// their points (9 per cell of equal texels: one cell for a uniform texture, one a texel
+// where neighbouring texels all differ).
+std::int64_t material_texture_quadrature_bytes(const std::vector<ElementMaterialTexture>& textures);
+
+// Throws SceneError(source_name, "material_textures", ...) when that memory exceeds
+// available_bytes (available_memory_bytes(), texel_memory_estimate.h), naming the elements,
+// points, bytes and the remedy; available_bytes < 0: no check. A 2048 x 2048 texture of
+// distinct texels on 4 elements needs 8.5 GB: refused on a smaller machine before the model
+// allocates it instead of the system killing the run.
+void check_material_texture_memory(const std::vector<ElementMaterialTexture>& textures, std::int64_t available_bytes,
+                                   const std::string& source_name);
 
 }  // namespace dgtex

@@ -18,7 +18,8 @@
 //  - creases (a fast-marching distance, no solve): 81-82 bytes (a crease over 8 of 64
 //    quad8 elements, T = 512 and 1024); bound kFieldBytesPerTexel.
 // A scene that passes may still need several times the bound (chad's cut on tri6
-// elements, one 8-element region: 4x). Material textures are not counted. Pure functions
+// elements, one 8-element region: 4x). Material textures have their own check
+// (check_material_texture_memory, material_texture.h). Pure functions
 // but available_memory_bytes (reads /proc and the cgroup's limit).
 #include <cstdint>
 #include <string>

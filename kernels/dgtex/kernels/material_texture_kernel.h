@@ -43,6 +43,10 @@ void material_texture_quadrature(ElementType type, std::int64_t count, const Mat
                                  const ShellSection* base, std::vector<std::int64_t>& start,
                                  std::vector<double>& points, std::vector<ShellSection>& sections);
 
+// The points material_texture_quadrature gives one texture: 9 per uniform quadtree cell
+// (one per texel where neighbouring texels all differ, one cell for a uniform texture).
+std::int64_t material_texture_point_count(const MaterialTextureView& texture);
+
 struct PointSectionBatch {
   ElementType type;
   std::int64_t count;
