@@ -7,11 +7,18 @@
 #include "dgtex/kernels/material_texture_kernel.h"
 #include "dgtex/png_io.h"
 #include "dgtex/scene_io.h"
+#include "dgtex/texel_memory_estimate.h"
 
 namespace dgtex {
 
 std::vector<ElementMaterialTexture> scene_material_textures(const Scene& scene, const Mesh& mesh) {
+  return scene_material_textures(scene, mesh, scene.material_textures.empty() ? -1 : available_memory_bytes());
+}
+
+std::vector<ElementMaterialTexture> scene_material_textures(const Scene& scene, const Mesh& mesh,
+                                                            std::int64_t available_bytes) {
   std::map<int, ElementMaterialTexture> per_element;
+  std::int64_t texel_bytes = 0;  // of the textured elements' arrays
   // Which texture set each (element, field): a second one would silently replace the first.
   std::map<std::pair<int, MaterialTexture::Field>, size_t> setter;
   const int ne = mesh.num_elements();
@@ -47,6 +54,16 @@ std::vector<ElementMaterialTexture> scene_material_textures(const Scene& scene, 
       auto [it, fresh] = per_element.try_emplace(e);
       ElementMaterialTexture& m = it->second;
       if (fresh) {
+        // Each element holds its own copy of E and h: an image on many elements multiplies.
+        texel_bytes += kMaterialBytesPerTexel * image.width * image.height;
+        if (available_bytes >= 0 && texel_bytes > available_bytes)
+          throw SceneError(scene.source_name, "material_textures",
+                           "the textured elements' copies of E and h (" + std::to_string(kMaterialBytesPerTexel) +
+                               " bytes a texel and element) outgrow the " + std::to_string(available_bytes >> 20) +
+                               " MiB of memory available at " + path + " (its " + std::to_string(image.width) + "x" +
+                               std::to_string(image.height) + " image on element " + std::to_string(e) + ", textured element " +
+                               std::to_string(per_element.size()) + ")",
+                           "", "smaller images, or textures on fewer elements");
         m.element = e;
         m.width = image.width;
         m.height = image.height;

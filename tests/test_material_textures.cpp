@@ -350,6 +350,25 @@ TEST_F(MaterialTextureScene, ParsesAndBuildsTexels) {
   EXPECT_EQ(model.model->num_textured_elements(), 1);
 }
 
+TEST_F(MaterialTextureScene, CopiesBeyondTheMemoryAvailableAreRefusedBeforeTheyAreMade) {
+  // step.png is 2 x 1: 32 bytes of E and h on each of the 3 elements.
+  const Scene scene = parse_scene(scene_text(R"([{"field": "thickness", "image": "step.png", "range": [0.004, 0.02]}])"),
+                                  (dir_ / "scene.json").string());
+  const Mesh mesh = build_scene_mesh(scene);
+  EXPECT_EQ(scene_material_textures(scene, mesh, 3 * 32).size(), 3u);
+  EXPECT_EQ(scene_material_textures(scene, mesh, -1).size(), 3u);  // nothing known: no check
+  try {
+    scene_material_textures(scene, mesh, 3 * 32 - 1);
+    FAIL() << "accepted with one byte too few";
+  } catch (const SceneError& e) {
+    EXPECT_EQ(e.json_path(), "material_textures");
+    const std::string what = e.what();
+    for (const char* part : {"16 bytes a texel and element", "at material_textures[0]", "2x1 image on element 2",
+                             "textured element 3", "fewer elements"})
+      EXPECT_NE(what.find(part), std::string::npos) << part << " not in: " << what;
+  }
+}
+
 TEST_F(MaterialTextureScene, RejectsBadInputsWithTheJsonPath) {
   EXPECT_EQ(error_path(R"([{"field": "thickness", "image": "missing.png", "range": [1, 2]}])"),
             "material_textures[0].image");

@@ -21,7 +21,16 @@ namespace dgtex {
 // path (material_textures[i]...) for an unreadable image, an element out of range, or two
 // textures of one element with different image sizes. Sorted by element; empty without
 // material textures.
+// Also throws SceneError at material_textures when the elements' texel arrays
+// (kMaterialBytesPerTexel each) would pass the memory available (available_memory_bytes(),
+// texel_memory_estimate.h), before they are allocated.
 std::vector<ElementMaterialTexture> scene_material_textures(const Scene& scene, const Mesh& mesh);
+// The same against available_bytes (< 0: no memory check).
+std::vector<ElementMaterialTexture> scene_material_textures(const Scene& scene, const Mesh& mesh,
+                                                            std::int64_t available_bytes);
+
+// Bytes a texel of an element's texture takes (E and h, ElementMaterialTexture).
+inline constexpr std::int64_t kMaterialBytesPerTexel = 2 * sizeof(double);
 
 // Bytes a quadrature point of a textured element takes in the model: its (xi1, xi2, weight)
 // and its section (material_texture_kernel.h). A whole static run measures the same: a
