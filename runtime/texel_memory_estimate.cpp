@@ -1,9 +1,12 @@
 #include "dgtex/texel_memory_estimate.h"
 
 #include <algorithm>
+#include <cerrno>
+#include <cstdlib>
 #include <cstdio>
 #include <fstream>
 #include <sstream>
+#include <stdexcept>
 #include <utility>
 
 #include "dgtex/scene_io.h"
@@ -49,13 +52,28 @@ std::int64_t texel_memory_lower_bound(const TexelFields& fields) {
   return per_tile * (fields.cuts.region_elements * cut_bytes + fields.creases.region_elements * kFieldBytesPerTexel);
 }
 
+// DGTEX_MEMORY_LIMIT_MB as bytes; -1 when unset or empty. Throws std::invalid_argument for
+// anything but a whole number of MiB >= 1.
+std::int64_t memory_limit_from_environment() {
+  const char* text = std::getenv("DGTEX_MEMORY_LIMIT_MB");
+  if (!text || !*text) return -1;
+  char* end = nullptr;
+  errno = 0;
+  const long long mib = std::strtoll(text, &end, 10);
+  if (*end != '\0' || errno == ERANGE || mib < 1 || mib > (std::int64_t{1} << 40))
+    throw std::invalid_argument(std::string("DGTEX_MEMORY_LIMIT_MB = '") + text +
+                                "': expected a whole number of MiB, 1 or more (or unset: the machine's memory)");
+  return static_cast<std::int64_t>(mib) << 20;
+}
+
 std::int64_t available_memory_bytes() {
+  const std::int64_t user_limit = memory_limit_from_environment();
   std::ifstream meminfo("/proc/meminfo");
-  if (!meminfo) return -1;
+  if (!meminfo) return user_limit;
   std::stringstream text;
   text << "\n" << meminfo.rdbuf();
   const std::int64_t available = meminfo_bytes(text.str(), "MemAvailable");
-  if (available < 0) return -1;
+  if (available < 0) return user_limit;
   std::int64_t bytes = available + std::max<std::int64_t>(0, meminfo_bytes(text.str(), "SwapFree"));
   // A container's limit (the cgroup's) can be far below the host's memory. v1 reports "no
   // limit" as a number near 2^63.
@@ -66,7 +84,7 @@ std::int64_t available_memory_bytes() {
     const std::int64_t limit = file_number(limit_file), usage = file_number(usage_file);
     if (limit > 0 && limit < no_limit && usage >= 0) bytes = std::min(bytes, std::max<std::int64_t>(0, limit - usage));
   }
-  return bytes;
+  return user_limit < 0 ? bytes : std::min(bytes, user_limit);
 }
 
 void check_texel_memory(const TexelFields& fields, std::int64_t available_bytes, const std::string& source_name) {

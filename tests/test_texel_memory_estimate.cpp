@@ -5,7 +5,9 @@
 #include <gtest/gtest.h>
 
 #include <cstdint>
+#include <cstdlib>
 #include <fstream>
+#include <stdexcept>
 #include <string>
 
 #include "dgtex/crease_enrichment.h"
@@ -186,6 +188,29 @@ TEST(TexelMemoryEstimate, AvailableMemoryIsPositiveAndAtMostWhatTheMachineHas) {
   const std::int64_t available = available_memory_bytes();
   EXPECT_GT(available, 0);
   EXPECT_LE(available, total);
+}
+
+// DGTEX_MEMORY_LIMIT_MB caps what the memory checks may use (one process per test: the
+// environment is this test's own).
+TEST(TexelMemoryEstimate, TheEnvironmentsLimitCapsTheMemoryAvailable) {
+  ::setenv("DGTEX_MEMORY_LIMIT_MB", "64", 1);
+  const std::int64_t capped = available_memory_bytes();
+  EXPECT_GT(capped, 0);
+  EXPECT_LE(capped, std::int64_t{64} << 20);
+  TexelFields fields;  // fracture-like: 5 segments over 280 tri6 elements at T = 256
+  fields.type = ElementType::tri6;
+  fields.resolution = 256;
+  fields.direct_solves = true;
+  fields.cuts = {5, 280};
+  EXPECT_THROW(check_texel_memory(fields, capped, "fracture.json"), SceneError);
+  for (const char* bad : {"abc", "0", "-5", "12x", "99999999999999999999"}) {
+    ::setenv("DGTEX_MEMORY_LIMIT_MB", bad, 1);
+    const std::string what = test::message_of<std::invalid_argument>([] { available_memory_bytes(); });
+    EXPECT_NE(what.find(std::string("DGTEX_MEMORY_LIMIT_MB = '") + bad + "'"), std::string::npos) << what;
+  }
+  ::setenv("DGTEX_MEMORY_LIMIT_MB", "", 1);  // empty: as unset
+  EXPECT_GT(available_memory_bytes(), capped);
+  ::unsetenv("DGTEX_MEMORY_LIMIT_MB");
 }
 
 // The whole path: fracture.json at T = 4096 through SceneRun, refused in the set-up before

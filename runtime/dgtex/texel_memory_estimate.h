@@ -50,7 +50,10 @@ std::int64_t texel_memory_lower_bound(const TexelFields& fields);
 
 // Memory this process may still take, in bytes: MemAvailable + SwapFree of /proc/meminfo,
 // capped by the cgroup's limit less its usage (cgroup v2 memory.max, v1
-// memory.limit_in_bytes) where one is set; -1 when /proc/meminfo cannot be read.
+// memory.limit_in_bytes) where one is set, and by the environment's DGTEX_MEMORY_LIMIT_MB
+// (MiB; to share a machine, or to try a scene's limits) where that is set; -1 when neither
+// /proc/meminfo nor DGTEX_MEMORY_LIMIT_MB gives a figure. Throws std::invalid_argument
+// naming DGTEX_MEMORY_LIMIT_MB when it is set but not a whole number >= 1.
 std::int64_t available_memory_bytes();
 
 // Throws SceneError(source_name, "enrichment.texture_resolution", ...) when the lower
