@@ -60,9 +60,9 @@ std::vector<ElementMaterialTexture> scene_material_textures(const Scene& scene, 
           throw SceneError(scene.source_name, "material_textures",
                            "the textured elements' copies of E and h (" + std::to_string(kMaterialBytesPerTexel) +
                                " bytes a texel and element) outgrow the " + std::to_string(available_bytes >> 20) +
-                               " MiB of memory available at " + path + " (its " + std::to_string(image.width) + "x" +
-                               std::to_string(image.height) + " image on element " + std::to_string(e) + ", textured element " +
-                               std::to_string(per_element.size()) + ")",
+                               " MiB of memory available at " + path + " (its " + std::to_string(image.width) +
+                               "x" + std::to_string(image.height) + " image on element " + std::to_string(e) +
+                               ", textured element " + std::to_string(per_element.size()) + ")",
                            "", "smaller images, or textures on fewer elements");
         m.element = e;
         m.width = image.width;
