@@ -1,5 +1,6 @@
 #include "dgtex/kernels/material_texture_kernel.h"
 
+#include <algorithm>
 #include <stdexcept>
 
 #include "dgtex/kernels/shell_point.h"
@@ -35,19 +36,33 @@ void check_texture(const MaterialTextureView& t) {
   if (t.width < 1 || t.height < 1) throw std::invalid_argument("material textures: empty texture");
 }
 
-// Appends the element rule mapped onto each uniform cell (points, sections).
-void emit_cells(const MaterialTextureView& t, const ShellSection& base, std::vector<double>& points,
-                std::vector<ShellSection>& sections) {
+bool reduced_rule(const MaterialTextureView& t, int i0, int i1, int j0, int j1, double reduced_rule_cell) {
+  return std::max(static_cast<double>(i1 - i0) / t.width, static_cast<double>(j1 - j0) / t.height) <= reduced_rule_cell;
+}
+
+// Appends the rule of each uniform cell, mapped onto it (points, sections).
+void emit_cells(const MaterialTextureView& t, const ShellSection& base, double reduced_rule_cell,
+                std::vector<double>& points, std::vector<ShellSection>& sections) {
   const QuadratureRule rule = element_quadrature(ElementType::quad8);
+  const LineRule line = gauss_legendre(2);
   for_each_uniform_cell(t, 0, t.width, 0, t.height, [&](int i0, int i1, int j0, int j1) {
     // Cell in xi: [x0, x1] x [y0, y1]; the whole element maps with mid 0, half 1 exactly.
     const double x0 = -1 + 2.0 * i0 / t.width, x1 = -1 + 2.0 * i1 / t.width;
     const double y1 = 1 - 2.0 * j0 / t.height, y0 = 1 - 2.0 * j1 / t.height;
     const double mx = 0.5 * (x0 + x1), hx = 0.5 * (x1 - x0), my = 0.5 * (y0 + y1), hy = 0.5 * (y1 - y0);
-    const double e0 = t.youngs_modulus[j0 * t.width + i0], h0 = t.thickness[j0 * t.width + i0];
+    const ShellSection section{t.youngs_modulus[j0 * t.width + i0], base.poisson_ratio,
+                               t.thickness[j0 * t.width + i0], base.density};
+    if (reduced_rule(t, i0, i1, j0, j1, reduced_rule_cell)) {
+      for (int b = 0; b < line.count; ++b)
+        for (int a = 0; a < line.count; ++a) {
+          points.insert(points.end(), {mx + hx * line.t[a], my + hy * line.t[b], line.weight[a] * line.weight[b] * hx * hy});
+          sections.push_back(section);
+        }
+      return;
+    }
     for (int q = 0; q < rule.count; ++q) {
       points.insert(points.end(), {mx + hx * rule.xi1[q], my + hy * rule.xi2[q], rule.weight[q] * hx * hy});
-      sections.push_back({e0, base.poisson_ratio, h0, base.density});
+      sections.push_back(section);
     }
   });
 }
@@ -137,26 +152,30 @@ void element_stiffness(const PointSectionBatch& b, std::int64_t e, const double*
 
 }  // namespace
 
-std::int64_t material_texture_point_count(const MaterialTextureView& texture) {
+std::int64_t material_texture_point_count(const MaterialTextureView& texture, double reduced_rule_cell) {
   check_texture(texture);
-  std::int64_t cells = 0;
-  for_each_uniform_cell(texture, 0, texture.width, 0, texture.height, [&](int, int, int, int) { ++cells; });
-  return cells * element_quadrature(ElementType::quad8).count;
+  const std::int64_t full = element_quadrature(ElementType::quad8).count, reduced = 4;
+  std::int64_t points = 0;
+  for_each_uniform_cell(texture, 0, texture.width, 0, texture.height, [&](int i0, int i1, int j0, int j1) {
+    points += reduced_rule(texture, i0, i1, j0, j1, reduced_rule_cell) ? reduced : full;
+  });
+  return points;
 }
 
 void material_texture_quadrature(ElementType type, std::int64_t count, const MaterialTextureView* textures,
                                  const ShellSection* base, std::vector<std::int64_t>& start,
-                                 std::vector<double>& points, std::vector<ShellSection>& sections) {
+                                 std::vector<double>& points, std::vector<ShellSection>& sections,
+                                 double reduced_rule_cell) {
   if (type != ElementType::quad8) throw std::invalid_argument("material textures: only quad8 elements are supported");
   // Counted first, so the arrays are allocated once at their size: growing them doubled
   // the memory of a texture whose texels all differ (~120 instead of 56 bytes a point).
   std::int64_t total = static_cast<std::int64_t>(sections.size());
-  for (std::int64_t e = 0; e < count; ++e) total += material_texture_point_count(textures[e]);
+  for (std::int64_t e = 0; e < count; ++e) total += material_texture_point_count(textures[e], reduced_rule_cell);
   points.reserve(3 * static_cast<std::size_t>(total));
   sections.reserve(static_cast<std::size_t>(total));
   if (start.empty()) start.push_back(0);
   for (std::int64_t e = 0; e < count; ++e) {
-    emit_cells(textures[e], base[e], points, sections);
+    emit_cells(textures[e], base[e], reduced_rule_cell, points, sections);
     start.push_back(static_cast<std::int64_t>(sections.size()));
   }
 }

@@ -111,7 +111,7 @@ void check_material_texture_memory(const std::vector<ElementMaterialTexture>& te
   throw SceneError(source_name, "material_textures",
                    "the quadrature of " + std::to_string(textures.size()) + " textured elements (" +
                        std::to_string(texels) + " texels, " + std::to_string(needed / kMaterialBytesPerPoint) +
-                       " points: a 3 x 3 rule on each cell of equal texels) needs " + megabytes(needed) +
+                       " points: a Gauss rule on each cell of equal texels) needs " + megabytes(needed) +
                        ", more than the " + megabytes(available_bytes) + " of memory available",
                    "", "smaller images, textures on fewer elements, or images with larger regions of one value (each "
                        "region of equal texels is integrated as one cell)");

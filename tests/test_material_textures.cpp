@@ -112,16 +112,62 @@ TEST(MaterialTextureQuadrature, PointCountIsTheRulesPointsPerTexture) {
     EXPECT_EQ(kernels::material_texture_point_count(view), start[1]) << w << " x " << h << ", " << levels << " levels";
     EXPECT_EQ(points.capacity(), points.size());  // allocated once, at its size
     if (levels == 256) {
-      EXPECT_EQ(start[1], 9 * w * h);  // every texel its own cell
+      EXPECT_EQ(start[1], 4 * w * h);  // every texel its own cell, narrower than 1/8: 2 x 2
     }
+    // The 3 x 3 rule everywhere: counted alike.
+    std::vector<std::int64_t> full_start;
+    std::vector<double> full_points;
+    std::vector<kernels::ShellSection> full_sections;
+    kernels::material_texture_quadrature(ElementType::quad8, 1, &view, &base, full_start, full_points, full_sections,
+                                         0.0);
+    EXPECT_EQ(kernels::material_texture_point_count(view, 0.0), full_start[1]);
   }
+}
+
+TEST(MaterialTextureQuadrature, TheReducedRuleOnSmallCellsKeepsStiffnessAndMass) {
+  // A curved quad8 element (a quarter of a cylinder's wall), a random 32 x 32 texture of E
+  // and h: the 2 x 2 rule on cells no wider than 1/8 of the element against 3 x 3 on every
+  // cell. Both integrate a rational integrand inexactly; they agree to 1e-6 of the largest
+  // entry, far below what the texture's resolution resolves.
+  const Mesh mesh = make_cylinder(0.5, 1.0, 0, 90, 1, 1, ElementType::quad8);
+  std::mt19937 random(11);
+  std::uniform_real_distribution<double> u(0.5, 1.5);
+  const int w = 32;
+  std::vector<double> E(w * w), thickness(E.size());
+  for (size_t i = 0; i < E.size(); ++i) E[i] = 1e6 * u(random), thickness[i] = 0.01 * u(random);
+  const kernels::MaterialTextureView view{w, w, E.data(), thickness.data()};
+  const kernels::ShellSection base{1e6, 0.3, 0.01, 1000};
+  std::vector<double> K[2], M[2];
+  std::int64_t count[2];
+  for (int full = 0; full < 2; ++full) {
+    std::vector<std::int64_t> start;
+    std::vector<double> points;
+    std::vector<kernels::ShellSection> sections;
+    kernels::material_texture_quadrature(ElementType::quad8, 1, &view, &base, start, points, sections,
+                                         full ? 0.0 : kernels::kMaterialReducedRuleCell);
+    count[full] = start[1];
+    const kernels::PointSectionBatch batch{ElementType::quad8, 1,           mesh.element_nodes(0), mesh.positions.data(),
+                                           start.data(),       points.data(), sections.data()};
+    K[full].assign(8 * 8 * 9, 0.0);
+    M[full].assign(8 * 8, 0.0);
+    kernels::point_section_stiffness(batch, nullptr, K[full].data(), nullptr);
+    kernels::point_section_mass(batch, M[full].data());
+  }
+  std::printf("2 x 2 on small cells against 3 x 3: K %.2e, M %.2e of the largest entry; %lld against %lld points\n",
+              max_difference(K[0], K[1]) / max_abs(K[1]), max_difference(M[0], M[1]) / max_abs(M[1]),
+              static_cast<long long>(count[0]), static_cast<long long>(count[1]));
+  EXPECT_EQ(count[1], 9 * w * w);
+  EXPECT_EQ(count[0], 4 * w * w);
+  EXPECT_LE(max_difference(K[0], K[1]), 1e-6 * max_abs(K[1]));
+  EXPECT_LE(max_difference(M[0], M[1]), 1e-6 * max_abs(M[1]));
+  EXPECT_GT(max_difference(K[0], K[1]), 0.0);  // a different rule, not the same points
 }
 
 TEST(MaterialTextureModel, QuadratureLargerThanTheMemoryAvailableIsRefusedNamingTheKey) {
   std::vector<ElementMaterialTexture> textures{uniform_texture(0, 64, 64, 1e6, 0.01),
                                                uniform_texture(2, 8, 8, 1e6, 0.01)};
   for (int i = 0; i < 64; ++i) textures[1].thickness[i] = 0.01 + 1e-4 * i;  // 64 texels, all different
-  const std::int64_t points = 9 + 9 * 64;
+  const std::int64_t points = 9 + 4 * 64;  // one 3 x 3 cell; 64 cells of 1/8, 2 x 2 each
   EXPECT_EQ(material_texture_quadrature_bytes(textures), points * kMaterialBytesPerPoint);
   // What the model then holds: exactly those points.
   auto model = make_model(make_rectangle(3, 1, 3, 1, ElementType::quad8), Material{}, 1.0);

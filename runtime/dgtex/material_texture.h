@@ -34,19 +34,19 @@ inline constexpr std::int64_t kMaterialBytesPerTexel = 2 * sizeof(double);
 
 // Bytes a quadrature point of a textured element takes in the model: its (xi1, xi2, weight)
 // and its section (material_texture_kernel.h). A whole static run measures the same: a
-// 2 x 2 plate with 512 x 512 texels an element, all different (9.4 M points), peaks at
-// 579 MB, with uniform textures of that size (36 points) at 63 MB: 56.0 bytes a point.
+// 2 x 2 plate with 512 x 512 texels an element, all different (4.2 M points), peaks at
+// 292 MB, with uniform textures of that size (36 points) at 63 MB: 56.0 bytes a point.
 inline constexpr std::int64_t kMaterialBytesPerPoint = 56;
 
 // The memory the model's quadrature of these textures takes: kMaterialBytesPerPoint times
-// their points (9 per cell of equal texels: one cell for a uniform texture, one a texel
-// where neighbouring texels all differ).
+// their points (kernels::material_texture_point_count: 9 or 4 per cell of equal texels; one
+// cell for a uniform texture, one a texel where neighbouring texels all differ).
 std::int64_t material_texture_quadrature_bytes(const std::vector<ElementMaterialTexture>& textures);
 
 // Throws SceneError(source_name, "material_textures", ...) when that memory exceeds
 // available_bytes (available_memory_bytes(), texel_memory_estimate.h), naming the elements,
 // points, bytes and the remedy; available_bytes < 0: no check. A 2048 x 2048 texture of
-// distinct texels on 4 elements needs 8.5 GB: refused on a smaller machine before the model
+// distinct texels on 4 elements needs 3.8 GB: refused on a smaller machine before the model
 // allocates it instead of the system killing the run.
 void check_material_texture_memory(const std::vector<ElementMaterialTexture>& textures, std::int64_t available_bytes,
                                    const std::string& source_name);
