@@ -55,7 +55,8 @@ void emit_cells(const MaterialTextureView& t, const ShellSection& base, double r
     if (reduced_rule(t, i0, i1, j0, j1, reduced_rule_cell)) {
       for (int b = 0; b < line.count; ++b)
         for (int a = 0; a < line.count; ++a) {
-          points.insert(points.end(), {mx + hx * line.t[a], my + hy * line.t[b], line.weight[a] * line.weight[b] * hx * hy});
+          const double weight = line.weight[a] * line.weight[b] * hx * hy;
+          points.insert(points.end(), {mx + hx * line.t[a], my + hy * line.t[b], weight});
           sections.push_back(section);
         }
       return;
@@ -154,7 +155,8 @@ void element_stiffness(const PointSectionBatch& b, std::int64_t e, const double*
 
 std::int64_t material_texture_point_count(const MaterialTextureView& texture, double reduced_rule_cell) {
   check_texture(texture);
-  const std::int64_t full = element_quadrature(ElementType::quad8).count, reduced = 4;
+  const LineRule line = gauss_legendre(2);
+  const std::int64_t full = element_quadrature(ElementType::quad8).count, reduced = line.count * line.count;
   std::int64_t points = 0;
   for_each_uniform_cell(texture, 0, texture.width, 0, texture.height, [&](int i0, int i1, int j0, int j1) {
     points += reduced_rule(texture, i0, i1, j0, j1, reduced_rule_cell) ? reduced : full;
