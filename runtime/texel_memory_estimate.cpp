@@ -44,14 +44,6 @@ std::string gigabytes(std::int64_t bytes) {
 
 std::string count_of(int n, const std::string& noun) { return std::to_string(n) + " " + noun + (n == 1 ? "" : "s"); }
 
-}  // namespace
-
-std::int64_t texel_memory_lower_bound(const TexelFields& fields) {
-  const std::int64_t per_tile = active_texels_per_tile(fields.type, fields.resolution);
-  const std::int64_t cut_bytes = fields.direct_solves ? kDirectSolveBytesPerTexel : kFieldBytesPerTexel;
-  return per_tile * (fields.cuts.region_elements * cut_bytes + fields.creases.region_elements * kFieldBytesPerTexel);
-}
-
 // DGTEX_MEMORY_LIMIT_MB as bytes; -1 when unset or empty. Throws std::invalid_argument for
 // anything but a whole number of MiB >= 1.
 std::int64_t memory_limit_from_environment() {
@@ -64,6 +56,14 @@ std::int64_t memory_limit_from_environment() {
     throw std::invalid_argument(std::string("DGTEX_MEMORY_LIMIT_MB = '") + text +
                                 "': expected a whole number of MiB, 1 or more (or unset: the machine's memory)");
   return static_cast<std::int64_t>(mib) << 20;
+}
+
+}  // namespace
+
+std::int64_t texel_memory_lower_bound(const TexelFields& fields) {
+  const std::int64_t per_tile = active_texels_per_tile(fields.type, fields.resolution);
+  const std::int64_t cut_bytes = fields.direct_solves ? kDirectSolveBytesPerTexel : kFieldBytesPerTexel;
+  return per_tile * (fields.cuts.region_elements * cut_bytes + fields.creases.region_elements * kFieldBytesPerTexel);
 }
 
 std::int64_t available_memory_bytes() {
