@@ -10,6 +10,11 @@
 #include "dgtex/texel_memory_estimate.h"
 
 namespace dgtex {
+namespace {
+
+std::string mebibytes(std::int64_t bytes) { return std::to_string(bytes >> 20) + " MiB"; }
+
+}  // namespace
 
 std::vector<ElementMaterialTexture> scene_material_textures(const Scene& scene, const Mesh& mesh) {
   return scene_material_textures(scene, mesh, scene.material_textures.empty() ? -1 : available_memory_bytes());
@@ -59,8 +64,8 @@ std::vector<ElementMaterialTexture> scene_material_textures(const Scene& scene, 
         if (available_bytes >= 0 && texel_bytes > available_bytes)
           throw SceneError(scene.source_name, "material_textures",
                            "the textured elements' copies of E and h (" + std::to_string(kMaterialBytesPerTexel) +
-                               " bytes a texel and element) outgrow the " + std::to_string(available_bytes >> 20) +
-                               " MiB of memory available at " + path + " (its " + std::to_string(image.width) +
+                               " bytes a texel and element) outgrow the " + mebibytes(available_bytes) +
+                               " of memory available at " + path + " (its " + std::to_string(image.width) +
                                "x" + std::to_string(image.height) + " image on element " + std::to_string(e) +
                                ", textured element " + std::to_string(per_element.size()) + ")",
                            "", "smaller images, or textures on fewer elements");
@@ -107,12 +112,11 @@ void check_material_texture_memory(const std::vector<ElementMaterialTexture>& te
   if (needed <= available_bytes) return;
   std::int64_t texels = 0;
   for (const ElementMaterialTexture& t : textures) texels += static_cast<std::int64_t>(t.width) * t.height;
-  const auto megabytes = [](std::int64_t bytes) { return std::to_string(bytes >> 20) + " MiB"; };
   throw SceneError(source_name, "material_textures",
                    "the quadrature of " + std::to_string(textures.size()) + " textured elements (" +
                        std::to_string(texels) + " texels, " + std::to_string(needed / kMaterialBytesPerPoint) +
-                       " points: a Gauss rule on each cell of equal texels) needs " + megabytes(needed) +
-                       ", more than the " + megabytes(available_bytes) + " of memory available",
+                       " points: a Gauss rule on each cell of equal texels) needs " + mebibytes(needed) +
+                       ", more than the " + mebibytes(available_bytes) + " of memory available",
                    "", "smaller images, textures on fewer elements, or images with larger regions of one value (each "
                        "region of equal texels is integrated as one cell)");
 }
