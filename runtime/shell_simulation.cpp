@@ -60,7 +60,7 @@ std::string ShellSimulation::enrichment_hint() const {
   return "; with cuts, also check for cuts that almost touch each other or a node (slivers narrower than a texel)";
 }
 
-void ShellSimulation::check_statically_constrained() const {
+void ShellSimulation::check_statically_constrained() {
   const Mesh& mesh = model_.mesh();
   const int n = mesh.num_nodes();
   Eigen::Vector3d centre = Eigen::Vector3d::Zero();
@@ -94,8 +94,7 @@ void ShellSimulation::check_statically_constrained() const {
   Eigen::MatrixXd motions(ndofs, free_modes.size());
   for (size_t k = 0; k < free_modes.size(); ++k) motions.col(k) = modes * svd.matrixV().col(free_modes[k]);
   // Clamped edges may still hold them: check the energy the stiffness gives these motions.
-  std::vector<double> K;
-  model_.assemble_stiffness(nullptr, K, nullptr);
+  const std::vector<double>& K = linear_stiffness();
   double kmax = 0;
   for (double value : K) kmax = std::max(kmax, std::abs(value));
   Eigen::MatrixXd KW(ndofs, free_modes.size());

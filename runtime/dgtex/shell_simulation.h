@@ -40,8 +40,9 @@ class ShellSimulation {
   ShellSimulation(ShellModel&&, std::vector<char>, std::vector<double>) = delete;
 
   // Throws ModelError naming a free rigid-body mode if the constraints (fixed DOFs and
-  // clamped edges) leave one.
-  void check_statically_constrained() const;
+  // clamped edges) leave one. Assembles the linear stiffness once and keeps it for
+  // solve_static and linear steps (a textured plate's assembly takes seconds).
+  void check_statically_constrained();
   // Throws ModelError "stiffness not positive definite (penalty too low?)" when K is not.
   void solve_static();
   // std::invalid_argument unless options.time_step is positive and finite.
