@@ -1,8 +1,11 @@
 #include "dgtex/kernels/material_texture_kernel.h"
 
 #include <algorithm>
+#include <cmath>
 #include <stdexcept>
+#include <string>
 
+#include "dgtex/kernels/gram_accumulation.h"
 #include "dgtex/kernels/shell_point.h"
 #include "dgtex/kernels/vec3.h"
 #include "shell_point_rows.h"
@@ -74,6 +77,63 @@ inline void apply_plane_stress(double nu, double scale, const double in[3], doub
   out[2] = scale * 0.5 * (1 - nu) * in[2];
 }
 
+// Adds a point's corrective force of shell report eq. 48 to f: B_R^T D B (X0 - R^T X0),
+// B the point's unrotated rows (Bm, Bb), B_R the rotated ones, times the weight w.
+void add_corrective_force(const PointSectionBatch& b, const int* nodes, int npe, const double (*Bm)[9],
+                          const double (*Bb)[9], const double* R, double nu, double dn, double dm, double w,
+                          double* f) {
+  double strain_m[3] = {0, 0, 0}, strain_b[3] = {0, 0, 0};
+  for (int a = 0; a < npe; ++a) {
+    const double* x = b.positions + 3 * static_cast<long>(nodes[a]);
+    double d[3];
+    for (int k = 0; k < 3; ++k) d[k] = x[k] - (R[0 * 3 + k] * x[0] + R[1 * 3 + k] * x[1] + R[2 * 3 + k] * x[2]);
+    for (int r = 0; r < 3; ++r)
+      for (int k = 0; k < 3; ++k) {
+        strain_m[r] += Bm[a][r * 3 + k] * d[k];
+        strain_b[r] += Bb[a][r * 3 + k] * d[k];
+      }
+  }
+  double sm[3], sb[3];
+  apply_plane_stress(nu, dn, strain_m, sm);
+  apply_plane_stress(nu, dm, strain_b, sb);
+  for (int a = 0; a < npe; ++a) {
+    double Rm[9], Rb[9];
+    rotate_rows(Bm[a], R, Rm);
+    rotate_rows(Bb[a], R, Rb);
+    for (int i = 0; i < 3; ++i) {
+      double v = 0;
+      for (int r = 0; r < 3; ++r) v += Rm[r * 3 + i] * sm[r] + Rb[r * 3 + i] * sb[r];
+      f[a * 3 + i] += w * v;
+    }
+  }
+}
+
+// One point's strain rows, rotated by R (when given), with the rigidities of its section:
+// the shared first half of both stiffness forms; adds the corrective force to f (when both
+// R and f are given).
+struct PointRows {
+  double Bm[max_element_nodes][9], Bb[max_element_nodes][9];
+  double nu, dn, dm, w;
+};
+
+void point_rows(const PointSectionBatch& b, const int* nodes, int npe, std::int64_t q, const double* rotations,
+                double* f, PointRows& p) {
+  const double* pt = b.points + 3 * q;
+  const ShellSection& sec = b.sections[q];
+  p.nu = sec.poisson_ratio;
+  p.dn = membrane_rigidity(sec.youngs_modulus, p.nu, sec.thickness);
+  p.dm = bending_rigidity(sec.youngs_modulus, p.nu, sec.thickness);
+  ShapeValues s;
+  evaluate_shape(b.type, pt[0], pt[1], s);
+  p.w = pt[2] * fast_rows::rest_strain_rows(s, nodes, b.positions, npe, p.Bm, p.Bb);
+  const double* R = rotations ? rotations + q * 9 : nullptr;
+  if (R && f) add_corrective_force(b, nodes, npe, p.Bm, p.Bb, R, p.nu, p.dn, p.dm, p.w, f);
+  if (R)
+    for (int a = 0; a < npe; ++a) rotate_rows(p.Bm[a], R), rotate_rows(p.Bb[a], R);
+}
+
+// The reference form: K_ab += w (Bm_a^T Dn Bm_b + Bb_a^T Dm Bb_b) point by point, block by
+// block, upper block triangle, mirrored below.
 void element_stiffness(const PointSectionBatch& b, std::int64_t e, const double* rotations, double* blocks,
                        double* forces) {
   const int npe = nodes_per_element(b.type);
@@ -84,62 +144,23 @@ void element_stiffness(const PointSectionBatch& b, std::int64_t e, const double*
   if (f)
     for (int i = 0; i < npe * 3; ++i) f[i] = 0;
   for (std::int64_t q = b.start[e]; q < b.start[e + 1]; ++q) {
-    const double* pt = b.points + 3 * q;
-    const ShellSection& sec = b.sections[q];
-    const double nu = sec.poisson_ratio;
-    const double dn = membrane_rigidity(sec.youngs_modulus, nu, sec.thickness);
-    const double dm = bending_rigidity(sec.youngs_modulus, nu, sec.thickness);
-    ShapeValues s;
-    evaluate_shape(b.type, pt[0], pt[1], s);
-    double Bm[max_element_nodes][9], Bb[max_element_nodes][9];
-    const double w = pt[2] * fast_rows::rest_strain_rows(s, nodes, b.positions, npe, Bm, Bb);
-    const double* R = rotations ? rotations + q * 9 : nullptr;
-    if (R && f) {
-      // Corrective term: B^T D B (X0 - R^T X0), B rotated afterwards (eq. 48).
-      double strain_m[3] = {0, 0, 0}, strain_b[3] = {0, 0, 0};
-      for (int a = 0; a < npe; ++a) {
-        const double* x = b.positions + 3 * static_cast<long>(nodes[a]);
-        double d[3];
-        for (int k = 0; k < 3; ++k) d[k] = x[k] - (R[0 * 3 + k] * x[0] + R[1 * 3 + k] * x[1] + R[2 * 3 + k] * x[2]);
-        for (int r = 0; r < 3; ++r)
-          for (int k = 0; k < 3; ++k) {
-            strain_m[r] += Bm[a][r * 3 + k] * d[k];
-            strain_b[r] += Bb[a][r * 3 + k] * d[k];
-          }
-      }
-      double sm[3], sb[3];
-      apply_plane_stress(nu, dn, strain_m, sm);
-      apply_plane_stress(nu, dm, strain_b, sb);
-      for (int a = 0; a < npe; ++a) {
-        double Rm[9], Rb[9];
-        for (int i = 0; i < 9; ++i) Rm[i] = Bm[a][i], Rb[i] = Bb[a][i];
-        rotate_rows(Rm, R);
-        rotate_rows(Rb, R);
-        for (int i = 0; i < 3; ++i) {
-          double v = 0;
-          for (int r = 0; r < 3; ++r) v += Rm[r * 3 + i] * sm[r] + Rb[r * 3 + i] * sb[r];
-          f[a * 3 + i] += w * v;
-        }
-      }
-    }
-    if (R)
-      for (int a = 0; a < npe; ++a) rotate_rows(Bm[a], R), rotate_rows(Bb[a], R);
-    // K_ab += w (Bm_a^T Dn Bm_b + Bb_a^T Dm Bb_b), upper block triangle, mirrored below.
+    PointRows p;
+    point_rows(b, nodes, npe, q, rotations, f, p);
     for (int bb = 0; bb < npe; ++bb) {
       double DBm[9], DBb[9];  // D times the rows of node b, column by column
       for (int c = 0; c < 3; ++c) {
-        const double vm[3] = {Bm[bb][c], Bm[bb][3 + c], Bm[bb][6 + c]};
-        const double vb[3] = {Bb[bb][c], Bb[bb][3 + c], Bb[bb][6 + c]};
+        const double vm[3] = {p.Bm[bb][c], p.Bm[bb][3 + c], p.Bm[bb][6 + c]};
+        const double vb[3] = {p.Bb[bb][c], p.Bb[bb][3 + c], p.Bb[bb][6 + c]};
         double om[3], ob[3];
-        apply_plane_stress(nu, w * dn, vm, om);
-        apply_plane_stress(nu, w * dm, vb, ob);
+        apply_plane_stress(p.nu, p.w * p.dn, vm, om);
+        apply_plane_stress(p.nu, p.w * p.dm, vb, ob);
         for (int r = 0; r < 3; ++r) DBm[r * 3 + c] = om[r], DBb[r * 3 + c] = ob[r];
       }
       for (int a = 0; a <= bb; ++a)
         for (int i = 0; i < 3; ++i)
           for (int j = 0; j < 3; ++j) {
             double v = 0;
-            for (int r = 0; r < 3; ++r) v += Bm[a][r * 3 + i] * DBm[r * 3 + j] + Bb[a][r * 3 + i] * DBb[r * 3 + j];
+            for (int r = 0; r < 3; ++r) v += p.Bm[a][r * 3 + i] * DBm[r * 3 + j] + p.Bb[a][r * 3 + i] * DBb[r * 3 + j];
             K[(a * npe + bb) * 9 + i * 3 + j] += v;
           }
     }
@@ -150,6 +171,47 @@ void element_stiffness(const PointSectionBatch& b, std::int64_t e, const double*
         for (int j = 0; j < 3; ++j) K[(bb * npe + a) * 9 + j * 3 + i] = K[(a * npe + bb) * 9 + i * 3 + j];
 }
 
+// Points per work item of point_section_stiffness: a fixed split of each element's points,
+// so the sums (and their bits) do not depend on the thread count, and one element with a
+// large texture still keeps every thread busy.
+constexpr std::int64_t kStiffnessChunkPoints = 4096;
+
+// Appends a point's six rows whose Gram is its stiffness: with D = c P(nu) and
+// P = L L^T, L = [1 0 0; nu s 0; 0 0 t] (s = sqrt(1 - nu^2), t = sqrt((1 - nu) / 2)),
+// B^T D B = (sqrt(c) L^T B)^T (sqrt(c) L^T B); c = w dn for the membrane rows, w dm for
+// the bending rows. Needs c >= 0 and |nu| < 1 (point_section_stiffness checks).
+void push_gram_rows(const PointRows& p, int npe, GramAccumulator& gram) {
+  const double s = std::sqrt(1 - p.nu * p.nu), t = std::sqrt(0.5 * (1 - p.nu));
+  for (int part = 0; part < 2; ++part) {
+    const double(*B)[9] = part == 0 ? p.Bm : p.Bb;
+    const double r = std::sqrt(p.w * (part == 0 ? p.dn : p.dm));
+    double* row0 = gram.next();
+    for (int a = 0; a < npe; ++a)
+      for (int k = 0; k < 3; ++k) row0[3 * a + k] = r * (B[a][k] + p.nu * B[a][3 + k]);
+    gram.push();
+    double* row1 = gram.next();
+    for (int a = 0; a < npe; ++a)
+      for (int k = 0; k < 3; ++k) row1[3 * a + k] = r * s * B[a][3 + k];
+    gram.push();
+    double* row2 = gram.next();
+    for (int a = 0; a < npe; ++a)
+      for (int k = 0; k < 3; ++k) row2[3 * a + k] = r * t * B[a][6 + k];
+    gram.push();
+  }
+}
+
+void check_sections(const PointSectionBatch& b) {
+  const std::int64_t points = b.start[b.count] - b.start[0];
+  for (std::int64_t q = b.start[0]; q < b.start[0] + points; ++q) {
+    const ShellSection& s = b.sections[q];
+    if (!(s.youngs_modulus >= 0 && s.thickness >= 0 && std::abs(s.poisson_ratio) < 1 && b.points[3 * q + 2] >= 0))
+      throw std::invalid_argument("point_section_stiffness: point " + std::to_string(q) + " has E = " +
+                                  std::to_string(s.youngs_modulus) + ", h = " + std::to_string(s.thickness) +
+                                  ", nu = " + std::to_string(s.poisson_ratio) + ", weight " +
+                                  std::to_string(b.points[3 * q + 2]) +
+                                  "; expected E >= 0, h >= 0, -1 < nu < 1 and a weight >= 0");
+  }
+}
 
 }  // namespace
 
@@ -184,7 +246,65 @@ void material_texture_quadrature(ElementType type, std::int64_t count, const Mat
 
 void point_section_stiffness(const PointSectionBatch& batch, const double* rotations, double* blocks, double* forces,
                              Execution execution) {
-  forall(batch.count, [&](std::int64_t e) { element_stiffness(batch, e, rotations, blocks, forces); }, execution);
+  check_sections(batch);
+  const int npe = nodes_per_element(batch.type), n = 3 * npe;
+  // Work items: each element's points in chunks of kStiffnessChunkPoints (at least one
+  // item an element, so an element without points gets zeros).
+  std::vector<std::int64_t> first_item(static_cast<std::size_t>(batch.count) + 1, 0);
+  for (std::int64_t e = 0; e < batch.count; ++e) {
+    const std::int64_t points = batch.start[e + 1] - batch.start[e];
+    first_item[e + 1] = first_item[e] + std::max<std::int64_t>(1, (points + kStiffnessChunkPoints - 1) / kStiffnessChunkPoints);
+  }
+  const std::int64_t items = first_item[batch.count];
+  std::vector<std::int64_t> item_element(static_cast<std::size_t>(items));
+  for (std::int64_t e = 0; e < batch.count; ++e)
+    for (std::int64_t i = first_item[e]; i < first_item[e + 1]; ++i) item_element[i] = e;
+  // Each item's sums: the upper triangle of its n x n Gram (row-major) and its forces.
+  std::vector<double> item_gram(static_cast<std::size_t>(items) * n * n), item_force(forces ? items * n : 0);
+  forall_then(
+      items,
+      [&](std::int64_t item) {
+        const std::int64_t e = item_element[item];
+        const int* nodes = batch.connectivity + e * npe;
+        const std::int64_t q0 = batch.start[e] + (item - first_item[e]) * kStiffnessChunkPoints;
+        const std::int64_t q1 = std::min(q0 + kStiffnessChunkPoints, batch.start[e + 1]);
+        double* f = forces ? item_force.data() + item * n : nullptr;
+        if (f) std::fill(f, f + n, 0.0);
+        GramAccumulator gram(n, 6 * std::max<std::int64_t>(1, q1 - q0));
+        for (std::int64_t q = q0; q < q1; ++q) {
+          PointRows p;
+          point_rows(batch, nodes, npe, q, rotations, f, p);
+          push_gram_rows(p, npe, gram);
+        }
+        gram.flush();
+        double* G = item_gram.data() + item * n * n;
+        for (int i = 0; i < n; ++i)
+          for (int j = i; j < n; ++j) G[i * n + j] = gram(i, j);
+      },
+      batch.count,
+      [&](std::int64_t e) {
+        // The items' sums in order, into the element's blocks (mirrored) and forces.
+        double* K = blocks + e * npe * npe * 9;
+        for (int i = 0; i < n; ++i)
+          for (int j = i; j < n; ++j) {
+            double v = 0;
+            for (std::int64_t item = first_item[e]; item < first_item[e + 1]; ++item) v += item_gram[(item * n + i) * n + j];
+            K[((i / 3) * npe + j / 3) * 9 + (i % 3) * 3 + j % 3] = v;
+            K[((j / 3) * npe + i / 3) * 9 + (j % 3) * 3 + i % 3] = v;
+          }
+        if (!forces) return;
+        for (int i = 0; i < n; ++i) {
+          double v = 0;
+          for (std::int64_t item = first_item[e]; item < first_item[e + 1]; ++item) v += item_force[item * n + i];
+          forces[e * n + i] = v;
+        }
+      },
+      execution);
+}
+
+void point_section_stiffness_reference(const PointSectionBatch& batch, const double* rotations, double* blocks,
+                                       double* forces) {
+  for (std::int64_t e = 0; e < batch.count; ++e) element_stiffness(batch, e, rotations, blocks, forces);
 }
 
 void point_section_deformation_gradients(const PointSectionBatch& b, const double* current, double* F,

@@ -241,6 +241,65 @@ TEST(MaterialTextureKernel, ParallelEqualsSerialBitwise) {
   EXPECT_EQ(mw[0], mw[1]);
 }
 
+TEST(MaterialTextureKernel, GramFormMatchesThePointByPointReference) {
+  // A curved element (a quarter cylinder) with a random 40 x 40 texture: 6400 points, so the
+  // Gram form sums several chunks; corotated, with the corrective forces.
+  const Mesh mesh = make_cylinder(0.5, 1.0, 0, 90, 2, 1, ElementType::quad8);
+  std::mt19937 random(5);
+  std::uniform_real_distribution<double> u(0.5, 1.5);
+  const int w = 40, ne = mesh.num_elements(), npe = 8;
+  std::vector<double> E(w * w), thickness(E.size());
+  for (size_t i = 0; i < E.size(); ++i) E[i] = 1e6 * u(random), thickness[i] = 0.01 * u(random);
+  const std::vector<kernels::MaterialTextureView> views(ne, {w, w, E.data(), thickness.data()});
+  const std::vector<kernels::ShellSection> base(ne, {1e6, 0.3, 0.01, 1000});
+  std::vector<std::int64_t> start;
+  std::vector<double> points;
+  std::vector<kernels::ShellSection> sections;
+  kernels::material_texture_quadrature(ElementType::quad8, ne, views.data(), base.data(), start, points, sections);
+  ASSERT_GT(start[1], 4 * 1024);
+  const kernels::PointSectionBatch batch{ElementType::quad8, ne,           mesh.elements.data(), mesh.positions.data(),
+                                         start.data(),       points.data(), sections.data()};
+  std::vector<double> current = mesh.positions;
+  for (int n = 0; n < mesh.num_nodes(); ++n) {  // rotated about z and sheared a little
+    const double x = mesh.positions[3 * n], y = mesh.positions[3 * n + 1], z = mesh.positions[3 * n + 2];
+    current[3 * n] = 0.6 * x - 0.8 * y + 0.05 * z;
+    current[3 * n + 1] = 0.8 * x + 0.6 * y;
+  }
+  const size_t np = sections.size();
+  std::vector<double> F(np * 9), R(np * 9);
+  kernels::point_section_deformation_gradients(batch, current.data(), F.data());
+  kernels::polar_decomposition_batch(static_cast<std::int64_t>(np), F.data(), R.data());
+  for (const double* rotations : {static_cast<const double*>(nullptr), static_cast<const double*>(R.data())}) {
+    std::vector<double> K(static_cast<size_t>(ne) * npe * npe * 9), K_ref(K.size());
+    std::vector<double> f(static_cast<size_t>(ne) * npe * 3), f_ref(f.size());
+    kernels::point_section_stiffness(batch, rotations, K.data(), f.data());
+    kernels::point_section_stiffness_reference(batch, rotations, K_ref.data(), f_ref.data());
+    std::printf("Gram form against the reference (%s): K %.2e, f %.2e of the largest entry\n",
+                rotations ? "corotated" : "linear", max_difference(K, K_ref) / max_abs(K_ref),
+                rotations ? max_difference(f, f_ref) / max_abs(f_ref) : 0.0);
+    EXPECT_LE(max_difference(K, K_ref), 1e-12 * max_abs(K_ref));
+    if (rotations) {
+      EXPECT_GT(max_abs(f_ref), 0.0);
+      EXPECT_LE(max_difference(f, f_ref), 1e-11 * max_abs(f_ref));
+    }
+    for (int e = 0; e < ne; ++e)  // symmetric, as the reference
+      for (int i = 0; i < 3 * npe; ++i)
+        for (int j = 0; j < 3 * npe; ++j) {
+          const auto at = [&](int r, int c) { return K[((e * npe + r / 3) * npe + c / 3) * 9 + (r % 3) * 3 + c % 3]; };
+          ASSERT_EQ(at(i, j), at(j, i));
+        }
+  }
+  // A negative thickness has no Cholesky factor of D: refused, naming the point.
+  sections[7].thickness = -0.01;
+  std::vector<double> K(static_cast<size_t>(ne) * npe * npe * 9);
+  try {
+    kernels::point_section_stiffness(batch, nullptr, K.data(), nullptr);
+    FAIL() << "a negative thickness was accepted";
+  } catch (const std::invalid_argument& error) {
+    EXPECT_NE(std::string(error.what()).find("point 7 "), std::string::npos) << error.what();
+  }
+}
+
 TEST(MaterialTextureModel, UniformTextureMatchesUntexturedModel) {
   Material m;
   m.nu = 0.0;
