@@ -6,6 +6,7 @@
 #include <string>
 
 #include "dgtex/kernels/gram_accumulation.h"
+#include "dgtex/kernels/polar_decomposition.h"
 #include "dgtex/kernels/shell_point.h"
 #include "dgtex/kernels/vec3.h"
 #include "shell_point_rows.h"
@@ -116,8 +117,8 @@ struct PointRows {
   double nu, dn, dm, w;
 };
 
-void point_rows(const PointSectionBatch& b, const int* nodes, int npe, std::int64_t q, const double* rotations,
-                double* f, PointRows& p) {
+void point_rows(const PointSectionBatch& b, const int* nodes, int npe, std::int64_t q, const double* R, double* f,
+                PointRows& p) {
   const double* pt = b.points + 3 * q;
   const ShellSection& sec = b.sections[q];
   p.nu = sec.poisson_ratio;
@@ -126,7 +127,6 @@ void point_rows(const PointSectionBatch& b, const int* nodes, int npe, std::int6
   ShapeValues s;
   evaluate_shape(b.type, pt[0], pt[1], s);
   p.w = pt[2] * fast_rows::rest_strain_rows(s, nodes, b.positions, npe, p.Bm, p.Bb);
-  const double* R = rotations ? rotations + q * 9 : nullptr;
   if (R && f) add_corrective_force(b, nodes, npe, p.Bm, p.Bb, R, p.nu, p.dn, p.dm, p.w, f);
   if (R)
     for (int a = 0; a < npe; ++a) rotate_rows(p.Bm[a], R), rotate_rows(p.Bb[a], R);
@@ -145,7 +145,7 @@ void element_stiffness(const PointSectionBatch& b, std::int64_t e, const double*
     for (int i = 0; i < npe * 3; ++i) f[i] = 0;
   for (std::int64_t q = b.start[e]; q < b.start[e + 1]; ++q) {
     PointRows p;
-    point_rows(b, nodes, npe, q, rotations, f, p);
+    point_rows(b, nodes, npe, q, rotations ? rotations + 9 * q : nullptr, f, p);
     for (int bb = 0; bb < npe; ++bb) {
       double DBm[9], DBb[9];  // D times the rows of node b, column by column
       for (int c = 0; c < 3; ++c) {
@@ -200,6 +200,17 @@ void push_gram_rows(const PointRows& p, int npe, GramAccumulator& gram) {
   }
 }
 
+// The surface deformation gradient of point q between the rest and current positions.
+void point_deformation_gradient(const PointSectionBatch& b, const int* nodes, std::int64_t q, const double* current,
+                                double F[9]) {
+  ShapeValues s;
+  evaluate_shape(b.type, b.points[3 * q], b.points[3 * q + 1], s);
+  fast_rows::SurfaceFrame p0, p;
+  fast_rows::evaluate_surface_frame(s, nodes, b.positions, p0);
+  fast_rows::evaluate_surface_frame(s, nodes, current, p);
+  surface_deformation_gradient(p0.a1, p0.a2, p0.t0, p.a1, p.a2, p.t0, F);
+}
+
 void check_sections(const PointSectionBatch& b) {
   const std::int64_t points = b.start[b.count] - b.start[0];
   for (std::int64_t q = b.start[0]; q < b.start[0] + points; ++q) {
@@ -211,6 +222,74 @@ void check_sections(const PointSectionBatch& b) {
                                   std::to_string(b.points[3 * q + 2]) +
                                   "; expected E >= 0, h >= 0, -1 < nu < 1 and a weight >= 0");
   }
+}
+
+// point_section_stiffness and its corotated form: rotations per point from `rotations`, or
+// formed here from `current` (one of them or neither).
+void gram_stiffness(const PointSectionBatch& batch, const double* rotations, const double* current, double* blocks,
+                    double* forces, Execution execution) {
+  check_sections(batch);
+  const int npe = nodes_per_element(batch.type), n = 3 * npe;
+  // Work items: each element's points in chunks of kStiffnessChunkPoints (at least one
+  // item an element, so an element without points gets zeros).
+  std::vector<std::int64_t> first_item(static_cast<std::size_t>(batch.count) + 1, 0);
+  for (std::int64_t e = 0; e < batch.count; ++e) {
+    const std::int64_t points = batch.start[e + 1] - batch.start[e];
+    first_item[e + 1] = first_item[e] + std::max<std::int64_t>(1, (points + kStiffnessChunkPoints - 1) / kStiffnessChunkPoints);
+  }
+  const std::int64_t items = first_item[batch.count];
+  std::vector<std::int64_t> item_element(static_cast<std::size_t>(items));
+  for (std::int64_t e = 0; e < batch.count; ++e)
+    for (std::int64_t i = first_item[e]; i < first_item[e + 1]; ++i) item_element[i] = e;
+  // Each item's sums: the upper triangle of its n x n Gram (row-major) and its forces.
+  std::vector<double> item_gram(static_cast<std::size_t>(items) * n * n), item_force(forces ? items * n : 0);
+  forall_then(
+      items,
+      [&](std::int64_t item) {
+        const std::int64_t e = item_element[item];
+        const int* nodes = batch.connectivity + e * npe;
+        const std::int64_t q0 = batch.start[e] + (item - first_item[e]) * kStiffnessChunkPoints;
+        const std::int64_t q1 = std::min(q0 + kStiffnessChunkPoints, batch.start[e + 1]);
+        double* f = forces ? item_force.data() + item * n : nullptr;
+        if (f) std::fill(f, f + n, 0.0);
+        GramAccumulator gram(n, 6 * std::max<std::int64_t>(1, q1 - q0));
+        for (std::int64_t q = q0; q < q1; ++q) {
+          double R[9];
+          const double* Rq = rotations ? rotations + 9 * q : nullptr;
+          if (current) {
+            double F[9];
+            point_deformation_gradient(batch, nodes, q, current, F);
+            polar_rotation(F, R);
+            Rq = R;
+          }
+          PointRows p;
+          point_rows(batch, nodes, npe, q, Rq, f, p);
+          push_gram_rows(p, npe, gram);
+        }
+        gram.flush();
+        double* G = item_gram.data() + item * n * n;
+        for (int i = 0; i < n; ++i)
+          for (int j = i; j < n; ++j) G[i * n + j] = gram(i, j);
+      },
+      batch.count,
+      [&](std::int64_t e) {
+        // The items' sums in order, into the element's blocks (mirrored) and forces.
+        double* K = blocks + e * npe * npe * 9;
+        for (int i = 0; i < n; ++i)
+          for (int j = i; j < n; ++j) {
+            double v = 0;
+            for (std::int64_t item = first_item[e]; item < first_item[e + 1]; ++item) v += item_gram[(item * n + i) * n + j];
+            K[((i / 3) * npe + j / 3) * 9 + (i % 3) * 3 + j % 3] = v;
+            K[((j / 3) * npe + i / 3) * 9 + (j % 3) * 3 + i % 3] = v;
+          }
+        if (!forces) return;
+        for (int i = 0; i < n; ++i) {
+          double v = 0;
+          for (std::int64_t item = first_item[e]; item < first_item[e + 1]; ++item) v += item_force[item * n + i];
+          forces[e * n + i] = v;
+        }
+      },
+      execution);
 }
 
 }  // namespace
@@ -246,60 +325,12 @@ void material_texture_quadrature(ElementType type, std::int64_t count, const Mat
 
 void point_section_stiffness(const PointSectionBatch& batch, const double* rotations, double* blocks, double* forces,
                              Execution execution) {
-  check_sections(batch);
-  const int npe = nodes_per_element(batch.type), n = 3 * npe;
-  // Work items: each element's points in chunks of kStiffnessChunkPoints (at least one
-  // item an element, so an element without points gets zeros).
-  std::vector<std::int64_t> first_item(static_cast<std::size_t>(batch.count) + 1, 0);
-  for (std::int64_t e = 0; e < batch.count; ++e) {
-    const std::int64_t points = batch.start[e + 1] - batch.start[e];
-    first_item[e + 1] = first_item[e] + std::max<std::int64_t>(1, (points + kStiffnessChunkPoints - 1) / kStiffnessChunkPoints);
-  }
-  const std::int64_t items = first_item[batch.count];
-  std::vector<std::int64_t> item_element(static_cast<std::size_t>(items));
-  for (std::int64_t e = 0; e < batch.count; ++e)
-    for (std::int64_t i = first_item[e]; i < first_item[e + 1]; ++i) item_element[i] = e;
-  // Each item's sums: the upper triangle of its n x n Gram (row-major) and its forces.
-  std::vector<double> item_gram(static_cast<std::size_t>(items) * n * n), item_force(forces ? items * n : 0);
-  forall_then(
-      items,
-      [&](std::int64_t item) {
-        const std::int64_t e = item_element[item];
-        const int* nodes = batch.connectivity + e * npe;
-        const std::int64_t q0 = batch.start[e] + (item - first_item[e]) * kStiffnessChunkPoints;
-        const std::int64_t q1 = std::min(q0 + kStiffnessChunkPoints, batch.start[e + 1]);
-        double* f = forces ? item_force.data() + item * n : nullptr;
-        if (f) std::fill(f, f + n, 0.0);
-        GramAccumulator gram(n, 6 * std::max<std::int64_t>(1, q1 - q0));
-        for (std::int64_t q = q0; q < q1; ++q) {
-          PointRows p;
-          point_rows(batch, nodes, npe, q, rotations, f, p);
-          push_gram_rows(p, npe, gram);
-        }
-        gram.flush();
-        double* G = item_gram.data() + item * n * n;
-        for (int i = 0; i < n; ++i)
-          for (int j = i; j < n; ++j) G[i * n + j] = gram(i, j);
-      },
-      batch.count,
-      [&](std::int64_t e) {
-        // The items' sums in order, into the element's blocks (mirrored) and forces.
-        double* K = blocks + e * npe * npe * 9;
-        for (int i = 0; i < n; ++i)
-          for (int j = i; j < n; ++j) {
-            double v = 0;
-            for (std::int64_t item = first_item[e]; item < first_item[e + 1]; ++item) v += item_gram[(item * n + i) * n + j];
-            K[((i / 3) * npe + j / 3) * 9 + (i % 3) * 3 + j % 3] = v;
-            K[((j / 3) * npe + i / 3) * 9 + (j % 3) * 3 + i % 3] = v;
-          }
-        if (!forces) return;
-        for (int i = 0; i < n; ++i) {
-          double v = 0;
-          for (std::int64_t item = first_item[e]; item < first_item[e + 1]; ++item) v += item_force[item * n + i];
-          forces[e * n + i] = v;
-        }
-      },
-      execution);
+  gram_stiffness(batch, rotations, nullptr, blocks, forces, execution);
+}
+
+void point_section_corotated_stiffness(const PointSectionBatch& batch, const double* current_positions,
+                                       double* blocks, double* forces, Execution execution) {
+  gram_stiffness(batch, nullptr, current_positions, blocks, forces, execution);
 }
 
 void point_section_stiffness_reference(const PointSectionBatch& batch, const double* rotations, double* blocks,
@@ -314,14 +345,7 @@ void point_section_deformation_gradients(const PointSectionBatch& b, const doubl
       b.count,
       [&](std::int64_t e) {
         const int* nodes = b.connectivity + e * npe;
-        for (std::int64_t q = b.start[e]; q < b.start[e + 1]; ++q) {
-          ShapeValues s;
-          evaluate_shape(b.type, b.points[3 * q], b.points[3 * q + 1], s);
-          fast_rows::SurfaceFrame p0, p;
-          fast_rows::evaluate_surface_frame(s, nodes, b.positions, p0);
-          fast_rows::evaluate_surface_frame(s, nodes, current, p);
-          surface_deformation_gradient(p0.a1, p0.a2, p0.t0, p.a1, p.a2, p.t0, F + q * 9);
-        }
+        for (std::int64_t q = b.start[e]; q < b.start[e + 1]; ++q) point_deformation_gradient(b, nodes, q, current, F + q * 9);
       },
       execution);
 }

@@ -795,21 +795,18 @@ void ShellModel::assemble_stiffness(const double* current, std::vector<double>& 
     vector_locals.insert(vector_locals.end(), {forces ? w.enriched_forces.data() : nullptr,
                                                forces ? w.enriched_edge_forces.data() : nullptr});
   }
-  // Material-textured elements: rotations per (texel-resolving) quadrature point.
+  // Material-textured elements: rotations per (texel-resolving) quadrature point, formed
+  // point by point in the stiffness kernel (no arrays of them).
   std::vector<double> textured_blocks, textured_forces;
   if (!textured_index_.empty()) {
     const kernels::PointSectionBatch tb = textured_batch();
-    std::vector<double> rotations;
-    if (current) {
-      std::vector<double> gradients(static_cast<size_t>(num_textured_quadrature_points()) * 9);
-      rotations.resize(gradients.size());
-      kernels::point_section_deformation_gradients(tb, current, gradients.data(), execution);
-      kernels::polar_decomposition_batch(num_textured_quadrature_points(), gradients.data(), rotations.data(), execution);
-    }
     textured_blocks.resize(static_cast<size_t>(num_textured_elements()) * npe * npe * 9);
     if (current && corrective) textured_forces.resize(static_cast<size_t>(num_textured_elements()) * npe * 3);
-    kernels::point_section_stiffness(tb, current ? rotations.data() : nullptr, textured_blocks.data(),
-                                     textured_forces.empty() ? nullptr : textured_forces.data(), execution);
+    double* const forces_out = textured_forces.empty() ? nullptr : textured_forces.data();
+    if (current)
+      kernels::point_section_corotated_stiffness(tb, current, textured_blocks.data(), forces_out, execution);
+    else
+      kernels::point_section_stiffness(tb, nullptr, textured_blocks.data(), forces_out, execution);
     matrix_locals.push_back(textured_blocks.data());
     vector_locals.push_back(textured_forces.data());
   }

@@ -227,6 +227,12 @@ TEST(MaterialTextureKernel, ParallelEqualsSerialBitwise) {
     blocks[k].resize(static_cast<size_t>(ne) * npe * npe * 9);
     forces[k].resize(static_cast<size_t>(ne) * npe * 3);
     kernels::point_section_stiffness(batch, R.data(), blocks[k].data(), forces[k].data(), exec);
+    // The corotated form forms the same rotations point by point: bitwise the same.
+    std::vector<double> corotated_blocks(blocks[k].size()), corotated_forces(forces[k].size());
+    kernels::point_section_corotated_stiffness(batch, current.data(), corotated_blocks.data(),
+                                               corotated_forces.data(), exec);
+    EXPECT_EQ(corotated_blocks, blocks[k]);
+    EXPECT_EQ(corotated_forces, forces[k]);
     mass[k].resize(static_cast<size_t>(ne) * npe * npe);
     kernels::point_section_mass(batch, mass[k].data(), exec);
     aw[k].resize(static_cast<size_t>(ne) * npe);

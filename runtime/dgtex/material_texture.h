@@ -35,7 +35,8 @@ inline constexpr std::int64_t kMaterialBytesPerTexel = 2 * sizeof(double);
 // Bytes a quadrature point of a textured element takes in the model: its (xi1, xi2, weight)
 // and its section (material_texture_kernel.h). A whole static run measures the same: a
 // 2 x 2 plate with 512 x 512 texels an element, all different (4.2 M points), peaks at
-// 292 MB, with uniform textures of that size (36 points) at 63 MB: 56.0 bytes a point.
+// 292 MB, with uniform textures of that size (36 points) at 63 MB: 56.0 bytes a point. A
+// corotated run keeps no more (its rotations are formed point by point, session 42).
 inline constexpr std::int64_t kMaterialBytesPerPoint = 56;
 
 // The memory the model's quadrature of these textures takes: kMaterialBytesPerPoint times

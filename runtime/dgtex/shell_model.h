@@ -85,6 +85,9 @@ class ShellModel {
   // std::invalid_argument for: element out of range or listed twice, sizes that do not
   // match W x H, non-positive or non-finite values, a tri6 mesh, or an element that is
   // also enriched (not supported). An empty list restores the plain model exactly.
+  // Memory: material_texture_quadrature_bytes(textures), static or corotated; it does not
+  // check that this fits (a scene does, build_scene_model): a program that takes textures
+  // from its users calls check_material_texture_memory first (material_texture.h).
   void set_material_textures(std::vector<ElementMaterialTexture> textures);
   const std::vector<ElementMaterialTexture>& material_textures() const { return material_textures_; }
   int num_textured_elements() const { return static_cast<int>(material_textures_.size()); }

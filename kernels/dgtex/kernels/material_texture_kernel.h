@@ -79,6 +79,12 @@ struct PointSectionBatch {
 // naming the point).
 void point_section_stiffness(const PointSectionBatch& batch, const double* rotations, double* blocks, double* forces,
                              Execution execution = Execution::parallel);
+// point_section_stiffness with each point's rotation formed as it is needed, from the
+// current positions (#nodes x 3): the rotations of point_section_deformation_gradients and
+// polar_decomposition_batch, bitwise, without their two arrays (144 bytes a point: a
+// 512 x 512 texture whose texels all differ would need 600 MB more for them).
+void point_section_corotated_stiffness(const PointSectionBatch& batch, const double* current_positions,
+                                       double* blocks, double* forces, Execution execution = Execution::parallel);
 // The same stiffness and forces summed point by point, block by block (the reference of the
 // Gram form; they agree to rounding).
 void point_section_stiffness_reference(const PointSectionBatch& batch, const double* rotations, double* blocks,
