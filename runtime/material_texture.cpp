@@ -10,11 +10,6 @@
 #include "dgtex/texel_memory_estimate.h"
 
 namespace dgtex {
-namespace {
-
-std::string mebibytes(std::int64_t bytes) { return std::to_string(bytes >> 20) + " MiB"; }
-
-}  // namespace
 
 std::vector<ElementMaterialTexture> scene_material_textures(const Scene& scene, const Mesh& mesh) {
   return scene_material_textures(scene, mesh, scene.material_textures.empty() ? -1 : available_memory_bytes());
@@ -64,7 +59,7 @@ std::vector<ElementMaterialTexture> scene_material_textures(const Scene& scene, 
         if (available_bytes >= 0 && texel_bytes > available_bytes)
           throw SceneError(scene.source_name, "material_textures",
                            "the textured elements' copies of E and h (" + std::to_string(kMaterialBytesPerTexel) +
-                               " bytes a texel and element) outgrow the " + mebibytes(available_bytes) +
+                               " bytes a texel and element) outgrow the " + memory_size_text(available_bytes) +
                                " of memory available at " + path + " (its " + std::to_string(image.width) +
                                "x" + std::to_string(image.height) + " image on element " + std::to_string(e) +
                                ", textured element " + std::to_string(per_element.size()) + ")",
@@ -115,8 +110,8 @@ void check_material_texture_memory(const std::vector<ElementMaterialTexture>& te
   throw SceneError(source_name, "material_textures",
                    "the quadrature of " + std::to_string(textures.size()) + " textured elements (" +
                        std::to_string(texels) + " texels, " + std::to_string(needed / kMaterialBytesPerPoint) +
-                       " points: a Gauss rule on each cell of equal texels) needs " + mebibytes(needed) +
-                       ", more than the " + mebibytes(available_bytes) + " of memory available",
+                       " points: a Gauss rule on each cell of equal texels) needs " + memory_size_text(needed) +
+                       ", more than the " + memory_size_text(available_bytes) + " of memory available",
                    "", "smaller images, textures on fewer elements, or images with larger regions of one value (each "
                        "region of equal texels is integrated as one cell)");
 }

@@ -36,12 +36,6 @@ std::int64_t file_number(const char* path) {
   return value;
 }
 
-std::string gigabytes(std::int64_t bytes) {
-  char text[32];
-  std::snprintf(text, sizeof text, "%.1f GB", static_cast<double>(bytes) / 1e9);
-  return text;
-}
-
 std::string count_of(int n, const std::string& noun) { return std::to_string(n) + " " + noun + (n == 1 ? "" : "s"); }
 
 // DGTEX_MEMORY_LIMIT_MB as bytes; -1 when unset or empty. Throws std::invalid_argument for
@@ -64,6 +58,14 @@ std::int64_t texel_memory_lower_bound(const TexelFields& fields) {
   const std::int64_t per_tile = active_texels_per_tile(fields.type, fields.resolution);
   const std::int64_t cut_bytes = fields.direct_solves ? kDirectSolveBytesPerTexel : kFieldBytesPerTexel;
   return per_tile * (fields.cuts.region_elements * cut_bytes + fields.creases.region_elements * kFieldBytesPerTexel);
+}
+
+std::string memory_size_text(std::int64_t bytes) {
+  constexpr std::int64_t gib = std::int64_t{1} << 30;
+  if (bytes < gib) return std::to_string(bytes >> 20) + " MiB";
+  char text[32];
+  std::snprintf(text, sizeof text, "%.1f GiB", static_cast<double>(bytes) / gib);
+  return text;
 }
 
 std::int64_t available_memory_bytes() {
@@ -108,7 +110,7 @@ void check_texel_memory(const TexelFields& fields, std::int64_t available_bytes,
             std::to_string(kFieldBytesPerTexel) + " bytes a texel)";
   const std::string t = std::to_string(fields.resolution);
   const std::string problem = "the texel fields of " + what + " at " + t + " x " + t + " texels an element need at least " +
-                              gigabytes(needed) + ", more than the " + gigabytes(available_bytes) +
+                              memory_size_text(needed) + ", more than the " + memory_size_text(available_bytes) +
                               " of memory available";
   const std::string valid = fitting > 0 ? "expected " + std::to_string(fitting) + " or less (the most that could fit on this machine)"
                                         : "no texture_resolution fits on this machine; fewer or shorter cuts or creases";
@@ -120,7 +122,7 @@ std::string texel_memory_caution(const TexelFields& fields, std::int64_t availab
   // Beyond the memory available check_texel_memory refuses the scene instead.
   if (available_bytes < 0 || 2 * needed <= available_bytes || needed > available_bytes) return "";
   return "enrichment.texture_resolution " + std::to_string(fields.resolution) + ": the texel fields need at least " +
-         gigabytes(needed) + " of the " + gigabytes(available_bytes) +
+         memory_size_text(needed) + " of the " + memory_size_text(available_bytes) +
          " of memory available, and runs measured 1.3-4x that bound; the run may be killed for memory (a lower "
          "texture_resolution is safer)";
 }

@@ -104,7 +104,7 @@ TEST(CliRun, BadInputExitsWithCodeTwoAndOneLine) {
   expect_rejected("clusters", accordion.dump(), "enrichment.rotation_cluster_texels = 1", "DGTEX_MEMORY_LIMIT_MB=4096");
 }
 
-// fracture.json at T = 4096: at least 371.9 GB of texel fields (dgtex/texel_memory_estimate.h).
+// fracture.json at T = 4096: at least 346.3 GiB of texel fields (dgtex/texel_memory_estimate.h).
 // Without the check the system killed such a run minutes in; now one line, at once.
 TEST(CliRun, CutsWhoseTexelFieldsCannotFitAreRefusedNamingTheResolution) {
   if (dgtex::available_memory_bytes() > std::int64_t{350} * 1000 * 1000 * 1000)

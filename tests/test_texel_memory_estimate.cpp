@@ -99,16 +99,16 @@ TEST(TexelMemoryEstimate, TooLittleMemoryIsASceneErrorNamingTheResolution) {
   EXPECT_NO_THROW(check_texel_memory(fields, needed, "f.json"));
   EXPECT_NO_THROW(check_texel_memory(fields, -1, "f.json"));  // unknown: no check
 
-  // 1 GB: T = 256 needs 284 x 32896 x 160 B = 1.49 GB, T = 128 0.38 GB.
+  // 1 GiB: T = 256 needs 284 x 32896 x 160 B = 1.39 GiB, T = 128 0.35 GiB.
   try {
-    check_texel_memory(fields, 1000000000, "f.json");
+    check_texel_memory(fields, std::int64_t{1} << 30, "f.json");
     FAIL() << "no SceneError";
   } catch (const SceneError& e) {
     EXPECT_EQ(e.json_path(), "enrichment.texture_resolution");
     EXPECT_EQ(std::string(e.what()),
               "f.json: enrichment.texture_resolution: the texel fields of 6 cut segments (284 element regions, 160 "
-              "bytes a texel with direct Laplace solves) at 4096 x 4096 texels an element need at least 381.3 GB, "
-              "more than the 1.0 GB of memory available, got 4096; expected 128 or less (the most that could fit on "
+              "bytes a texel with direct Laplace solves) at 4096 x 4096 texels an element need at least 355.1 GiB, "
+              "more than the 1.0 GiB of memory available, got 4096; expected 128 or less (the most that could fit on "
               "this machine)");
   }
   fields.type = ElementType::quad8;
@@ -124,19 +124,30 @@ TEST(TexelMemoryEstimate, TooLittleMemoryIsASceneErrorNamingTheResolution) {
       << none;
 }
 
+// Every memory message writes sizes alike, in the binary units of DGTEX_MEMORY_LIMIT_MB.
+TEST(TexelMemoryEstimate, MemorySizesAreWholeMiBBelowAGiBAndGiBAbove) {
+  constexpr std::int64_t mib = std::int64_t{1} << 20;
+  EXPECT_EQ(memory_size_text(0), "0 MiB");
+  EXPECT_EQ(memory_size_text(645 * mib + 1), "645 MiB");
+  EXPECT_EQ(memory_size_text(1024 * mib - 1), "1023 MiB");
+  EXPECT_EQ(memory_size_text(1024 * mib), "1.0 GiB");
+  EXPECT_EQ(memory_size_text(381300000000), "355.1 GiB");
+}
+
 // Between half the memory and all of it the scene runs, with a caution first (runs measured
 // up to 4x the bound): fracture at T = 1024 passed the check and was still killed.
 TEST(TexelMemoryEstimate, ACautionAboveHalfTheMemoryAvailable) {
   const TexelFields fields = fracture_like(1024);
-  const std::int64_t needed = texel_memory_lower_bound(fields);  // 23.8 GB
+  const std::int64_t needed = texel_memory_lower_bound(fields);  // 22.2 GiB
+  const std::int64_t available = std::int64_t{25} << 30;
   EXPECT_EQ(texel_memory_caution(fields, 2 * needed), "");
   EXPECT_EQ(texel_memory_caution(fields, -1), "");
   EXPECT_EQ(texel_memory_caution(fields, needed - 1), "");  // refused by check_texel_memory instead
-  EXPECT_EQ(texel_memory_caution(fields, 25000000000),
-            "enrichment.texture_resolution 1024: the texel fields need at least 23.8 GB of the 25.0 GB of memory "
+  EXPECT_EQ(texel_memory_caution(fields, available),
+            "enrichment.texture_resolution 1024: the texel fields need at least 22.2 GiB of the 25.0 GiB of memory "
             "available, and runs measured 1.3-4x that bound; the run may be killed for memory (a lower "
             "texture_resolution is safer)");
-  EXPECT_NO_THROW(check_texel_memory(fields, 25000000000, "f.json"));  // a caution, not a refusal
+  EXPECT_NO_THROW(check_texel_memory(fields, available, "f.json"));  // a caution, not a refusal
 }
 
 // The fields SceneRun checks, handed to SceneRunOptions::before_texel_fields (where
@@ -233,7 +244,7 @@ TEST(TexelMemoryEstimate, SceneRunRefusesCutsThatCannotFitBeforeItsFirstUpdate) 
 }
 
 // The same for a crease (no cuts): 16 x 16 elements, the crease through a column of 16,
-// 48 regions, at least 51.5 GB at T = 4096.
+// 48 regions, at least 48.0 GiB at T = 4096.
 TEST(TexelMemoryEstimate, SceneRunRefusesCreasesThatCannotFitBeforeBuildingThem) {
   Scene scene = example_scene("crease");
   scene.mesh.divisions = {16, 16};
@@ -245,7 +256,7 @@ TEST(TexelMemoryEstimate, SceneRunRefusesCreasesThatCannotFitBeforeBuildingThem)
   if (available_memory_bytes() >= texel_memory_lower_bound(fields)) GTEST_SKIP() << "this machine has the memory";
   const std::string message = message_of<SceneError>([&] { SceneRun run(scene); });
   EXPECT_NE(message.find("crease.json: enrichment.texture_resolution: the texel fields of 1 crease (48 element "
-                         "regions, 64 bytes a texel) at 4096 x 4096 texels an element need at least 51.5 GB"),
+                         "regions, 64 bytes a texel) at 4096 x 4096 texels an element need at least 48.0 GiB"),
             std::string::npos)
       << message;
 }

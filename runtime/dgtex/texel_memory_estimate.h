@@ -56,6 +56,11 @@ std::int64_t texel_memory_lower_bound(const TexelFields& fields);
 // naming DGTEX_MEMORY_LIMIT_MB when it is set but not a whole number >= 1.
 std::int64_t available_memory_bytes();
 
+// A memory size as every memory refusal and caution writes it, in the binary units of
+// DGTEX_MEMORY_LIMIT_MB: whole MiB below 1 GiB ("645 MiB"), else GiB to one decimal
+// ("355.1 GiB").
+std::string memory_size_text(std::int64_t bytes);
+
 // Throws SceneError(source_name, "enrichment.texture_resolution", ...) when the lower
 // bound exceeds available_bytes, naming both, the fields and the largest power of two
 // T >= 8 whose bound fits (or that none does). available_bytes < 0: no check.
