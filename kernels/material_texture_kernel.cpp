@@ -109,24 +109,21 @@ void add_corrective_force(const PointSectionBatch& b, const int* nodes, int npe,
   }
 }
 
-// One point's strain rows, rotated by R (when given), with the rigidities of its section:
-// the shared first half of both stiffness forms; adds the corrective force to f (when both
-// R and f are given).
+// Point q's strain rows (s: its shape values), rotated by R (when given), with the
+// rigidities of its section: the shared first half of both stiffness forms; adds the
+// corrective force to f (when both R and f are given).
 struct PointRows {
   double Bm[max_element_nodes][9], Bb[max_element_nodes][9];
   double nu, dn, dm, w;
 };
 
-void point_rows(const PointSectionBatch& b, const int* nodes, int npe, std::int64_t q, const double* R, double* f,
-                PointRows& p) {
-  const double* pt = b.points + 3 * q;
+void point_rows(const PointSectionBatch& b, const int* nodes, int npe, std::int64_t q, const ShapeValues& s,
+                const double* R, double* f, PointRows& p) {
   const ShellSection& sec = b.sections[q];
   p.nu = sec.poisson_ratio;
   p.dn = membrane_rigidity(sec.youngs_modulus, p.nu, sec.thickness);
   p.dm = bending_rigidity(sec.youngs_modulus, p.nu, sec.thickness);
-  ShapeValues s;
-  evaluate_shape(b.type, pt[0], pt[1], s);
-  p.w = pt[2] * fast_rows::rest_strain_rows(s, nodes, b.positions, npe, p.Bm, p.Bb);
+  p.w = b.points[3 * q + 2] * fast_rows::rest_strain_rows(s, nodes, b.positions, npe, p.Bm, p.Bb);
   if (R && f) add_corrective_force(b, nodes, npe, p.Bm, p.Bb, R, p.nu, p.dn, p.dm, p.w, f);
   if (R)
     for (int a = 0; a < npe; ++a) rotate_rows(p.Bm[a], R), rotate_rows(p.Bb[a], R);
@@ -144,8 +141,10 @@ void element_stiffness(const PointSectionBatch& b, std::int64_t e, const double*
   if (f)
     for (int i = 0; i < npe * 3; ++i) f[i] = 0;
   for (std::int64_t q = b.start[e]; q < b.start[e + 1]; ++q) {
+    ShapeValues s;
+    evaluate_shape(b.type, b.points[3 * q], b.points[3 * q + 1], s);
     PointRows p;
-    point_rows(b, nodes, npe, q, rotations ? rotations + 9 * q : nullptr, f, p);
+    point_rows(b, nodes, npe, q, s, rotations ? rotations + 9 * q : nullptr, f, p);
     for (int bb = 0; bb < npe; ++bb) {
       double DBm[9], DBb[9];  // D times the rows of node b, column by column
       for (int c = 0; c < 3; ++c) {
@@ -200,11 +199,10 @@ void push_gram_rows(const PointRows& p, int npe, GramAccumulator& gram) {
   }
 }
 
-// The surface deformation gradient of point q between the rest and current positions.
-void point_deformation_gradient(const PointSectionBatch& b, const int* nodes, std::int64_t q, const double* current,
-                                double F[9]) {
-  ShapeValues s;
-  evaluate_shape(b.type, b.points[3 * q], b.points[3 * q + 1], s);
+// The surface deformation gradient at a point (s: its shape values) between the rest and
+// current positions.
+void point_deformation_gradient(const PointSectionBatch& b, const int* nodes, const ShapeValues& s,
+                                const double* current, double F[9]) {
   fast_rows::SurfaceFrame p0, p;
   fast_rows::evaluate_surface_frame(s, nodes, b.positions, p0);
   fast_rows::evaluate_surface_frame(s, nodes, current, p);
@@ -212,8 +210,7 @@ void point_deformation_gradient(const PointSectionBatch& b, const int* nodes, st
 }
 
 void check_sections(const PointSectionBatch& b) {
-  const std::int64_t points = b.start[b.count] - b.start[0];
-  for (std::int64_t q = b.start[0]; q < b.start[0] + points; ++q) {
+  for (std::int64_t q = b.start[0]; q < b.start[b.count]; ++q) {
     const ShellSection& s = b.sections[q];
     if (!(s.youngs_modulus >= 0 && s.thickness >= 0 && std::abs(s.poisson_ratio) < 1 && b.points[3 * q + 2] >= 0))
       throw std::invalid_argument("point_section_stiffness: point " + std::to_string(q) + " has E = " +
@@ -235,7 +232,8 @@ void gram_stiffness(const PointSectionBatch& batch, const double* rotations, con
   std::vector<std::int64_t> first_item(static_cast<std::size_t>(batch.count) + 1, 0);
   for (std::int64_t e = 0; e < batch.count; ++e) {
     const std::int64_t points = batch.start[e + 1] - batch.start[e];
-    first_item[e + 1] = first_item[e] + std::max<std::int64_t>(1, (points + kStiffnessChunkPoints - 1) / kStiffnessChunkPoints);
+    const std::int64_t chunks = (points + kStiffnessChunkPoints - 1) / kStiffnessChunkPoints;
+    first_item[e + 1] = first_item[e] + std::max<std::int64_t>(1, chunks);
   }
   const std::int64_t items = first_item[batch.count];
   std::vector<std::int64_t> item_element(static_cast<std::size_t>(items));
@@ -254,16 +252,18 @@ void gram_stiffness(const PointSectionBatch& batch, const double* rotations, con
         if (f) std::fill(f, f + n, 0.0);
         GramAccumulator gram(n, 6 * std::max<std::int64_t>(1, q1 - q0));
         for (std::int64_t q = q0; q < q1; ++q) {
+          ShapeValues s;
+          evaluate_shape(batch.type, batch.points[3 * q], batch.points[3 * q + 1], s);
           double R[9];
           const double* Rq = rotations ? rotations + 9 * q : nullptr;
           if (current) {
             double F[9];
-            point_deformation_gradient(batch, nodes, q, current, F);
+            point_deformation_gradient(batch, nodes, s, current, F);
             polar_rotation(F, R);
             Rq = R;
           }
           PointRows p;
-          point_rows(batch, nodes, npe, q, Rq, f, p);
+          point_rows(batch, nodes, npe, q, s, Rq, f, p);
           push_gram_rows(p, npe, gram);
         }
         gram.flush();
@@ -278,7 +278,8 @@ void gram_stiffness(const PointSectionBatch& batch, const double* rotations, con
         for (int i = 0; i < n; ++i)
           for (int j = i; j < n; ++j) {
             double v = 0;
-            for (std::int64_t item = first_item[e]; item < first_item[e + 1]; ++item) v += item_gram[(item * n + i) * n + j];
+            for (std::int64_t item = first_item[e]; item < first_item[e + 1]; ++item)
+              v += item_gram[(item * n + i) * n + j];
             K[((i / 3) * npe + j / 3) * 9 + (i % 3) * 3 + j % 3] = v;
             K[((j / 3) * npe + i / 3) * 9 + (j % 3) * 3 + i % 3] = v;
           }
@@ -345,7 +346,11 @@ void point_section_deformation_gradients(const PointSectionBatch& b, const doubl
       b.count,
       [&](std::int64_t e) {
         const int* nodes = b.connectivity + e * npe;
-        for (std::int64_t q = b.start[e]; q < b.start[e + 1]; ++q) point_deformation_gradient(b, nodes, q, current, F + q * 9);
+        for (std::int64_t q = b.start[e]; q < b.start[e + 1]; ++q) {
+          ShapeValues s;
+          evaluate_shape(b.type, b.points[3 * q], b.points[3 * q + 1], s);
+          point_deformation_gradient(b, nodes, s, current, F + q * 9);
+        }
       },
       execution);
 }

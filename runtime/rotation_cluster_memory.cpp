@@ -13,7 +13,8 @@ void check_rotation_cluster_memory(std::int64_t rest_bytes, std::int64_t availab
   if (available_bytes < 0 || rest_bytes <= available_bytes) return;
   throw ModelError("enrichment.rotation_cluster_texels = " + std::to_string(block_texels) + ": " +
                    std::to_string(clusters) + " rotation clusters would take " + memory_size_text(rest_bytes) +
-                   " of rest sums, more than the " + memory_size_text(available_bytes) + " of memory available; use larger blocks or 0 (a rotation per point, no rest sums)");
+                   " of rest sums, more than the " + memory_size_text(available_bytes) +
+                   " of memory available; use larger blocks or 0 (a rotation per point, no rest sums)");
 }
 
 std::int64_t rotation_cluster_memory_available() {

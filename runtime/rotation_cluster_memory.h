@@ -10,9 +10,10 @@
 namespace dgtex::detail {
 
 // Throws ModelError naming enrichment.rotation_cluster_texels (block_texels), the cluster
-// count, the memory the rest sums need and that available (memory_size_text), when rest_bytes exceed
-// available_bytes: memory the process may still take (available_memory_bytes()) plus the
-// released blocks it keeps for reuse (cached_block_bytes()). available_bytes < 0: no check.
+// count, the memory the rest sums need and that available (memory_size_text), when
+// rest_bytes exceed available_bytes: memory the process may still take
+// (available_memory_bytes()) plus the released blocks it keeps for reuse
+// (cached_block_bytes()). available_bytes < 0: no check.
 void check_rotation_cluster_memory(std::int64_t rest_bytes, std::int64_t available_bytes, int block_texels,
                                    std::int64_t clusters);
 

@@ -72,9 +72,9 @@ struct PointSectionBatch {
 // Membrane + bending stiffness with D evaluated per point (E h / (1 - nu^2) and
 // E h^3 / (12 (1 - nu^2))); with rotations R K R^T per point and the corrective force of
 // shell report eq. 48, as shell_element_stiffness. Summed as Gram products of the points'
-// strain rows scaled by the Cholesky factor of D (accumulate_gram_upper: vectorised; the
-// products 1.3-1.5x faster than point by point on a textured plate, the rest being the
-// per-point geometry), in chunks of a fixed number of points.
+// strain rows scaled by the Cholesky factor of D (accumulate_gram_upper: vectorised; a
+// textured plate's assembly 1.1-1.5x faster than point by point, the rest of its time being
+// the per-point geometry), in chunks of a fixed number of points.
 // Needs E >= 0, h >= 0, -1 < nu < 1 and weights >= 0 at every point (else invalid_argument,
 // naming the point).
 void point_section_stiffness(const PointSectionBatch& batch, const double* rotations, double* blocks, double* forces,
