@@ -13,6 +13,7 @@
 #include "dgtex/kernels/flood_fill.h"
 #include "dgtex/kernels/forall.h"
 #include "dgtex/kernels/multigrid_unknowns.h"
+#include "graph_laplacian_amg.h"
 #include "seamed_patch_laplace.h"
 
 namespace dgtex {
@@ -217,6 +218,34 @@ bool place_region_in_plane(const std::vector<RegionTile>& tiles, ElementType typ
   placement.x = std::move(x);
   placement.y = std::move(y);
   return true;
+}
+
+// The reference solve of a texel Laplacian (full rows) and the safety net of the
+// multigrids: CHOLMOD, simplicial (no BLAS: Debian's serial OpenBLAS is not safe for
+// concurrent calls) with AMD alone (METIS draws from a global random generator): lock-free
+// and the same bits on any thread. The texel graphs of a few tri6 elements (fracture:
+// 6k-20k unknowns) factor 2-4x faster simplicial than supernodal here, and AMD was
+// CHOLMOD's own pick.
+Eigen::VectorXd solve_by_cholmod(const detail::SparseRows& a, const Eigen::VectorXd& b, std::size_t elements,
+                                 double& relative_residual) {
+  const Eigen::SparseMatrix<double> lower = a.triangularView<Eigen::Lower>();
+  Eigen::CholmodSupernodalLLT<Eigen::SparseMatrix<double>, Eigen::Lower> cholesky;
+  cholmod_common& common = cholesky.cholmod();
+  common.supernodal = CHOLMOD_SIMPLICIAL;
+  common.nmethods = 1;
+  common.method[0].ordering = CHOLMOD_AMD;
+  common.postorder = 1;
+  cholesky.compute(lower);
+  const auto m = std::to_string(a.rows());
+  if (cholesky.info() != Eigen::Success)
+    throw std::runtime_error("enrichment Laplace solve: CHOLMOD could not factor the " + m +
+                             "-unknown texel Laplacian over " + std::to_string(elements) +
+                             " elements (not positive definite or out of memory)");
+  Eigen::VectorXd x = cholesky.solve(b);
+  if (cholesky.info() != Eigen::Success || !x.allFinite())
+    throw std::runtime_error("enrichment Laplace solve: CHOLMOD solve failed for " + m + " unknowns");
+  relative_residual = b.norm() > 0 ? (b - a * x).norm() / b.norm() : 0.0;
+  return x;
 }
 
 }  // namespace
@@ -491,46 +520,44 @@ MeshLaplaceStats solve_mesh_texel_laplace(std::vector<RegionTile>& tiles, Elemen
       }
     }
     if (!stats.multigrid) {
-      // Lower triangle, column by column (rows in increasing order: cheap inserts).
+      // The texel Laplacian over the unknowns, row by row (columns in increasing order:
+      // cheap inserts), and the data's share of the right side.
       const int m = stats.unknowns;
-      Eigen::SparseMatrix<double> a(m, m);
+      detail::SparseRows a(m, m);
       a.reserve(Eigen::VectorXi::Constant(m, 5));
       Eigen::VectorXd b = Eigen::VectorXd::Zero(m);
-      std::vector<int> rows;
+      std::vector<int> columns;
       for (int k = 0; k < m; ++k) {
-        const int v = node_of[k];
         int degree = 0;
-        rows.clear();
-        graph.for_each_coupling(v, [&](int w) {
+        columns.assign(1, k);
+        graph.for_each_coupling(node_of[k], [&](int w) {
           ++degree;
-          if (unknown_of[w] > k) rows.push_back(unknown_of[w]);
-          else if (unknown_of[w] < 0) b[k] += graph.value(w);
+          if (unknown_of[w] >= 0) columns.push_back(unknown_of[w]);
+          else b[k] += graph.value(w);
         });
-        std::sort(rows.begin(), rows.end());
-        a.insert(k, k) = static_cast<double>(degree);
-        for (int r : rows) a.insert(r, k) = -1.0;
+        std::sort(columns.begin(), columns.end());
+        for (int c : columns) a.insert(k, c) = c == k ? static_cast<double>(degree) : -1.0;
       }
       a.makeCompressed();
-      Eigen::CholmodSupernodalLLT<Eigen::SparseMatrix<double>, Eigen::Lower> cholesky;
-      // Simplicial (no BLAS: Debian's serial OpenBLAS is not safe for concurrent calls) with
-      // AMD alone (METIS draws from a global random generator): lock-free and the same bits
-      // on any thread. The texel graphs of a few tri6 elements (fracture: 6k-20k unknowns)
-      // factor 2-4x faster simplicial than supernodal here, and AMD was CHOLMOD's own pick.
-      cholmod_common& common = cholesky.cholmod();
-      common.supernodal = CHOLMOD_SIMPLICIAL;
-      common.nmethods = 1;
-      common.method[0].ordering = CHOLMOD_AMD;
-      common.postorder = 1;
-      cholesky.compute(a);
-      if (cholesky.info() != Eigen::Success)
-        throw std::runtime_error("enrichment Laplace solve: CHOLMOD could not factor the " + std::to_string(m) +
-                                 "-unknown texel Laplacian over " + std::to_string(tiles.size()) +
-                                 " elements (not positive definite or out of memory)");
-      const Eigen::VectorXd x = cholesky.solve(b);
-      if (cholesky.info() != Eigen::Success || !x.allFinite())
-        throw std::runtime_error("enrichment Laplace solve: CHOLMOD solve failed for " + std::to_string(m) + " unknowns");
-      stats.relative_residual = b.norm() > 0 ? (b - a.selfadjointView<Eigen::Lower>() * x).norm() / b.norm() : 0.0;
-      for (int k = 0; k < m; ++k) graph.value(node_of[k]) = x[k];
+      if (solver == LaplaceSolver::multigrid) {
+        // No planar patch holds the region (tri6, turned neighbours) or its multigrid did not
+        // converge: algebraic multigrid on the texel graph, warm-started like the tile's.
+        try {
+          Eigen::VectorXd x(m);
+          for (int k = 0; k < m; ++k) x[k] = options.warm_start ? graph.value(node_of[k]) : 0.0;
+          const detail::GraphAmgStats s =
+              detail::solve_graph_laplacian_amg(a, b, x, options.tolerance, options.max_cycles);
+          for (int k = 0; k < m; ++k) graph.value(node_of[k]) = x[k];
+          stats.relative_residual = s.relative_residual;
+          stats.multigrid = stats.algebraic_multigrid = true;
+        } catch (const std::runtime_error&) {
+          stats.multigrid = false;
+        }
+      }
+      if (!stats.multigrid) {
+        const Eigen::VectorXd x = solve_by_cholmod(a, b, tiles.size(), stats.relative_residual);
+        for (int k = 0; k < m; ++k) graph.value(node_of[k]) = x[k];
+      }
     }
   }
   stats.ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();

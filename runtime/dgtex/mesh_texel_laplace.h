@@ -75,16 +75,20 @@ struct MeshLaplaceStats {
   int constant_components = 0;  // components set to their single data value
   int solved_tiles = 0, frozen_tiles = 0;
   double relative_residual = 0;
-  bool multigrid = false;  // solved by the tile multigrid (else CHOLMOD, or nothing to solve)
+  bool multigrid = false;  // solved by a multigrid (else CHOLMOD, or nothing to solve) ...
+  bool algebraic_multigrid = false;  // ... the algebraic one on the texel graph (no planar patch)
   double ms = 0;  // wall time of the whole call
 };
 
 // Solves in place: free texels of non-frozen tiles get H; data texels keep their values.
 // All tiles must be T x T of the same T, elements distinct (std::invalid_argument
-// otherwise); std::runtime_error if CHOLMOD fails. Where the multigrid does not apply (tri6
-// regions, regions that do not lie flat) or does not converge, CHOLMOD solves the region:
-// simplicial with the AMD ordering, which call neither BLAS nor METIS, so concurrent calls
-// (one segment per thread in CutManager) need no lock and give the bits of a serial call.
+// otherwise); std::runtime_error if CHOLMOD fails. With LaplaceSolver::multigrid, regions
+// that lie flat are solved by the tile multigrid on one patch tile, the others (tri6,
+// turned neighbours) by algebraic multigrid on the texel graph (graph_laplacian_amg.h),
+// both to options.tolerance. CHOLMOD solves the region with LaplaceSolver::cholmod and
+// where a multigrid does not converge: simplicial with the AMD ordering. None calls BLAS or
+// METIS, so concurrent calls (one segment per thread in CutManager) need no lock and give
+// the bits of a serial call.
 MeshLaplaceStats solve_mesh_texel_laplace(std::vector<RegionTile>& tiles, ElementType type,
                                           const ElementAdjacency& adjacency, const MeshEdgeWalls& edge_walls,
                                           LaplaceSolver solver = LaplaceSolver::cholmod,
