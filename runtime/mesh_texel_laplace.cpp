@@ -551,7 +551,7 @@ MeshLaplaceStats solve_mesh_texel_laplace(std::vector<RegionTile>& tiles, Elemen
           stats.relative_residual = s.relative_residual;
           stats.multigrid = stats.algebraic_multigrid = true;
         } catch (const std::runtime_error&) {
-          stats.multigrid = false;
+          // not converged: CHOLMOD below
         }
       }
       if (!stats.multigrid) {

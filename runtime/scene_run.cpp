@@ -35,7 +35,7 @@ TexelFields texel_fields(const Scene& scene, const Mesh& mesh, const CutManager*
   TexelFields fields;
   fields.type = mesh.type;
   fields.resolution = scene.enrichment.texture_resolution;
-  fields.direct_solves = mesh.type == ElementType::tri6 || scene.enrichment.solver == EnrichmentOptions::Solver::cholmod;
+  fields.graph_solves = mesh.type == ElementType::tri6 || scene.enrichment.solver == EnrichmentOptions::Solver::cholmod;
   if (cuts) fields.cuts = cuts->full_footprint();
   fields.creases = crease_footprint(creases);
   return fields;

@@ -56,7 +56,7 @@ std::int64_t memory_limit_from_environment() {
 
 std::int64_t texel_memory_lower_bound(const TexelFields& fields) {
   const std::int64_t per_tile = active_texels_per_tile(fields.type, fields.resolution);
-  const std::int64_t cut_bytes = fields.direct_solves ? kDirectSolveBytesPerTexel : kFieldBytesPerTexel;
+  const std::int64_t cut_bytes = fields.graph_solves ? kGraphSolveBytesPerTexel : kFieldBytesPerTexel;
   return per_tile * (fields.cuts.region_elements * cut_bytes + fields.creases.region_elements * kFieldBytesPerTexel);
 }
 
@@ -102,8 +102,8 @@ void check_texel_memory(const TexelFields& fields, std::int64_t available_bytes,
   std::string what;
   if (fields.cuts.fields > 0)
     what = count_of(fields.cuts.fields, "cut segment") + " (" + std::to_string(fields.cuts.region_elements) +
-           " element regions, " + std::to_string(fields.direct_solves ? kDirectSolveBytesPerTexel : kFieldBytesPerTexel) +
-           " bytes a texel with " + (fields.direct_solves ? "direct" : "multigrid") + " Laplace solves)";
+           " element regions, " + std::to_string(fields.graph_solves ? kGraphSolveBytesPerTexel : kFieldBytesPerTexel) +
+           " bytes a texel with " + (fields.graph_solves ? "texel-graph" : "tile multigrid") + " Laplace solves)";
   if (fields.creases.fields > 0)
     what += (what.empty() ? "" : " and ") + count_of(fields.creases.fields, "crease") + " (" +
             std::to_string(fields.creases.region_elements) + " element regions, " +

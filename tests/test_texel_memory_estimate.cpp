@@ -34,7 +34,7 @@ TexelFields fracture_like(int resolution) {
   TexelFields fields;
   fields.type = ElementType::tri6;
   fields.resolution = resolution;
-  fields.direct_solves = true;
+  fields.graph_solves = true;
   fields.cuts = {6, 284};
   return fields;
 }
@@ -42,10 +42,10 @@ TexelFields fracture_like(int resolution) {
 TEST(TexelMemoryEstimate, LowerBoundIsBytesPerActiveTexelOfEveryFieldsRegion) {
   TexelFields fields = fracture_like(256);
   // tri6: the texels with i + j <= T - 1
-  EXPECT_EQ(texel_memory_lower_bound(fields), 284LL * 256 * 257 / 2 * kDirectSolveBytesPerTexel);
+  EXPECT_EQ(texel_memory_lower_bound(fields), 284LL * 256 * 257 / 2 * kGraphSolveBytesPerTexel);
   fields.type = ElementType::quad8;
-  EXPECT_EQ(texel_memory_lower_bound(fields), 284LL * 256 * 256 * kDirectSolveBytesPerTexel);
-  fields.direct_solves = false;
+  EXPECT_EQ(texel_memory_lower_bound(fields), 284LL * 256 * 256 * kGraphSolveBytesPerTexel);
+  fields.graph_solves = false;
   EXPECT_EQ(texel_memory_lower_bound(fields), 284LL * 256 * 256 * kFieldBytesPerTexel);
   fields.creases = {1, 24};  // creases count as fields without a solve
   EXPECT_EQ(texel_memory_lower_bound(fields), (284LL + 24) * 256 * 256 * kFieldBytesPerTexel);
@@ -107,15 +107,15 @@ TEST(TexelMemoryEstimate, TooLittleMemoryIsASceneErrorNamingTheResolution) {
     EXPECT_EQ(e.json_path(), "enrichment.texture_resolution");
     EXPECT_EQ(std::string(e.what()),
               "f.json: enrichment.texture_resolution: the texel fields of 6 cut segments (284 element regions, 160 "
-              "bytes a texel with direct Laplace solves) at 4096 x 4096 texels an element need at least 355.1 GiB, "
+              "bytes a texel with texel-graph Laplace solves) at 4096 x 4096 texels an element need at least 355.1 GiB, "
               "more than the 1.0 GiB of memory available, got 4096; expected 128 or less (the most that could fit on "
               "this machine)");
   }
   fields.type = ElementType::quad8;
-  fields.direct_solves = false;
+  fields.graph_solves = false;
   fields.creases = {1, 24};
   const std::string none = message_of<SceneError>([&] { check_texel_memory(fields, 1000, "f.json"); });
-  EXPECT_NE(none.find("the texel fields of 6 cut segments (284 element regions, 64 bytes a texel with multigrid "
+  EXPECT_NE(none.find("the texel fields of 6 cut segments (284 element regions, 64 bytes a texel with tile multigrid "
                       "Laplace solves) and 1 crease (24 element regions, 64 bytes a texel) at 4096 x 4096"),
             std::string::npos)
       << none;
@@ -173,13 +173,13 @@ TEST(TexelMemoryEstimate, SceneRunHandsItsFieldsToTheCallerBeforeAllocatingThem)
   EXPECT_EQ(calls, 1);
   EXPECT_EQ(fracture.type, ElementType::tri6);
   EXPECT_EQ(fracture.resolution, 32);
-  EXPECT_TRUE(fracture.direct_solves);
+  EXPECT_TRUE(fracture.graph_solves);
   EXPECT_EQ(fracture.cuts.fields, 6);
   EXPECT_EQ(fracture.cuts.region_elements, 290);
   EXPECT_EQ(fracture.creases.fields, 0);
   const TexelFields crease = fields_seen_by_scene_run("crease", calls);
   EXPECT_EQ(calls, 2);
-  EXPECT_FALSE(crease.direct_solves);
+  EXPECT_FALSE(crease.graph_solves);
   EXPECT_EQ(crease.cuts.fields, 0);
   EXPECT_EQ(crease.creases.fields, 1);
   EXPECT_EQ(crease.creases.region_elements, 1);
@@ -211,7 +211,7 @@ TEST(TexelMemoryEstimate, TheEnvironmentsLimitCapsTheMemoryAvailable) {
   TexelFields fields;  // fracture-like: 5 segments over 280 tri6 elements at T = 256
   fields.type = ElementType::tri6;
   fields.resolution = 256;
-  fields.direct_solves = true;
+  fields.graph_solves = true;
   fields.cuts = {5, 280};
   EXPECT_THROW(check_texel_memory(fields, capped, "fracture.json"), SceneError);
   for (const char* bad : {"abc", "0", "-5", "12x", "99999999999999999999"}) {

@@ -21,9 +21,10 @@
 // through frozen tiles: slinky after its first cut settles), is solved by the tile multigrid
 // on one patch tile holding the same couplings (options: tolerance, warm start from the
 // tiles' values); frozen texels coupled to solved ones enter that patch as Dirichlet ghost
-// texels beside the edge they couple across, walled off from everything else. Other regions
-// (tri6, rings closed through solved tiles, turned neighbours) and LaplaceSolver::cholmod
-// use CHOLMOD.
+// texels beside the edge they couple across, walled off from everything else; a ring closed
+// through solved tiles, on a patch cut open at a seam. Regions that no patch holds (tri6,
+// turned neighbours) are solved by algebraic multigrid on the texel graph. With
+// LaplaceSolver::cholmod, or where a multigrid misses its tolerance, CHOLMOD solves.
 // Value types that own their data (MeshEdgeWalls its key set, RegionTile its tile) and
 // functions that keep nothing; a solve may use all OpenMP threads. Values dimensionless.
 #include <cstdint>

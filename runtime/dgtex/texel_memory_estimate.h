@@ -13,8 +13,9 @@
 // the start (set-up and one step, T = 256-4096, 2-core machine; README "enrichment"):
 //  - cuts with multigrid Laplace solves: 84-226 bytes, falling with T toward ~85 (spiral6
 //    at 4096: 8.5 GB); bound kFieldBytesPerTexel;
-//  - cuts whose solves are direct (tri6 elements, or enrichment.solver "cholmod":
-//    CHOLMOD's factor): 187-678 bytes; bound kDirectSolveBytesPerTexel;
+//  - cuts whose solves run on the texel graph (tri6 elements: the algebraic multigrid's
+//    hierarchy, 203-257 bytes at T = 256-128 (fracture, session 43); enrichment.solver
+//    "cholmod": CHOLMOD's factor, 187-678 bytes): bound kGraphSolveBytesPerTexel;
 //  - creases (a fast-marching distance, no solve): 81-82 bytes (a crease over 8 of 64
 //    quad8 elements, T = 512 and 1024); bound kFieldBytesPerTexel.
 // A scene that passes may still need several times the bound (chad's cut on tri6
@@ -29,7 +30,7 @@
 namespace dgtex {
 
 inline constexpr std::int64_t kFieldBytesPerTexel = 64;
-inline constexpr std::int64_t kDirectSolveBytesPerTexel = 160;
+inline constexpr std::int64_t kGraphSolveBytesPerTexel = 160;
 
 // Enrichment fields of one kind (cut segments, or creases) and their regions.
 struct TexelFootprint {
@@ -41,7 +42,7 @@ struct TexelFootprint {
 struct TexelFields {
   ElementType type = ElementType::quad8;
   int resolution = 0;          // T
-  bool direct_solves = false;  // the cuts' Laplace solves go to CHOLMOD
+  bool graph_solves = false;  // the cuts' Laplace solves run on the texel graph (tri6, or CHOLMOD)
   TexelFootprint cuts, creases;
 };
 
