@@ -1,7 +1,8 @@
 // CutManager solves the Laplace problems of different segments concurrently
 // (cut_manager.cpp): the functions must be bitwise the same for 1, 2 and 4 threads, with
-// multigrid regions (a quad8 rectangle) and regions that need CHOLMOD (tri6, solved
-// concurrently too: the direct solve is lock-free), static and progressive.
+// multigrid regions (a quad8 rectangle) and tri6 regions (no planar patch: the algebraic
+// multigrid, or CHOLMOD with solver "cholmod"; both serial per region and lock-free, so
+// solved concurrently too), static and progressive.
 #include <gtest/gtest.h>
 
 #include <omp.h>
@@ -74,12 +75,15 @@ TEST(CutsConcurrentSolves, StaticMultigridCutsAreThreadCountIndependent) {
   expect_thread_count_independent(mesh, cuts, multigrid_enrichment(32), {0.0}, 4);
 }
 
-TEST(CutsConcurrentSolves, ProgressiveTri6CutsNeedingCholmodAreThreadCountIndependent) {
+TEST(CutsConcurrentSolves, ProgressiveTri6CutsAreThreadCountIndependent) {
   const Mesh mesh = make_rectangle(3, 2, 3, 2, ElementType::tri6);
   std::vector<Cut> cuts = {points_cut({{0.1, 0.35, 0}, {2.6, 0.6, 0}}), points_cut({{0.2, 1.5, 0}, {2.7, 1.3, 0}}),
                            points_cut({{1.45, 0.9, 0}, {1.55, 1.2, 0}})};
   for (Cut& cut : cuts) cut.has_schedule = true, cut.speed = 1.0;
-  expect_thread_count_independent(mesh, cuts, multigrid_enrichment(16), {0.5, 1.0, 1.5, 2.0, 3.0}, 8);
+  for (const EnrichmentOptions& options : {multigrid_enrichment(16), cholmod_enrichment(16)}) {
+    SCOPED_TRACE(options.solver == EnrichmentOptions::Solver::multigrid ? "algebraic multigrid" : "CHOLMOD");
+    expect_thread_count_independent(mesh, cuts, options, {0.5, 1.0, 1.5, 2.0, 3.0}, 8);
+  }
 }
 
 TEST(CutsConcurrentSolves, ProgressiveMixedRegionsAreThreadCountIndependent) {
