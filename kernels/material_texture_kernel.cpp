@@ -10,6 +10,7 @@
 #include "dgtex/kernels/shell_point.h"
 #include "dgtex/kernels/vec3.h"
 #include "shell_point_rows.h"
+#include "shell_point_rows_batch.h"
 
 namespace dgtex::kernels {
 namespace {
@@ -117,16 +118,24 @@ struct PointRows {
   double nu, dn, dm, w;
 };
 
-void point_rows(const PointSectionBatch& b, const int* nodes, int npe, std::int64_t q, const ShapeValues& s,
-                const double* R, double* f, PointRows& p) {
+// With p.Bm, p.Bb the rest rows and j0 the area element at point q: the section's
+// rigidities and weight, the corrective force, the rotation.
+void finish_point_rows(const PointSectionBatch& b, const int* nodes, int npe, std::int64_t q, double j0,
+                       const double* R, double* f, PointRows& p) {
   const ShellSection& sec = b.sections[q];
   p.nu = sec.poisson_ratio;
   p.dn = membrane_rigidity(sec.youngs_modulus, p.nu, sec.thickness);
   p.dm = bending_rigidity(sec.youngs_modulus, p.nu, sec.thickness);
-  p.w = b.points[3 * q + 2] * fast_rows::rest_strain_rows(s, nodes, b.positions, npe, p.Bm, p.Bb);
+  p.w = b.points[3 * q + 2] * j0;
   if (R && f) add_corrective_force(b, nodes, npe, p.Bm, p.Bb, R, p.nu, p.dn, p.dm, p.w, f);
   if (R)
     for (int a = 0; a < npe; ++a) rotate_rows(p.Bm[a], R), rotate_rows(p.Bb[a], R);
+}
+
+void point_rows(const PointSectionBatch& b, const int* nodes, int npe, std::int64_t q, const ShapeValues& s,
+                const double* R, double* f, PointRows& p) {
+  const double j0 = fast_rows::rest_strain_rows(s, nodes, b.positions, npe, p.Bm, p.Bb);
+  finish_point_rows(b, nodes, npe, q, j0, R, f, p);
 }
 
 // The reference form: K_ab += w (Bm_a^T Dn Bm_b + Bb_a^T Dm Bb_b) point by point, block by
@@ -251,20 +260,29 @@ void gram_stiffness(const PointSectionBatch& batch, const double* rotations, con
         double* f = forces ? item_force.data() + item * n : nullptr;
         if (f) std::fill(f, f + n, 0.0);
         GramAccumulator gram(n, 6 * std::max<std::int64_t>(1, q1 - q0));
-        for (std::int64_t q = q0; q < q1; ++q) {
-          ShapeValues s;
-          evaluate_shape(batch.type, batch.points[3 * q], batch.points[3 * q + 1], s);
-          double R[9];
-          const double* Rq = rotations ? rotations + 9 * q : nullptr;
-          if (current) {
-            double F[9];
-            point_deformation_gradient(batch, nodes, s, current, F);
-            polar_rotation(F, R);
-            Rq = R;
+        constexpr int lanes = fast_rows::kRestRowLanes;
+        for (std::int64_t first = q0; first < q1; first += lanes) {
+          const int count = static_cast<int>(std::min<std::int64_t>(lanes, q1 - first));
+          ShapeValues s[lanes];
+          for (int l = 0; l < count; ++l)
+            evaluate_shape(batch.type, batch.points[3 * (first + l)], batch.points[3 * (first + l) + 1], s[l]);
+          fast_rows::RestRowsBatch rest;
+          fast_rows::rest_strain_rows_batch(s, count, nodes, batch.positions, npe, rest);
+          for (int l = 0; l < count; ++l) {
+            const std::int64_t q = first + l;
+            double R[9];
+            const double* Rq = rotations ? rotations + 9 * q : nullptr;
+            if (current) {
+              double F[9];
+              point_deformation_gradient(batch, nodes, s[l], current, F);
+              polar_rotation(F, R);
+              Rq = R;
+            }
+            PointRows p;
+            rest.lane(l, npe, p.Bm, p.Bb);
+            finish_point_rows(batch, nodes, npe, q, rest.j0[l], Rq, f, p);
+            push_gram_rows(p, npe, gram);
           }
-          PointRows p;
-          point_rows(batch, nodes, npe, q, s, Rq, f, p);
-          push_gram_rows(p, npe, gram);
         }
         gram.flush();
         double* G = item_gram.data() + item * n * n;
@@ -366,9 +384,8 @@ void point_section_mass(const PointSectionBatch& b, double* mass, Execution exec
         for (std::int64_t q = b.start[e]; q < b.start[e + 1]; ++q) {
           ShapeValues s;
           evaluate_shape(b.type, b.points[3 * q], b.points[3 * q + 1], s);
-          RestPoint p;
-          evaluate_rest_point(s, nodes, b.positions, p);
-          const double w = b.points[3 * q + 2] * p.j0 * b.sections[q].density * b.sections[q].thickness;
+          const double j0 = rest_area_factor(s, nodes, b.positions);  // evaluate_rest_point's j0, bitwise
+          const double w = b.points[3 * q + 2] * j0 * b.sections[q].density * b.sections[q].thickness;
           for (int a = 0; a < npe; ++a)
             for (int c = 0; c < npe; ++c) m[a * npe + c] += w * s.N[a] * s.N[c];
         }
@@ -387,9 +404,7 @@ void point_section_load_weights(const PointSectionBatch& b, double* area_weights
         for (std::int64_t q = b.start[e]; q < b.start[e + 1]; ++q) {
           ShapeValues s;
           evaluate_shape(b.type, b.points[3 * q], b.points[3 * q + 1], s);
-          RestPoint p;
-          evaluate_rest_point(s, nodes, b.positions, p);
-          const double w = b.points[3 * q + 2] * p.j0;
+          const double w = b.points[3 * q + 2] * rest_area_factor(s, nodes, b.positions);
           const double rho_h = b.sections[q].density * b.sections[q].thickness;
           for (int a = 0; a < npe; ++a) {
             area_weights[e * npe + a] += w * s.N[a];

@@ -13,12 +13,15 @@
 #include <unistd.h>
 
 #include "dgtex/kernels/material_texture_kernel.h"
+#include "dgtex/kernels/shape_functions.h"
 #include "dgtex/kernels/polar_decomposition.h"
 #include "dgtex/material_texture.h"
 #include "dgtex/png_io.h"
 #include "dgtex/scene_io.h"
 #include "dgtex/scene_model.h"
 #include "dgtex/shell_simulation.h"
+#include "shell_point_rows.h"        // internal (kernels/)
+#include "shell_point_rows_batch.h"  // internal (kernels/)
 #include "shell_test_support.h"
 
 namespace {
@@ -245,6 +248,38 @@ TEST(MaterialTextureKernel, ParallelEqualsSerialBitwise) {
   EXPECT_EQ(mass[0], mass[1]);
   EXPECT_EQ(aw[0], aw[1]);
   EXPECT_EQ(mw[0], mw[1]);
+}
+
+// The textured stiffness forms its points' rest rows several at a time
+// (shell_point_rows_batch.h): on a doubly curved element, for every number of points in a
+// batch, each lane's rows and area element are bitwise those of the one-point form.
+TEST(MaterialTextureKernel, BatchedRestRowsAreBitwiseTheOnePointRows) {
+  Mesh mesh = make_rectangle(1.0, 0.7, 1, 1, ElementType::quad8);
+  for (int n = 0; n < mesh.num_nodes(); ++n) {
+    double* x = &mesh.positions[3 * n];
+    x[2] = 0.3 * x[0] * x[0] - 0.2 * x[0] * x[1] + 0.1 * x[1] * x[1] * x[1];
+  }
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> xi(-1.0, 1.0);
+  constexpr int lanes = kernels::fast_rows::kRestRowLanes;
+  for (int count = 1; count <= lanes; ++count) {
+    kernels::ShapeValues shapes[lanes];
+    for (int l = 0; l < count; ++l) kernels::evaluate_shape(ElementType::quad8, xi(rng), xi(rng), shapes[l]);
+    kernels::fast_rows::RestRowsBatch batch;
+    kernels::fast_rows::rest_strain_rows_batch(shapes, count, mesh.elements.data(), mesh.positions.data(), 8, batch);
+    for (int l = 0; l < count; ++l) {
+      double Bm[8][9], Bb[8][9], batched_Bm[8][9], batched_Bb[8][9];
+      const double j0 =
+          kernels::fast_rows::rest_strain_rows(shapes[l], mesh.elements.data(), mesh.positions.data(), 8, Bm, Bb);
+      batch.lane(l, 8, batched_Bm, batched_Bb);
+      EXPECT_EQ(batch.j0[l], j0) << count << " points, lane " << l;
+      int differ = 0;
+      for (int a = 0; a < 8; ++a)
+        for (int r = 0; r < 9; ++r) differ += Bm[a][r] != batched_Bm[a][r] || Bb[a][r] != batched_Bb[a][r];
+      EXPECT_EQ(differ, 0) << count << " points, lane " << l;
+      EXPECT_NE(Bb[0][0], 0.0);  // curved: the bending rows are not trivially zero
+    }
+  }
 }
 
 TEST(MaterialTextureKernel, GramFormMatchesThePointByPointReference) {

@@ -11,3 +11,8 @@ set_source_files_properties(
 set_source_files_properties(${CMAKE_CURRENT_SOURCE_DIR}/kernels/block_product.cpp
   ${CMAKE_CURRENT_SOURCE_DIR}/kernels/dense_cholesky_solve.cpp
   PROPERTIES COMPILE_OPTIONS -ffp-contract=off)
+# The material-texture stiffness's rest rows, several points at a time
+# (kernels/shell_point_rows_batch.cpp), have a path per instruction set; without
+# contraction each lane rounds like the one-point rows of the reference form.
+set_source_files_properties(${CMAKE_CURRENT_SOURCE_DIR}/kernels/shell_point_rows_batch.cpp
+  PROPERTIES COMPILE_OPTIONS -ffp-contract=off)

@@ -1,0 +1,34 @@
+#pragma once
+// Private to the material-texture stiffness (material_texture_kernel.cpp): the rest strain
+// rows of fast_rows::rest_strain_rows (shell_point_rows.h) for up to kRestRowLanes points
+// of one element at once. Every quantity is held across the points (one lane each), so the
+// arithmetic vectorises across points (target_clones: AVX-512, AVX2, baseline); each lane
+// takes the operations of rest_strain_rows in the same order, so with FMA contraction off
+// the rows are bitwise those of the one-point form. Why: the per-point geometry was ~60 % of
+// a textured element's assembly (session 42's profile), scalar and latency-bound.
+#include "dgtex/kernels/shape_functions.h"
+
+namespace dgtex::kernels::fast_rows {
+
+constexpr int kRestRowLanes = 8;
+
+struct RestRowsBatch {
+  // Bm[a][r][l]: membrane row r (eps11, eps22, 2 eps12 times x, y, z) of node a at lane l's
+  // point; Bb likewise for bending; j0[l]: the area element there.
+  alignas(64) double Bm[max_element_nodes][9][kRestRowLanes];
+  alignas(64) double Bb[max_element_nodes][9][kRestRowLanes];
+  alignas(64) double j0[kRestRowLanes];
+
+  // Lane l's rows in the one-point layout of rest_strain_rows.
+  void lane(int l, int npe, double (*Bm_out)[9], double (*Bb_out)[9]) const {
+    for (int a = 0; a < npe; ++a)
+      for (int r = 0; r < 9; ++r) Bm_out[a][r] = Bm[a][r][l], Bb_out[a][r] = Bb[a][r][l];
+  }
+};
+
+// shapes[0 .. count): the points' shape values over the element's npe nodes (1 <= count <=
+// kRestRowLanes); lanes from count on repeat the last point.
+void rest_strain_rows_batch(const ShapeValues* shapes, int count, const int* nodes, const double* X, int npe,
+                            RestRowsBatch& out);
+
+}  // namespace dgtex::kernels::fast_rows
