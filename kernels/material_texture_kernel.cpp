@@ -79,11 +79,12 @@ inline void apply_plane_stress(double nu, double scale, const double in[3], doub
   out[2] = scale * 0.5 * (1 - nu) * in[2];
 }
 
-// Adds a point's corrective force of shell report eq. 48 to f: B_R^T D B (X0 - R^T X0),
-// B the point's unrotated rows (Bm, Bb), B_R the rotated ones, times the weight w.
-void add_corrective_force(const PointSectionBatch& b, const int* nodes, int npe, const double (*Bm)[9],
-                          const double (*Bb)[9], const double* R, double nu, double dn, double dm, double w,
-                          double* f) {
+// The corrective force of shell report eq. 48, B_R^T D B (X0 - R^T X0) times the weight w
+// (B the point's unrotated rows, B_R the rotated ones), in two halves around the rotation
+// of the rows: first the stresses D B (X0 - R^T X0) from the unrotated rows ...
+void corrective_stresses(const PointSectionBatch& b, const int* nodes, int npe, const double (*Bm)[9],
+                         const double (*Bb)[9], const double* R, double nu, double dn, double dm, double sm[3],
+                         double sb[3]) {
   double strain_m[3] = {0, 0, 0}, strain_b[3] = {0, 0, 0};
   for (int a = 0; a < npe; ++a) {
     const double* x = b.positions + 3 * static_cast<long>(nodes[a]);
@@ -95,19 +96,19 @@ void add_corrective_force(const PointSectionBatch& b, const int* nodes, int npe,
         strain_b[r] += Bb[a][r * 3 + k] * d[k];
       }
   }
-  double sm[3], sb[3];
   apply_plane_stress(nu, dn, strain_m, sm);
   apply_plane_stress(nu, dm, strain_b, sb);
-  for (int a = 0; a < npe; ++a) {
-    double Rm[9], Rb[9];
-    rotate_rows(Bm[a], R, Rm);
-    rotate_rows(Bb[a], R, Rb);
+}
+
+// ... then w B_R^T times them, added to f.
+void add_corrective_force(int npe, const double (*Rm)[9], const double (*Rb)[9], const double sm[3],
+                          const double sb[3], double w, double* f) {
+  for (int a = 0; a < npe; ++a)
     for (int i = 0; i < 3; ++i) {
       double v = 0;
-      for (int r = 0; r < 3; ++r) v += Rm[r * 3 + i] * sm[r] + Rb[r * 3 + i] * sb[r];
+      for (int r = 0; r < 3; ++r) v += Rm[a][r * 3 + i] * sm[r] + Rb[a][r * 3 + i] * sb[r];
       f[a * 3 + i] += w * v;
     }
-  }
 }
 
 // Point q's strain rows (s: its shape values), rotated by R (when given), with the
@@ -127,9 +128,11 @@ void finish_point_rows(const PointSectionBatch& b, const int* nodes, int npe, st
   p.dn = membrane_rigidity(sec.youngs_modulus, p.nu, sec.thickness);
   p.dm = bending_rigidity(sec.youngs_modulus, p.nu, sec.thickness);
   p.w = b.points[3 * q + 2] * j0;
-  if (R && f) add_corrective_force(b, nodes, npe, p.Bm, p.Bb, R, p.nu, p.dn, p.dm, p.w, f);
-  if (R)
-    for (int a = 0; a < npe; ++a) rotate_rows(p.Bm[a], R), rotate_rows(p.Bb[a], R);
+  if (!R) return;
+  double sm[3] = {0, 0, 0}, sb[3] = {0, 0, 0};
+  if (f) corrective_stresses(b, nodes, npe, p.Bm, p.Bb, R, p.nu, p.dn, p.dm, sm, sb);
+  for (int a = 0; a < npe; ++a) rotate_rows(p.Bm[a], R), rotate_rows(p.Bb[a], R);
+  if (f) add_corrective_force(npe, p.Bm, p.Bb, sm, sb, p.w, f);
 }
 
 void point_rows(const PointSectionBatch& b, const int* nodes, int npe, std::int64_t q, const ShapeValues& s,
