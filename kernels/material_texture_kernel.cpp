@@ -314,6 +314,24 @@ void gram_stiffness(const PointSectionBatch& batch, const double* rotations, con
       execution);
 }
 
+// visit(q, shape values, area element j0) for element e's points in order, their j0 formed
+// several at a time (bitwise evaluate_rest_point's).
+template <class Visit>
+void for_each_point_area(const PointSectionBatch& b, std::int64_t e, Visit&& visit) {
+  const int npe = nodes_per_element(b.type);
+  const int* nodes = b.connectivity + e * npe;
+  constexpr int lanes = fast_rows::kRestRowLanes;
+  for (std::int64_t first = b.start[e]; first < b.start[e + 1]; first += lanes) {
+    const int count = static_cast<int>(std::min<std::int64_t>(lanes, b.start[e + 1] - first));
+    ShapeValues s[lanes];
+    for (int l = 0; l < count; ++l)
+      evaluate_shape(b.type, b.points[3 * (first + l)], b.points[3 * (first + l) + 1], s[l]);
+    double j0[lanes];
+    fast_rows::rest_area_factor_batch(s, count, nodes, b.positions, npe, j0);
+    for (int l = 0; l < count; ++l) visit(first + l, s[l], j0[l]);
+  }
+}
+
 }  // namespace
 
 std::int64_t material_texture_point_count(const MaterialTextureView& texture, double reduced_rule_cell) {
@@ -381,17 +399,13 @@ void point_section_mass(const PointSectionBatch& b, double* mass, Execution exec
   forall(
       b.count,
       [&](std::int64_t e) {
-        const int* nodes = b.connectivity + e * npe;
         double* m = mass + e * npe * npe;
         for (int i = 0; i < npe * npe; ++i) m[i] = 0;
-        for (std::int64_t q = b.start[e]; q < b.start[e + 1]; ++q) {
-          ShapeValues s;
-          evaluate_shape(b.type, b.points[3 * q], b.points[3 * q + 1], s);
-          const double j0 = rest_area_factor(s, nodes, b.positions);  // evaluate_rest_point's j0, bitwise
+        for_each_point_area(b, e, [&](std::int64_t q, const ShapeValues& s, double j0) {
           const double w = b.points[3 * q + 2] * j0 * b.sections[q].density * b.sections[q].thickness;
           for (int a = 0; a < npe; ++a)
             for (int c = 0; c < npe; ++c) m[a * npe + c] += w * s.N[a] * s.N[c];
-        }
+        });
       },
       execution);
 }
@@ -402,18 +416,15 @@ void point_section_load_weights(const PointSectionBatch& b, double* area_weights
   forall(
       b.count,
       [&](std::int64_t e) {
-        const int* nodes = b.connectivity + e * npe;
         for (int a = 0; a < npe; ++a) area_weights[e * npe + a] = mass_weights[e * npe + a] = 0;
-        for (std::int64_t q = b.start[e]; q < b.start[e + 1]; ++q) {
-          ShapeValues s;
-          evaluate_shape(b.type, b.points[3 * q], b.points[3 * q + 1], s);
-          const double w = b.points[3 * q + 2] * rest_area_factor(s, nodes, b.positions);
+        for_each_point_area(b, e, [&](std::int64_t q, const ShapeValues& s, double j0) {
+          const double w = b.points[3 * q + 2] * j0;
           const double rho_h = b.sections[q].density * b.sections[q].thickness;
           for (int a = 0; a < npe; ++a) {
             area_weights[e * npe + a] += w * s.N[a];
             mass_weights[e * npe + a] += w * rho_h * s.N[a];
           }
-        }
+        });
       },
       execution);
 }

@@ -22,17 +22,44 @@ inline void cross(const Lanes* a, const Lanes* b, Lanes* c) {
   }
 }
 
+// dN[a][k][l] = shapes[l].dN[a][k]; lanes from count on repeat the last point.
+inline void first_derivatives(const ShapeValues* shapes, int count, int npe, double (*dN)[2][L]) {
+  for (int l = 0; l < L; ++l) {
+    const ShapeValues& s = shapes[std::min(l, count - 1)];
+    for (int a = 0; a < npe; ++a)
+      for (int k = 0; k < 2; ++k) dN[a][k][l] = s.dN[a][k];
+  }
+}
+
 }  // namespace
+
+__attribute__((target_clones("avx512f", "avx2", "default"))) void rest_area_factor_batch(
+    const ShapeValues* shapes, int count, const int* nodes, const double* X, int npe, double* j0) {
+  alignas(64) double dN[max_element_nodes][2][L];
+  first_derivatives(shapes, count, npe, dN);
+  alignas(64) double a1[3][L] = {}, a2[3][L] = {}, n[3][L], area[L];
+  for (int a = 0; a < npe; ++a) {
+    const double* x = X + 3 * static_cast<long>(nodes[a]);
+    for (int d = 0; d < 3; ++d)
+      for (int l = 0; l < L; ++l) {
+        a1[d][l] += dN[a][0][l] * x[d];
+        a2[d][l] += dN[a][1][l] * x[d];
+      }
+  }
+  cross(a1, a2, n);
+  dot(n, n, area);
+  for (int l = 0; l < L; ++l) area[l] = std::sqrt(area[l]);
+  std::copy(area, area + count, j0);
+}
 
 __attribute__((target_clones("avx512f", "avx2", "default"))) void rest_strain_rows_batch(
     const ShapeValues* shapes, int count, const int* nodes, const double* X, int npe, RestRowsBatch& out) {
   alignas(64) double dN[max_element_nodes][2][L], d2N[max_element_nodes][3][L];
+  first_derivatives(shapes, count, npe, dN);
   for (int l = 0; l < L; ++l) {
     const ShapeValues& s = shapes[std::min(l, count - 1)];
-    for (int a = 0; a < npe; ++a) {
-      for (int k = 0; k < 2; ++k) dN[a][k][l] = s.dN[a][k];
+    for (int a = 0; a < npe; ++a)
       for (int k = 0; k < 3; ++k) d2N[a][k][l] = s.d2N[a][k];
-    }
   }
   // evaluate_rest_point: tangents, second derivatives, normal, area element, dual basis.
   alignas(64) double a1[3][L] = {}, a2[3][L] = {}, a11[3][L] = {}, a22[3][L] = {}, a12[3][L] = {};

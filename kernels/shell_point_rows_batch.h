@@ -31,4 +31,9 @@ struct RestRowsBatch {
 void rest_strain_rows_batch(const ShapeValues* shapes, int count, const int* nodes, const double* X, int npe,
                             RestRowsBatch& out);
 
+// The area elements j0 = |a1 x a2| alone (rest_area_factor, shell_point.h) at the same
+// points, bitwise those of the one-point form: j0[0 .. count).
+void rest_area_factor_batch(const ShapeValues* shapes, int count, const int* nodes, const double* X, int npe,
+                            double* j0);
+
 }  // namespace dgtex::kernels::fast_rows

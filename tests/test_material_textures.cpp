@@ -14,6 +14,7 @@
 
 #include "dgtex/kernels/material_texture_kernel.h"
 #include "dgtex/kernels/shape_functions.h"
+#include "dgtex/kernels/shell_point.h"
 #include "dgtex/kernels/polar_decomposition.h"
 #include "dgtex/material_texture.h"
 #include "dgtex/png_io.h"
@@ -250,9 +251,10 @@ TEST(MaterialTextureKernel, ParallelEqualsSerialBitwise) {
   EXPECT_EQ(mw[0], mw[1]);
 }
 
-// The textured stiffness forms its points' rest rows several at a time
-// (shell_point_rows_batch.h): on a doubly curved element, for every number of points in a
-// batch, each lane's rows and area element are bitwise those of the one-point form.
+// The textured stiffness forms its points' rest rows several at a time, and the mass and
+// load weights their area elements (shell_point_rows_batch.h): on a doubly curved element,
+// for every number of points in a batch, each lane's rows and area element are bitwise
+// those of the one-point forms.
 TEST(MaterialTextureKernel, BatchedRestRowsAreBitwiseTheOnePointRows) {
   Mesh mesh = make_rectangle(1.0, 0.7, 1, 1, ElementType::quad8);
   for (int n = 0; n < mesh.num_nodes(); ++n) {
@@ -279,6 +281,11 @@ TEST(MaterialTextureKernel, BatchedRestRowsAreBitwiseTheOnePointRows) {
       EXPECT_EQ(differ, 0) << count << " points, lane " << l;
       EXPECT_NE(Bb[0][0], 0.0);  // curved: the bending rows are not trivially zero
     }
+    // The area elements alone (mass, load weights): the same bits again.
+    double j0[lanes];
+    kernels::fast_rows::rest_area_factor_batch(shapes, count, mesh.elements.data(), mesh.positions.data(), 8, j0);
+    for (int l = 0; l < count; ++l)
+      EXPECT_EQ(j0[l], kernels::rest_area_factor(shapes[l], mesh.elements.data(), mesh.positions.data()));
   }
 }
 
