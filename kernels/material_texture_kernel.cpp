@@ -81,10 +81,11 @@ inline void apply_plane_stress(double nu, double scale, const double in[3], doub
 
 // The corrective force of shell report eq. 48, B_R^T D B (X0 - R^T X0) times the weight w
 // (B the point's unrotated rows, B_R the rotated ones), in two halves around the rotation
-// of the rows: first the stresses D B (X0 - R^T X0) from the unrotated rows ...
-void corrective_stresses(const PointSectionBatch& b, const int* nodes, int npe, const double (*Bm)[9],
-                         const double (*Bb)[9], const double* R, double nu, double dn, double dm, double sm[3],
-                         double sb[3]) {
+// of the rows: first the stresses D B (X0 - R^T X0) from the unrotated rows (bm(a, i),
+// bb(a, i): entry i of node a's membrane and bending rows) ...
+template <class MembraneRow, class BendingRow>
+void corrective_stresses(const PointSectionBatch& b, const int* nodes, int npe, MembraneRow&& bm, BendingRow&& bb,
+                         const double* R, double nu, double dn, double dm, double sm[3], double sb[3]) {
   double strain_m[3] = {0, 0, 0}, strain_b[3] = {0, 0, 0};
   for (int a = 0; a < npe; ++a) {
     const double* x = b.positions + 3 * static_cast<long>(nodes[a]);
@@ -92,8 +93,8 @@ void corrective_stresses(const PointSectionBatch& b, const int* nodes, int npe, 
     for (int k = 0; k < 3; ++k) d[k] = x[k] - (R[0 * 3 + k] * x[0] + R[1 * 3 + k] * x[1] + R[2 * 3 + k] * x[2]);
     for (int r = 0; r < 3; ++r)
       for (int k = 0; k < 3; ++k) {
-        strain_m[r] += Bm[a][r * 3 + k] * d[k];
-        strain_b[r] += Bb[a][r * 3 + k] * d[k];
+        strain_m[r] += bm(a, r * 3 + k) * d[k];
+        strain_b[r] += bb(a, r * 3 + k) * d[k];
       }
   }
   apply_plane_stress(nu, dn, strain_m, sm);
@@ -119,26 +120,27 @@ struct PointRows {
   double nu, dn, dm, w;
 };
 
-// With p.Bm, p.Bb the rest rows and j0 the area element at point q: the section's
-// rigidities and weight, the corrective force, the rotation.
-void finish_point_rows(const PointSectionBatch& b, const int* nodes, int npe, std::int64_t q, double j0,
-                       const double* R, double* f, PointRows& p) {
+// The rigidities and weight of point q (j0: its area element).
+void set_section(const PointSectionBatch& b, std::int64_t q, double j0, PointRows& p) {
   const ShellSection& sec = b.sections[q];
   p.nu = sec.poisson_ratio;
   p.dn = membrane_rigidity(sec.youngs_modulus, p.nu, sec.thickness);
   p.dm = bending_rigidity(sec.youngs_modulus, p.nu, sec.thickness);
   p.w = b.points[3 * q + 2] * j0;
-  if (!R) return;
-  double sm[3] = {0, 0, 0}, sb[3] = {0, 0, 0};
-  if (f) corrective_stresses(b, nodes, npe, p.Bm, p.Bb, R, p.nu, p.dn, p.dm, sm, sb);
-  for (int a = 0; a < npe; ++a) rotate_rows(p.Bm[a], R), rotate_rows(p.Bb[a], R);
-  if (f) add_corrective_force(npe, p.Bm, p.Bb, sm, sb, p.w, f);
 }
 
+// One point at a time (the reference form): rows, section, corrective force, rotation.
 void point_rows(const PointSectionBatch& b, const int* nodes, int npe, std::int64_t q, const ShapeValues& s,
                 const double* R, double* f, PointRows& p) {
-  const double j0 = fast_rows::rest_strain_rows(s, nodes, b.positions, npe, p.Bm, p.Bb);
-  finish_point_rows(b, nodes, npe, q, j0, R, f, p);
+  set_section(b, q, fast_rows::rest_strain_rows(s, nodes, b.positions, npe, p.Bm, p.Bb), p);
+  if (!R) return;
+  double sm[3] = {0, 0, 0}, sb[3] = {0, 0, 0};
+  if (f)
+    corrective_stresses(
+        b, nodes, npe, [&](int a, int i) { return p.Bm[a][i]; }, [&](int a, int i) { return p.Bb[a][i]; }, R, p.nu,
+        p.dn, p.dm, sm, sb);
+  for (int a = 0; a < npe; ++a) rotate_rows(p.Bm[a], R), rotate_rows(p.Bb[a], R);
+  if (f) add_corrective_force(npe, p.Bm, p.Bb, sm, sb, p.w, f);
 }
 
 // The reference form: K_ab += w (Bm_a^T Dn Bm_b + Bb_a^T Dm Bb_b) point by point, block by
@@ -271,20 +273,29 @@ void gram_stiffness(const PointSectionBatch& batch, const double* rotations, con
             evaluate_shape(batch.type, batch.points[3 * (first + l)], batch.points[3 * (first + l) + 1], s[l]);
           fast_rows::RestRowsBatch rest;
           fast_rows::rest_strain_rows_batch(s, count, nodes, batch.positions, npe, rest);
-          for (int l = 0; l < count; ++l) {
-            const std::int64_t q = first + l;
-            double R[9];
-            const double* Rq = rotations ? rotations + 9 * q : nullptr;
+          // The same steps as point_rows, each over the batch's points.
+          PointRows p[lanes];
+          for (int l = 0; l < count; ++l) set_section(batch, first + l, rest.j0[l], p[l]);
+          const bool rotated = rotations || current;
+          double R[lanes][9], sm[lanes][3], sb[lanes][3];
+          for (int l = 0; rotated && l < count; ++l) {
             if (current) {
               double F[9];
               point_deformation_gradient(batch, nodes, s[l], current, F);
-              polar_rotation(F, R);
-              Rq = R;
+              polar_rotation(F, R[l]);
+            } else {
+              std::copy(rotations + 9 * (first + l), rotations + 9 * (first + l + 1), R[l]);
             }
-            PointRows p;
-            rest.lane(l, npe, p.Bm, p.Bb);
-            finish_point_rows(batch, nodes, npe, q, rest.j0[l], Rq, f, p);
-            push_gram_rows(p, npe, gram);
+            if (f)
+              corrective_stresses(
+                  batch, nodes, npe, [&](int a, int i) { return rest.Bm[a][i][l]; },
+                  [&](int a, int i) { return rest.Bb[a][i][l]; }, R[l], p[l].nu, p[l].dn, p[l].dm, sm[l], sb[l]);
+          }
+          if (rotated) fast_rows::rotate_rows_batch(R, count, npe, rest);
+          for (int l = 0; l < count; ++l) {
+            rest.lane(l, npe, p[l].Bm, p[l].Bb);
+            if (rotated && f) add_corrective_force(npe, p[l].Bm, p[l].Bb, sm[l], sb[l], p[l].w, f);
+            push_gram_rows(p[l], npe, gram);
           }
         }
         gram.flush();

@@ -33,6 +33,24 @@ inline void first_derivatives(const ShapeValues* shapes, int count, int npe, dou
 
 }  // namespace
 
+__attribute__((target_clones("avx512f", "avx2", "default"))) void rotate_rows_batch(const double (*R)[9],
+                                                                                     int count, int npe,
+                                                                                     RestRowsBatch& rows) {
+  alignas(64) double r_lanes[9][L];
+  for (int l = 0; l < L; ++l)
+    for (int i = 0; i < 9; ++i) r_lanes[i][l] = R[std::min(l, count - 1)][i];
+  for (int a = 0; a < npe; ++a)
+    for (double(*B)[L] : {rows.Bm[a], rows.Bb[a]}) {
+      alignas(64) double out[9][L];
+      for (int r = 0; r < 3; ++r)
+        for (int c = 0; c < 3; ++c)
+          for (int l = 0; l < L; ++l)
+            out[r * 3 + c][l] = B[r * 3 + 0][l] * r_lanes[c * 3 + 0][l] + B[r * 3 + 1][l] * r_lanes[c * 3 + 1][l] +
+                                B[r * 3 + 2][l] * r_lanes[c * 3 + 2][l];
+      std::copy(&out[0][0], &out[0][0] + 9 * L, &B[0][0]);
+    }
+}
+
 __attribute__((target_clones("avx512f", "avx2", "default"))) void rest_area_factor_batch(
     const ShapeValues* shapes, int count, const int* nodes, const double* X, int npe, double* j0) {
   alignas(64) double dN[max_element_nodes][2][L];

@@ -31,6 +31,11 @@ struct RestRowsBatch {
 void rest_strain_rows_batch(const ShapeValues* shapes, int count, const int* nodes, const double* X, int npe,
                             RestRowsBatch& out);
 
+// Rotates every lane's rows in place, B <- B R_l^T (rotate_rows, dgtex/kernels/vec3.h),
+// R[l] lane l's rotation (row-major, l < count), bitwise as rotate_rows: the strain rows
+// of corotated points.
+void rotate_rows_batch(const double (*R)[9], int count, int npe, RestRowsBatch& rows);
+
 // The area elements j0 = |a1 x a2| alone (rest_area_factor, shell_point.h) at the same
 // points, bitwise those of the one-point form: j0[0 .. count).
 void rest_area_factor_batch(const ShapeValues* shapes, int count, const int* nodes, const double* X, int npe,

@@ -15,6 +15,7 @@
 #include "dgtex/kernels/material_texture_kernel.h"
 #include "dgtex/kernels/shape_functions.h"
 #include "dgtex/kernels/shell_point.h"
+#include "dgtex/kernels/vec3.h"
 #include "dgtex/kernels/polar_decomposition.h"
 #include "dgtex/material_texture.h"
 #include "dgtex/png_io.h"
@@ -253,8 +254,8 @@ TEST(MaterialTextureKernel, ParallelEqualsSerialBitwise) {
 
 // The textured stiffness forms its points' rest rows several at a time, and the mass and
 // load weights their area elements (shell_point_rows_batch.h): on a doubly curved element,
-// for every number of points in a batch, each lane's rows and area element are bitwise
-// those of the one-point forms.
+// for every number of points in a batch, each lane's rows (also rotated, as corotated points
+// take them) and area element are bitwise those of the one-point forms.
 TEST(MaterialTextureKernel, BatchedRestRowsAreBitwiseTheOnePointRows) {
   Mesh mesh = make_rectangle(1.0, 0.7, 1, 1, ElementType::quad8);
   for (int n = 0; n < mesh.num_nodes(); ++n) {
@@ -280,6 +281,26 @@ TEST(MaterialTextureKernel, BatchedRestRowsAreBitwiseTheOnePointRows) {
         for (int r = 0; r < 9; ++r) differ += Bm[a][r] != batched_Bm[a][r] || Bb[a][r] != batched_Bb[a][r];
       EXPECT_EQ(differ, 0) << count << " points, lane " << l;
       EXPECT_NE(Bb[0][0], 0.0);  // curved: the bending rows are not trivially zero
+    }
+    // Rotated (corotated points): each lane by its own rotation, as rotate_rows.
+    double R[lanes][9];
+    for (int l = 0; l < count; ++l) {
+      const double angle = 0.3 + 0.2 * l, c = std::cos(angle), s = std::sin(angle);
+      const double rotation[9] = {c, -s, 0, s * 0.6, c * 0.6, -0.8, s * 0.8, c * 0.8, 0.6};
+      std::copy(rotation, rotation + 9, R[l]);
+    }
+    kernels::fast_rows::rotate_rows_batch(R, count, 8, batch);
+    for (int l = 0; l < count; ++l) {
+      double Bm[8][9], Bb[8][9], rotated_Bm[8][9], rotated_Bb[8][9];
+      kernels::fast_rows::rest_strain_rows(shapes[l], mesh.elements.data(), mesh.positions.data(), 8, Bm, Bb);
+      batch.lane(l, 8, rotated_Bm, rotated_Bb);
+      int differ = 0;
+      for (int a = 0; a < 8; ++a) {
+        kernels::rotate_rows(Bm[a], R[l]);
+        kernels::rotate_rows(Bb[a], R[l]);
+        for (int r = 0; r < 9; ++r) differ += Bm[a][r] != rotated_Bm[a][r] || Bb[a][r] != rotated_Bb[a][r];
+      }
+      EXPECT_EQ(differ, 0) << count << " points, lane " << l << ", rotated";
     }
     // The area elements alone (mass, load weights): the same bits again.
     double j0[lanes];
