@@ -112,9 +112,8 @@ void add_corrective_force(int npe, const double (*Rm)[9], const double (*Rb)[9],
     }
 }
 
-// Point q's strain rows (s: its shape values), rotated by R (when given), with the
-// rigidities of its section: the shared first half of both stiffness forms; adds the
-// corrective force to f (when both R and f are given).
+// A point's strain rows (rotated, for a corotated point) with the rigidities and weight of
+// its section: what both stiffness forms sum.
 struct PointRows {
   double Bm[max_element_nodes][9], Bb[max_element_nodes][9];
   double nu, dn, dm, w;
@@ -129,7 +128,8 @@ void set_section(const PointSectionBatch& b, std::int64_t q, double j0, PointRow
   p.w = b.points[3 * q + 2] * j0;
 }
 
-// One point at a time (the reference form): rows, section, corrective force, rotation.
+// Point q's PointRows (s: its shape values), rotated by R when given, one point at a time
+// (the reference form); adds the corrective force to f (when both R and f are given).
 void point_rows(const PointSectionBatch& b, const int* nodes, int npe, std::int64_t q, const ShapeValues& s,
                 const double* R, double* f, PointRows& p) {
   set_section(b, q, fast_rows::rest_strain_rows(s, nodes, b.positions, npe, p.Bm, p.Bb), p);
@@ -213,6 +213,15 @@ void push_gram_rows(const PointRows& p, int npe, GramAccumulator& gram) {
   }
 }
 
+// The shape values of points first .. min(first + kRestRowLanes, end) - 1 (a batch of the
+// *_batch forms of shell_point_rows_batch.h); returns their count.
+int batch_shapes(const PointSectionBatch& b, std::int64_t first, std::int64_t end, ShapeValues* s) {
+  const int count = static_cast<int>(std::min<std::int64_t>(fast_rows::kRestRowLanes, end - first));
+  for (int l = 0; l < count; ++l)
+    evaluate_shape(b.type, b.points[3 * (first + l)], b.points[3 * (first + l) + 1], s[l]);
+  return count;
+}
+
 // The surface deformation gradient at a point (s: its shape values) between the rest and
 // current positions.
 void point_deformation_gradient(const PointSectionBatch& b, const int* nodes, const ShapeValues& s,
@@ -267,10 +276,8 @@ void gram_stiffness(const PointSectionBatch& batch, const double* rotations, con
         GramAccumulator gram(n, 6 * std::max<std::int64_t>(1, q1 - q0));
         constexpr int lanes = fast_rows::kRestRowLanes;
         for (std::int64_t first = q0; first < q1; first += lanes) {
-          const int count = static_cast<int>(std::min<std::int64_t>(lanes, q1 - first));
           ShapeValues s[lanes];
-          for (int l = 0; l < count; ++l)
-            evaluate_shape(batch.type, batch.points[3 * (first + l)], batch.points[3 * (first + l) + 1], s[l]);
+          const int count = batch_shapes(batch, first, q1, s);
           fast_rows::RestRowsBatch rest;
           fast_rows::rest_strain_rows_batch(s, count, nodes, batch.positions, npe, rest);
           // The same steps as point_rows, each over the batch's points.
@@ -333,10 +340,8 @@ void for_each_point_area(const PointSectionBatch& b, std::int64_t e, Visit&& vis
   const int* nodes = b.connectivity + e * npe;
   constexpr int lanes = fast_rows::kRestRowLanes;
   for (std::int64_t first = b.start[e]; first < b.start[e + 1]; first += lanes) {
-    const int count = static_cast<int>(std::min<std::int64_t>(lanes, b.start[e + 1] - first));
     ShapeValues s[lanes];
-    for (int l = 0; l < count; ++l)
-      evaluate_shape(b.type, b.points[3 * (first + l)], b.points[3 * (first + l) + 1], s[l]);
+    const int count = batch_shapes(b, first, b.start[e + 1], s);
     double j0[lanes];
     fast_rows::rest_area_factor_batch(s, count, nodes, b.positions, npe, j0);
     for (int l = 0; l < count; ++l) visit(first + l, s[l], j0[l]);

@@ -31,6 +31,24 @@ inline void first_derivatives(const ShapeValues* shapes, int count, int npe, dou
   }
 }
 
+// rest_tangents: a1, a2 (zeroed here) and the normal n = a1 x a2, and j0 = |n|.
+inline void tangents_and_area(const double (*dN)[2][L], const int* nodes, const double* X, int npe, Lanes* a1,
+                              Lanes* a2, Lanes* n, Lanes& j0) {
+  for (int d = 0; d < 3; ++d)
+    for (int l = 0; l < L; ++l) a1[d][l] = a2[d][l] = 0;
+  for (int a = 0; a < npe; ++a) {
+    const double* x = X + 3 * static_cast<long>(nodes[a]);
+    for (int d = 0; d < 3; ++d)
+      for (int l = 0; l < L; ++l) {
+        a1[d][l] += dN[a][0][l] * x[d];
+        a2[d][l] += dN[a][1][l] * x[d];
+      }
+  }
+  cross(a1, a2, n);
+  dot(n, n, j0);
+  for (int l = 0; l < L; ++l) j0[l] = std::sqrt(j0[l]);
+}
+
 }  // namespace
 
 __attribute__((target_clones("avx512f", "avx2", "default"))) void rotate_rows_batch(const double (*R)[9],
@@ -55,18 +73,8 @@ __attribute__((target_clones("avx512f", "avx2", "default"))) void rest_area_fact
     const ShapeValues* shapes, int count, const int* nodes, const double* X, int npe, double* j0) {
   alignas(64) double dN[max_element_nodes][2][L];
   first_derivatives(shapes, count, npe, dN);
-  alignas(64) double a1[3][L] = {}, a2[3][L] = {}, n[3][L], area[L];
-  for (int a = 0; a < npe; ++a) {
-    const double* x = X + 3 * static_cast<long>(nodes[a]);
-    for (int d = 0; d < 3; ++d)
-      for (int l = 0; l < L; ++l) {
-        a1[d][l] += dN[a][0][l] * x[d];
-        a2[d][l] += dN[a][1][l] * x[d];
-      }
-  }
-  cross(a1, a2, n);
-  dot(n, n, area);
-  for (int l = 0; l < L; ++l) area[l] = std::sqrt(area[l]);
+  alignas(64) double a1[3][L], a2[3][L], n[3][L], area[L];
+  tangents_and_area(dN, nodes, X, npe, a1, a2, n, area);
   std::copy(area, area + count, j0);
 }
 
@@ -79,23 +87,20 @@ __attribute__((target_clones("avx512f", "avx2", "default"))) void rest_strain_ro
     for (int a = 0; a < npe; ++a)
       for (int k = 0; k < 3; ++k) d2N[a][k][l] = s.d2N[a][k];
   }
-  // evaluate_rest_point: tangents, second derivatives, normal, area element, dual basis.
-  alignas(64) double a1[3][L] = {}, a2[3][L] = {}, a11[3][L] = {}, a22[3][L] = {}, a12[3][L] = {};
+  // evaluate_rest_point: tangents, normal, area element, second derivatives, dual basis.
+  alignas(64) double a1[3][L], a2[3][L], n[3][L], j0[L];
+  tangents_and_area(dN, nodes, X, npe, a1, a2, n, j0);
+  alignas(64) double a11[3][L] = {}, a22[3][L] = {}, a12[3][L] = {};
   for (int a = 0; a < npe; ++a) {
     const double* x = X + 3 * static_cast<long>(nodes[a]);
     for (int d = 0; d < 3; ++d)
       for (int l = 0; l < L; ++l) {
-        a1[d][l] += dN[a][0][l] * x[d];
-        a2[d][l] += dN[a][1][l] * x[d];
         a11[d][l] += d2N[a][0][l] * x[d];
         a22[d][l] += d2N[a][1][l] * x[d];
         a12[d][l] += d2N[a][2][l] * x[d];
       }
   }
-  alignas(64) double n[3][L], t0[3][L], dual1[3][L], dual2[3][L], j0[L];
-  cross(a1, a2, n);
-  dot(n, n, j0);
-  for (int l = 0; l < L; ++l) j0[l] = std::sqrt(j0[l]);
+  alignas(64) double t0[3][L], dual1[3][L], dual2[3][L];
   for (int d = 0; d < 3; ++d)
     for (int l = 0; l < L; ++l) t0[d][l] = n[d][l] / j0[l];
   cross(a2, t0, dual1);

@@ -29,8 +29,9 @@ struct GraphAmgStats {
 
 // Solves a x = b from x's values to ||b - a x|| <= tolerance * ||b||. a: symmetric positive
 // definite with non-positive off-diagonal entries (a graph Laplacian whose every component
-// touches Dirichlet data), every row with its diagonal entry. Throws std::runtime_error
-// when max_iterations do not reach the tolerance.
+// touches Dirichlet data), every row with its diagonal entry, compressed
+// (std::invalid_argument otherwise). Throws std::runtime_error when max_iterations do not
+// reach the tolerance or a coarse level does not factor.
 GraphAmgStats solve_graph_laplacian_amg(const SparseRows& a, const Eigen::VectorXd& b, Eigen::VectorXd& x,
                                         double tolerance, int max_iterations);
 

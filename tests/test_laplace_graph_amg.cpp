@@ -3,7 +3,7 @@
 // and Dirichlet data in few iterations, agrees with a sparse Cholesky solve, keeps its
 // iteration count as the graph grows, solves a graph on which aggregation stalls (the
 // coarsest level factored sparse), starts from the caller's guess, and reports failure
-// instead of returning an unconverged answer.
+// instead of returning an unconverged answer (and refuses a matrix it cannot read).
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -111,6 +111,13 @@ TEST(GraphLaplacianAmg, ReportsAToleranceItCannotReach) {
   const System s = slit_grid(60);
   Eigen::VectorXd x = Eigen::VectorXd::Zero(s.b.size());
   EXPECT_THROW(detail::solve_graph_laplacian_amg(s.a, s.b, x, 1e-14, 2), std::runtime_error);
+}
+
+TEST(GraphLaplacianAmg, RefusesAnUncompressedMatrix) {
+  System s = slit_grid(30);
+  s.a.uncompress();
+  Eigen::VectorXd x = Eigen::VectorXd::Zero(s.b.size());
+  EXPECT_THROW(detail::solve_graph_laplacian_amg(s.a, s.b, x, 1e-6, 100), std::invalid_argument);
 }
 
 TEST(GraphLaplacianAmg, ZeroRightSideGivesZero) {
