@@ -284,15 +284,11 @@ void gram_stiffness(const PointSectionBatch& batch, const double* rotations, con
           PointRows p[lanes];
           for (int l = 0; l < count; ++l) set_section(batch, first + l, rest.j0[l], p[l]);
           const bool rotated = rotations || current;
-          double R[lanes][9], sm[lanes][3], sb[lanes][3];
+          double R[lanes][9], sm[lanes][3], sb[lanes][3], F[lanes][9];
+          if (current) fast_rows::deformation_gradient_batch(s, count, nodes, batch.positions, current, npe, F);
           for (int l = 0; rotated && l < count; ++l) {
-            if (current) {
-              double F[9];
-              point_deformation_gradient(batch, nodes, s[l], current, F);
-              polar_rotation(F, R[l]);
-            } else {
-              std::copy(rotations + 9 * (first + l), rotations + 9 * (first + l + 1), R[l]);
-            }
+            if (current) polar_rotation(F[l], R[l]);
+            else std::copy(rotations + 9 * (first + l), rotations + 9 * (first + l + 1), R[l]);
             if (f)
               corrective_stresses(
                   batch, nodes, npe, [&](int a, int i) { return rest.Bm[a][i][l]; },

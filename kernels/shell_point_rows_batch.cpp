@@ -69,6 +69,26 @@ __attribute__((target_clones("avx512f", "avx2", "default"))) void rotate_rows_ba
     }
 }
 
+__attribute__((target_clones("avx512f", "avx2", "default"))) void deformation_gradient_batch(
+    const ShapeValues* shapes, int count, const int* nodes, const double* X, const double* current, int npe,
+    double (*F)[9]) {
+  alignas(64) double dN[max_element_nodes][2][L];
+  first_derivatives(shapes, count, npe, dN);
+  // evaluate_surface_frame at rest (A1, A2, T0) and now (a1, a2, t).
+  alignas(64) double A1[3][L], A2[3][L], N0[3][L], J0[L], a1[3][L], a2[3][L], n[3][L], j[L];
+  tangents_and_area(dN, nodes, X, npe, A1, A2, N0, J0);
+  tangents_and_area(dN, nodes, current, npe, a1, a2, n, j);
+  for (int d = 0; d < 3; ++d)
+    for (int l = 0; l < L; ++l) N0[d][l] /= J0[l], n[d][l] /= j[l];
+  for (int l = 0; l < count; ++l) {
+    const double rest_a1[3] = {A1[0][l], A1[1][l], A1[2][l]}, rest_a2[3] = {A2[0][l], A2[1][l], A2[2][l]};
+    const double rest_t[3] = {N0[0][l], N0[1][l], N0[2][l]};
+    const double now_a1[3] = {a1[0][l], a1[1][l], a1[2][l]}, now_a2[3] = {a2[0][l], a2[1][l], a2[2][l]};
+    const double now_t[3] = {n[0][l], n[1][l], n[2][l]};
+    surface_deformation_gradient(rest_a1, rest_a2, rest_t, now_a1, now_a2, now_t, F[l]);
+  }
+}
+
 __attribute__((target_clones("avx512f", "avx2", "default"))) void rest_area_factor_batch(
     const ShapeValues* shapes, int count, const int* nodes, const double* X, int npe, double* j0) {
   alignas(64) double dN[max_element_nodes][2][L];

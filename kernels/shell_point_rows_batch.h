@@ -7,6 +7,7 @@
 // the rows are bitwise those of the one-point form. Why: the per-point geometry was ~60 % of
 // a textured element's assembly (session 42's profile), scalar and latency-bound.
 #include "dgtex/kernels/shape_functions.h"
+#include "dgtex/kernels/vec3.h"
 
 namespace dgtex::kernels::fast_rows {
 
@@ -35,6 +36,12 @@ void rest_strain_rows_batch(const ShapeValues* shapes, int count, const int* nod
 // R[l] lane l's rotation (row-major, l < count), bitwise as rotate_rows: the strain rows
 // of corotated points.
 void rotate_rows_batch(const double (*R)[9], int count, int npe, RestRowsBatch& rows);
+
+// The surface deformation gradients F[0 .. count) (row-major) between the rest positions X
+// and the current ones at the same points, bitwise the one-point form
+// (evaluate_surface_frame at rest and now, surface_deformation_gradient).
+void deformation_gradient_batch(const ShapeValues* shapes, int count, const int* nodes, const double* X,
+                                const double* current, int npe, double (*F)[9]);
 
 // The area elements j0 = |a1 x a2| alone (rest_area_factor, shell_point.h) at the same
 // points, bitwise those of the one-point form: j0[0 .. count).

@@ -255,7 +255,7 @@ TEST(MaterialTextureKernel, ParallelEqualsSerialBitwise) {
 // The textured stiffness forms its points' rest rows several at a time, and the mass and
 // load weights their area elements (shell_point_rows_batch.h): on a doubly curved element,
 // for every number of points in a batch, each lane's rows (also rotated, as corotated points
-// take them) and area element are bitwise those of the one-point forms.
+// take them), deformation gradient and area element are bitwise those of the one-point forms.
 TEST(MaterialTextureKernel, BatchedRestRowsAreBitwiseTheOnePointRows) {
   Mesh mesh = make_rectangle(1.0, 0.7, 1, 1, ElementType::quad8);
   for (int n = 0; n < mesh.num_nodes(); ++n) {
@@ -301,6 +301,23 @@ TEST(MaterialTextureKernel, BatchedRestRowsAreBitwiseTheOnePointRows) {
         for (int r = 0; r < 9; ++r) differ += Bm[a][r] != rotated_Bm[a][r] || Bb[a][r] != rotated_Bb[a][r];
       }
       EXPECT_EQ(differ, 0) << count << " points, lane " << l << ", rotated";
+    }
+    // The deformation gradients of corotated points (a stretched, sheared, lifted state).
+    std::vector<double> current = mesh.positions;
+    for (int k = 0; k < mesh.num_nodes(); ++k) {
+      const double x = mesh.positions[3 * k], y = mesh.positions[3 * k + 1];
+      current[3 * k] = 0.8 * x - 0.3 * y, current[3 * k + 1] = 0.3 * x + 0.9 * y, current[3 * k + 2] += 0.1 * x * y;
+    }
+    double F[lanes][9];
+    kernels::fast_rows::deformation_gradient_batch(shapes, count, mesh.elements.data(), mesh.positions.data(),
+                                                   current.data(), 8, F);
+    for (int l = 0; l < count; ++l) {
+      kernels::fast_rows::SurfaceFrame rest, now;
+      kernels::fast_rows::evaluate_surface_frame(shapes[l], mesh.elements.data(), mesh.positions.data(), rest);
+      kernels::fast_rows::evaluate_surface_frame(shapes[l], mesh.elements.data(), current.data(), now);
+      double one_point[9];
+      kernels::surface_deformation_gradient(rest.a1, rest.a2, rest.t0, now.a1, now.a2, now.t0, one_point);
+      for (int i = 0; i < 9; ++i) EXPECT_EQ(F[l][i], one_point[i]) << count << " points, lane " << l << ", F";
     }
     // The area elements alone (mass, load weights): the same bits again.
     double j0[lanes];
