@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "dgtex/kernels/vec3.h"
+
 namespace dgtex::kernels::fast_rows {
 namespace {
 

@@ -1,13 +1,14 @@
 #pragma once
-// Private to the material-texture stiffness (material_texture_kernel.cpp): the rest strain
-// rows of fast_rows::rest_strain_rows (shell_point_rows.h) for up to kRestRowLanes points
-// of one element at once. Every quantity is held across the points (one lane each), so the
-// arithmetic vectorises across points (target_clones: AVX-512, AVX2, baseline); each lane
-// takes the operations of rest_strain_rows in the same order, so with FMA contraction off
-// the rows are bitwise those of the one-point form. Why: the per-point geometry was ~60 % of
-// a textured element's assembly (session 42's profile), scalar and latency-bound.
+// Private to the material-texture kernels (material_texture_kernel.cpp): the per-point
+// geometry of up to kRestRowLanes points of one element at once: the rest strain rows of
+// fast_rows::rest_strain_rows (shell_point_rows.h), their rotation for corotated points, the
+// surface deformation gradients and the area elements. Every quantity is held across the
+// points (one lane each), so the arithmetic vectorises across points (target_clones:
+// AVX-512, AVX2, baseline); each lane takes the operations of the one-point form in the
+// same order, so with FMA contraction off the results are bitwise those. Why: the per-point
+// geometry was ~60 % of a textured element's assembly (session 42's profile), scalar and
+// latency-bound.
 #include "dgtex/kernels/shape_functions.h"
-#include "dgtex/kernels/vec3.h"
 
 namespace dgtex::kernels::fast_rows {
 
