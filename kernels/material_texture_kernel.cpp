@@ -9,6 +9,7 @@
 #include "dgtex/kernels/polar_decomposition.h"
 #include "dgtex/kernels/shell_point.h"
 #include "dgtex/kernels/vec3.h"
+#include "plane_stress.h"
 #include "shell_point_rows.h"
 #include "shell_point_rows_batch.h"
 
@@ -73,16 +74,11 @@ void emit_cells(const MaterialTextureView& t, const ShellSection& base, double r
   });
 }
 
-inline void apply_plane_stress(double nu, double scale, const double in[3], double out[3]) {
-  out[0] = scale * (in[0] + nu * in[1]);
-  out[1] = scale * (nu * in[0] + in[1]);
-  out[2] = scale * 0.5 * (1 - nu) * in[2];
-}
-
 // The corrective force of shell report eq. 48, B_R^T D B (X0 - R^T X0) times the weight w
 // (B the point's unrotated rows, B_R the rotated ones), in two halves around the rotation
 // of the rows: first the stresses D B (X0 - R^T X0) from the unrotated rows (bm(a, i),
-// bb(a, i): entry i of node a's membrane and bending rows) ...
+// bb(a, i): entry i of node a's membrane and bending rows); add_corrective_force
+// (plane_stress.h) then adds w B_R^T times them.
 template <class MembraneRow, class BendingRow>
 void corrective_stresses(const PointSectionBatch& b, const int* nodes, int npe, MembraneRow&& bm, BendingRow&& bb,
                          const double* R, double nu, double dn, double dm, double sm[3], double sb[3]) {
@@ -99,17 +95,6 @@ void corrective_stresses(const PointSectionBatch& b, const int* nodes, int npe, 
   }
   apply_plane_stress(nu, dn, strain_m, sm);
   apply_plane_stress(nu, dm, strain_b, sb);
-}
-
-// ... then w B_R^T times them, added to f.
-void add_corrective_force(int npe, const double (*Rm)[9], const double (*Rb)[9], const double sm[3],
-                          const double sb[3], double w, double* f) {
-  for (int a = 0; a < npe; ++a)
-    for (int i = 0; i < 3; ++i) {
-      double v = 0;
-      for (int r = 0; r < 3; ++r) v += Rm[a][r * 3 + i] * sm[r] + Rb[a][r * 3 + i] * sb[r];
-      f[a * 3 + i] += w * v;
-    }
 }
 
 // A point's strain rows (rotated, for a corotated point) with the rigidities and weight of

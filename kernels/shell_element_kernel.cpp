@@ -4,18 +4,12 @@
 
 #include "dgtex/kernels/shell_point.h"
 #include "dgtex/kernels/vec3.h"
+#include "plane_stress.h"
 #include "shell_point_rows.h"
 
 namespace dgtex::kernels {
 namespace {
 
-
-// C = [[1, nu, 0], [nu, 1, 0], [0, 0, (1-nu)/2]] times scale, applied to a Voigt vector.
-inline void apply_plane_stress(double nu, double scale, const double in[3], double out[3]) {
-  out[0] = scale * (in[0] + nu * in[1]);
-  out[1] = scale * (nu * in[0] + in[1]);
-  out[2] = scale * 0.5 * (1 - nu) * in[2];
-}
 
 // Most quadrature points of any element rule (quad8: 3x3 Gauss, tri6: 7 points).
 constexpr int max_element_points = 9;
@@ -135,12 +129,7 @@ void element_stiffness(const ElementBatch& b, const ElementRuleShapes& shapes, s
       double sm[3], sb[3];
       apply_plane_stress(nu, dn, strain_m, sm);
       apply_plane_stress(nu, dm, strain_b, sb);
-      for (int a = 0; a < npe; ++a)
-        for (int i = 0; i < 3; ++i) {
-          double v = 0;
-          for (int r = 0; r < 3; ++r) v += Bm[a][r * 3 + i] * sm[r] + Bb[a][r * 3 + i] * sb[r];
-          f[a * 3 + i] += w * v;
-        }
+      add_corrective_force(npe, Bm, Bb, sm, sb, w, f);
     }
   }
 
