@@ -36,6 +36,11 @@ std::int64_t file_number(const char* path) {
   return value;
 }
 
+// The bound's bytes a texel of a cut's region: its Laplace solves decide it.
+std::int64_t cut_bytes_per_texel(const TexelFields& fields) {
+  return fields.graph_solves ? kGraphSolveBytesPerTexel : kFieldBytesPerTexel;
+}
+
 std::string count_of(int n, const std::string& noun) { return std::to_string(n) + " " + noun + (n == 1 ? "" : "s"); }
 
 // DGTEX_MEMORY_LIMIT_MB as bytes; -1 when unset or empty. Throws std::invalid_argument for
@@ -56,8 +61,8 @@ std::int64_t memory_limit_from_environment() {
 
 std::int64_t texel_memory_lower_bound(const TexelFields& fields) {
   const std::int64_t per_tile = active_texels_per_tile(fields.type, fields.resolution);
-  const std::int64_t cut_bytes = fields.graph_solves ? kGraphSolveBytesPerTexel : kFieldBytesPerTexel;
-  return per_tile * (fields.cuts.region_elements * cut_bytes + fields.creases.region_elements * kFieldBytesPerTexel);
+  return per_tile * (fields.cuts.region_elements * cut_bytes_per_texel(fields) +
+                     fields.creases.region_elements * kFieldBytesPerTexel);
 }
 
 std::string memory_size_text(std::int64_t bytes) {
@@ -102,7 +107,7 @@ void check_texel_memory(const TexelFields& fields, std::int64_t available_bytes,
   std::string what;
   if (fields.cuts.fields > 0)
     what = count_of(fields.cuts.fields, "cut segment") + " (" + std::to_string(fields.cuts.region_elements) +
-           " element regions, " + std::to_string(fields.graph_solves ? kGraphSolveBytesPerTexel : kFieldBytesPerTexel) +
+           " element regions, " + std::to_string(cut_bytes_per_texel(fields)) +
            " bytes a texel with " + (fields.graph_solves ? "texel-graph" : "tile multigrid") + " Laplace solves)";
   if (fields.creases.fields > 0)
     what += (what.empty() ? "" : " and ") + count_of(fields.creases.fields, "crease") + " (" +
