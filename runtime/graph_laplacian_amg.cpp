@@ -186,9 +186,41 @@ Rows smoothed_interpolation(const Rows& a, const std::vector<double>& diagonal, 
   return p;
 }
 
+// A's strictly lower and strictly upper parts, each row's columns in A's order (increasing
+// on the finest level, the texel graph's): the Gauss-Seidel sweeps sum the terms of values
+// already final first and those updated in the sweep last, so that on the finest level one
+// neighbour's update waits on two operations instead of on the whole row's sum.
+struct Triangles {
+  Rows lower, upper;
+};
+
+Triangles triangles_of(const Rows& a) {
+  Triangles t;
+  for (Rows* part : {&t.lower, &t.upper}) {
+    part->rows = a.rows, part->columns_count = a.columns_count;
+    part->offsets.assign(a.rows + 1, 0);
+  }
+  for (int i = 0; i < a.rows; ++i) {
+    int below = 0, above = 0;
+    for (int e = a.offsets[i]; e < a.offsets[i + 1]; ++e) (a.columns[e] < i ? below : above) += a.columns[e] != i;
+    t.lower.offsets[i + 1] = t.lower.offsets[i] + below, t.upper.offsets[i + 1] = t.upper.offsets[i] + above;
+  }
+  for (Rows* part : {&t.lower, &t.upper}) part->columns.resize(part->offsets.back()), part->values.resize(part->offsets.back());
+  for (int i = 0; i < a.rows; ++i) {
+    int below = t.lower.offsets[i], above = t.upper.offsets[i];
+    for (int e = a.offsets[i]; e < a.offsets[i + 1]; ++e) {
+      const int j = a.columns[e];
+      if (j < i) t.lower.columns[below] = j, t.lower.values[below++] = a.values[e];
+      if (j > i) t.upper.columns[above] = j, t.upper.values[above++] = a.values[e];
+    }
+  }
+  return t;
+}
+
 struct Level {
   Rows a;
   std::vector<double> diagonal, inverse_diagonal;
+  Triangles triangles;  // the smoother's copy of A's off-diagonal part (not on the coarsest)
   Rows p, r;  // interpolation from the next coarser level and its transpose (not on the coarsest)
   std::vector<double> x, b, residual;
 };
@@ -211,6 +243,7 @@ class Hierarchy {
       levels_.back().a = std::move(coarse);
       levels_.back().diagonal = diagonal_of(levels_.back().a);
     }
+    for (std::size_t l = 0; l + 1 < levels_.size(); ++l) levels_[l].triangles = triangles_of(levels_[l].a);
     for (Level& level : levels_) {
       level.inverse_diagonal.resize(level.a.rows);
       for (int i = 0; i < level.a.rows; ++i) level.inverse_diagonal[i] = 1.0 / level.diagonal[i];
@@ -253,26 +286,43 @@ class Hierarchy {
       x = level.a.rows <= kDenseCoarsestNodes ? Eigen::VectorXd(dense_.solve(b)) : Eigen::VectorXd(sparse_.solve(b));
       return;
     }
-    std::fill(level.x.begin(), level.x.end(), 0.0);
-    sweep(level, true);
-    multiply(level.a, level.x, level.residual);
-    for (int i = 0; i < level.a.rows; ++i) level.residual[i] = level.b[i] - level.residual[i];
+    forward_sweep_from_zero(level);
+    // After a forward sweep from zero, b - A x is minus the upper part times x: each row's
+    // lower part and diagonal were met exactly by the sweep.
+    const Rows& upper = level.triangles.upper;
+    for (int i = 0; i < level.a.rows; ++i) {
+      double s = 0;
+      for (int e = upper.offsets[i]; e < upper.offsets[i + 1]; ++e) s -= upper.values[e] * level.x[upper.columns[e]];
+      level.residual[i] = s;
+    }
     Level& coarse = levels_[l + 1];
     multiply(level.r, level.residual, coarse.b);
     cycle(l + 1);
     for (int i = 0; i < level.a.rows; ++i)
       for (int e = level.p.offsets[i]; e < level.p.offsets[i + 1]; ++e)
         level.x[i] += level.p.values[e] * coarse.x[level.p.columns[e]];
-    sweep(level, false);
+    backward_sweep(level);
   }
 
-  // One Gauss-Seidel sweep, rows in increasing (forward) or decreasing order.
-  static void sweep(Level& level, bool forward) {
-    const Rows& a = level.a;
-    for (int k = 0; k < a.rows; ++k) {
-      const int i = forward ? k : a.rows - 1 - k;
-      double s = level.b[i] + level.diagonal[i] * level.x[i];  // the loop subtracts the diagonal too
-      for (int e = a.offsets[i]; e < a.offsets[i + 1]; ++e) s -= a.values[e] * level.x[a.columns[e]];
+  // Forward Gauss-Seidel from x = 0: the upper part multiplies zeros.
+  static void forward_sweep_from_zero(Level& level) {
+    const Rows& lower = level.triangles.lower;
+    for (int i = 0; i < lower.rows; ++i) {
+      double s = level.b[i];
+      for (int e = lower.offsets[i]; e < lower.offsets[i + 1]; ++e) s -= lower.values[e] * level.x[lower.columns[e]];
+      level.x[i] = s * level.inverse_diagonal[i];
+    }
+  }
+
+  // Backward Gauss-Seidel: the lower part (values of the previous iterate) first, then the
+  // upper part from its farthest column to the row just below, updated last.
+  static void backward_sweep(Level& level) {
+    const Rows& lower = level.triangles.lower;
+    const Rows& upper = level.triangles.upper;
+    for (int i = lower.rows - 1; i >= 0; --i) {
+      double s = level.b[i];
+      for (int e = lower.offsets[i]; e < lower.offsets[i + 1]; ++e) s -= lower.values[e] * level.x[lower.columns[e]];
+      for (int e = upper.offsets[i + 1] - 1; e >= upper.offsets[i]; --e) s -= upper.values[e] * level.x[upper.columns[e]];
       level.x[i] = s * level.inverse_diagonal[i];
     }
   }
