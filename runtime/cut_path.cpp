@@ -32,6 +32,26 @@ Vec3 lerp(const Vec3& a, const Vec3& b, double s) {
 
 int corners(const Mesh& mesh) { return kernels::corners_per_element(mesh.type); }
 
+Vec3 cross_product(const Vec3& a, const Vec3& b) {
+  return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
+}
+
+// The surface point of `element` at xi and its tangents d/dxi1, d/dxi2.
+void surface_frame(const Mesh& mesh, int element, const double xi[2], Vec3& position, Vec3& d1, Vec3& d2) {
+  kernels::ShapeValues s;
+  kernels::evaluate_shape(mesh.type, xi[0], xi[1], s);
+  position = d1 = d2 = {0, 0, 0};
+  const int* nodes = mesh.element_nodes(element);
+  for (int a = 0; a < s.count; ++a) {
+    const double* x = mesh.node(nodes[a]);
+    for (int c = 0; c < 3; ++c) {
+      position[c] += s.N[a] * x[c];
+      d1[c] += s.dN[a][0] * x[c];
+      d2[c] += s.dN[a][1] * x[c];
+    }
+  }
+}
+
 CutPathVertex vertex_at(const Mesh& mesh, int element, double xi1, double xi2) {
   CutPathVertex v;
   v.element = element;
@@ -150,6 +170,37 @@ class PathTracer {
     return false;
   }
 
+  // The edge element a shares with element b: its local index in a (k) and in b (kb).
+  struct EdgePair {
+    int k = -1, kb = -1;
+    bool valid() const { return k >= 0; }
+  };
+  EdgePair shared_edge(int a, int b) const {
+    for (int k = 0; k < adjacency_.edges_per_element(); ++k) {
+      const auto nb = adjacency_.neighbour(a, k);
+      if (nb[0] == b) return {k, nb[1]};
+    }
+    return {};
+  }
+
+  // Distance from v to its element's local edge k, perpendicular to the edge on the
+  // surface: the parameter offset from the edge mapped by the element's tangents at v, less
+  // its part along the edge. Exact for flat straight-sided elements and to first order
+  // otherwise, and the same measure from either element of the edge, so the false position
+  // below sees one smooth function across the edge.
+  double edge_gap(const CutPathVertex& v, int k) const {
+    double on[2], along[2];
+    kernels::local_edge_point(mesh_.type, k, edge_parameter(mesh_.type, k, v.xi), on, along);
+    Vec3 position, d1, d2;
+    surface_frame(mesh_, v.element, v.xi.data(), position, d1, d2);
+    const double off[2] = {v.xi[0] - on[0], v.xi[1] - on[1]};
+    const Vec3 offset{d1[0] * off[0] + d2[0] * off[1], d1[1] * off[0] + d2[1] * off[1], d1[2] * off[0] + d2[2] * off[1]};
+    const Vec3 edge{d1[0] * along[0] + d2[0] * along[1], d1[1] * along[0] + d2[1] * along[1],
+                    d1[2] * along[0] + d2[2] * along[1]};
+    const double edge_length = norm(edge);
+    return edge_length > 0 ? norm(cross_product(offset, edge)) / edge_length : norm(offset);
+  }
+
   // Appends the path from p (already emitted) to q (emitted here).
   void bridge(Sample p, Sample q, const Vec3& pa, const Vec3& pb, int depth) {
     if (p.v.element == q.v.element) {
@@ -163,18 +214,44 @@ class PathTracer {
                                   "; use more cut points where the surface folds");
     const Sample q_end = q;
     const double scale = norm(sub(pb, pa));
-    for (int it = 0; it < 80 && (q.lambda - p.lambda) * scale > 1e-13 * (1.0 + scale); ++it) {
-      const double lambda = 0.5 * (p.lambda + q.lambda);
+    // Where p's and q's elements share an edge, the crossing is found by false position on
+    // the signed distance from that edge (Illinois: the distance at an end that stays twice
+    // is halved), and the search ends once p or q lies on the edge: a few projections where
+    // bisection took ~35 (fracture's tracing: 3361 bisection projections against 496 chord
+    // samples). Projections within the search's tie tolerance of the edge land on the edge
+    // itself, in the lower-numbered element. Elements sharing only a corner, and steps
+    // outside the bracket, bisect.
+    const EdgePair edge = shared_edge(p.v.element, q.v.element);
+    double gap_p = edge.valid() ? edge_gap(p.v, edge.k) : 0.0, gap_q = edge.valid() ? edge_gap(q.v, edge.kb) : 0.0;
+    double weight_p = 1, weight_q = 1;  // Illinois' factors on the gaps in the false position
+    int kept = 0;                       // +1: p stayed in the last step, -1: q did
+    // The bracket is closed at this width; a false-position step keeps 0.4 of it from
+    // either end, so that a step onto the crossing itself is followed by one just past it.
+    const double width = 1e-13 * (1.0 + scale) / scale, margin = 0.4 * width, on_edge = width * scale;
+    for (int it = 0; it < 80 && q.lambda - p.lambda > width; ++it) {
+      double lambda = 0.5 * (p.lambda + q.lambda);
+      if (edge.valid()) {
+        if (std::min(gap_p, gap_q) <= on_edge) break;
+        const double f_p = weight_p * gap_p, f_q = weight_q * gap_q;  // the signed distance: f_p, -f_q
+        const double secant = p.lambda + f_p * (q.lambda - p.lambda) / (f_p + f_q);
+        if (secant >= p.lambda && secant <= q.lambda) lambda = std::clamp(secant, p.lambda + margin, q.lambda - margin);
+      }
       Sample m{project(lerp(pa, pb, lambda), p.v.element), lambda};
-      if (m.v.element == p.v.element) p = m;
-      else if (m.v.element == q.v.element) q = m;
-      else {  // the chord passes through a third element
+      if (m.v.element == p.v.element) {
+        p = m;
+        if (edge.valid()) gap_p = edge_gap(p.v, edge.k), weight_p = 1, weight_q *= kept < 0 ? 0.5 : 1.0;
+        kept = -1;
+      } else if (m.v.element == q.v.element) {
+        q = m;
+        if (edge.valid()) gap_q = edge_gap(q.v, edge.kb), weight_q = 1, weight_p *= kept > 0 ? 0.5 : 1.0;
+        kept = 1;
+      } else {  // the chord passes through a third element
         bridge(p, m, pa, pb, depth + 1);
         bridge(m, q_end, pa, pb, depth + 1);
         return;
       }
     }
-    cross(p.v, q.v);
+    cross(p.v, q.v, edge.valid() && gap_q < gap_p);
     // The bisection's own end points are not kept: lying within a fraction of a texel of
     // the edge, they would snap onto the border lattice and draw a spur along the edge.
     out_.push_back(q_end.v);
@@ -182,8 +259,9 @@ class PathTracer {
   }
 
   // Emits the crossing from element of p to element of q: a lattice point of the shared
-  // edge written in both elements, or their shared corner node.
-  void cross(const CutPathVertex& p, const CutPathVertex& q) {
+  // edge written in both elements, or their shared corner node. The crossing is the edge
+  // point nearest p in parameters, or nearest q with `from_q` (q the nearer to the edge).
+  void cross(const CutPathVertex& p, const CutPathVertex& q, bool from_q = false) {
     const int a = p.element, b = q.element;
     const int edges = adjacency_.edges_per_element();
     int best_k = -1, best_kb = -1;
@@ -191,13 +269,16 @@ class PathTracer {
     for (int k = 0; k < edges; ++k) {
       const auto nb = adjacency_.neighbour(a, k);
       if (nb[0] != b) continue;
+      const CutPathVertex& near = from_q ? q : p;
+      const int near_k = from_q ? nb[1] : k;
       double e[2], d[2];
-      kernels::local_edge_point(mesh_.type, k, edge_parameter(mesh_.type, k, p.xi), e, d);
-      const double gap = std::hypot(e[0] - p.xi[0], e[1] - p.xi[1]);
+      kernels::local_edge_point(mesh_.type, near_k, edge_parameter(mesh_.type, near_k, near.xi), e, d);
+      const double gap = std::hypot(e[0] - near.xi[0], e[1] - near.xi[1]);
       if (gap < best_gap) best_gap = gap, best_k = k, best_kb = nb[1];
     }
     if (best_k >= 0) {
-      const double t = edge_parameter(mesh_.type, best_k, p.xi);
+      // (A shared edge runs the other way in b: its parameter there is -t.)
+      const double t = from_q ? -edge_parameter(mesh_.type, best_kb, q.xi) : edge_parameter(mesh_.type, best_k, p.xi);
       const double u = std::floor(0.5 * (t + 1.0) * resolution_ + 0.5);  // lattice point, halves up
       const double ta = 2.0 * u / resolution_ - 1.0;
       double xa[2], xb[2], xe[2], d[2];
@@ -265,20 +346,9 @@ ElementAdjacency::ElementAdjacency(const Mesh& mesh, const Topology& topology) {
 }
 
 void element_surface_point(const Mesh& mesh, int element, const double xi[2], Vec3& position, Vec3& normal) {
-  kernels::ShapeValues s;
-  kernels::evaluate_shape(mesh.type, xi[0], xi[1], s);
-  Vec3 d1{}, d2{};
-  position = {0, 0, 0};
-  const int* nodes = mesh.element_nodes(element);
-  for (int a = 0; a < s.count; ++a) {
-    const double* x = mesh.node(nodes[a]);
-    for (int c = 0; c < 3; ++c) {
-      position[c] += s.N[a] * x[c];
-      d1[c] += s.dN[a][0] * x[c];
-      d2[c] += s.dN[a][1] * x[c];
-    }
-  }
-  normal = {d1[1] * d2[2] - d1[2] * d2[1], d1[2] * d2[0] - d1[0] * d2[2], d1[0] * d2[1] - d1[1] * d2[0]};
+  Vec3 d1, d2;
+  surface_frame(mesh, element, xi, position, d1, d2);
+  normal = cross_product(d1, d2);
   const double n = norm(normal);
   if (n > 0)
     for (double& c : normal) c /= n;

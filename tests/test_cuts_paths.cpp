@@ -82,6 +82,34 @@ TEST(CutPaths, Tri6CrossingsMeetOnTheTexelLattice) {
   expect_continuous_crossings(mesh, points_cut({{0.2, 0.71, 0}, {1.4, 1.3, 0}, {2.83, 2.27, 0}}), 32, 5);
 }
 
+// On a flat mesh a chord is its own projection: each crossing's (unsnapped) position lies
+// on the line between the cut's points and on a grid line of the mesh (x or y a whole
+// number; tri6 also the diagonals x - y whole), found by false position on the distance
+// from the shared edge.
+TEST(CutPaths, FlatCrossingsLieWhereTheChordMeetsTheEdge) {
+  for (ElementType type : {ElementType::quad8, ElementType::tri6}) {
+    const Mesh mesh = make_rectangle(3, 3, 3, 3, type);
+    const Topology topology = build_topology(mesh);
+    const ElementAdjacency adjacency(mesh, topology);
+    const Vec3 a{0.2, 0.71, 0}, b{2.83, 2.27, 0};
+    const MeshCutPath path = trace_cut_path(mesh, adjacency, points_cut({a, b}), 32, "cuts[0]");
+    int crossings = 0;
+    for (std::size_t k = 0; k + 1 < path.vertices.size(); ++k) {
+      if (path.vertices[k].element == path.vertices[k + 1].element) continue;
+      ++crossings;
+      const Vec3& x = path.vertices[k].position;
+      const double off_line = std::abs((b[0] - a[0]) * (x[1] - a[1]) - (b[1] - a[1]) * (x[0] - a[0])) /
+                              std::hypot(b[0] - a[0], b[1] - a[1]);
+      EXPECT_LT(off_line, 1e-12) << "crossing " << crossings;
+      double off_grid = std::min(std::abs(x[0] - std::round(x[0])), std::abs(x[1] - std::round(x[1])));
+      if (type == ElementType::tri6) off_grid = std::min(off_grid, std::abs(x[0] - x[1] - std::round(x[0] - x[1])));
+      EXPECT_LT(off_grid, 1e-12) << "crossing " << crossings << " at " << x[0] << ", " << x[1];
+      EXPECT_EQ(x[2], 0.0);
+    }
+    EXPECT_GE(crossings, type == ElementType::quad8 ? 3 : 5);
+  }
+}
+
 TEST(CutPaths, CurvedCylinderCrossingsMeet) {
   const Mesh mesh = make_cylinder(1.0, 2.0, 0, 360, 6, 2, ElementType::quad8);
   std::vector<Vec3> ring;
