@@ -520,25 +520,31 @@ MeshLaplaceStats solve_mesh_texel_laplace(std::vector<RegionTile>& tiles, Elemen
       }
     }
     if (!stats.multigrid) {
-      // The texel Laplacian over the unknowns, row by row (columns in increasing order:
-      // cheap inserts), and the data's share of the right side.
+      // The texel Laplacian over the unknowns, row by row (columns in increasing order),
+      // written straight into the compressed rows, and the data's share of the right side.
       const int m = stats.unknowns;
-      detail::SparseRows a(m, m);
-      a.reserve(Eigen::VectorXi::Constant(m, 5));
+      std::vector<int> offsets(m + 1, 0), columns;
+      std::vector<double> values;
+      columns.reserve(5 * static_cast<std::size_t>(m)), values.reserve(5 * static_cast<std::size_t>(m));
       Eigen::VectorXd b = Eigen::VectorXd::Zero(m);
-      std::vector<int> columns;
       for (int k = 0; k < m; ++k) {
         int degree = 0;
-        columns.assign(1, k);
+        const std::size_t row_start = columns.size();
+        columns.push_back(k);
         graph.for_each_coupling(node_of[k], [&](int w) {
           ++degree;
           if (unknown_of[w] >= 0) columns.push_back(unknown_of[w]);
           else b[k] += graph.value(w);
         });
-        std::sort(columns.begin(), columns.end());
-        for (int c : columns) a.insert(k, c) = c == k ? static_cast<double>(degree) : -1.0;
+        std::sort(columns.begin() + row_start, columns.end());
+        for (std::size_t e = row_start; e < columns.size(); ++e) values.push_back(columns[e] == k ? degree : -1.0);
+        offsets[k + 1] = static_cast<int>(columns.size());
       }
-      a.makeCompressed();
+      detail::SparseRows a(m, m);
+      a.resizeNonZeros(static_cast<Eigen::Index>(columns.size()));
+      std::copy(offsets.begin(), offsets.end(), a.outerIndexPtr());
+      std::copy(columns.begin(), columns.end(), a.innerIndexPtr());
+      std::copy(values.begin(), values.end(), a.valuePtr());
       if (solver == LaplaceSolver::multigrid) {
         // No planar patch holds the region (tri6, turned neighbours) or its multigrid did not
         // converge: algebraic multigrid on the texel graph, warm-started like the tile's.
