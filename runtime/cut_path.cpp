@@ -252,8 +252,8 @@ class PathTracer {
       }
     }
     cross(p.v, q.v, edge.valid() && gap_q < gap_p);
-    // The bisection's own end points are not kept: lying within a fraction of a texel of
-    // the edge, they would snap onto the border lattice and draw a spur along the edge.
+    // The search's own end points are not kept: lying within a fraction of a texel of the
+    // edge, they would snap onto the border lattice and draw a spur along the edge.
     out_.push_back(q_end.v);
     sample_.push_back(q_end.lambda != 1.0);
   }
@@ -266,10 +266,10 @@ class PathTracer {
     const int edges = adjacency_.edges_per_element();
     int best_k = -1, best_kb = -1;
     double best_gap = INFINITY;
+    const CutPathVertex& near = from_q ? q : p;
     for (int k = 0; k < edges; ++k) {
       const auto nb = adjacency_.neighbour(a, k);
       if (nb[0] != b) continue;
-      const CutPathVertex& near = from_q ? q : p;
       const int near_k = from_q ? nb[1] : k;
       double e[2], d[2];
       kernels::local_edge_point(mesh_.type, near_k, edge_parameter(mesh_.type, near_k, near.xi), e, d);

@@ -152,6 +152,37 @@ class TexelGraph {
   std::vector<std::array<int, 2>> across_;
 };
 
+// The texel Laplacian over the unknowns (node_of: unknown -> graph node, unknown_of: node
+// -> unknown or -1), row by row with columns in increasing order, written straight into
+// compressed rows (Eigen's inserts took ~2 ms of a 20k-unknown fracture region); b gets the
+// data's share of the right side. The row arrays are freed on return, before any solve.
+detail::SparseRows texel_laplacian(TexelGraph& graph, const std::vector<int>& node_of,
+                                   const std::vector<int>& unknown_of, Eigen::VectorXd& b) {
+  const int m = static_cast<int>(node_of.size());
+  std::vector<int> offsets(m + 1, 0), columns;
+  std::vector<double> values;
+  columns.reserve(5 * static_cast<std::size_t>(m)), values.reserve(5 * static_cast<std::size_t>(m));
+  for (int k = 0; k < m; ++k) {
+    int degree = 0;
+    const std::size_t row_start = columns.size();
+    columns.push_back(k);
+    graph.for_each_coupling(node_of[k], [&](int w) {
+      ++degree;
+      if (unknown_of[w] >= 0) columns.push_back(unknown_of[w]);
+      else b[k] += graph.value(w);
+    });
+    std::sort(columns.begin() + row_start, columns.end());
+    for (std::size_t e = row_start; e < columns.size(); ++e) values.push_back(columns[e] == k ? degree : -1.0);
+    offsets[k + 1] = static_cast<int>(columns.size());
+  }
+  detail::SparseRows a(m, m);
+  a.resizeNonZeros(static_cast<Eigen::Index>(columns.size()));
+  std::copy(offsets.begin(), offsets.end(), a.outerIndexPtr());
+  std::copy(columns.begin(), columns.end(), a.innerIndexPtr());
+  std::copy(values.begin(), values.end(), a.valuePtr());
+  return a;
+}
+
 // Where each solved region tile sits in one planar texel tile (quad8 only): tile l covers
 // texels [T * x[l], T * (x[l] + 1)) x [T * y[l], T * (y[l] + 1)) of the patch (inside a
 // one-texel margin). Frozen tiles are not placed: their texels coupled to placed tiles
@@ -520,31 +551,9 @@ MeshLaplaceStats solve_mesh_texel_laplace(std::vector<RegionTile>& tiles, Elemen
       }
     }
     if (!stats.multigrid) {
-      // The texel Laplacian over the unknowns, row by row (columns in increasing order),
-      // written straight into the compressed rows, and the data's share of the right side.
       const int m = stats.unknowns;
-      std::vector<int> offsets(m + 1, 0), columns;
-      std::vector<double> values;
-      columns.reserve(5 * static_cast<std::size_t>(m)), values.reserve(5 * static_cast<std::size_t>(m));
       Eigen::VectorXd b = Eigen::VectorXd::Zero(m);
-      for (int k = 0; k < m; ++k) {
-        int degree = 0;
-        const std::size_t row_start = columns.size();
-        columns.push_back(k);
-        graph.for_each_coupling(node_of[k], [&](int w) {
-          ++degree;
-          if (unknown_of[w] >= 0) columns.push_back(unknown_of[w]);
-          else b[k] += graph.value(w);
-        });
-        std::sort(columns.begin() + row_start, columns.end());
-        for (std::size_t e = row_start; e < columns.size(); ++e) values.push_back(columns[e] == k ? degree : -1.0);
-        offsets[k + 1] = static_cast<int>(columns.size());
-      }
-      detail::SparseRows a(m, m);
-      a.resizeNonZeros(static_cast<Eigen::Index>(columns.size()));
-      std::copy(offsets.begin(), offsets.end(), a.outerIndexPtr());
-      std::copy(columns.begin(), columns.end(), a.innerIndexPtr());
-      std::copy(values.begin(), values.end(), a.valuePtr());
+      const detail::SparseRows a = texel_laplacian(graph, node_of, unknown_of, b);
       if (solver == LaplaceSolver::multigrid) {
         // No planar patch holds the region (tri6, turned neighbours) or its multigrid did not
         // converge: algebraic multigrid on the texel graph, warm-started like the tile's.
