@@ -118,6 +118,42 @@ TEST(BenchScenes, JsonHasEveryRequestedSceneWithRequiredKeysAndThesisRatios) {
   EXPECT_NE(heading.find("machine probe "), std::string::npos) << heading;
 }
 
+// --repeats: every run of a scene is listed; the tables and the scene's own keys are the
+// fastest whole run's; the runs end in bitwise the same state.
+TEST(BenchScenes, RepeatsShowTheFastestRunAndListEveryRun) {
+  const fs::path dir = fresh_dir("repeats");
+  const Result r = run_cli("bench scenes --scene-dir " + kScenes + " --scenes spiral1 --steps 2 --repeats 3 --json " +
+                               (dir / "out.json").string() + " --markdown " + (dir / "out.md").string() + " --quiet",
+                           dir);
+  ASSERT_EQ(r.exit_code, 0) << r.stderr_text;
+  const nlohmann::json j = read_json(dir / "out.json");
+  EXPECT_EQ(j["repeats"], 3);
+  ASSERT_EQ(j["scenes"].size(), 1u);
+  const nlohmann::json& scene = j["scenes"][0];
+  const nlohmann::json& runs = scene["runs"];
+  EXPECT_EQ(runs["count"], 3);
+  for (const char* key : {"steps_per_second", "peak_step_ms", "enrichment_ms_max", "machine_probe_ms"})
+    ASSERT_EQ(runs[key].size(), 3u) << key;
+  const std::size_t shown = runs["shown"].get<std::size_t>();
+  ASSERT_LT(shown, 3u);
+  for (const nlohmann::json& other : runs["steps_per_second"])
+    EXPECT_GE(runs["steps_per_second"][shown].get<double>(), other.get<double>());
+  EXPECT_EQ(scene["steps_per_second"].get<double>(), runs["steps_per_second"][shown].get<double>());
+  EXPECT_EQ(scene["peak_step_ms"].get<double>(), runs["peak_step_ms"][shown].get<double>());
+  EXPECT_EQ(scene["timings_ms"]["enrichment"]["max"].get<double>(), runs["enrichment_ms_max"][shown].get<double>());
+  EXPECT_EQ(scene["machine_probe_ms"].get<double>(), runs["machine_probe_ms"][shown].get<double>());
+  EXPECT_TRUE(runs["identical"].get<bool>());
+  std::ifstream markdown(dir / "out.md");
+  std::string heading;
+  std::getline(markdown, heading);
+  EXPECT_NE(heading.find("the fastest of 3 runs"), std::string::npos) << heading;
+
+  const Result zero = run_cli("bench scenes --scenes spiral1 --repeats 0", dir);
+  EXPECT_EQ(zero.exit_code, 2);
+  EXPECT_NE(zero.stderr_text.find("--repeats: Value 0 not in range 1 to 2147483647"), std::string::npos)
+      << zero.stderr_text;
+}
+
 TEST(BenchScenes, CountsMatchTheReportOfDgtexRun) {
   const fs::path dir = fresh_dir("counts");
   const fs::path scene = short_spiral(dir, 3);
