@@ -17,8 +17,8 @@
 // compressed rows here 9.4-9.9 ms, 5.3-6.9 ms when malloc keeps its memory (the rest is
 // first-touch page faults), and the 8 CG iterations ~10 ms: a solve ~15-20 ms where CHOLMOD
 // (simplicial, AMD) took ~40 ms. With the smoother's lower and upper parts apart (session
-// 44, best of 100 calls in one process): the grid's 7 iterations 5.2-6.1 ms, a fracture
-// graph's 9 iterations 9.3 ms instead of 11.6-12.7.
+// 44, best of 100-150 calls in one process): the grid's 7 iterations 5.2-7.0 ms instead of
+// 7.1-7.4, a fracture graph's 9 iterations 9.3 ms instead of 11.6-12.7.
 
 namespace dgtex::detail {
 namespace {
