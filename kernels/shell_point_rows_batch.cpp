@@ -33,19 +33,26 @@ inline void first_derivatives(const ShapeValues* shapes, int count, int npe, dou
   }
 }
 
-// rest_tangents: a1, a2 (zeroed here) and the normal n = a1 x a2, and j0 = |n|.
-inline void tangents_and_area(const double (*dN)[2][L], const int* nodes, const double* X, int npe, Lanes* a1,
-                              Lanes* a2, Lanes* n, Lanes& j0) {
-  for (int d = 0; d < 3; ++d)
-    for (int l = 0; l < L; ++l) a1[d][l] = a2[d][l] = 0;
+// sums[k] = sum over the nodes a (in order) of coefficient[a][k] times node a's position:
+// the tangents (coefficients dN) or the second derivatives (d2N) of the surface.
+template <int K>
+inline void node_sums(const double (*coefficient)[K][L], const int* nodes, const double* X, int npe,
+                      Lanes* const (&sums)[K]) {
+  for (int k = 0; k < K; ++k)
+    for (int d = 0; d < 3; ++d)
+      for (int l = 0; l < L; ++l) sums[k][d][l] = 0;
   for (int a = 0; a < npe; ++a) {
     const double* x = X + 3 * static_cast<long>(nodes[a]);
-    for (int d = 0; d < 3; ++d)
-      for (int l = 0; l < L; ++l) {
-        a1[d][l] += dN[a][0][l] * x[d];
-        a2[d][l] += dN[a][1][l] * x[d];
-      }
+    for (int k = 0; k < K; ++k)
+      for (int d = 0; d < 3; ++d)
+        for (int l = 0; l < L; ++l) sums[k][d][l] += coefficient[a][k][l] * x[d];
   }
+}
+
+// rest_tangents: a1, a2 and the normal n = a1 x a2, and j0 = |n|.
+inline void tangents_and_area(const double (*dN)[2][L], const int* nodes, const double* X, int npe, Lanes* a1,
+                              Lanes* a2, Lanes* n, Lanes& j0) {
+  node_sums<2>(dN, nodes, X, npe, {a1, a2});
   cross(a1, a2, n);
   dot(n, n, j0);
   for (int l = 0; l < L; ++l) j0[l] = std::sqrt(j0[l]);
@@ -112,16 +119,8 @@ __attribute__((target_clones("avx512f", "avx2", "default"))) void rest_strain_ro
   // evaluate_rest_point: tangents, normal, area element, second derivatives, dual basis.
   alignas(64) double a1[3][L], a2[3][L], n[3][L], j0[L];
   tangents_and_area(dN, nodes, X, npe, a1, a2, n, j0);
-  alignas(64) double a11[3][L] = {}, a22[3][L] = {}, a12[3][L] = {};
-  for (int a = 0; a < npe; ++a) {
-    const double* x = X + 3 * static_cast<long>(nodes[a]);
-    for (int d = 0; d < 3; ++d)
-      for (int l = 0; l < L; ++l) {
-        a11[d][l] += d2N[a][0][l] * x[d];
-        a22[d][l] += d2N[a][1][l] * x[d];
-        a12[d][l] += d2N[a][2][l] * x[d];
-      }
-  }
+  alignas(64) double a11[3][L], a22[3][L], a12[3][L];
+  node_sums<3>(d2N, nodes, X, npe, {a11, a22, a12});
   alignas(64) double t0[3][L], dual1[3][L], dual2[3][L];
   for (int d = 0; d < 3; ++d)
     for (int l = 0; l < L; ++l) t0[d][l] = n[d][l] / j0[l];
