@@ -438,6 +438,7 @@ bool CutManager::update(double time) {
     last_.unknowns += stats.unknowns;
     last_.solved_tiles += stats.solved_tiles;
     last_.frozen_tiles += stats.frozen_tiles;
+    last_.algebraic_multigrid_solves += stats.algebraic_multigrid;
 
     SegmentState& state = states_.at(job.key);
     state.values.clear();

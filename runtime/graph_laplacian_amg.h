@@ -1,10 +1,11 @@
 #pragma once
 // Internal to the enrichment Laplace solve (mesh_texel_laplace.cpp): conjugate gradients
 // preconditioned by smoothed-aggregation algebraic multigrid, for texel graphs that no
-// planar patch holds (tri6 regions, turned neighbours), where the tile multigrid does not
-// apply. Why: CHOLMOD took ~40 ms for each of the fracture scene's 20k-unknown texel
-// graphs (AMD's analysis half of it); a nested-dissection order instead of AMD was tried
-// and rejected (1.3-1.4x AMD's fill on grids, 2.5-3x its flops on the fracture graphs).
+// planar patch or texel lattice holds (tri6 cells split sheared, rings of tri6 cells), where
+// the tile multigrid does not apply. Why: CHOLMOD took ~40 ms for each of the fracture
+// scene's 20k-unknown texel graphs (AMD's analysis half of it; the scene's cells were split
+// sheared until session 45); a nested-dissection order instead of AMD was tried and
+// rejected (1.3-1.4x AMD's fill on grids, 2.5-3x its flops on the fracture graphs).
 //
 // The hierarchy: aggregates grown greedily from the graph's rows in order (a node and its
 // strong neighbours, then the rest joined to an adjacent aggregate), so an aggregate never

@@ -305,12 +305,14 @@ struct LaplaceMultigrid::Hierarchy {
       // keeps coarsening and leaves them to the smoother and CG. A single orphan beside
       // slinky's ghost texels (386 x 130 patch) had stopped its hierarchy at the texels, and
       // CHOLMOD factored all 50k of them every step (220-330 ms); with 7 levels the setup is
-      // 0.6 ms and CG takes 6 iterations. Channels (the spiral: 80 orphans at 128 x 128)
-      // still stop.
+      // 0.6 ms and CG takes 6 iterations. One per 2048 nodes since session 45: fracture's
+      // lattice patches (square-split tri6, 136 x 194) have 7 orphans at level 0 (one per
+      // 3770), and stopping there factored 26k texels (43-53 ms) where 10 CG iterations take
+      // 6.5 ms. Channels (the spiral: 80 orphans at 128 x 128) still stop.
       const double nodes = static_cast<double>(levels[l].shape.nx) * levels[l].shape.ny;
       const double band = levels[l].shape.nx + 2.0;
       const bool cheap_to_factor = nodes * band * band <= banded_coarsest_max_work;
-      const bool isolated = orphans <= nodes / 4096;
+      const bool isolated = orphans <= nodes / 2048;
       if (orphans > options.max_orphans && (cheap_to_factor || !isolated)) {
         orphans_at_stop = orphans;
         break;

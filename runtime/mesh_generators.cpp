@@ -54,7 +54,7 @@ struct ParametricSurface {
   std::function<void(double u, double v, double x[3])> point;
 };
 
-Mesh mesh_parametric_surface(const ParametricSurface& surface, ElementType type) {
+Mesh mesh_parametric_surface(const ParametricSurface& surface, ElementType type, TriangleSplit split) {
   // Nodes live on the half-step grid (2nu + 1) x (2nv + 1); periodic directions drop the
   // last column/row, quad8 drops the cell centres (both indices odd).
   const int su = 2 * surface.nu, sv = 2 * surface.nv;
@@ -85,8 +85,13 @@ Mesh mesh_parametric_surface(const ParametricSurface& surface, ElementType type)
         mesh.elements.insert(mesh.elements.end(), {c0, c1, c2, c3, m01, m12, m23, m30});
       } else {
         const int centre = node(i + 1, j + 1);
-        mesh.elements.insert(mesh.elements.end(), {c0, c1, c2, m01, m12, centre});
-        mesh.elements.insert(mesh.elements.end(), {c0, c2, c3, centre, m23, m30});
+        if (split == TriangleSplit::sheared) {
+          mesh.elements.insert(mesh.elements.end(), {c0, c1, c2, m01, m12, centre});
+          mesh.elements.insert(mesh.elements.end(), {c0, c2, c3, centre, m23, m30});
+        } else {
+          mesh.elements.insert(mesh.elements.end(), {c1, c2, c0, m12, centre, m01});
+          mesh.elements.insert(mesh.elements.end(), {c3, c0, c2, m30, centre, m23});
+        }
       }
     }
   return mesh;
@@ -94,7 +99,7 @@ Mesh mesh_parametric_surface(const ParametricSurface& surface, ElementType type)
 
 }  // namespace
 
-Mesh make_rectangle(double size_x, double size_y, int nx, int ny, ElementType type) {
+Mesh make_rectangle(double size_x, double size_y, int nx, int ny, ElementType type, TriangleSplit split) {
   require_positive_length("rectangle", "size x", size_x);
   require_positive_length("rectangle", "size y", size_y);
   require_divisions("rectangle", "divisions x", nx, 1);
@@ -108,11 +113,11 @@ Mesh make_rectangle(double size_x, double size_y, int nx, int ny, ElementType ty
     x[1] = v * size_y;
     x[2] = 0;
   };
-  return mesh_parametric_surface(s, type);
+  return mesh_parametric_surface(s, type, split);
 }
 
 Mesh make_cylinder(double radius, double length, double angle0_deg, double angle1_deg, int n_angle, int n_length,
-                   ElementType type) {
+                   ElementType type, TriangleSplit split) {
   require_positive_length("cylinder", "radius", radius);
   require_positive_length("cylinder", "length", length);
   require(std::isfinite(angle0_deg) && std::isfinite(angle1_deg),
@@ -139,10 +144,10 @@ Mesh make_cylinder(double radius, double length, double angle0_deg, double angle
     x[1] = v * length;
     x[2] = radius * ct;
   };
-  return mesh_parametric_surface(s, type);
+  return mesh_parametric_surface(s, type, split);
 }
 
-Mesh make_hemisphere(double radius, double hole_deg, int n_polar, int n_azimuth, ElementType type) {
+Mesh make_hemisphere(double radius, double hole_deg, int n_polar, int n_azimuth, ElementType type, TriangleSplit split) {
   require_positive_length("hemisphere", "radius", radius);
   require(std::isfinite(hole_deg) && hole_deg > 0 && hole_deg < 90,
           "hemisphere: hole_deg must lie in (0, 90) degrees (the pole itself cannot be meshed by this grid), got " +
@@ -162,7 +167,7 @@ Mesh make_hemisphere(double radius, double hole_deg, int n_polar, int n_azimuth,
     x[1] = radius * sp * sl;
     x[2] = radius * cp;
   };
-  return mesh_parametric_surface(s, type);
+  return mesh_parametric_surface(s, type, split);
 }
 
 }  // namespace dgtex

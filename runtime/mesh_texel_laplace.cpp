@@ -1,7 +1,10 @@
 #include "dgtex/mesh_texel_laplace.h"
 
 #include <algorithm>
+#include <array>
 #include <chrono>
+#include <cstdlib>
+#include <limits>
 #include <memory>
 #include <stdexcept>
 #include <string>
@@ -249,6 +252,171 @@ bool place_region_in_plane(const std::vector<RegionTile>& tiles, ElementType typ
   placement.x = std::move(x);
   placement.y = std::move(y);
   return true;
+}
+
+// Where a tile's texels lie on one texel lattice: texel (i, j) at origin + R (i, j), R one of
+// the eight symmetries of the square lattice (rotations and reflections, row-major).
+struct LatticeTransform {
+  std::array<int, 4> r{1, 0, 0, 1};
+  int ox = 0, oy = 0;
+  std::array<int, 2> turn(int di, int dj) const { return {r[0] * di + r[1] * dj, r[2] * di + r[3] * dj}; }
+  std::array<int, 2> at(int i, int j) const {
+    const auto d = turn(i, j);
+    return {ox + d[0], oy + d[1]};
+  }
+  bool operator==(const LatticeTransform& o) const { return r == o.r && ox == o.ox && oy == o.oy; }
+};
+
+constexpr std::array<std::array<int, 4>, 8> kLatticeSymmetries = {{
+    {1, 0, 0, 1}, {0, -1, 1, 0}, {-1, 0, 0, -1}, {0, 1, -1, 0},  // rotations by 0, 90, 180, 270 degrees
+    {-1, 0, 0, 1}, {1, 0, 0, -1}, {0, 1, 1, 0}, {0, -1, -1, 0},  // reflections
+}};
+
+// The step from boundary texel s of a local edge to its partner across the edge, in the
+// element's own texel frame: straight out of the edge; for the tri6 hypotenuse's staircase
+// texels (T-1-s, s), east (their north neighbours then hold the partners of the next texel).
+std::array<int, 2> step_across(ElementType type, int edge) {
+  constexpr int quad8[4][2] = {{0, -1}, {1, 0}, {0, 1}, {-1, 0}};
+  constexpr int tri6[3][2] = {{0, -1}, {1, 0}, {-1, 0}};
+  const int* d = type == ElementType::quad8 ? quad8[edge] : tri6[edge];
+  return {d[0], d[1]};
+}
+
+// Lays every tile of the region on one texel lattice so that each boundary texel's partner
+// across a mesh edge is its lattice neighbour there: a breadth-first walk over the solved
+// tiles fixes each neighbour's transform from the shared edge (its T partner texels must sit
+// one step out of the edge, and its interior on the far side). Frozen tiles are placed from
+// the first solved tile that meets them and not walked from (their texels only become ghost
+// data beside the solved ones). A rectangle tri6 mesh's two triangles of a square sit side by
+// side, sheared by one column per row of squares. Fails (false) where two ways round reach a
+// solved tile with different transforms (a closed ring, a vertex the lattice cannot
+// surround) or the solved tiles are not edge-connected.
+bool place_tiles_on_lattice(const TexelGraph& graph, const std::vector<RegionTile>& tiles, ElementType type,
+                            std::vector<LatticeTransform>& placed) {
+  const int count = static_cast<int>(tiles.size()), t = tiles.front().tile.width;
+  const int edges = type == ElementType::quad8 ? 4 : 3;
+  placed.assign(count, {});
+  std::vector<char> known(count, 0);
+  int first = 0;
+  while (first < count && tiles[first].frozen) ++first;
+  if (first == count) return false;
+  known[first] = 1;
+  std::vector<int> queue = {first};
+  int solved = 0;
+  for (const RegionTile& r : tiles) solved += !r.frozen;
+  auto local = [&](int edge, int s) {
+    const int k = edge_texel_index(type, t, edge, s);
+    return std::array<int, 2>{k % t, k / t};
+  };
+  for (std::size_t q = 0; q < queue.size(); ++q) {
+    const int l = queue[q];
+    const LatticeTransform& from = placed[l];
+    for (int k = 0; k < edges; ++k) {
+      const auto [m, km] = graph.across(l, k);
+      if (m < 0) continue;
+      const auto out = step_across(type, k), d = from.turn(out[0], out[1]);
+      // The partner of texel s is texel T-1-s of the neighbour's edge km.
+      auto target = [&](int s) {
+        const auto e = local(k, s), p = from.at(e[0], e[1]);
+        return std::array<int, 2>{p[0] + d[0], p[1] + d[1]};
+      };
+      LatticeTransform to;
+      bool found = false;
+      for (const auto& r : kLatticeSymmetries) {
+        to.r = r;
+        const auto back = step_across(type, km), db = to.turn(back[0], back[1]);
+        if (db[0] != -d[0] || db[1] != -d[1]) continue;  // its interior must lie beyond the edge
+        const auto e0 = local(km, t - 1), p0 = target(0), r0 = to.turn(e0[0], e0[1]);
+        to.ox = p0[0] - r0[0], to.oy = p0[1] - r0[1];
+        found = true;
+        for (int s = 1; s < t && found; ++s) {
+          const auto e = local(km, t - 1 - s);
+          found = to.at(e[0], e[1]) == target(s);
+        }
+        if (found) break;
+      }
+      if (!found) return false;
+      if (known[m]) {
+        if (!tiles[m].frozen && !(placed[m] == to)) return false;
+        continue;
+      }
+      known[m] = 1, placed[m] = to;
+      if (!tiles[m].frozen) queue.push_back(m);
+    }
+  }
+  return static_cast<int>(queue.size()) == solved;
+}
+
+// Solves the region's unknowns by the tile multigrid on one patch tile holding the texel
+// graph exactly: the tiles laid on the lattice (place_tiles_on_lattice), every lattice pair
+// walled except the couplings of the graph, a coupling that does not join lattice neighbours
+// refused. Texels that are not unknowns are Dirichlet data there; frozen texels coupled to
+// unknowns become Dirichlet ghost texels at their lattice places. Throws std::runtime_error
+// where that fails (two texels on one place, a ghost on two values) or the multigrid does
+// not converge; the caller then solves the texel graph by algebraic multigrid.
+LaplaceSolveStats solve_on_lattice_patch(TexelGraph& graph, const std::vector<RegionTile>& tiles,
+                                         const std::vector<LatticeTransform>& placed, const std::vector<int>& node_of,
+                                         const std::vector<int>& unknown_of, const LaplaceMultigridOptions& options) {
+  const int t = tiles.front().tile.width, tt = t * t;
+  auto lattice_point = [&](int node) {
+    const int k = node % tt;
+    return placed[node / tt].at(k % t, k / t);
+  };
+  // The patch: the solved tiles' active texels and a one-texel margin for ghosts.
+  int x0 = std::numeric_limits<int>::max(), y0 = x0, x1 = std::numeric_limits<int>::min(), y1 = x1;
+  for (int l = 0; l < static_cast<int>(tiles.size()); ++l) {
+    if (tiles[l].frozen) continue;
+    for (int i : {0, t - 1})
+      for (int j : {0, t - 1}) {
+        const auto p = placed[l].at(i, j);
+        x0 = std::min(x0, p[0]), x1 = std::max(x1, p[0]), y0 = std::min(y0, p[1]), y1 = std::max(y1, p[1]);
+      }
+  }
+  const int w = x1 - x0 + 3, h = y1 - y0 + 3;
+  auto cell = [&](std::array<int, 2> p) { return (p[1] - y0 + 1) * w + (p[0] - x0 + 1); };
+  TexelTile patch(w, h);
+  std::fill(patch.flags.begin(), patch.flags.end(), static_cast<std::uint8_t>(kernels::inactive));
+  constexpr int empty = -1, ghost = -2;
+  std::vector<int> occupant(patch.flags.size(), empty);
+  constexpr std::uint8_t walled = kernels::wall_east | kernels::wall_north;
+  for (int l = 0; l < static_cast<int>(tiles.size()); ++l) {
+    if (tiles[l].frozen) continue;
+    for (int k = 0; k < tt; ++k) {
+      const int v = l * tt + k;
+      if (!graph.active(v)) continue;
+      const int g = cell(lattice_point(v));
+      if (occupant[g] != empty) throw std::runtime_error("two texels on one lattice place");
+      occupant[g] = v;
+      patch.flags[g] = walled | (unknown_of[v] < 0 ? kernels::dirichlet : 0);
+      patch.values[g] = graph.value(v);  // data, or the initial guess (the previous H)
+    }
+  }
+  // Open the couplings of the unknowns (data-data pairs stay walled: they do not enter the
+  // equations).
+  for (int v : node_of) {
+    const auto p = lattice_point(v);
+    const int g = cell(p);
+    graph.for_each_coupling(v, [&](int u) {
+      const auto q = lattice_point(u);
+      const int dx = q[0] - p[0], dy = q[1] - p[1];
+      if (std::abs(dx) + std::abs(dy) != 1) throw std::runtime_error("a coupling off the lattice");
+      const int c = cell(q);
+      if (tiles[u / tt].frozen) {
+        const double value = graph.value(u);
+        if (occupant[c] >= 0 || (occupant[c] == ghost && patch.values[c] != value))
+          throw std::runtime_error("a ghost texel on a taken lattice place");
+        if (occupant[c] == empty) occupant[c] = ghost, patch.flags[c] = walled | kernels::dirichlet, patch.values[c] = value;
+      }
+      // The wall bit sits on the west / south texel of the pair.
+      if (dx == 1) patch.flags[g] &= static_cast<std::uint8_t>(~kernels::wall_east);
+      if (dx == -1) patch.flags[c] &= static_cast<std::uint8_t>(~kernels::wall_east);
+      if (dy == 1) patch.flags[g] &= static_cast<std::uint8_t>(~kernels::wall_north);
+      if (dy == -1) patch.flags[c] &= static_cast<std::uint8_t>(~kernels::wall_north);
+    });
+  }
+  const LaplaceSolveStats s = solve_laplace(patch, LaplaceSolver::multigrid, options);
+  for (int v : node_of) graph.value(v) = patch.values[cell(lattice_point(v))];
+  return s;
 }
 
 // The reference solve of a texel Laplacian (full rows) and the safety net of the
@@ -525,6 +693,17 @@ MeshLaplaceStats solve_mesh_texel_laplace(std::vector<RegionTile>& tiles, Elemen
           for (int i = 0; i < t; ++i)
             if (unknown_of[first + i] >= 0) tiles[l].tile.values[j * t + i] = patch.values[g + i];
         });
+      } catch (const std::runtime_error&) {
+        stats.multigrid = false;
+      }
+    } else if (std::vector<LatticeTransform> lattice; solver == LaplaceSolver::multigrid && tiles.size() > 1 &&
+                                                      place_tiles_on_lattice(graph, tiles, type, lattice)) {
+      // Regions the block placement refuses (tri6, turned neighbours) may still lie on one
+      // texel lattice, texel by texel.
+      try {
+        const LaplaceSolveStats s = solve_on_lattice_patch(graph, tiles, lattice, node_of, unknown_of, options);
+        stats.relative_residual = s.relative_residual;
+        stats.multigrid = true;
       } catch (const std::runtime_error&) {
         stats.multigrid = false;
       }

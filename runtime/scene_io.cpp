@@ -326,7 +326,7 @@ class SceneReader {
     const json* file = find(v, "file");
     const json* generator = find(v, "generator");
     if (!file && !generator) {
-      check_keys(v, path, {"generator", "file", "element", "size", "divisions", "radius", "length", "angle_deg", "hole_deg"});
+      check_keys(v, path, {"generator", "file", "element", "triangles", "size", "divisions", "radius", "length", "angle_deg", "hole_deg"});
       fail(path, "needs \"generator\" or \"file\"", v,
            "expected e.g. {\"generator\": \"rectangle\", ...} or {\"file\": \"mesh.obj\"}");
     }
@@ -349,13 +349,13 @@ class SceneReader {
     mesh.source = static_cast<MeshSource>(choice(*generator, child(path, "generator"), {"rectangle", "cylinder", "hemisphere"}));
     switch (mesh.source) {
       case MeshSource::rectangle:
-        check_keys(v, path, {"generator", "size", "divisions", "element"});
+        check_keys(v, path, {"generator", "size", "divisions", "element", "triangles"});
         mesh.size = numbers<2>(require(v, path, "size", "[a, b]"), child(path, "size"));
         for (int i = 0; i < 2; ++i)
           if (!(mesh.size[i] > 0)) fail(item(child(path, "size"), i), "must be positive", v["size"][i], "expected a length > 0");
         break;
       case MeshSource::cylinder: {
-        check_keys(v, path, {"generator", "radius", "length", "angle_deg", "divisions", "element"});
+        check_keys(v, path, {"generator", "radius", "length", "angle_deg", "divisions", "element", "triangles"});
         mesh.radius = positive(require(v, path, "radius", "a radius > 0"), child(path, "radius"));
         mesh.length = positive(require(v, path, "length", "a length > 0"), child(path, "length"));
         const json& angles = require(v, path, "angle_deg", "[t0, t1] in degrees with t0 < t1 <= t0 + 360");
@@ -367,7 +367,7 @@ class SceneReader {
         break;
       }
       case MeshSource::hemisphere: {
-        check_keys(v, path, {"generator", "radius", "hole_deg", "divisions", "element"});
+        check_keys(v, path, {"generator", "radius", "hole_deg", "divisions", "element", "triangles"});
         mesh.radius = positive(require(v, path, "radius", "a radius > 0"), child(path, "radius"));
         const json& hole = require(v, path, "hole_deg", "a polar hole angle in (0, 90) degrees");
         mesh.hole_deg = number(hole, child(path, "hole_deg"));
@@ -393,6 +393,13 @@ class SceneReader {
       fail(divisions_path, "too many cells", divisions, "at most 10000000 cells (product of the divisions)");
     mesh.element = ElementType::quad8;
     if (const json* e = find(v, "element")) mesh.element = element_type(*e, child(path, "element"));
+    if (const json* t = find(v, "triangles")) {
+      if (mesh.element != ElementType::tri6)
+        fail(child(path, "triangles"), "only tri6 cells are split into triangles", *t,
+             "remove it, or set \"element\": \"tri6\"");
+      mesh.triangles = choice(*t, child(path, "triangles"), {"sheared", "square"}) == 0 ? TriangleSplit::sheared
+                                                                                        : TriangleSplit::square;
+    }
     return mesh;
   }
 
@@ -828,6 +835,7 @@ json mesh_to_json(const MeshSpec& m) {
     return out;
   }
   out["element"] = element_name(m.element.value_or(ElementType::quad8));
+  if (m.triangles == TriangleSplit::square) out["triangles"] = "square";  // the reader refuses it on quad8
   out["divisions"] = {m.divisions[0], m.divisions[1]};
   switch (m.source) {
     case MeshSource::rectangle:

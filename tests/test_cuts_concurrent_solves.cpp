@@ -21,16 +21,17 @@ namespace {
 
 // Every function's values, elements and nodes after each update time, in one list.
 std::vector<double> run(const Mesh& mesh, const std::vector<Cut>& cuts, const EnrichmentOptions& options,
-                        const std::vector<double>& times, int threads, int& solves) {
+                        const std::vector<double>& times, int threads, int& solves, int& graph_solves) {
   const int saved = omp_get_max_threads();
   omp_set_num_threads(threads);
   const Topology topology = build_topology(mesh);
   CutManager manager(mesh, topology, cuts, options);
   std::vector<double> out;
-  solves = 0;
+  solves = 0, graph_solves = 0;
   for (double t : times) {
     manager.update(t);
     solves += manager.last_update().solves;
+    graph_solves += manager.last_update().algebraic_multigrid_solves;
     for (const EnrichmentFunction& f : manager.functions()) {
       out.insert(out.end(), f.enriched_nodes.begin(), f.enriched_nodes.end());
       for (const ElementTexture& texture : f.elements) {
@@ -43,12 +44,13 @@ std::vector<double> run(const Mesh& mesh, const std::vector<Cut>& cuts, const En
   return out;
 }
 
+// graph_solves: how many of the solves (one thread) the algebraic multigrid made.
 void expect_thread_count_independent(const Mesh& mesh, const std::vector<Cut>& cuts, const EnrichmentOptions& options,
-                                     const std::vector<double>& times, int min_solves) {
-  int solves1 = 0, solves2 = 0, solves4 = 0;
-  const std::vector<double> one = run(mesh, cuts, options, times, 1, solves1);
-  const std::vector<double> two = run(mesh, cuts, options, times, 2, solves2);
-  const std::vector<double> four = run(mesh, cuts, options, times, 4, solves4);
+                                     const std::vector<double>& times, int min_solves, int& graph_solves) {
+  int solves1 = 0, solves2 = 0, solves4 = 0, ignored = 0;
+  const std::vector<double> one = run(mesh, cuts, options, times, 1, solves1, graph_solves);
+  const std::vector<double> two = run(mesh, cuts, options, times, 2, solves2, ignored);
+  const std::vector<double> four = run(mesh, cuts, options, times, 4, solves4, ignored);
   EXPECT_GE(solves1, min_solves);
   EXPECT_EQ(solves1, solves2);
   EXPECT_EQ(solves1, solves4);
@@ -58,6 +60,12 @@ void expect_thread_count_independent(const Mesh& mesh, const std::vector<Cut>& c
   for (std::size_t k = 0; k < one.size(); ++k) differ2 += one[k] != two[k], differ4 += one[k] != four[k];
   EXPECT_EQ(differ2, 0u) << "of " << one.size();
   EXPECT_EQ(differ4, 0u) << "of " << one.size();
+}
+
+void expect_thread_count_independent(const Mesh& mesh, const std::vector<Cut>& cuts, const EnrichmentOptions& options,
+                                     const std::vector<double>& times, int min_solves) {
+  int graph_solves = 0;
+  expect_thread_count_independent(mesh, cuts, options, times, min_solves, graph_solves);
 }
 
 EnrichmentOptions multigrid_enrichment(int resolution) {
@@ -82,8 +90,22 @@ TEST(CutsConcurrentSolves, ProgressiveTri6CutsAreThreadCountIndependent) {
   for (Cut& cut : cuts) cut.has_schedule = true, cut.speed = 1.0;
   for (const EnrichmentOptions& options : {multigrid_enrichment(16), cholmod_enrichment(16)}) {
     SCOPED_TRACE(options.solver == EnrichmentOptions::Solver::multigrid ? "algebraic multigrid" : "CHOLMOD");
-    expect_thread_count_independent(mesh, cuts, options, {0.5, 1.0, 1.5, 2.0, 3.0}, 8);
+    int graph_solves = 0;
+    expect_thread_count_independent(mesh, cuts, options, {0.5, 1.0, 1.5, 2.0, 3.0}, 8, graph_solves);
+    const bool multigrid = options.solver == EnrichmentOptions::Solver::multigrid;
+    EXPECT_EQ(graph_solves > 0, multigrid);  // sheared cells: no lattice holds these regions
   }
+}
+
+// The same cuts on square-split cells: the regions lie on texel lattices (tile multigrid).
+TEST(CutsConcurrentSolves, ProgressiveCutsOnSquareSplitTri6AreThreadCountIndependent) {
+  const Mesh mesh = make_rectangle(3, 2, 3, 2, ElementType::tri6, TriangleSplit::square);
+  std::vector<Cut> cuts = {points_cut({{0.1, 0.35, 0}, {2.6, 0.6, 0}}), points_cut({{0.2, 1.5, 0}, {2.7, 1.3, 0}}),
+                           points_cut({{1.45, 0.9, 0}, {1.55, 1.2, 0}})};
+  for (Cut& cut : cuts) cut.has_schedule = true, cut.speed = 1.0;
+  int graph_solves = -1;
+  expect_thread_count_independent(mesh, cuts, multigrid_enrichment(16), {0.5, 1.0, 1.5, 2.0, 3.0}, 8, graph_solves);
+  EXPECT_EQ(graph_solves, 0);
 }
 
 TEST(CutsConcurrentSolves, ProgressiveMixedRegionsAreThreadCountIndependent) {

@@ -1,9 +1,11 @@
 // The multi-element harmonic problem (mesh_texel_laplace.h) solved by the tile multigrid on
 // one patch tile must give CHOLMOD's solution on the texel graph: same couplings across
 // element edges, walls (inside tiles and along mesh edges), frozen neighbours as data; a
-// closed cylinder ring is cut open into a seamed patch (seamed_patch_laplace.h) and regions
-// that cannot lie flat (tri6) are solved by algebraic multigrid on the texel graph
-// (graph_laplacian_amg.h) to the same answer.
+// closed cylinder ring is cut open into a seamed patch (seamed_patch_laplace.h); regions whose
+// tiles lie on one texel lattice only texel by texel (turned quad8 neighbours, tri6 cells
+// split into square texels) are solved on a lattice patch, and those that cannot lie flat
+// (a tri6 hypotenuse meeting a leg) by algebraic multigrid on the texel graph
+// (graph_laplacian_amg.h), all to the same answer.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -85,8 +87,37 @@ TEST(LaplaceMeshMultigrid, ClosedCylinderRingSolvesOnASeamedPatch) {
                                   MeshEdgeWalls(T), true);
 }
 
-TEST(LaplaceMeshMultigrid, Tri6RegionSolvesByAlgebraicMultigridToTheSameAnswer) {
-  expect_multigrid_equals_cholmod({make_rectangle(1, 1, 1, 1, ElementType::tri6), {0, 1}}, MeshEdgeWalls(T), false);
+// The sheared split's hypotenuses meet legs across the cell sides: a staircase of texels
+// coupled to a straight row closes 5-cycles, which no square lattice holds.
+TEST(LaplaceMeshMultigrid, ShearedTri6BlockSolvesByAlgebraicMultigridToTheSameAnswer) {
+  expect_multigrid_equals_cholmod({make_rectangle(2, 2, 2, 2, ElementType::tri6), {0, 1, 2, 3, 4, 5, 6, 7}},
+                                  MeshEdgeWalls(T), false);
+}
+
+// One sheared cell: its two triangles meet leg to leg along the diagonal, which the lattice holds.
+TEST(LaplaceMeshMultigrid, ShearedTri6CellLiesOnTheLattice) {
+  expect_multigrid_equals_cholmod({make_rectangle(1, 1, 1, 1, ElementType::tri6), {0, 1}}, MeshEdgeWalls(T), true);
+}
+
+// A 2 x 2 block of square-split cells (eight triangles, hypotenuse to hypotenuse on the
+// diagonals, legs across the cell sides), one triangle settled, half of a diagonal and half
+// of a cell side walled: the lattice patch with ghost texels gives CHOLMOD's answer.
+TEST(LaplaceMeshMultigrid, SquareSplitTri6BlockWithEdgeWallsAndFrozenTileSolvesOnTheLattice) {
+  const Mesh mesh = make_rectangle(3, 3, 3, 3, ElementType::tri6, TriangleSplit::square);
+  const ElementAdjacency adjacency(mesh, build_topology(mesh));
+  MeshEdgeWalls walls(T);
+  for (int s = 0; s < T / 2; ++s) walls.block(0, 1, s, adjacency), walls.block(1, 2, s, adjacency);
+  expect_multigrid_equals_cholmod({mesh, {0, 1, 2, 3, 6, 7, 8, 9}}, walls, true, {5});
+}
+
+// Element 1 numbered from another corner: its edge toward element 0 is not the one opposite
+// element 0's, so the blocks of tiles do not fit, but the texels still lie on one lattice.
+TEST(LaplaceMeshMultigrid, TurnedQuad8NeighbourSolvesOnTheLattice) {
+  Mesh mesh = make_rectangle(2, 2, 2, 2, ElementType::quad8);
+  int* nodes = mesh.elements.data() + 8;  // element 1: corners then midside nodes
+  std::rotate(nodes, nodes + 1, nodes + 4);
+  std::rotate(nodes + 4, nodes + 5, nodes + 8);
+  expect_multigrid_equals_cholmod({mesh, {0, 1, 2, 3}}, MeshEdgeWalls(T), true, {2});
 }
 
 // The eight triangles of a 2 x 2 block, one of them settled, half of an element edge walled

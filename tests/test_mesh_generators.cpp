@@ -2,11 +2,13 @@
 // areas (with their convergence rate under refinement) and the documented normal directions.
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <functional>
 #include <set>
 
+#include "dgtex/cut_path.h"
 #include "dgtex/mesh_generators.h"
 #include "dgtex/mesh_validation.h"
 #include "dgtex/topology.h"
@@ -90,6 +92,44 @@ TEST_P(Generators, RectangleCountsAreaAndNormals) {
   EXPECT_EQ(lo[2], 0.0);
   EXPECT_EQ(hi[2], 0.0);
   expect_normals(mesh, [](const double*, double* m) { m[0] = 0, m[1] = 0, m[2] = 1; });
+}
+
+// The square split: the same nodes and cells as the sheared one, each triangle's first vertex
+// at a right angle of the cell with its legs along the cell sides (so its texels are square on
+// a square cell), the diagonal the hypotenuse (local edge 1) of both, normals +z. On a closed
+// cylinder and the hemisphere too, every mesh stays valid with outward normals.
+TEST(Generators, SquareSplitTrianglesStartAtACellCorner) {
+  const int nx = 3, ny = 2;
+  const Mesh sheared = make_rectangle(1.5, 1.0, nx, ny, ElementType::tri6);
+  const Mesh square = make_rectangle(1.5, 1.0, nx, ny, ElementType::tri6, TriangleSplit::square);
+  validate_mesh(square);
+  EXPECT_EQ(square.positions, sheared.positions);
+  ASSERT_EQ(square.num_elements(), sheared.num_elements());
+  for (int e = 0; e < square.num_elements(); ++e) {
+    const int* a = square.element_nodes(e);
+    const int* b = sheared.element_nodes(e);
+    EXPECT_EQ(std::multiset<int>(a, a + 6), std::multiset<int>(b, b + 6)) << "element " << e;
+    const double *p0 = square.node(a[0]), *p1 = square.node(a[1]), *p2 = square.node(a[2]);
+    const double u[2] = {p1[0] - p0[0], p1[1] - p0[1]}, v[2] = {p2[0] - p0[0], p2[1] - p0[1]};
+    EXPECT_EQ(u[0] * v[0] + u[1] * v[1], 0.0) << "element " << e << ": a right angle at vertex 0";
+    EXPECT_TRUE((u[0] == 0) != (u[1] == 0)) << "element " << e << ": legs along the cell sides";
+  }
+  const Topology topology = build_topology(square);
+  const ElementAdjacency adjacency(square, topology);
+  for (int e = 0; e < square.num_elements(); e += 2) EXPECT_EQ(adjacency.neighbour(e, 1), (std::array<int, 2>{e + 1, 1}));
+  expect_normals(square, [](const double*, double* m) { m[0] = 0, m[1] = 0, m[2] = 1; });
+  const Mesh ring = make_cylinder(1.0, 2.0, 0, 360, 6, 2, ElementType::tri6, TriangleSplit::square);
+  validate_mesh(ring);
+  expect_normals(ring, [](const double* x, double* m) {
+    const double r = std::hypot(x[0], x[2]);
+    m[0] = x[0] / r, m[1] = 0, m[2] = x[2] / r;
+  });
+  const Mesh cap = make_hemisphere(1.0, 10, 4, 8, ElementType::tri6, TriangleSplit::square);
+  validate_mesh(cap);
+  expect_normals(cap, [](const double* x, double* m) {
+    const double r = std::sqrt(x[0] * x[0] + x[1] * x[1] + x[2] * x[2]);
+    for (int d = 0; d < 3; ++d) m[d] = x[d] / r;
+  });
 }
 
 TEST_P(Generators, CylinderOpenAndClosed) {

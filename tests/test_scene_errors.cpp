@@ -183,6 +183,12 @@ TEST(SceneErrors, MeshParameters) {
   expect_error(with(valid_scene(), "/mesh"_json_pointer, {{"file", "nowhere.obj"}}), "mesh.file", "\"nowhere.obj\"",
                "no such file");
   expect_error(with(valid_scene(), "/mesh/file"_json_pointer, "x.obj"), "mesh.file", "\"x.obj\"", "exclude each other");
+  // The tri6 split: only on tri6, one of two words.
+  expect_error(with(valid_scene(), "/mesh/triangles"_json_pointer, "square"), "mesh.triangles", "\"square\"",
+               "only tri6 cells");
+  const json tri6 = with(valid_scene(), "/mesh/element"_json_pointer, "tri6");
+  expect_error(with(tri6, "/mesh/triangles"_json_pointer, "diagonal"), "mesh.triangles", "\"diagonal\"",
+               "\"sheared\", \"square\"");
 }
 
 TEST(SceneErrors, BoundarySelections) {

@@ -6,7 +6,9 @@
 #include <sstream>
 #include <string>
 
+#include "dgtex/mesh_generators.h"
 #include "dgtex/scene_io.h"
+#include "dgtex/scene_model.h"
 
 namespace {
 
@@ -107,6 +109,7 @@ TEST(SceneParse, FullSceneHasEveryValue) {
 TEST(SceneParse, MinimalSceneGetsDocumentedDefaults) {
   const Scene s = load_scene(scene_path("minimal.json"));
   EXPECT_EQ(s.mesh.element.value(), ElementType::quad8);
+  EXPECT_EQ(s.mesh.triangles, TriangleSplit::sheared);
   EXPECT_EQ(s.material.density, 0.0);
   EXPECT_EQ(s.penalty, 10.0);
   EXPECT_TRUE(s.boundary.empty());
@@ -171,6 +174,23 @@ TEST(SceneParse, GeneratorsReadTheirParameters) {
   EXPECT_EQ(dome.mesh.radius, 1.5);
   EXPECT_EQ(dome.mesh.hole_deg, 10.0);
   EXPECT_EQ(dome.mesh.divisions, (std::array<int, 2>{4, 16}));
+}
+
+// "triangles" picks the tri6 split; it survives the canonical round trip (and so
+// validate_scene), and the scene's mesh is the generator's square split.
+TEST(SceneParse, Tri6TrianglesSplitIsReadAndKept) {
+  const std::string material = R"("material": {"youngs_modulus": 1, "poisson_ratio": 0.3, "thickness": 0.1})";
+  const Scene square = parse_scene(R"({"mesh": {"generator": "rectangle", "size": [2, 1], "divisions": [2, 1],
+      "element": "tri6", "triangles": "square"}, )" + material + "}", "t.json");
+  EXPECT_EQ(square.mesh.triangles, TriangleSplit::square);
+  const Scene echo = parse_scene(scene_to_json_text(square), "echo.json");
+  EXPECT_EQ(echo.mesh.triangles, TriangleSplit::square);
+  EXPECT_EQ(build_scene_mesh(square).elements, make_rectangle(2, 1, 2, 1, ElementType::tri6, TriangleSplit::square).elements);
+  EXPECT_NE(build_scene_mesh(square).elements, make_rectangle(2, 1, 2, 1, ElementType::tri6).elements);
+  const Scene sheared = parse_scene(R"({"mesh": {"generator": "rectangle", "size": [2, 1], "divisions": [2, 1],
+      "element": "tri6", "triangles": "sheared"}, )" + material + "}", "t.json");
+  EXPECT_EQ(sheared.mesh.triangles, TriangleSplit::sheared);
+  EXPECT_EQ(scene_to_json_text(sheared).find("triangles"), std::string::npos);  // the default is not written
 }
 
 TEST(SceneParse, MeshFileResolvesAgainstTheSceneFolder) {

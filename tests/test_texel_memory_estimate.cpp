@@ -54,9 +54,10 @@ TEST(TexelMemoryEstimate, LowerBoundIsBytesPerActiveTexelOfEveryFieldsRegion) {
 }
 
 // The counts come from the paths alone; the update's own regions (its functions' Omega_i)
-// can hold an element less where a path grazes one (fracture 290 against 284, slinky 48
-// against 47): an over-count of at most a few per cent, inside the bound's margin (64 bytes
-// a texel against >= 84 measured).
+// can hold an element less where a path grazes one (fracture 290 against 281 on its square
+// split, 290 against 284 on the sheared one; slinky 48 against 47): an over-count of at most a
+// few per cent, inside the bounds' margins (64 bytes a texel against >= 84 measured; on
+// tri6, 160 against >= 192).
 TEST(TexelMemoryEstimate, FootprintMatchesTheRegionsOfTheWholeCuts) {
   for (const std::string name : {"chad", "spiral6", "slinky", "fracture"}) {
     SCOPED_TRACE(name);
@@ -72,7 +73,7 @@ TEST(TexelMemoryEstimate, FootprintMatchesTheRegionsOfTheWholeCuts) {
     EXPECT_EQ(footprint.fields, cuts.total_segments());
     EXPECT_EQ(static_cast<int>(cuts.functions().size()), footprint.fields);  // each segment has a function here
     EXPECT_GE(footprint.region_elements, region_elements);
-    EXPECT_LE(footprint.region_elements, region_elements * 103 / 100);
+    EXPECT_LE(footprint.region_elements, region_elements * 105 / 100);
   }
 }
 

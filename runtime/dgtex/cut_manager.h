@@ -72,6 +72,7 @@ struct CutUpdateStats {
   int solves = 0;       // functions (re)solved
   int unknowns = 0;     // texel unknowns over those solves
   int solved_tiles = 0, frozen_tiles = 0;
+  int algebraic_multigrid_solves = 0;  // of the solves, those no patch held (mesh_texel_laplace.h)
 };
 
 class CutManager {

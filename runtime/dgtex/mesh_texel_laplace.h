@@ -22,9 +22,15 @@
 // on one patch tile holding the same couplings (options: tolerance, warm start from the
 // tiles' values); frozen texels coupled to solved ones enter that patch as Dirichlet ghost
 // texels beside the edge they couple across, walled off from everything else; a ring closed
-// through solved tiles, on a patch cut open at a seam. Regions that no patch holds (tri6,
-// turned neighbours) are solved by algebraic multigrid on the texel graph. With
-// LaplaceSolver::cholmod, or where a multigrid misses its tolerance, CHOLMOD solves.
+// through solved tiles, on a patch cut open at a seam. Other regions whose texels still lie on
+// one square lattice with every coupling between lattice neighbours (quad8 neighbours turned
+// against each other; tri6 cells split with the diagonal as both hypotenuses,
+// TriangleSplit::square: each hypotenuse texel's partner sits beside it) are solved by the
+// tile multigrid on a lattice patch, texel by texel, walled wherever lattice neighbours are
+// not coupled. Regions no lattice holds (a tri6 hypotenuse meeting a leg: the sheared
+// split's 5-cycles; rings of such cells) are solved by algebraic multigrid on the texel
+// graph. With LaplaceSolver::cholmod, or where a multigrid misses its tolerance, CHOLMOD
+// solves.
 // Value types that own their data (MeshEdgeWalls its key set, RegionTile its tile) and
 // functions that keep nothing; a solve may use all OpenMP threads. Values dimensionless.
 #include <cstdint>
@@ -84,8 +90,8 @@ struct MeshLaplaceStats {
 // Solves in place: free texels of non-frozen tiles get H; data texels keep their values.
 // All tiles must be T x T of the same T, elements distinct (std::invalid_argument
 // otherwise); std::runtime_error if CHOLMOD fails. With LaplaceSolver::multigrid, regions
-// that lie flat are solved by the tile multigrid on one patch tile, the others (tri6,
-// turned neighbours) by algebraic multigrid on the texel graph (graph_laplacian_amg.h),
+// that lie flat (as blocks of tiles or texel by texel) are solved by the tile multigrid on
+// one patch tile, the others by algebraic multigrid on the texel graph (graph_laplacian_amg.h),
 // both to options.tolerance. CHOLMOD solves the region with LaplaceSolver::cholmod and
 // where a multigrid does not converge: simplicial with the AMD ordering. None calls BLAS or
 // METIS, so concurrent calls (one segment per thread in CutManager) need no lock and give

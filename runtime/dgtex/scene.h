@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "dgtex/kernels/shape_functions.h"
+#include "dgtex/mesh_generators.h"
 
 namespace dgtex {
 
@@ -29,6 +30,7 @@ struct MeshSpec {
   // Elements along each generator parameter: rectangle [x, y], cylinder [angle, length],
   // hemisphere [polar, azimuth]. A tri6 generator makes two triangles per cell.
   std::array<int, 2> divisions{};
+  TriangleSplit triangles = TriangleSplit::sheared;  // tri6 generators: the corners each triangle starts at
   std::array<double, 2> size{};       // rectangle: [a, b], points (x, y, 0) in [0,a]x[0,b]
   double radius = 0;                  // cylinder, hemisphere
   double length = 0;                  // cylinder: axis y in [0, L]

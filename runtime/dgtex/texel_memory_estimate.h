@@ -13,9 +13,11 @@
 // the start (set-up and one step, T = 256-4096, 2-core machine; README "enrichment"):
 //  - cuts with multigrid Laplace solves: 84-226 bytes, falling with T toward ~85 (spiral6
 //    at 4096: 8.5 GB); bound kFieldBytesPerTexel;
-//  - cuts whose solves run on the texel graph (tri6 elements: the algebraic multigrid's
-//    hierarchy, 203-257 bytes at T = 256-128 (fracture, session 43); enrichment.solver
-//    "cholmod": CHOLMOD's factor, 187-678 bytes): bound kGraphSolveBytesPerTexel;
+//  - cuts on tri6 elements, and cuts whose solves run on the texel graph: the algebraic
+//    multigrid's hierarchy (cells split sheared), 203-257 bytes at T = 256-128 (fracture,
+//    session 43); lattice patches of the tile multigrid (cells split square), 192-272 bytes
+//    at T = 512-128 (fracture, session 45); enrichment.solver "cholmod": CHOLMOD's factor,
+//    187-678 bytes: bound kGraphSolveBytesPerTexel;
 //  - creases (a fast-marching distance, no solve): 81-82 bytes (a crease over 8 of 64
 //    quad8 elements, T = 512 and 1024); bound kFieldBytesPerTexel.
 // A scene that passes may still need several times the bound (chad's cut on tri6
