@@ -287,10 +287,11 @@ std::array<int, 2> step_across(ElementType type, int edge) {
 // tiles fixes each neighbour's transform from the shared edge (its T partner texels must sit
 // one step out of the edge, and its interior on the far side). Frozen tiles are placed from
 // the first solved tile that meets them and not walked from (their texels only become ghost
-// data beside the solved ones). A rectangle tri6 mesh's two triangles of a square sit side by
-// side, sheared by one column per row of squares. Fails (false) where two ways round reach a
-// solved tile with different transforms (a closed ring, a vertex the lattice cannot
-// surround) or the solved tiles are not edge-connected.
+// data beside the solved ones). The two triangles of a square-split cell
+// (TriangleSplit::square) sit side by side in T x (T + 1) texels, and each row of cells one
+// column on from the row below. Fails (false) where two ways round reach a solved tile with
+// different transforms (a closed ring, a vertex the lattice cannot surround, the sheared
+// split's hypotenuse against a leg) or the solved tiles are not edge-connected.
 bool place_tiles_on_lattice(const TexelGraph& graph, const std::vector<RegionTile>& tiles, ElementType type,
                             std::vector<LatticeTransform>& placed) {
   const int count = static_cast<int>(tiles.size()), t = tiles.front().tile.width;
