@@ -464,20 +464,37 @@ MeshLaplaceStats solve_mesh_texel_laplace(std::vector<RegionTile>& tiles, Elemen
   // links the larger root under the smaller, so parent[v] <= v and one forward pass
   // flattens every texel to its root.
   const int t = tiles.front().tile.width, tt = t * t;
-  std::vector<char> is_free(n), is_data(n);
+  std::vector<char> is_free(n), is_data(n), tile_has_data(tiles.size(), 0);
   // Data: active texels of frozen tiles and Dirichlet texels; free: the other active ones.
   for (int l = 0; l < static_cast<int>(tiles.size()); ++l) {
     const std::uint8_t* flags = tiles[l].tile.flags.data();
     const bool frozen = tiles[l].frozen;
     char* free_texel = is_free.data() + static_cast<std::size_t>(l) * tt;
     char* data_texel = is_data.data() + static_cast<std::size_t>(l) * tt;
+    char any_data = 0;
     for (int k = 0; k < tt; ++k) {
       const bool active = !(flags[k] & kernels::inactive);
       const bool data = active && (frozen || (flags[k] & kernels::dirichlet));
       data_texel[k] = data;
       free_texel[k] = active && !data;
+      any_data |= data;
     }
+    tile_has_data[l] = any_data;
   }
+  // Calls f(i, j) once for each texel that can couple across a mesh edge: all of the first
+  // (and the quad8's last) row, else the first texel of the row and its last active one
+  // (tri6: the hypotenuse's, i = t - 1 - j; the texels beyond it are inactive).
+  auto for_each_border_texel = [&](auto&& f) {
+    for (int j = 0; j < t; ++j) {
+      if (j == 0 || (type == ElementType::quad8 && j == t - 1)) {
+        for (int i = 0; i < t; ++i) f(i, j);
+        continue;
+      }
+      f(0, j);
+      const int last = type == ElementType::quad8 ? t - 1 : t - 1 - j;
+      if (last > 0) f(last, j);
+    }
+  };
   std::vector<int> parent(n);
   for (int l = 0; l < static_cast<int>(tiles.size()); ++l) {
     // Within the tile, in texel order: a free texel joins its west or south neighbour's set
@@ -506,15 +523,7 @@ MeshLaplaceStats solve_mesh_texel_laplace(std::vector<RegionTile>& tiles, Elemen
       if (w / tt != l && is_free[w]) kernels::unite_smaller_root(parent, v, w);
     });
   };
-  for (int l = 0; l < static_cast<int>(tiles.size()); ++l)
-    for (int j = 0; j < t; ++j) {
-      // Row j's border texels: all of the first (and the quad8's last) row, else the first
-      // texel and the last one (tri6: those on or past the hypotenuse, i + j >= t - 1).
-      const bool whole_row = j == 0 || (type == ElementType::quad8 && j == t - 1);
-      const int tail = whole_row ? 1 : std::max(1, type == ElementType::quad8 ? t - 1 : t - 1 - j);
-      unite_across(l, 0, j);
-      for (int i = tail; i < t; ++i) unite_across(l, i, j);
-    }
+  for (int l = 0; l < static_cast<int>(tiles.size()); ++l) for_each_border_texel([&](int i, int j) { unite_across(l, i, j); });
   for (int v = 0; v < n; ++v) parent[v] = parent[parent[v]];
   enum : std::uint8_t { no_data = 0, constant = 1, varying = 2 };
   std::vector<std::uint8_t> state(n, no_data);
@@ -525,29 +534,35 @@ MeshLaplaceStats solve_mesh_texel_laplace(std::vector<RegionTile>& tiles, Elemen
   for (int l = 0; l < static_cast<int>(tiles.size()); ++l) {
     const std::uint8_t* flags = tiles[l].tile.flags.data();
     const double* values = tiles[l].tile.values.data();
-    for (int j = 0; j < t; ++j)
-      for (int i = 0; i < t; ++i) {
-        const int k = j * t + i, v = l * tt + k;
-        if (!is_free[v]) continue;
-        const int root = parent[v];
-        if (state[root] == varying) continue;  // nothing more to learn
-        auto meet = [&](double x) {
-          if (state[root] == no_data) state[root] = constant, constant_value[root] = x;
-          else if (state[root] == constant && x != constant_value[root]) state[root] = varying;
-        };
-        const bool border = i == 0 || j == 0 || i == t - 1 || j == t - 1 || (type == ElementType::tri6 && i + j >= t - 1);
-        if (border) {
-          graph.for_each_coupling(v, [&](int w) {
-            if (is_data[w]) meet(graph.value(w));
-          });
-          continue;
-        }
-        // Interior texel: its four neighbours are in the tile (data implies active).
-        if (is_data[v + 1] && !(flags[k] & kernels::wall_east)) meet(values[k + 1]);
-        if (is_data[v - 1] && !(flags[k - 1] & kernels::wall_east)) meet(values[k - 1]);
-        if (is_data[v + t] && !(flags[k] & kernels::wall_north)) meet(values[k + t]);
-        if (is_data[v - t] && !(flags[k - t] & kernels::wall_north)) meet(values[k - t]);
+    auto meet_at = [&](int i, int j) {
+      const int k = j * t + i, v = l * tt + k;
+      if (!is_free[v]) return;
+      const int root = parent[v];
+      if (state[root] == varying) return;  // nothing more to learn
+      auto meet = [&](double x) {
+        if (state[root] == no_data) state[root] = constant, constant_value[root] = x;
+        else if (state[root] == constant && x != constant_value[root]) state[root] = varying;
+      };
+      const bool border = i == 0 || j == 0 || i == t - 1 || j == t - 1 || (type == ElementType::tri6 && i + j >= t - 1);
+      if (border) {
+        graph.for_each_coupling(v, [&](int w) {
+          if (is_data[w]) meet(graph.value(w));
+        });
+        return;
       }
+      // Interior texel: its four neighbours are in the tile (data implies active).
+      if (is_data[v + 1] && !(flags[k] & kernels::wall_east)) meet(values[k + 1]);
+      if (is_data[v - 1] && !(flags[k - 1] & kernels::wall_east)) meet(values[k - 1]);
+      if (is_data[v + t] && !(flags[k] & kernels::wall_north)) meet(values[k + t]);
+      if (is_data[v - t] && !(flags[k - t] & kernels::wall_north)) meet(values[k - t]);
+    };
+    // A tile without data meets data only across its edges: its border texels alone.
+    if (!tile_has_data[l]) {
+      for_each_border_texel(meet_at);
+      continue;
+    }
+    for (int j = 0; j < t; ++j)
+      for (int i = 0; i < t; ++i) meet_at(i, j);
   }
   std::vector<int> unknown_of(n, -1);
   std::vector<int> node_of;
