@@ -147,7 +147,8 @@ Mesh make_cylinder(double radius, double length, double angle0_deg, double angle
   return mesh_parametric_surface(s, type, split);
 }
 
-Mesh make_hemisphere(double radius, double hole_deg, int n_polar, int n_azimuth, ElementType type, TriangleSplit split) {
+Mesh make_hemisphere(double radius, double hole_deg, int n_polar, int n_azimuth, ElementType type,
+                     TriangleSplit split) {
   require_positive_length("hemisphere", "radius", radius);
   require(std::isfinite(hole_deg) && hole_deg > 0 && hole_deg < 90,
           "hemisphere: hole_deg must lie in (0, 90) degrees (the pole itself cannot be meshed by this grid), got " +

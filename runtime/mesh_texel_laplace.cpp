@@ -406,7 +406,8 @@ LaplaceSolveStats solve_on_lattice_patch(TexelGraph& graph, const std::vector<Re
         const double value = graph.value(u);
         if (occupant[c] >= 0 || (occupant[c] == ghost && patch.values[c] != value))
           throw std::runtime_error("a ghost texel on a taken lattice place");
-        if (occupant[c] == empty) occupant[c] = ghost, patch.flags[c] = walled | kernels::dirichlet, patch.values[c] = value;
+        if (occupant[c] == empty)
+          occupant[c] = ghost, patch.flags[c] = walled | kernels::dirichlet, patch.values[c] = value;
       }
       // The wall bit sits on the west / south texel of the pair.
       if (dx == 1) patch.flags[g] &= static_cast<std::uint8_t>(~kernels::wall_east);
@@ -523,7 +524,8 @@ MeshLaplaceStats solve_mesh_texel_laplace(std::vector<RegionTile>& tiles, Elemen
       if (w / tt != l && is_free[w]) kernels::unite_smaller_root(parent, v, w);
     });
   };
-  for (int l = 0; l < static_cast<int>(tiles.size()); ++l) for_each_border_texel([&](int i, int j) { unite_across(l, i, j); });
+  for (int l = 0; l < static_cast<int>(tiles.size()); ++l)
+    for_each_border_texel([&](int i, int j) { unite_across(l, i, j); });
   for (int v = 0; v < n; ++v) parent[v] = parent[parent[v]];
   enum : std::uint8_t { no_data = 0, constant = 1, varying = 2 };
   std::vector<std::uint8_t> state(n, no_data);

@@ -19,11 +19,13 @@ Mesh build_scene_mesh(const Scene& scene) {
   const MeshSpec& m = scene.mesh;
   const ElementType type = m.element.value_or(ElementType::quad8);
   switch (m.source) {
-    case MeshSource::rectangle: return make_rectangle(m.size[0], m.size[1], m.divisions[0], m.divisions[1], type, m.triangles);
+    case MeshSource::rectangle:
+      return make_rectangle(m.size[0], m.size[1], m.divisions[0], m.divisions[1], type, m.triangles);
     case MeshSource::cylinder:
       return make_cylinder(m.radius, m.length, m.angle_deg[0], m.angle_deg[1], m.divisions[0], m.divisions[1], type,
                            m.triangles);
-    case MeshSource::hemisphere: return make_hemisphere(m.radius, m.hole_deg, m.divisions[0], m.divisions[1], type, m.triangles);
+    case MeshSource::hemisphere:
+      return make_hemisphere(m.radius, m.hole_deg, m.divisions[0], m.divisions[1], type, m.triangles);
     case MeshSource::file: return load_obj(m.file);
   }
   return {};

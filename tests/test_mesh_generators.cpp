@@ -116,7 +116,8 @@ TEST(Generators, SquareSplitTrianglesStartAtACellCorner) {
   }
   const Topology topology = build_topology(square);
   const ElementAdjacency adjacency(square, topology);
-  for (int e = 0; e < square.num_elements(); e += 2) EXPECT_EQ(adjacency.neighbour(e, 1), (std::array<int, 2>{e + 1, 1}));
+  for (int e = 0; e < square.num_elements(); e += 2)
+    EXPECT_EQ(adjacency.neighbour(e, 1), (std::array<int, 2>{e + 1, 1})) << "the diagonal: both hypotenuses";
   expect_normals(square, [](const double*, double* m) { m[0] = 0, m[1] = 0, m[2] = 1; });
   const Mesh ring = make_cylinder(1.0, 2.0, 0, 360, 6, 2, ElementType::tri6, TriangleSplit::square);
   validate_mesh(ring);
