@@ -186,6 +186,15 @@ detail::SparseRows texel_laplacian(TexelGraph& graph, const std::vector<int>& no
   return a;
 }
 
+// Walls (or opens) the edge between patch texels g and q, lattice neighbours (q = g +- 1 or
+// g +- width, width > 1): its bit sits on the west / south texel of the pair.
+void set_wall_between(TexelTile& patch, int g, int q, bool wall) {
+  const int low = std::min(g, q);
+  const std::uint8_t bit = std::abs(q - g) == 1 ? kernels::wall_east : kernels::wall_north;
+  if (wall) patch.flags[low] |= bit;
+  else patch.flags[low] &= static_cast<std::uint8_t>(~bit);
+}
+
 // Where each solved region tile sits in one planar texel tile (quad8 only): tile l covers
 // texels [T * x[l], T * (x[l] + 1)) x [T * y[l], T * (y[l] + 1)) of the patch (inside a
 // one-texel margin). Frozen tiles are not placed: their texels coupled to placed tiles
@@ -409,11 +418,7 @@ LaplaceSolveStats solve_on_lattice_patch(TexelGraph& graph, const std::vector<Re
         if (occupant[c] == empty)
           occupant[c] = ghost, patch.flags[c] = walled | kernels::dirichlet, patch.values[c] = value;
       }
-      // The wall bit sits on the west / south texel of the pair.
-      if (dx == 1) patch.flags[g] &= static_cast<std::uint8_t>(~kernels::wall_east);
-      if (dx == -1) patch.flags[c] &= static_cast<std::uint8_t>(~kernels::wall_east);
-      if (dy == 1) patch.flags[g] &= static_cast<std::uint8_t>(~kernels::wall_north);
-      if (dy == -1) patch.flags[c] &= static_cast<std::uint8_t>(~kernels::wall_north);
+      set_wall_between(patch, g, c, false);
     });
   }
   const LaplaceSolveStats s = solve_laplace(patch, LaplaceSolver::multigrid, options);
@@ -677,15 +682,8 @@ MeshLaplaceStats solve_mesh_texel_laplace(std::vector<RegionTile>& tiles, Elemen
           const int gi = g % w, gj = g / w;
           const int neighbour[4] = {g - w, g + 1, g + w, g - 1};  // south, east, north, west
           const bool inside[4] = {gj > 0, gi + 1 < w, gj + 1 < h, gi > 0};
-          for (int d = 0; d < 4; ++d) {
-            if ((partners & (1u << d)) || !inside[d]) continue;
-            const int q = neighbour[d];
-            // the wall bit sits on the west / south texel of the pair
-            if (d == 0) patch.flags[q] |= kernels::wall_north;
-            if (d == 1) patch.flags[g] |= kernels::wall_east;
-            if (d == 2) patch.flags[g] |= kernels::wall_north;
-            if (d == 3) patch.flags[q] |= kernels::wall_east;
-          }
+          for (int d = 0; d < 4; ++d)
+            if (!(partners & (1u << d)) && inside[d]) set_wall_between(patch, g, neighbour[d], true);
         }
         // Seam couplings: texel pairs across each seam edge (listed once, from the lower tile).
         std::vector<detail::SeamCoupling> seams;
