@@ -9,6 +9,7 @@
 
 #include "dgtex/kernels/cut_rasterization.h"
 #include "dgtex/kernels/shape_functions.h"
+#include "dgtex/kernels/vec3.h"
 #include "dgtex/surface_point.h"
 
 namespace dgtex {
@@ -31,10 +32,6 @@ Vec3 lerp(const Vec3& a, const Vec3& b, double s) {
 }
 
 int corners(const Mesh& mesh) { return kernels::corners_per_element(mesh.type); }
-
-Vec3 cross_product(const Vec3& a, const Vec3& b) {
-  return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
-}
 
 // The surface point of `element` at xi and its tangents d/dxi1, d/dxi2.
 void surface_frame(const Mesh& mesh, int element, const double xi[2], Vec3& position, Vec3& d1, Vec3& d2) {
@@ -193,12 +190,15 @@ class PathTracer {
     kernels::local_edge_point(mesh_.type, k, edge_parameter(mesh_.type, k, v.xi), on, along);
     Vec3 position, d1, d2;
     surface_frame(mesh_, v.element, v.xi.data(), position, d1, d2);
-    const double off[2] = {v.xi[0] - on[0], v.xi[1] - on[1]};
-    const Vec3 offset{d1[0] * off[0] + d2[0] * off[1], d1[1] * off[0] + d2[1] * off[1], d1[2] * off[0] + d2[2] * off[1]};
-    const Vec3 edge{d1[0] * along[0] + d2[0] * along[1], d1[1] * along[0] + d2[1] * along[1],
-                    d1[2] * along[0] + d2[2] * along[1]};
+    // A parameter step mapped onto the surface by the tangents.
+    auto on_surface = [&](double w1, double w2) {
+      return Vec3{d1[0] * w1 + d2[0] * w2, d1[1] * w1 + d2[1] * w2, d1[2] * w1 + d2[2] * w2};
+    };
+    const Vec3 offset = on_surface(v.xi[0] - on[0], v.xi[1] - on[1]), edge = on_surface(along[0], along[1]);
     const double edge_length = norm(edge);
-    return edge_length > 0 ? norm(cross_product(offset, edge)) / edge_length : norm(offset);
+    Vec3 normal_part;
+    kernels::cross3(offset.data(), edge.data(), normal_part.data());
+    return edge_length > 0 ? norm(normal_part) / edge_length : norm(offset);
   }
 
   // Appends the path from p (already emitted) to q (emitted here).
@@ -348,7 +348,7 @@ ElementAdjacency::ElementAdjacency(const Mesh& mesh, const Topology& topology) {
 void element_surface_point(const Mesh& mesh, int element, const double xi[2], Vec3& position, Vec3& normal) {
   Vec3 d1, d2;
   surface_frame(mesh, element, xi, position, d1, d2);
-  normal = cross_product(d1, d2);
+  kernels::cross3(d1.data(), d2.data(), normal.data());
   const double n = norm(normal);
   if (n > 0)
     for (double& c : normal) c /= n;
