@@ -175,15 +175,14 @@ nlohmann::json scene_json(const SceneBenchResult& r) {
 // Every run of a scene (--repeats): the one the tables show, each run's steps/s, peak step
 // and enrichment peak, and whether all runs ended in bitwise the same displacement (the
 // simulation does not depend on timing).
-nlohmann::json runs_json(const std::vector<SceneBenchResult>& runs, const SceneBenchResult& chosen_run,
-                         std::size_t chosen, const std::vector<double>& probes_ms) {
+nlohmann::json runs_json(const std::vector<SceneBenchResult>& runs, std::size_t chosen,
+                         const std::vector<double>& probes_ms) {
   nlohmann::json j = {{"count", runs.size()}, {"shown", chosen}, {"identical", true}, {"machine_probe_ms", probes_ms}};
-  for (std::size_t k = 0; k < runs.size(); ++k) {
-    const SceneBenchResult& r = k == chosen ? chosen_run : runs[k];  // runs[chosen] was moved out
+  for (const SceneBenchResult& r : runs) {
     j["steps_per_second"].push_back(r.steps_per_second());
     j["peak_step_ms"].push_back(r.peak_step_ms());
     j["enrichment_ms_max"].push_back(series_max(r.times.enrichment));
-    if (r.displacement != chosen_run.displacement) j["identical"] = false;
+    if (r.displacement != runs[chosen].displacement) j["identical"] = false;
   }
   return j;
 }
@@ -342,10 +341,11 @@ int bench_scenes_command(int argc, char** argv) {
                              return a.steps_per_second() < b.steps_per_second();
                            }) -
           runs.begin());
+      nlohmann::json every_run = runs_json(runs, chosen, run_probes_ms);
       SceneBenchResult r = std::move(runs[chosen]);
       all["scenes"].push_back(scene_json(r));
       all["scenes"].back()["machine_probe_ms"] = run_probes_ms[chosen];
-      all["scenes"].back()["runs"] = runs_json(runs, r, chosen, run_probes_ms);
+      all["scenes"].back()["runs"] = std::move(every_run);
       results.push_back(std::move(r));
       if (!json_path.empty()) write_output_file(json_path, all.dump(2) + "\n", "--json");
     } catch (const SceneError& e) {
