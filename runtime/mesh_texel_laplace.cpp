@@ -59,24 +59,31 @@ int texel_edges(ElementType type, int t, int i, int j, int edges[2], int positio
   return n;
 }
 
+void MeshEdgeWalls::set(int element, int edge, int s) {
+  std::vector<char>& row = rows_[element];
+  if (row.empty()) row.assign(4 * static_cast<std::size_t>(resolution_), 0);
+  row[static_cast<std::size_t>(edge) * resolution_ + s] = 1;
+}
+
 void MeshEdgeWalls::block(int element, int edge, int s, const ElementAdjacency& adjacency) {
-  keys_.insert(key(element, edge, s));
+  set(element, edge, s);
   const auto nb = adjacency.neighbour(element, edge);
-  if (nb[0] >= 0) keys_.insert(key(nb[0], nb[1], resolution_ - 1 - s));
+  if (nb[0] >= 0) set(nb[0], nb[1], resolution_ - 1 - s);
 }
 
 std::vector<long long> MeshEdgeWalls::keys_of_element(int element) const {
   std::vector<long long> out;
-  for (int k = 0; k < 4; ++k)
-    for (int s = 0; s < resolution_; ++s)
-      if (blocked(element, k, s)) out.push_back(key(element, k, s));
+  if (const char* row = of_element(element))
+    for (int k = 0; k < 4 * resolution_; ++k)
+      if (row[k]) out.push_back(static_cast<long long>(element) * 4 * resolution_ + k);
   return out;
 }
 
 std::vector<char> MeshEdgeWalls::flags(int num_elements) const {
   std::vector<char> out(static_cast<size_t>(num_elements) * 4 * resolution_, 0);
-  for (long long k : keys_)
-    if (k >= 0 && k < static_cast<long long>(out.size())) out[static_cast<size_t>(k)] = 1;
+  for (const auto& [element, row] : rows_)
+    if (element >= 0 && element < num_elements)
+      std::copy(row.begin(), row.end(), out.begin() + static_cast<std::ptrdiff_t>(element) * 4 * resolution_);
   return out;
 }
 
@@ -88,7 +95,7 @@ class TexelGraph {
  public:
   TexelGraph(std::vector<RegionTile>& tiles, ElementType type, const ElementAdjacency& adjacency,
              const MeshEdgeWalls& walls)
-      : tiles_(tiles), type_(type), walls_(walls) {
+      : tiles_(tiles), type_(type) {
     t_ = tiles.front().tile.width;
     tt_ = t_ * t_;
     std::unordered_map<int, int> local;
@@ -102,7 +109,12 @@ class TexelGraph {
         throw std::invalid_argument("mesh texel Laplace: element " + std::to_string(tiles[l].element) +
                                     " appears twice in the region");
     }
+    if (!walls.empty() && walls.resolution() != t_)
+      throw std::invalid_argument("mesh texel Laplace: the edge walls are at resolution " +
+                                  std::to_string(walls.resolution()) + ", the tiles at " + std::to_string(t_));
     across_.assign(tiles.size() * 4, {-1, -1});
+    blocked_.resize(tiles.size());
+    for (std::size_t l = 0; l < tiles.size(); ++l) blocked_[l] = walls.of_element(tiles[l].element);
     for (std::size_t l = 0; l < tiles.size(); ++l)
       for (int k = 0; k < adjacency.edges_per_element(); ++k) {
         const auto nb = adjacency.neighbour(tiles[l].element, k);
@@ -116,14 +128,18 @@ class TexelGraph {
   // Whether boundary texel s of local edge `edge` of tile l couples to the tile across it.
   bool couples_across(int l, int edge, int s) const {
     const auto nb = across_[4 * l + edge];
-    return nb[0] >= 0 && !walls_.blocked(tiles_[l].element, edge, s) &&
-           !walls_.blocked(tiles_[nb[0]].element, nb[1], t_ - 1 - s);
+    return nb[0] >= 0 && !blocked(l, edge, s) && !blocked(nb[0], nb[1], t_ - 1 - s);
   }
   // The region tile across local edge `edge` of tile l and its local edge there ({-1, -1}: none).
   std::array<int, 2> across(int l, int edge) const { return across_[4 * l + edge]; }
   bool active(int node) const { return !(flags(node) & kernels::inactive); }
   double& value(int node) { return tiles_[node / tt_].tile.values[node % tt_]; }
 
+  // Whether texel (i, j) of a tile can couple across a mesh edge: the element's border
+  // texels (tri6: also the hypotenuse's staircase; beyond it all texels are inactive).
+  bool on_border(int i, int j) const {
+    return i == 0 || j == 0 || i == t_ - 1 || j == t_ - 1 || (type_ == ElementType::tri6 && i + j >= t_ - 1);
+  }
   // Calls f(neighbour node) for every active texel coupled to `node` (an active texel).
   template <class F>
   void for_each_coupling(int node, F&& f) const {
@@ -133,13 +149,12 @@ class TexelGraph {
     if (i > 0 && kernels::texels_coupled_east(tile, i - 1, j)) f(node - 1);
     if (kernels::texels_coupled_north(tile, i, j)) f(node + t_);
     if (j > 0 && kernels::texels_coupled_north(tile, i, j - 1)) f(node - t_);
-    // Only texels on the element border couple across mesh edges (tri6: also the hypotenuse).
-    if (i > 0 && j > 0 && i < t_ - 1 && j < t_ - 1 && (type_ == ElementType::quad8 || i + j < t_ - 1)) return;
+    if (!on_border(i, j)) return;
     int edges[2], positions[2];
     const int n = texel_edges(type_, t_, i, j, edges, positions);
     for (int e = 0; e < n; ++e) {
       const auto nb = across_[4 * l + edges[e]];
-      if (nb[0] < 0 || walls_.blocked(tiles_[l].element, edges[e], positions[e])) continue;
+      if (nb[0] < 0 || blocked(l, edges[e], positions[e])) continue;
       const int other = nb[0] * tt_ + edge_texel_index(type_, t_, nb[1], t_ - 1 - positions[e]);
       if (active(other)) f(other);
     }
@@ -147,12 +162,13 @@ class TexelGraph {
 
  private:
   std::uint8_t flags(int node) const { return tiles_[node / tt_].tile.flags[node % tt_]; }
+  bool blocked(int l, int edge, int s) const { return blocked_[l] && blocked_[l][edge * t_ + s]; }
 
   std::vector<RegionTile>& tiles_;
   ElementType type_;
-  const MeshEdgeWalls& walls_;
   int t_ = 0, tt_ = 0;
   std::vector<std::array<int, 2>> across_;
+  std::vector<const char*> blocked_;  // per tile: its element's MeshEdgeWalls flags, or nullptr
 };
 
 // The texel Laplacian over the unknowns (node_of: unknown -> graph node, unknown_of: node
@@ -365,8 +381,8 @@ bool place_tiles_on_lattice(const TexelGraph& graph, const std::vector<RegionTil
 // where that fails (two texels on one place, a ghost on two values) or the multigrid does
 // not converge; the caller then solves the texel graph by algebraic multigrid.
 LaplaceSolveStats solve_on_lattice_patch(TexelGraph& graph, const std::vector<RegionTile>& tiles,
-                                         const std::vector<LatticeTransform>& placed, const std::vector<int>& node_of,
-                                         const std::vector<int>& unknown_of, const LaplaceMultigridOptions& options) {
+                                         const std::vector<LatticeTransform>& placed, const std::vector<int>& unknown_of,
+                                         const LaplaceMultigridOptions& options) {
   const int t = tiles.front().tile.width, tt = t * t;
   auto lattice_point = [&](int node) {
     const int k = node % tt;
@@ -384,6 +400,16 @@ LaplaceSolveStats solve_on_lattice_patch(TexelGraph& graph, const std::vector<Re
   }
   const int w = x1 - x0 + 3, h = y1 - y0 + 3;
   auto cell = [&](std::array<int, 2> p) { return (p[1] - y0 + 1) * w + (p[0] - x0 + 1); };
+  // Texel (i, j) of tile l sits at patch index origin + i * di + j * dj (the transform is
+  // linear): no division per texel.
+  struct TileCells {
+    int origin = 0, di = 0, dj = 0;
+  };
+  std::vector<TileCells> cells(tiles.size());
+  for (std::size_t l = 0; l < tiles.size(); ++l) {
+    const LatticeTransform& p = placed[l];
+    cells[l] = {cell({p.ox, p.oy}), p.r[0] + p.r[2] * w, p.r[1] + p.r[3] * w};
+  }
   TexelTile patch(w, h);
   std::fill(patch.flags.begin(), patch.flags.end(), static_cast<std::uint8_t>(kernels::inactive));
   constexpr int empty = -1, ghost = -2;
@@ -391,38 +417,63 @@ LaplaceSolveStats solve_on_lattice_patch(TexelGraph& graph, const std::vector<Re
   constexpr std::uint8_t walled = kernels::wall_east | kernels::wall_north;
   for (int l = 0; l < static_cast<int>(tiles.size()); ++l) {
     if (tiles[l].frozen) continue;
-    for (int k = 0; k < tt; ++k) {
-      const int v = l * tt + k;
-      if (!graph.active(v)) continue;
-      const int g = cell(lattice_point(v));
-      if (occupant[g] != empty) throw std::runtime_error("two texels on one lattice place");
-      occupant[g] = v;
-      patch.flags[g] = walled | (unknown_of[v] < 0 ? kernels::dirichlet : 0);
-      patch.values[g] = graph.value(v);  // data, or the initial guess (the previous H)
-    }
+    const TileCells c = cells[l];
+    for (int j = 0; j < t; ++j)
+      for (int i = 0; i < t; ++i) {
+        const int v = l * tt + j * t + i;
+        if (!graph.active(v)) continue;
+        const int g = c.origin + i * c.di + j * c.dj;
+        if (occupant[g] != empty) throw std::runtime_error("two texels on one lattice place");
+        occupant[g] = v;
+        patch.flags[g] = walled | (unknown_of[v] < 0 ? kernels::dirichlet : 0);
+        patch.values[g] = graph.value(v);  // data, or the initial guess (the previous H)
+      }
   }
   // Open the couplings of the unknowns (data-data pairs stay walled: they do not enter the
-  // equations).
-  for (int v : node_of) {
-    const auto p = lattice_point(v);
-    const int g = cell(p);
-    graph.for_each_coupling(v, [&](int u) {
-      const auto q = lattice_point(u);
-      const int dx = q[0] - p[0], dy = q[1] - p[1];
-      if (std::abs(dx) + std::abs(dy) != 1) throw std::runtime_error("a coupling off the lattice");
-      const int c = cell(q);
-      if (tiles[u / tt].frozen) {
-        const double value = graph.value(u);
-        if (occupant[c] >= 0 || (occupant[c] == ghost && patch.values[c] != value))
-          throw std::runtime_error("a ghost texel on a taken lattice place");
-        if (occupant[c] == empty)
-          occupant[c] = ghost, patch.flags[c] = walled | kernels::dirichlet, patch.values[c] = value;
+  // equations). Within a tile a coupling is a lattice step by construction; one across a
+  // mesh edge is checked, and a frozen partner becomes a ghost.
+  for (int l = 0; l < static_cast<int>(tiles.size()); ++l) {
+    if (tiles[l].frozen) continue;
+    const TexelTile& tile = tiles[l].tile;
+    const TileCells c = cells[l];
+    for (int j = 0; j < t; ++j)
+      for (int i = 0; i < t; ++i) {
+        const int v = l * tt + j * t + i;
+        if (unknown_of[v] < 0) continue;
+        const int g = c.origin + i * c.di + j * c.dj;
+        if (kernels::texels_coupled_east(tile, i, j)) set_wall_between(patch, g, g + c.di, false);
+        if (i > 0 && kernels::texels_coupled_east(tile, i - 1, j)) set_wall_between(patch, g, g - c.di, false);
+        if (kernels::texels_coupled_north(tile, i, j)) set_wall_between(patch, g, g + c.dj, false);
+        if (j > 0 && kernels::texels_coupled_north(tile, i, j - 1)) set_wall_between(patch, g, g - c.dj, false);
+        if (!graph.on_border(i, j)) continue;
+        const auto p = placed[l].at(i, j);
+        graph.for_each_coupling(v, [&](int u) {
+          if (u / tt == l) return;  // opened above
+          const auto q = lattice_point(u);
+          const int dx = q[0] - p[0], dy = q[1] - p[1];
+          if (std::abs(dx) + std::abs(dy) != 1) throw std::runtime_error("a coupling off the lattice");
+          const int k = cell(q);
+          if (tiles[u / tt].frozen) {
+            const double value = graph.value(u);
+            if (occupant[k] >= 0 || (occupant[k] == ghost && patch.values[k] != value))
+              throw std::runtime_error("a ghost texel on a taken lattice place");
+            if (occupant[k] == empty)
+              occupant[k] = ghost, patch.flags[k] = walled | kernels::dirichlet, patch.values[k] = value;
+          }
+          set_wall_between(patch, g, k, false);
+        });
       }
-      set_wall_between(patch, g, c, false);
-    });
   }
   const LaplaceSolveStats s = solve_laplace(patch, LaplaceSolver::multigrid, options);
-  for (int v : node_of) graph.value(v) = patch.values[cell(lattice_point(v))];
+  for (int l = 0; l < static_cast<int>(tiles.size()); ++l) {
+    if (tiles[l].frozen) continue;
+    const TileCells c = cells[l];
+    for (int j = 0; j < t; ++j)
+      for (int i = 0; i < t; ++i) {
+        const int v = l * tt + j * t + i;
+        if (unknown_of[v] >= 0) graph.value(v) = patch.values[c.origin + i * c.di + j * c.dj];
+      }
+  }
   return s;
 }
 
@@ -550,8 +601,7 @@ MeshLaplaceStats solve_mesh_texel_laplace(std::vector<RegionTile>& tiles, Elemen
         if (state[root] == no_data) state[root] = constant, constant_value[root] = x;
         else if (state[root] == constant && x != constant_value[root]) state[root] = varying;
       };
-      const bool border = i == 0 || j == 0 || i == t - 1 || j == t - 1 || (type == ElementType::tri6 && i + j >= t - 1);
-      if (border) {
+      if (graph.on_border(i, j)) {
         graph.for_each_coupling(v, [&](int w) {
           if (is_data[w]) meet(graph.value(w));
         });
@@ -717,7 +767,7 @@ MeshLaplaceStats solve_mesh_texel_laplace(std::vector<RegionTile>& tiles, Elemen
       // Regions the block placement refuses (tri6, turned neighbours) may still lie on one
       // texel lattice, texel by texel.
       try {
-        const LaplaceSolveStats s = solve_on_lattice_patch(graph, tiles, lattice, node_of, unknown_of, options);
+        const LaplaceSolveStats s = solve_on_lattice_patch(graph, tiles, lattice, unknown_of, options);
         stats.relative_residual = s.relative_residual;
         stats.multigrid = true;
       } catch (const std::runtime_error&) {

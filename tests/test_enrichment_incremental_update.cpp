@@ -97,6 +97,44 @@ TEST(EnrichmentIncrementalUpdate, GhostBesideATileItMustNotCoupleTo) {
   expect_multigrid_equals_cholmod(mesh, {0, 1, 2, 3}, {2}, walls, true);
 }
 
+TEST(EnrichmentIncrementalUpdate, EdgeWallsKeepEachBlockedTexelOnBothSides) {
+  const Mesh mesh = make_rectangle(2, 1, 2, 1, ElementType::quad8);  // elements 0 | 1
+  const ElementAdjacency adjacency(mesh, build_topology(mesh));
+  const auto across = adjacency.neighbour(0, 1);  // element 0's east edge
+  ASSERT_EQ(across[0], 1);
+  MeshEdgeWalls walls(T);
+  walls.block(0, 1, 3, adjacency);
+  walls.block(0, 1, 3, adjacency);  // twice: still one wall
+  EXPECT_TRUE(walls.blocked(0, 1, 3));
+  EXPECT_TRUE(walls.blocked(1, across[1], T - 1 - 3));
+  EXPECT_FALSE(walls.blocked(0, 1, 4));
+  EXPECT_FALSE(walls.blocked(0, 0, 3));
+  EXPECT_EQ(walls.keys_of_element(0), (std::vector<long long>{(0 * 4 + 1) * T + 3}));
+  EXPECT_EQ(walls.keys_of_element(1), (std::vector<long long>{(1 * 4 + across[1]) * T + T - 1 - 3}));
+  const std::vector<char> flags = walls.flags(mesh.num_elements());
+  ASSERT_EQ(flags.size(), static_cast<std::size_t>(mesh.num_elements()) * 4 * T);
+  EXPECT_EQ(std::count(flags.begin(), flags.end(), 1), 2);
+  EXPECT_EQ(flags[(0 * 4 + 1) * T + 3], 1);
+  EXPECT_EQ(flags[(1 * 4 + across[1]) * T + T - 1 - 3], 1);
+}
+
+TEST(EnrichmentIncrementalUpdate, EdgeWallsOfAnotherResolutionAreRefused) {
+  const Mesh mesh = make_rectangle(2, 1, 2, 1, ElementType::quad8);
+  const ElementAdjacency adjacency(mesh, build_topology(mesh));
+  MeshEdgeWalls walls(2 * T);
+  walls.block(0, 1, 3, adjacency);
+  std::vector<RegionTile> region(2);
+  for (int e = 0; e < 2; ++e) region[e].element = e, region[e].tile = kernels::make_element_tile(mesh.type, T);
+  region[0].tile.flags[0] |= kernels::dirichlet;
+  try {
+    solve_mesh_texel_laplace(region, mesh.type, adjacency, walls, LaplaceSolver::multigrid, {});
+    FAIL() << "expected std::invalid_argument";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_STREQ(e.what(), ("mesh texel Laplace: the edge walls are at resolution " + std::to_string(2 * T) +
+                            ", the tiles at " + std::to_string(T)).c_str());
+  }
+}
+
 TEST(EnrichmentIncrementalUpdate, RingClosedThroughSolvedTilesSolvesOnASeamedPatch) {
   // Row 1 is solved all around: the solved tiles close up, so the patch is cut open at a
   // seam that the seamed solve couples again.

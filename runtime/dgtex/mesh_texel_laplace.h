@@ -31,10 +31,10 @@
 // split's 5-cycles; rings of such cells) are solved by algebraic multigrid on the texel
 // graph. With LaplaceSolver::cholmod, or where a multigrid misses its tolerance, CHOLMOD
 // solves.
-// Value types that own their data (MeshEdgeWalls its key set, RegionTile its tile) and
+// Value types that own their data (MeshEdgeWalls its flag rows, RegionTile its tile) and
 // functions that keep nothing; a solve may use all OpenMP threads. Values dimensionless.
 #include <cstdint>
-#include <unordered_set>
+#include <unordered_map>
 #include <vector>
 
 #include "dgtex/cut_path.h"
@@ -55,9 +55,17 @@ class MeshEdgeWalls {
   // Blocks boundary texel s of (element, edge) and its partner across the edge.
   void block(int element, int edge, int s, const ElementAdjacency& adjacency);
   bool blocked(int element, int edge, int s) const {
-    return !keys_.empty() && keys_.count(key(element, edge, s)) > 0;
+    const char* row = of_element(element);
+    return row && row[edge * resolution_ + s];
   }
-  bool empty() const { return keys_.empty(); }
+  bool empty() const { return rows_.empty(); }
+  // The element's flags, index edge * resolution + s (4 edges, also for tri6), or nullptr
+  // where none of its edges is blocked: one look-up per element instead of one per texel.
+  const char* of_element(int element) const {
+    if (rows_.empty()) return nullptr;
+    const auto it = rows_.find(element);
+    return it != rows_.end() ? it->second.data() : nullptr;
+  }
   // Blocked (element, edge, s) of one element, sorted (for change detection).
   std::vector<long long> keys_of_element(int element) const;
   int resolution() const { return resolution_; }
@@ -65,9 +73,9 @@ class MeshEdgeWalls {
   std::vector<char> flags(int num_elements) const;
 
  private:
-  long long key(int element, int edge, int s) const { return (static_cast<long long>(element) * 4 + edge) * resolution_ + s; }
+  void set(int element, int edge, int s);
   int resolution_;
-  std::unordered_set<long long> keys_;
+  std::unordered_map<int, std::vector<char>> rows_;  // element -> 4 * resolution flags
 };
 
 struct RegionTile {
