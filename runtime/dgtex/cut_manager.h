@@ -126,8 +126,7 @@ class CutManager {
  private:
   struct SegmentState {
     std::map<int, std::uint64_t> wall_hash, data_hash;  // per element of Omega_i at the last solve
-    std::map<int, std::vector<double>> values;          // H_i per element of Omega_i
-    EnrichmentFunction function;
+    EnrichmentFunction function;  // H_i on every element of Omega_i (sorted by element), all N_i
   };
   void rasterize_visible(const std::vector<VisibleCutSegment>& visible,
                          std::vector<std::vector<std::pair<int, kernels::CutRaster>>>& rasters);
