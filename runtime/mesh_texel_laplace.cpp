@@ -13,6 +13,7 @@
 #include <Eigen/CholmodSupport>
 #include <Eigen/SparseCore>
 
+#include "dgtex/kernels/cut_rasterization.h"
 #include "dgtex/kernels/flood_fill.h"
 #include "dgtex/kernels/forall.h"
 #include "dgtex/kernels/multigrid_unknowns.h"
@@ -149,7 +150,30 @@ class TexelGraph {
     if (i > 0 && kernels::texels_coupled_east(tile, i - 1, j)) f(node - 1);
     if (kernels::texels_coupled_north(tile, i, j)) f(node + t_);
     if (j > 0 && kernels::texels_coupled_north(tile, i, j - 1)) f(node - t_);
-    if (!on_border(i, j)) return;
+    if (on_border(i, j)) for_each_coupling_across(node, f);
+  }
+
+  // Calls f(v, w) for every coupling across tile l's mesh edges, v in tile l, w beyond
+  // (both active), edge by edge: the same pairs as for_each_coupling_across over l's
+  // border texels, without finding each texel's edges.
+  template <class F>
+  void for_each_coupling_across_edges(int l, F&& f) const {
+    for (int k = 0; k < (type_ == ElementType::quad8 ? 4 : 3); ++k) {
+      const auto nb = across_[4 * l + k];
+      if (nb[0] < 0) continue;
+      for (int s = 0; s < t_; ++s) {
+        if (blocked(l, k, s)) continue;
+        const int v = l * tt_ + edge_texel_index(type_, t_, k, s);
+        const int w = nb[0] * tt_ + edge_texel_index(type_, t_, nb[1], t_ - 1 - s);
+        if (active(v) && active(w)) f(v, w);
+      }
+    }
+  }
+
+  // The couplings of `node` (an active texel on its tile's border) across mesh edges only.
+  template <class F>
+  void for_each_coupling_across(int node, F&& f) const {
+    const int l = node / tt_, t = node % tt_, i = t % t_, j = t / t_;
     int edges[2], positions[2];
     const int n = texel_edges(type_, t_, i, j, edges, positions);
     for (int e = 0; e < n; ++e) {
@@ -447,8 +471,7 @@ LaplaceSolveStats solve_on_lattice_patch(TexelGraph& graph, const std::vector<Re
         if (j > 0 && kernels::texels_coupled_north(tile, i, j - 1)) set_wall_between(patch, g, g - c.dj, false);
         if (!graph.on_border(i, j)) continue;
         const auto p = placed[l].at(i, j);
-        graph.for_each_coupling(v, [&](int u) {
-          if (u / tt == l) return;  // opened above
+        graph.for_each_coupling_across(v, [&](int u) {
           const auto q = lattice_point(u);
           const int dx = q[0] - p[0], dy = q[1] - p[1];
           if (std::abs(dx) + std::abs(dy) != 1) throw std::runtime_error("a coupling off the lattice");
@@ -521,11 +544,18 @@ MeshLaplaceStats solve_mesh_texel_laplace(std::vector<RegionTile>& tiles, Elemen
   // links the larger root under the smaller, so parent[v] <= v and one forward pass
   // flattens every texel to its root.
   const int t = tiles.front().tile.width, tt = t * t;
-  std::vector<char> is_free(n), is_data(n), tile_has_data(tiles.size(), 0);
+  std::vector<char> is_free(n), is_data(n), tile_has_data(tiles.size(), 0), is_uncut(tiles.size(), 0);
+  // An uncut element's flags: only its shape's inactive texels (no walls, no data).
+  std::vector<std::uint8_t> uncut(tt, 0);
+  if (type == ElementType::tri6)
+    for (int j = 0; j < t; ++j)
+      for (int i = 0; i < t; ++i)
+        if (!kernels::is_tri6_texel_active(i, j, t)) uncut[j * t + i] = kernels::inactive;
   // Data: active texels of frozen tiles and Dirichlet texels; free: the other active ones.
   for (int l = 0; l < static_cast<int>(tiles.size()); ++l) {
     const std::uint8_t* flags = tiles[l].tile.flags.data();
     const bool frozen = tiles[l].frozen;
+    is_uncut[l] = !frozen && tiles[l].tile.flags == uncut;
     char* free_texel = is_free.data() + static_cast<std::size_t>(l) * tt;
     char* data_texel = is_data.data() + static_cast<std::size_t>(l) * tt;
     char any_data = 0;
@@ -538,28 +568,22 @@ MeshLaplaceStats solve_mesh_texel_laplace(std::vector<RegionTile>& tiles, Elemen
     }
     tile_has_data[l] = any_data;
   }
-  // Calls f(i, j) once for each texel that can couple across a mesh edge: all of the first
-  // (and the quad8's last) row, else the first texel of the row and its last active one
-  // (tri6: the hypotenuse's, i = t - 1 - j; the texels beyond it are inactive).
-  auto for_each_border_texel = [&](auto&& f) {
-    for (int j = 0; j < t; ++j) {
-      if (j == 0 || (type == ElementType::quad8 && j == t - 1)) {
-        for (int i = 0; i < t; ++i) f(i, j);
-        continue;
-      }
-      f(0, j);
-      const int last = type == ElementType::quad8 ? t - 1 : t - 1 - j;
-      if (last > 0) f(last, j);
-    }
-  };
   std::vector<int> parent(n);
+  // The in-tile sets of an uncut tile, relative to its first texel: every uncut tile has the
+  // same flags and free texels, so the first one labelled is copied to the others (most of
+  // a region's tiles away from the cut; fracture: 148 in one region).
+  std::vector<int> uncut_sets;
   for (int l = 0; l < static_cast<int>(tiles.size()); ++l) {
+    const int base = l * tt;
+    if (is_uncut[l] && !uncut_sets.empty()) {
+      for (int k = 0; k < tt; ++k) parent[base + k] = base + uncut_sets[k];
+      continue;
+    }
     // Within the tile, in texel order: a free texel joins its west or south neighbour's set
     // by pointing where that neighbour points (an earlier texel, so parent[v] < v), and only
     // where both neighbours are coupled are two sets united (one find each, most texels
     // none). The same sets and roots as uniting every coupling, in half the time (chad).
     const std::uint8_t* flags = tiles[l].tile.flags.data();
-    const int base = l * tt;
     for (int j = 0; j < t; ++j)
       for (int i = 0; i < t; ++i) {
         const int k = j * t + i, v = base + k;
@@ -571,17 +595,16 @@ MeshLaplaceStats solve_mesh_texel_laplace(std::vector<RegionTile>& tiles, Elemen
         else if (south) parent[v] = parent[v - t];
         if (west && south && parent[v - 1] != parent[v - t]) kernels::unite_smaller_root(parent, v - 1, v - t);
       }
+    if (is_uncut[l]) {
+      uncut_sets.resize(tt);
+      for (int k = 0; k < tt; ++k) uncut_sets[k] = parent[base + k] - base;
+    }
   }
-  // Couplings across mesh edges: only element-border texels (tri6: also the hypotenuse) have them.
-  auto unite_across = [&](int l, int i, int j) {
-    const int v = l * tt + j * t + i;
-    if (!is_free[v]) return;
-    graph.for_each_coupling(v, [&](int w) {
-      if (w / tt != l && is_free[w]) kernels::unite_smaller_root(parent, v, w);
-    });
-  };
+  // Couplings across mesh edges, one shared edge at a time.
   for (int l = 0; l < static_cast<int>(tiles.size()); ++l)
-    for_each_border_texel([&](int i, int j) { unite_across(l, i, j); });
+    graph.for_each_coupling_across_edges(l, [&](int v, int w) {
+      if (is_free[v] && is_free[w]) kernels::unite_smaller_root(parent, v, w);
+    });
   for (int v = 0; v < n; ++v) parent[v] = parent[parent[v]];
   enum : std::uint8_t { no_data = 0, constant = 1, varying = 2 };
   std::vector<std::uint8_t> state(n, no_data);
@@ -589,37 +612,28 @@ MeshLaplaceStats solve_mesh_texel_laplace(std::vector<RegionTile>& tiles, Elemen
   const std::unique_ptr<double[]> constant_value(new double[n]);
   // (The order in which a component meets its data does not matter: it ends constant
   // with the one value it met, or varying.)
+  auto meet = [&](int root, double x) {
+    if (state[root] == no_data) state[root] = constant, constant_value[root] = x;
+    else if (state[root] == constant && x != constant_value[root]) state[root] = varying;
+  };
   for (int l = 0; l < static_cast<int>(tiles.size()); ++l) {
+    graph.for_each_coupling_across_edges(l, [&](int v, int w) {
+      if (is_free[v] && is_data[w]) meet(parent[v], graph.value(w));
+    });
+    if (!tile_has_data[l]) continue;  // then no texel of the tile is data
     const std::uint8_t* flags = tiles[l].tile.flags.data();
     const double* values = tiles[l].tile.values.data();
-    auto meet_at = [&](int i, int j) {
-      const int k = j * t + i, v = l * tt + k;
-      if (!is_free[v]) return;
-      const int root = parent[v];
-      if (state[root] == varying) return;  // nothing more to learn
-      auto meet = [&](double x) {
-        if (state[root] == no_data) state[root] = constant, constant_value[root] = x;
-        else if (state[root] == constant && x != constant_value[root]) state[root] = varying;
-      };
-      if (graph.on_border(i, j)) {
-        graph.for_each_coupling(v, [&](int w) {
-          if (is_data[w]) meet(graph.value(w));
-        });
-        return;
-      }
-      // Interior texel: its four neighbours are in the tile (data implies active).
-      if (is_data[v + 1] && !(flags[k] & kernels::wall_east)) meet(values[k + 1]);
-      if (is_data[v - 1] && !(flags[k - 1] & kernels::wall_east)) meet(values[k - 1]);
-      if (is_data[v + t] && !(flags[k] & kernels::wall_north)) meet(values[k + t]);
-      if (is_data[v - t] && !(flags[k - t] & kernels::wall_north)) meet(values[k - t]);
-    };
-    // A tile without data meets data only across its edges: its border texels alone.
-    if (!tile_has_data[l]) {
-      for_each_border_texel(meet_at);
-      continue;
-    }
     for (int j = 0; j < t; ++j)
-      for (int i = 0; i < t; ++i) meet_at(i, j);
+      for (int i = 0; i < t; ++i) {
+        const int k = j * t + i, v = l * tt + k;
+        if (!is_free[v]) continue;
+        const int root = parent[v];
+        // Neighbours in the tile (data implies active).
+        if (i + 1 < t && is_data[v + 1] && !(flags[k] & kernels::wall_east)) meet(root, values[k + 1]);
+        if (i > 0 && is_data[v - 1] && !(flags[k - 1] & kernels::wall_east)) meet(root, values[k - 1]);
+        if (j + 1 < t && is_data[v + t] && !(flags[k] & kernels::wall_north)) meet(root, values[k + t]);
+        if (j > 0 && is_data[v - t] && !(flags[k - t] & kernels::wall_north)) meet(root, values[k - t]);
+      }
   }
   std::vector<int> unknown_of(n, -1);
   std::vector<int> node_of;
