@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <set>
 #include <sstream>
 #include <unordered_map>
 #include <stdexcept>
@@ -144,14 +143,16 @@ class PathTracer {
       for (int f = 0; f < mesh_.num_elements(); ++f)
         for (int a = 0; a < mesh_.nodes_per_element(); ++a) node_elements_[mesh_.element_nodes(f)[a]].push_back(f);
     }
-    std::set<int> ring{e};
+    std::vector<int> ring = {e};
     for (int round = 0; round < 2; ++round) {
-      const std::vector<int> inner(ring.begin(), ring.end());
-      for (int f : inner)
+      const std::size_t inner = ring.size();
+      for (std::size_t k = 0; k < inner; ++k)
         for (int a = 0; a < mesh_.nodes_per_element(); ++a)
-          for (int g : node_elements_[mesh_.element_nodes(f)[a]]) ring.insert(g);
+          for (int g : node_elements_[mesh_.element_nodes(ring[k])[a]]) ring.push_back(g);
+      std::sort(ring.begin(), ring.end());
+      ring.erase(std::unique(ring.begin(), ring.end()), ring.end());
     }
-    return patches_[e] = std::vector<int>(ring.begin(), ring.end());
+    return patches_[e] = std::move(ring);
   }
 
   // Whether xi lies on a local edge of e whose neighbour is outside the patch.

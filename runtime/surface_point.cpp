@@ -7,6 +7,8 @@
 #include <string>
 #include <vector>
 
+#include "box_hierarchy.h"
+
 namespace dgtex {
 namespace {
 
@@ -226,16 +228,21 @@ void refine(const ElementDistance& f, ElementType type, double xi[2]) {
 }
 
 // Fixed sample points seeding the refinement.
-std::vector<std::array<double, 2>> sample_points(ElementType type) {
-  std::vector<std::array<double, 2>> s;
-  if (type == ElementType::quad8) {
+const std::vector<std::array<double, 2>>& sample_points(ElementType type) {
+  // Built once per type (a search asks for them per query).
+  static const std::vector<std::array<double, 2>> quad8 = [] {
+    std::vector<std::array<double, 2>> s;
     for (int j = 0; j <= 4; ++j)
       for (int i = 0; i <= 4; ++i) s.push_back({-1 + 0.5 * i, -1 + 0.5 * j});
-  } else {
+    return s;
+  }();
+  static const std::vector<std::array<double, 2>> tri6 = [] {
+    std::vector<std::array<double, 2>> s;
     for (int j = 0; j <= 4; ++j)
       for (int i = 0; i + j <= 4; ++i) s.push_back({0.25 * i, 0.25 * j});
-  }
-  return s;
+    return s;
+  }();
+  return type == ElementType::quad8 ? quad8 : tri6;
 }
 
 // How far the element's surface can leave the box of its corners: x(xi) is the (bi)linear
@@ -332,15 +339,7 @@ double corner_facet_bound(const Mesh& mesh, int e, const double p[3], double sla
   return std::isfinite(bound) ? bound : 0.0;
 }
 
-// Distance from p to an axis-aligned box lo[3], hi[3] (0 inside).
-double box_distance(const double* lo, const double* hi, const double p[3]) {
-  double s = 0;
-  for (int d = 0; d < 3; ++d) {
-    const double gap = p[d] - std::clamp(p[d], lo[d], hi[d]);
-    s += gap * gap;
-  }
-  return std::sqrt(s);
-}
+using detail::box_distance;
 
 // A refined candidate of the closest-point searches. (A private struct: a
 // std::vector<SurfacePoint> here would instantiate templates that clash with scene.h's
@@ -384,7 +383,7 @@ SurfacePoint closest_surface_point(const Mesh& mesh, const double p[3]) {
   // distance, the largest of: the sampled distance less half the diameter; the distance to
   // the box of its samples less its bulge beyond its corners' box; the distance to its
   // corner facets less the bulge (and a quad8's twist).
-  const auto samples = sample_points(mesh.type);
+  const auto& samples = sample_points(mesh.type);
   std::vector<kernels::ShapeValues> shapes(samples.size());
   for (size_t s = 0; s < samples.size(); ++s) kernels::evaluate_shape(mesh.type, samples[s][0], samples[s][1], shapes[s]);
   struct Seed {
@@ -453,7 +452,7 @@ SurfacePoint closest_surface_point(const Mesh& mesh, const double p[3]) {
 
 SurfacePointSearch::SurfacePointSearch(const Mesh& mesh) : mesh_(mesh) {
   const int elements = mesh.num_elements();
-  const auto samples = sample_points(mesh.type);
+  const auto& samples = sample_points(mesh.type);
   samples_ = static_cast<int>(samples.size());
   std::vector<kernels::ShapeValues> shapes(samples.size());
   for (size_t s = 0; s < samples.size(); ++s) kernels::evaluate_shape(mesh.type, samples[s][0], samples[s][1], shapes[s]);
@@ -495,45 +494,72 @@ SurfacePointSearch::SurfacePointSearch(const Mesh& mesh) : mesh_(mesh) {
       double* out = &sample_positions_[(static_cast<size_t>(e) * samples_ + s) * 3];
       for (int d = 0; d < 3; ++d) out[d] = x[d], box[d] = std::min(box[d], x[d]), box[3 + d] = std::max(box[3 + d], x[d]);
     }
+    largest_slack_ = std::max(largest_slack_, std::min(margins_[e], bulges_[e]));
   }
+  sample_box_tree_ = std::make_shared<const detail::BoxHierarchy>(sample_boxes_);
+  if (elements > 0) whole_tie_tolerance_ = tie_tolerance_of(all_);
 }
 
-SurfacePoint SurfacePointSearch::closest(const double p[3]) const {
-  if (all_.empty()) throw MeshError("closest_surface_point: the mesh has no elements");
-  return closest_among(all_, p);
-}
-
-SurfacePoint SurfacePointSearch::closest_among(const std::vector<int>& elements, const double p[3]) const {
-  if (elements.empty()) throw MeshError("closest_surface_point: no elements to search");
-  if (!std::isfinite(p[0]) || !std::isfinite(p[1]) || !std::isfinite(p[2]))
-    throw MeshError("closest_surface_point: query point (" + mesh_number(p[0]) + ", " + mesh_number(p[1]) + ", " +
-                    mesh_number(p[2]) + ") is not finite");
-  // The bounding box of the searched elements' nodes, as closest_surface_point takes it
-  // from the (sub-)mesh's nodes: min and max are exact, so the tolerance is the same.
+// closest_surface_point's tie tolerance for the sub-mesh of these elements: 1e-12 x the
+// diagonal of its nodes' bounding box (min and max are exact: the same value).
+double SurfacePointSearch::tie_tolerance_of(const std::vector<int>& elements) const {
   double lo[3], hi[3];
   for (int d = 0; d < 3; ++d) lo[d] = hi[d] = node_boxes_[6 * static_cast<size_t>(elements.front()) + d];
   for (int e : elements)
     for (int d = 0; d < 3; ++d)
       lo[d] = std::min(lo[d], node_boxes_[6 * static_cast<size_t>(e) + d]),
       hi[d] = std::max(hi[d], node_boxes_[6 * static_cast<size_t>(e) + 3 + d]);
-  const double tie_tolerance = 1e-12 * std::sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) +
-                                                 (hi[2] - lo[2]) * (hi[2] - lo[2]));
-  return search(elements.data(), static_cast<int>(elements.size()), p, tie_tolerance);
+  return 1e-12 * std::sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) +
+                           (hi[2] - lo[2]) * (hi[2] - lo[2]));
+}
+
+SurfacePoint SurfacePointSearch::closest(const double p[3]) const {
+  if (all_.empty()) throw MeshError("closest_surface_point: the mesh has no elements");
+  check_query(p);
+  return search(all_.data(), static_cast<int>(all_.size()), p, whole_tie_tolerance_);
+}
+
+SurfacePoint SurfacePointSearch::closest_among(const std::vector<int>& elements, const double p[3]) const {
+  if (elements.empty()) throw MeshError("closest_surface_point: no elements to search");
+  check_query(p);
+  return search(elements.data(), static_cast<int>(elements.size()), p, tie_tolerance_of(elements));
+}
+
+void SurfacePointSearch::check_query(const double p[3]) {
+  if (!std::isfinite(p[0]) || !std::isfinite(p[1]) || !std::isfinite(p[2]))
+    throw MeshError("closest_surface_point: query point (" + mesh_number(p[0]) + ", " + mesh_number(p[1]) + ", " +
+                    mesh_number(p[2]) + ") is not finite");
 }
 
 SurfacePoint SurfacePointSearch::search(const int* elements, int count, const double p[3], double tie_tolerance) const {
-  const auto samples = sample_points(mesh_.type);
+  const auto& samples = sample_points(mesh_.type);
   constexpr double unknown = -1;
-  std::vector<double> lower(count), seed_distance(count, unknown);
+  std::vector<double> box_lower(count, unknown), seed_distance(count, unknown);
   std::vector<int> seed_sample(count, 0);
-  for (int k = 0; k < count; ++k) {
-    const double* box = &sample_boxes_[6 * static_cast<size_t>(elements[k])];
-    lower[k] = box_distance(box, box + 3, p);
-  }
+  // Element k's sample-box distance (a lower bound of its seed distance), measured once.
+  auto lower = [&](int k) {
+    if (box_lower[k] == unknown) {
+      const double* box = &sample_boxes_[6 * static_cast<size_t>(elements[k])];
+      box_lower[k] = box_distance(box, box + 3, p);
+    }
+    return box_lower[k];
+  };
+  // The k whose lower(k) <= r, in list order: from the box hierarchy for the whole mesh
+  // (k is the element there), else by measuring each.
+  const bool whole = elements == all_.data();
+  std::vector<int> near;
+  auto within = [&](double r) {
+    if (std::isnan(r)) r = std::numeric_limits<double>::infinity();  // as the scan's `> r` tests
+    near.clear();
+    if (whole) sample_box_tree_->within(p, r, near);
+    else
+      for (int k = 0; k < count; ++k)
+        if (lower(k) <= r) near.push_back(k);
+  };
   // closest_surface_point's lower bound of element k's true distance (once seeded).
   auto lower_bound = [&](int k) {
     const int e = elements[k];
-    return std::max({seed_distance[k] - margins_[e], lower[k] - bulges_[e],
+    return std::max({seed_distance[k] - margins_[e], lower(k) - bulges_[e],
                      corner_facet_bound(mesh_, e, p, facet_slacks_[e])});
   };
   auto seed = [&](int k) {
@@ -547,11 +573,19 @@ SurfacePoint SurfacePointSearch::search(const int* elements, int count, const do
     }
     seed_distance[k] = best;
   };
-  // The first seed of the full search: the least (distance, element).
-  int first = static_cast<int>(std::min_element(lower.begin(), lower.end()) - lower.begin());
+  // The first seed of the full search: the least (distance, element). Its box is the
+  // nearest (the first of equals in list order); the boxes farther than its seed cannot
+  // hold a nearer seed.
+  double nearest = std::numeric_limits<double>::infinity();
+  if (whole) nearest = sample_box_tree_->nearest_distance(p);
+  else
+    for (int k = 0; k < count; ++k) nearest = std::min(nearest, lower(k));
+  within(nearest);
+  int first = near.front();
   seed(first);
-  for (int k = 0; k < count; ++k) {
-    if (lower[k] > seed_distance[first]) continue;
+  within(seed_distance[first]);
+  for (int k : near) {
+    if (lower(k) > seed_distance[first]) continue;
     seed(k);
     if (seed_distance[k] < seed_distance[first] ||
         (seed_distance[k] == seed_distance[first] && elements[k] < elements[first]))
@@ -575,8 +609,12 @@ SurfacePoint SurfacePointSearch::search(const int* elements, int count, const do
   std::vector<int> rest;
   // (The box distance is at most the seeded distance, so a box too far for the first two
   // terms of lower_bound is skipped without a seed.)
-  for (int k = 0; k < count; ++k)
-    if (k != first && !(lower[k] - std::min(margins_[elements[k]], bulges_[elements[k]]) > best + tie_tolerance))
+  // Every box within best + tie_tolerance + the largest slack, widened by 1e-6 so that no
+  // rounding drops one the exact test below keeps (the list: all of them).
+  if (whole) within((best + tie_tolerance + largest_slack_) * (1 + 1e-6));
+  else within(std::numeric_limits<double>::infinity());
+  for (int k : near)
+    if (k != first && !(lower(k) - std::min(margins_[elements[k]], bulges_[elements[k]]) > best + tie_tolerance))
       seed(k), rest.push_back(k);
   std::sort(rest.begin(), rest.end(), [&](int a, int b) {
     return seed_distance[a] != seed_distance[b] ? seed_distance[a] < seed_distance[b] : elements[a] < elements[b];

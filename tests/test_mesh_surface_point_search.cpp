@@ -68,7 +68,9 @@ TEST(SurfacePointSearch, MatchesTheFullSearchBitwise) {
   const std::vector<Mesh> meshes = {make_cylinder(0.5, 2.0, 0, 360, 8, 5, ElementType::quad8),
                                     make_cylinder(0.5, 2.0, -60, 150, 6, 4, ElementType::tri6),
                                     make_hemisphere(1.0, 20, 4, 9, ElementType::tri6),
-                                    make_rectangle(2.0, 1.0, 6, 3, ElementType::quad8)};
+                                    make_rectangle(2.0, 1.0, 6, 3, ElementType::quad8),
+                                    // a deep box hierarchy: fracture's mesh
+                                    make_rectangle(1.0, 1.0, 16, 17, ElementType::tri6, TriangleSplit::square)};
   unsigned seed = 3;
   for (const Mesh& mesh : meshes) {
     const SurfacePointSearch search(mesh);

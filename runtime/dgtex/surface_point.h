@@ -2,6 +2,7 @@
 // Closest point on the curved (quadratic) mesh surface: probes and cut paths given as
 // rest-configuration points are projected with this.
 // A pure function (thread-safe). Positions and distances in the mesh's length unit (SI: m).
+#include <memory>
 #include <vector>
 
 #include "dgtex/mesh.h"
@@ -37,9 +38,15 @@ SurfacePoint closest_surface_point(const Mesh& mesh, const double p[3]);
 // a query computes the exact seed distance only for elements whose box could hold the
 // nearest seed or whose margin could let them be refined (a lower bound, so the refined
 // candidates, their order and the answer are those of the full search). A cut path of
-// the 544-element bunny projects ~6x faster.
+// the 544-element bunny projects ~6x faster. The whole-mesh search (closest) finds those
+// elements in a hierarchy of their sample boxes instead of measuring every box: fracture's
+// 213 cut points, ~1 ms of its cut tracing, ~10x faster.
 // Keeps a reference to the mesh (which must outlive it and not change). Thread-safe
 // queries (const).
+namespace detail {
+class BoxHierarchy;
+}
+
 class SurfacePointSearch {
  public:
   explicit SurfacePointSearch(const Mesh& mesh);
@@ -51,6 +58,8 @@ class SurfacePointSearch {
 
  private:
   SurfacePoint search(const int* elements, int count, const double p[3], double tie_tolerance) const;
+  double tie_tolerance_of(const std::vector<int>& elements) const;
+  static void check_query(const double p[3]);
   const Mesh& mesh_;
   int samples_ = 0;
   std::vector<double> sample_positions_;  // per element and sample: x, y, z
@@ -60,6 +69,11 @@ class SurfacePointSearch {
   std::vector<double> sample_boxes_;      // per element: lo[3], hi[3] of its samples
   std::vector<double> node_boxes_;        // per element: lo[3], hi[3] of its nodes
   std::vector<int> all_;                  // 0..elements-1
+  // The whole mesh: its sample boxes' hierarchy, the largest min(margin, bulge) of its
+  // elements, and closest_among's tie tolerance over all of them.
+  std::shared_ptr<const detail::BoxHierarchy> sample_box_tree_;
+  double largest_slack_ = 0;
+  double whole_tie_tolerance_ = 0;
 };
 
 }  // namespace dgtex
