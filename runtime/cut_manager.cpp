@@ -501,8 +501,12 @@ bool CutManager::update(double time) {
   // Nodes where a function repeats the earlier ones (a crack continued by the next
   // segment or cut crosses the node's support completely: both are the same Heaviside)
   // keep only the earlier enrichment (enrichment_span.h); without it M and K are singular.
-  std::vector<EnrichmentFunction> all;
-  for (const auto& key : order_) all.push_back(states_.at(key).function);
+  // (Copied one function per thread: fracture's 281 tiles are 2.6 MB of fresh pages.)
+  std::vector<const SegmentState*> in_order;
+  for (const auto& key : order_) in_order.push_back(&states_.at(key));
+  std::vector<EnrichmentFunction> all(in_order.size());
+  kernels::forall_dynamic(static_cast<std::int64_t>(all.size()),
+                          [&](std::int64_t k) { all[k] = in_order[k]->function; });
   const std::vector<std::vector<int>> independent = independent_enriched_nodes(node_elements_, all);
   functions_.clear();
   function_segments_.clear();

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <exception>
 #include <map>
 #include <stdexcept>
 #include <string>
@@ -74,6 +75,49 @@ TexelMoments pool(const std::vector<const TexelMoments*>& parts) {
   return all;
 }
 
+// Nodes that several functions enrich and that share a support (the node's elements).
+struct SharedSupport {
+  int node;                                                   // the first such node (for messages)
+  std::vector<int> functions;                                 // in function order
+  std::vector<std::vector<const kernels::TexelTile*>> tiles;  // per function, per element
+  std::vector<char> keeps;                                    // per function: adds to the span there
+};
+
+// Which functions add to the span of 1 and the earlier functions over the support's active
+// texels: classical Gram-Schmidt, twice.
+void span_keeps(SharedSupport& support, double tolerance) {
+  const auto& tiles = support.tiles;
+  support.keeps.assign(support.functions.size(), 0);
+  // Sample positions: the active texels of the support (flags are the same in every
+  // function: the walls of all cuts and the inactive bits).
+  std::size_t n = 0;
+  for (const kernels::TexelTile* tile : tiles[0])
+    for (std::uint8_t flag : tile->flags) n += !(flag & kernels::inactive);
+  if (n == 0) return;
+  std::vector<std::vector<double>> basis(1, std::vector<double>(n, 1.0 / std::sqrt(static_cast<double>(n))));
+  std::vector<double> column;
+  for (std::size_t k = 0; k < support.functions.size(); ++k) {
+    column.clear();
+    for (std::size_t t = 0; t < tiles[k].size(); ++t) {
+      const kernels::TexelTile& mask = *tiles[0][t];
+      for (std::size_t p = 0; p < mask.flags.size(); ++p)
+        if (!(mask.flags[p] & kernels::inactive)) column.push_back(tiles[k][t]->values[p]);
+    }
+    if (column.size() != n)
+      throw std::invalid_argument("enrichment function " + std::to_string(support.functions[k]) +
+                                  ": the textures around node " + std::to_string(support.node) +
+                                  " differ in size or active texels from function " +
+                                  std::to_string(support.functions[0]) + "'s");
+    for (int pass = 0; pass < 2; ++pass)  // twice: classical Gram-Schmidt loses orthogonality once
+      for (const std::vector<double>& q : basis) subtract_projection(column, q);
+    const double norm = std::sqrt(dot(column, column));
+    if (!(norm > tolerance * std::sqrt(static_cast<double>(n)))) continue;  // adds nothing there
+    divide(column, norm);
+    basis.push_back(column);
+    support.keeps[k] = 1;
+  }
+}
+
 }  // namespace
 
 std::vector<std::vector<int>> independent_enriched_nodes(const std::vector<std::vector<int>>& node_elements,
@@ -85,8 +129,6 @@ std::vector<std::vector<int>> independent_enriched_nodes(const std::vector<std::
     for (int a : functions[i].enriched_nodes) by_node[a].push_back(i);
 
   std::vector<std::vector<int>> kept(functions.size());
-  std::vector<std::vector<double>> basis;  // orthonormal over the node's support texels
-  std::vector<double> column;
   // Per (function, element) moments, for nodes that only one function enriches: there the
   // Gram-Schmidt residual of H against 1 is H minus its mean, whose norm is sqrt(m2) of the
   // pooled moments, so each tile is read once instead of once per incident node. Computed
@@ -108,7 +150,13 @@ std::vector<std::vector<int>> independent_enriched_nodes(const std::vector<std::
                     [&](std::int64_t k) { *work[k].second = active_moments(*work[k].first); });
   }
   std::vector<const TexelMoments*> parts;
-  std::map<std::pair<std::vector<int>, std::vector<int>>, std::vector<char>> memo;  // (support, functions) -> kept
+  // Nodes that several functions enrich: one Gram-Schmidt per distinct (support, functions)
+  // (nodes with the same elements in the same order and the same functions get the same
+  // answer: all nodes of an element with many cuts, midside nodes), one per work item.
+  std::vector<SharedSupport> shared;
+  std::map<std::pair<std::vector<int>, std::vector<int>>, int> shared_index;
+  constexpr int dropped = -1, kept_alone = -2;
+  std::vector<int> answer;  // per node of by_node: dropped, kept_alone, or its shared support
   for (const auto& [a, list] : by_node) {
     if (list.size() == 1 && a >= 0 && a < static_cast<int>(node_elements.size())) {
       parts.clear();
@@ -121,61 +169,44 @@ std::vector<std::vector<int>> independent_enriched_nodes(const std::vector<std::
         parts.push_back(&moments.at({list[0], e}));
       }
       const TexelMoments all = pool(parts);
-      if (all.count == 0) continue;
-      if (std::sqrt(all.m2) > tolerance * std::sqrt(all.count)) kept[list[0]].push_back(a);
+      answer.push_back(all.count > 0 && std::sqrt(all.m2) > tolerance * std::sqrt(all.count) ? kept_alone : dropped);
       continue;
     }
     if (a < 0 || a >= static_cast<int>(node_elements.size()))
       throw std::invalid_argument("enrichment function " + std::to_string(list[0]) + ": enriched node " +
                                   std::to_string(a) + " out of range [0, " + std::to_string(node_elements.size()) + ")");
-    // Nodes with the same support (same elements, same order) and the same functions get
-    // the same answer: computed once (all nodes of an element with many cuts, midside nodes).
-    auto memo_key = std::make_pair(node_elements[a], list);
-    const auto known = memo.find(memo_key);
-    if (known != memo.end()) {
-      for (std::size_t k = 0; k < list.size(); ++k)
-        if (known->second[k]) kept[list[k]].push_back(a);
-      continue;
-    }
-    std::vector<char>& keeps = memo[memo_key];
-    keeps.assign(list.size(), 0);
-    // The tiles of every function on every element incident to a.
-    std::vector<std::vector<const kernels::TexelTile*>> tiles(list.size());
+    const auto [it, fresh] =
+        shared_index.emplace(std::make_pair(node_elements[a], list), static_cast<int>(shared.size()));
+    answer.push_back(it->second);
+    if (!fresh) continue;
+    SharedSupport support{a, list, std::vector<std::vector<const kernels::TexelTile*>>(list.size()), {}};
     for (std::size_t k = 0; k < list.size(); ++k)
       for (int e : node_elements[a]) {
         const kernels::TexelTile* tile = texture_of(functions[list[k]], e);
         if (!tile)
           throw std::invalid_argument("enrichment function " + std::to_string(list[k]) + ": element " + std::to_string(e) +
                                       " is incident to enriched node " + std::to_string(a) + " but has no texture");
-        tiles[k].push_back(tile);
+        support.tiles[k].push_back(tile);
       }
-    // Sample positions: the active texels of the support (flags are the same in every
-    // function: the walls of all cuts and the inactive bits).
-    std::size_t n = 0;
-    for (const kernels::TexelTile* tile : tiles[0])
-      for (std::uint8_t flag : tile->flags) n += !(flag & kernels::inactive);
-    if (n == 0) continue;
-    basis.assign(1, std::vector<double>(n, 1.0 / std::sqrt(static_cast<double>(n))));
-    for (std::size_t k = 0; k < list.size(); ++k) {
-      column.clear();
-      for (std::size_t t = 0; t < tiles[k].size(); ++t) {
-        const kernels::TexelTile& mask = *tiles[0][t];
-        for (std::size_t p = 0; p < mask.flags.size(); ++p)
-          if (!(mask.flags[p] & kernels::inactive)) column.push_back(tiles[k][t]->values[p]);
-      }
-      if (column.size() != n)
-        throw std::invalid_argument("enrichment function " + std::to_string(list[k]) + ": the textures around node " +
-                                    std::to_string(a) + " differ in size or active texels from function " +
-                                    std::to_string(list[0]) + "'s");
-      for (int pass = 0; pass < 2; ++pass)  // twice: classical Gram-Schmidt loses orthogonality once
-        for (const std::vector<double>& q : basis) subtract_projection(column, q);
-      const double norm = std::sqrt(dot(column, column));
-      if (!(norm > tolerance * std::sqrt(static_cast<double>(n)))) continue;  // adds nothing at a
-      divide(column, norm);
-      basis.push_back(column);
-      kept[list[k]].push_back(a);
-      keeps[k] = 1;
+    shared.push_back(std::move(support));
+  }
+  std::vector<std::exception_ptr> failures(shared.size());
+  kernels::forall_dynamic(static_cast<std::int64_t>(shared.size()), [&](std::int64_t k) {
+    try {
+      span_keeps(shared[k], tolerance);
+    } catch (...) {
+      failures[k] = std::current_exception();
     }
+  });
+  for (const std::exception_ptr& failure : failures)
+    if (failure) std::rethrow_exception(failure);
+  std::size_t next = 0;
+  for (const auto& [a, list] : by_node) {
+    const int answer_here = answer[next++];
+    if (answer_here == kept_alone) kept[list[0]].push_back(a);
+    if (answer_here >= 0)
+      for (std::size_t k = 0; k < list.size(); ++k)
+        if (shared[answer_here].keeps[k]) kept[list[k]].push_back(a);
   }
   return kept;  // by_node is ordered by node, so each list is sorted
 }
