@@ -439,64 +439,54 @@ LaplaceSolveStats solve_on_lattice_patch(TexelGraph& graph, const std::vector<Re
   constexpr int empty = -1, ghost = -2;
   std::vector<int> occupant(patch.flags.size(), empty);
   constexpr std::uint8_t walled = kernels::wall_east | kernels::wall_north;
-  for (int l = 0; l < static_cast<int>(tiles.size()); ++l) {
-    if (tiles[l].frozen) continue;
-    const TileCells c = cells[l];
-    for (int j = 0; j < t; ++j)
-      for (int i = 0; i < t; ++i) {
-        const int v = l * tt + j * t + i;
-        if (!graph.active(v)) continue;
-        const int g = c.origin + i * c.di + j * c.dj;
-        if (occupant[g] != empty) throw std::runtime_error("two texels on one lattice place");
-        occupant[g] = v;
-        patch.flags[g] = walled | (unknown_of[v] < 0 ? kernels::dirichlet : 0);
-        patch.values[g] = graph.value(v);  // data, or the initial guess (the previous H)
-      }
-  }
+  // Calls f(l, i, j, v, g) for texel (i, j) of every solved tile l: graph node v, patch index g.
+  auto for_each_solved_texel = [&](auto&& f) {
+    for (int l = 0; l < static_cast<int>(tiles.size()); ++l) {
+      if (tiles[l].frozen) continue;
+      const TileCells c = cells[l];
+      for (int j = 0; j < t; ++j)
+        for (int i = 0; i < t; ++i) f(l, i, j, l * tt + j * t + i, c.origin + i * c.di + j * c.dj);
+    }
+  };
+  for_each_solved_texel([&](int, int, int, int v, int g) {
+    if (!graph.active(v)) return;
+    if (occupant[g] != empty) throw std::runtime_error("two texels on one lattice place");
+    occupant[g] = v;
+    patch.flags[g] = walled | (unknown_of[v] < 0 ? kernels::dirichlet : 0);
+    patch.values[g] = graph.value(v);  // data, or the initial guess (the previous H)
+  });
   // Open the couplings of the unknowns (data-data pairs stay walled: they do not enter the
   // equations). Within a tile a coupling is a lattice step by construction; one across a
   // mesh edge is checked, and a frozen partner becomes a ghost.
-  for (int l = 0; l < static_cast<int>(tiles.size()); ++l) {
-    if (tiles[l].frozen) continue;
+  for_each_solved_texel([&](int l, int i, int j, int v, int g) {
+    if (unknown_of[v] < 0) return;
     const TexelTile& tile = tiles[l].tile;
     const TileCells c = cells[l];
-    for (int j = 0; j < t; ++j)
-      for (int i = 0; i < t; ++i) {
-        const int v = l * tt + j * t + i;
-        if (unknown_of[v] < 0) continue;
-        const int g = c.origin + i * c.di + j * c.dj;
-        if (kernels::texels_coupled_east(tile, i, j)) set_wall_between(patch, g, g + c.di, false);
-        if (i > 0 && kernels::texels_coupled_east(tile, i - 1, j)) set_wall_between(patch, g, g - c.di, false);
-        if (kernels::texels_coupled_north(tile, i, j)) set_wall_between(patch, g, g + c.dj, false);
-        if (j > 0 && kernels::texels_coupled_north(tile, i, j - 1)) set_wall_between(patch, g, g - c.dj, false);
-        if (!graph.on_border(i, j)) continue;
-        const auto p = placed[l].at(i, j);
-        graph.for_each_coupling_across(v, [&](int u) {
-          const auto q = lattice_point(u);
-          const int dx = q[0] - p[0], dy = q[1] - p[1];
-          if (std::abs(dx) + std::abs(dy) != 1) throw std::runtime_error("a coupling off the lattice");
-          const int k = cell(q);
-          if (tiles[u / tt].frozen) {
-            const double value = graph.value(u);
-            if (occupant[k] >= 0 || (occupant[k] == ghost && patch.values[k] != value))
-              throw std::runtime_error("a ghost texel on a taken lattice place");
-            if (occupant[k] == empty)
-              occupant[k] = ghost, patch.flags[k] = walled | kernels::dirichlet, patch.values[k] = value;
-          }
-          set_wall_between(patch, g, k, false);
-        });
+    if (kernels::texels_coupled_east(tile, i, j)) set_wall_between(patch, g, g + c.di, false);
+    if (i > 0 && kernels::texels_coupled_east(tile, i - 1, j)) set_wall_between(patch, g, g - c.di, false);
+    if (kernels::texels_coupled_north(tile, i, j)) set_wall_between(patch, g, g + c.dj, false);
+    if (j > 0 && kernels::texels_coupled_north(tile, i, j - 1)) set_wall_between(patch, g, g - c.dj, false);
+    if (!graph.on_border(i, j)) return;
+    const auto p = placed[l].at(i, j);
+    graph.for_each_coupling_across(v, [&](int u) {
+      const auto q = lattice_point(u);
+      const int dx = q[0] - p[0], dy = q[1] - p[1];
+      if (std::abs(dx) + std::abs(dy) != 1) throw std::runtime_error("a coupling off the lattice");
+      const int k = cell(q);
+      if (tiles[u / tt].frozen) {
+        const double value = graph.value(u);
+        if (occupant[k] >= 0 || (occupant[k] == ghost && patch.values[k] != value))
+          throw std::runtime_error("a ghost texel on a taken lattice place");
+        if (occupant[k] == empty)
+          occupant[k] = ghost, patch.flags[k] = walled | kernels::dirichlet, patch.values[k] = value;
       }
-  }
+      set_wall_between(patch, g, k, false);
+    });
+  });
   const LaplaceSolveStats s = solve_laplace(patch, LaplaceSolver::multigrid, options);
-  for (int l = 0; l < static_cast<int>(tiles.size()); ++l) {
-    if (tiles[l].frozen) continue;
-    const TileCells c = cells[l];
-    for (int j = 0; j < t; ++j)
-      for (int i = 0; i < t; ++i) {
-        const int v = l * tt + j * t + i;
-        if (unknown_of[v] >= 0) graph.value(v) = patch.values[c.origin + i * c.di + j * c.dj];
-      }
-  }
+  for_each_solved_texel([&](int, int, int, int v, int g) {
+    if (unknown_of[v] >= 0) graph.value(v) = patch.values[g];
+  });
   return s;
 }
 
