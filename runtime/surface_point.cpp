@@ -581,7 +581,7 @@ SurfacePoint SurfacePointSearch::search(const int* elements, int count, const do
   else
     for (int k = 0; k < count; ++k) nearest = std::min(nearest, lower(k));
   within(nearest);
-  int first = near.front();
+  int first = near.empty() ? 0 : near.front();  // empty only for NaN boxes (an invalid mesh)
   seed(first);
   within(seed_distance[first]);
   for (int k : near) {
