@@ -516,13 +516,13 @@ double SurfacePointSearch::tie_tolerance_of(const std::vector<int>& elements) co
 SurfacePoint SurfacePointSearch::closest(const double p[3]) const {
   if (all_.empty()) throw MeshError("closest_surface_point: the mesh has no elements");
   check_query(p);
-  return search(all_.data(), static_cast<int>(all_.size()), p, whole_tie_tolerance_);
+  return search(all_.data(), static_cast<int>(all_.size()), p, whole_tie_tolerance_, true);
 }
 
 SurfacePoint SurfacePointSearch::closest_among(const std::vector<int>& elements, const double p[3]) const {
   if (elements.empty()) throw MeshError("closest_surface_point: no elements to search");
   check_query(p);
-  return search(elements.data(), static_cast<int>(elements.size()), p, tie_tolerance_of(elements));
+  return search(elements.data(), static_cast<int>(elements.size()), p, tie_tolerance_of(elements), false);
 }
 
 void SurfacePointSearch::check_query(const double p[3]) {
@@ -531,7 +531,8 @@ void SurfacePointSearch::check_query(const double p[3]) {
                     mesh_number(p[2]) + ") is not finite");
 }
 
-SurfacePoint SurfacePointSearch::search(const int* elements, int count, const double p[3], double tie_tolerance) const {
+SurfacePoint SurfacePointSearch::search(const int* elements, int count, const double p[3], double tie_tolerance,
+                                        bool whole) const {
   const auto& samples = sample_points(mesh_.type);
   constexpr double unknown = -1;
   std::vector<double> box_lower(count, unknown), seed_distance(count, unknown);
@@ -545,8 +546,7 @@ SurfacePoint SurfacePointSearch::search(const int* elements, int count, const do
     return box_lower[k];
   };
   // The k whose lower(k) <= r, in list order: from the box hierarchy for the whole mesh
-  // (k is the element there), else by measuring each.
-  const bool whole = elements == all_.data();
+  // (elements is all_ there, so k is the element), else by measuring each.
   std::vector<int> near;
   auto within = [&](double r) {
     if (std::isnan(r)) r = std::numeric_limits<double>::infinity();  // as the scan's `> r` tests

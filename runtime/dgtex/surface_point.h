@@ -58,7 +58,8 @@ class SurfacePointSearch {
   SurfacePoint closest_among(const std::vector<int>& elements, const double p[3]) const;
 
  private:
-  SurfacePoint search(const int* elements, int count, const double p[3], double tie_tolerance) const;
+  // whole: elements is all_ (then the box hierarchy finds the candidates).
+  SurfacePoint search(const int* elements, int count, const double p[3], double tie_tolerance, bool whole) const;
   double tie_tolerance_of(const std::vector<int>& elements) const;
   static void check_query(const double p[3]);
   const Mesh& mesh_;
