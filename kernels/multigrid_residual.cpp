@@ -182,6 +182,15 @@ void apply_texels(GridShape shape, const std::uint8_t* bits, const double* x, do
       execution);
 }
 
+void apply_texels_at(GridShape shape, const std::uint8_t* bits, const double* x, const std::int64_t* texels,
+                     std::int64_t count, double* y) {
+  const std::int64_t s = shape.stride();
+  for (std::int64_t m = 0; m < count; ++m) {
+    const std::int64_t t = texels[m];
+    y[t] = (bits[t] & is_unknown) ? detail::texel_operator(bits[t], x, t, s) : 0.0;
+  }
+}
+
 void update_direction_and_apply_texels(GridShape shape, const std::uint8_t* bits, const double* z, double beta,
                                        double* p, double* q, double* row_dot, Execution execution) {
   const detail::TexelRowKernels& rows = texel_rows();

@@ -58,8 +58,9 @@ LaplaceSolveStats solve_seamed_patch_laplace(kernels::TexelTile& tile, const std
   for (const SeamCoupling& c : seams) on_seam[c.a] = on_seam[c.b] = 1;
   bool pin = false;
   for (int t = 0; t < n && !pin; ++t) pin = free_texel(t) && !(bits[at(t)] & kernels::is_unknown);
-  kernels::TexelTile pinned = tile;
+  kernels::TexelTile pinned;
   if (pin) {
+    pinned = tile;
     for (int t = 0; t < n; ++t)
       if (on_seam[t] && free_texel(t)) pinned.flags[t] |= kernels::dirichlet;
     kernels::classify_laplace_texels_padded(pinned, bits.data());
@@ -93,7 +94,8 @@ LaplaceSolveStats solve_seamed_patch_laplace(kernels::TexelTile& tile, const std
   // Coarse levels and the strip factor only once a solve needs them (below): a warm start
   // that meets the tolerance already (a settled enrichment solved again for a new wall
   // elsewhere) needs neither.
-  LaplaceMultigrid chain(pinned, options, LaplaceMultigrid::CoarseLevels::on_demand);
+  const kernels::TexelTile& chain_tile = pin ? pinned : tile;
+  LaplaceMultigrid chain(chain_tile, options, LaplaceMultigrid::CoarseLevels::on_demand);
   std::vector<char> unknown(n, 0);
   for (int t = 0; t < n; ++t) {
     unknown[t] = (bits[at(t)] & kernels::is_unknown) != 0;
@@ -101,18 +103,27 @@ LaplaceSolveStats solve_seamed_patch_laplace(kernels::TexelTile& tile, const std
       throw std::runtime_error("seamed patch Laplace: texel " + std::to_string(t) +
                                " is in a part of the ring without Dirichlet data");
   }
-  // Seam partners per seam texel (padded indices), each unknown seam texel listed once.
+  // Seam partners per seam texel (padded indices), each unknown seam texel listed once, its
+  // partners in the order of `seams`.
   std::vector<std::int64_t> seam_texel;
   std::vector<int> partner_start = {0};
   std::vector<std::int64_t> partner;
   {
-    std::vector<std::vector<std::int64_t>> partners_of(n);
-    for (const SeamCoupling& c : seams) partners_of[c.a].push_back(at(c.b)), partners_of[c.b].push_back(at(c.a));
-    for (int t = 0; t < n; ++t) {
-      if (partners_of[t].empty() || !unknown[t]) continue;
-      seam_texel.push_back(at(t));
-      partner.insert(partner.end(), partners_of[t].begin(), partners_of[t].end());
-      partner_start.push_back(static_cast<int>(partner.size()));
+    std::vector<std::pair<int, std::int64_t>> ends;  // (seam texel, partner)
+    ends.reserve(2 * seams.size());
+    for (const SeamCoupling& c : seams) ends.emplace_back(c.a, at(c.b)), ends.emplace_back(c.b, at(c.a));
+    std::stable_sort(ends.begin(), ends.end(),
+                     [](const auto& one, const auto& other) { return one.first < other.first; });
+    for (std::size_t e = 0; e < ends.size();) {
+      const int t = ends[e].first;
+      std::size_t last = e;
+      while (last < ends.size() && ends[last].first == t) ++last;
+      if (unknown[t]) {
+        seam_texel.push_back(at(t));
+        for (; e < last; ++e) partner.push_back(ends[e].second);
+        partner_start.push_back(static_cast<int>(partner.size()));
+      }
+      e = last;
     }
   }
   const auto is_unknown = [&](std::int64_t k) { return (bits[k] & kernels::is_unknown) != 0; };
@@ -156,8 +167,8 @@ LaplaceSolveStats solve_seamed_patch_laplace(kernels::TexelTile& tile, const std
     return sum_rows();
   };
   // b: values of coupled Dirichlet texels, grid neighbours and seam partners.
-  std::vector<double> b(padded, 0.0), x(padded, 0.0), r(padded, 0.0), z(padded, 0.0), p(padded, 0.0),
-      q(padded, 0.0);
+  std::vector<double> b(padded, 0.0), x(padded, 0.0), r(padded, 0.0), q(padded, 0.0);
+  std::vector<double> z, p;  // allocated once CG runs (a warm start often meets the tolerance)
   for (int j = 0; j < h; ++j)
     for (int i = 0; i < w; ++i) {
       const int t = tile.index(i, j);
@@ -186,6 +197,9 @@ LaplaceSolveStats solve_seamed_patch_laplace(kernels::TexelTile& tile, const std
   // sees the seams as walls; the strip solves put their couplings back where it errs most.
   // Slinky's step-17 ring from x = 0: 34 -> 14 iterations.
   std::vector<std::int64_t> strip;  // padded indices, ordered for a narrow band
+  // The strip and the unknowns coupled to it: where A z can differ from 0 while z is 0 off the
+  // strip (sorted padded indices).
+  std::vector<std::int64_t> strip_halo;
   BandedCholesky strip_factor;
   Eigen::VectorXd strip_r, strip_z;
   const auto factor_strip = [&] {
@@ -242,54 +256,65 @@ LaplaceSolveStats solve_seamed_patch_laplace(kernels::TexelTile& tile, const std
     strip = use_rows ? by_rows : by_columns;
     if (!strip_factor.factorize(use_rows ? rows_block : columns_block)) strip.clear();  // (SPD: not expected)
     strip_r.resize(static_cast<Eigen::Index>(strip.size()));
+    // Grid couplings only: a seam partner of a strip texel is a seam texel, in the strip itself.
+    for (const std::int64_t k : strip) {
+      strip_halo.push_back(k);
+      const std::uint8_t bk = bits[k];
+      if (bk & kernels::couples_west_unknown) strip_halo.push_back(k - 1);
+      if (bk & kernels::couples_east_unknown) strip_halo.push_back(k + 1);
+      if (bk & kernels::couples_south_unknown) strip_halo.push_back(k - g.stride());
+      if (bk & kernels::couples_north_unknown) strip_halo.push_back(k + g.stride());
+    }
+    std::sort(strip_halo.begin(), strip_halo.end());
+    strip_halo.erase(std::unique(strip_halo.begin(), strip_halo.end()), strip_halo.end());
   };
-  // z[strip] += D^-1 v[strip].
-  const auto strip_solve = [&](const std::vector<double>& v) {
-    for (std::size_t m = 0; m < strip.size(); ++m) strip_r[static_cast<Eigen::Index>(m)] = v[strip[m]];
+  // strip_z = D^-1 f on the strip, f(k) the value at strip texel k.
+  const auto strip_solve = [&](auto&& f) {
+    for (std::size_t m = 0; m < strip.size(); ++m) strip_r[static_cast<Eigen::Index>(m)] = f(strip[m]);
     strip_factor.solve(strip_r, strip_z);
-    for (std::size_t m = 0; m < strip.size(); ++m) z[strip[m]] += strip_z[static_cast<Eigen::Index>(m)];
   };
-  // v = r - A z at the unknowns.
-  std::vector<double> az(padded, 0.0), v(padded, 0.0);
-  const auto remaining = [&] {
-    kernels::apply_texels(g, bits.data(), z.data(), az.data(), rows.data(), execution);
-    add_seams(z, az);
-    kernels::forall(
-        h,
-        [&](std::int64_t j) {
-          const std::int64_t first = g.at(0, static_cast<int>(j));
-          for (std::int64_t k = first; k < first + w; ++k) v[k] = is_unknown(k) ? r[k] - az[k] : 0.0;
-        },
-        execution);
+  // az = A u at the listed texels (grid part, then the seams: every seam texel is listed).
+  std::vector<double> az;  // allocated with z (below)
+  const auto apply_at = [&](const std::vector<double>& u, const std::vector<std::int64_t>& texels) {
+    kernels::apply_texels_at(g, bits.data(), u.data(), texels.data(), static_cast<std::int64_t>(texels.size()),
+                             az.data());
+    add_seams(u, az);
   };
-  // The multigrid's preconditioner reads and writes per tile texel (unpadded).
-  std::vector<double> r_tile(n), z_tile(n);
+  // The multigrid's preconditioner reads and writes per tile texel (unpadded). z_strip holds
+  // the first strip solve's correction on the strip and 0 everywhere else.
+  std::vector<double> r_tile, z_tile, z_strip;  // allocated with z (below)
   const auto precondition = [&] {
     const bool with_strip = !strip.empty();
+    // The V-cycle's input: r - A z_strip, which differs from r only on the strip's halo.
     if (with_strip) {
-      std::fill(z.begin(), z.end(), 0.0);
-      strip_solve(r);
-      remaining();
+      strip_solve([&](std::int64_t k) { return r[k]; });
+      for (std::size_t m = 0; m < strip.size(); ++m) z_strip[strip[m]] = strip_z[static_cast<Eigen::Index>(m)];
     }
-    const std::vector<double>& input = with_strip ? v : r;
     kernels::forall(
         h,
-        [&](std::int64_t j) {
-          std::copy_n(input.data() + g.at(0, static_cast<int>(j)), w, r_tile.data() + j * w);
-        },
+        [&](std::int64_t j) { std::copy_n(r.data() + g.at(0, static_cast<int>(j)), w, r_tile.data() + j * w); },
         execution);
+    if (with_strip) {
+      apply_at(z_strip, strip_halo);
+      for (const std::int64_t k : strip_halo) {
+        const int i = static_cast<int>(k % g.stride()) - 1, j = static_cast<int>(k / g.stride()) - 1;
+        r_tile[static_cast<std::size_t>(j) * w + i] = r[k] - az[k];
+      }
+    }
     chain.precondition(r_tile, z_tile);
     kernels::forall(
         h,
         [&](std::int64_t j) {
           const std::int64_t first = g.at(0, static_cast<int>(j));
           const double* from = z_tile.data() + j * w;
-          for (int i = 0; i < w; ++i) z[first + i] = (with_strip ? z[first + i] : 0.0) + from[i];
+          for (int i = 0; i < w; ++i) z[first + i] = (with_strip ? z_strip[first + i] : 0.0) + from[i];
         },
         execution);
+    // Then z += D^-1 (r - A z) on the strip.
     if (with_strip) {
-      remaining();
-      strip_solve(v);
+      apply_at(z, strip);
+      strip_solve([&](std::int64_t k) { return r[k] - az[k]; });
+      for (std::size_t m = 0; m < strip.size(); ++m) z[strip[m]] += strip_z[static_cast<Eigen::Index>(m)];
     }
     return row_sum([&](std::int64_t k) { return r[k] * z[k]; });
   };
@@ -311,7 +336,7 @@ LaplaceSolveStats solve_seamed_patch_laplace(kernels::TexelTile& tile, const std
   // x = 0 and 6 chain cycles + 7 iterations from there; the chain's solution is wrong only
   // near the seam. A warm start (the previous H) is kept as it is.
   if (relative > fresh_start_residual) {
-    kernels::TexelTile open = pinned;  // the seam texels keep their current values as data
+    kernels::TexelTile open = chain_tile;  // the seam texels keep their current values as data
     for (int t = 0; t < n; ++t)
       if (unknown[t]) open.values[t] = x[at(t)];
     try {
@@ -324,6 +349,8 @@ LaplaceSolveStats solve_seamed_patch_laplace(kernels::TexelTile& tile, const std
     }
   }
   if (relative > options.tolerance) {
+    for (std::vector<double>* padded_vector : {&z, &p, &az, &z_strip}) padded_vector->assign(padded, 0.0);
+    r_tile.resize(n), z_tile.resize(n);
     factor_strip();
     double rz = precondition();
     p = z;

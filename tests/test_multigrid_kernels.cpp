@@ -261,6 +261,32 @@ TEST_P(MultigridKernels, FusedConjugateGradientStepsEqualReference) {
   }
 }
 
+// The listed-texel form writes what the whole-grid product writes there, and nothing else.
+TEST_P(MultigridKernels, OperatorAtListedTexelsEqualsTheWholeGridProduct) {
+  TwoLevels L(make_laplace_domain(GetParam(), 100));
+  std::vector<double> whole(L.x.size(), 0.0), rows(L.fine.ny);
+  apply_texels(L.fine, L.bits.data(), L.x.data(), whole.data(), rows.data(), Execution::serial);
+  std::vector<std::int64_t> listed;
+  for (int j = 0; j < L.fine.ny; j += 3)
+    for (int i = j % 5; i < L.fine.nx; i += 7) listed.push_back(L.fine.at(i, j));
+  const double untouched = -12345.0;
+  std::vector<double> at(L.x.size(), untouched);
+  apply_texels_at(L.fine, L.bits.data(), L.x.data(), listed.data(), static_cast<std::int64_t>(listed.size()),
+                  at.data());
+  std::vector<char> is_listed(L.x.size(), 0);
+  for (std::int64_t t : listed) is_listed[t] = 1;
+  int unknowns_listed = 0;
+  for (std::size_t t = 0; t < at.size(); ++t) {
+    if (is_listed[t]) {
+      EXPECT_EQ(at[t], whole[t]) << "texel " << t;
+      unknowns_listed += (L.bits[t] & is_unknown) != 0;
+    } else {
+      EXPECT_EQ(at[t], untouched) << "texel " << t;
+    }
+  }
+  EXPECT_GT(unknowns_listed, 100);
+}
+
 TEST_P(MultigridKernels, RedBlackTransfersMatchReferencesAndFullForms) {
   omp_set_num_threads(2);
   TwoLevels L(make_laplace_domain(GetParam(), 96));

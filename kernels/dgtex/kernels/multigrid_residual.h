@@ -68,6 +68,13 @@ void residual_stencil9_reference(GridShape shape, Stencil9ViewFloat a, const flo
 void apply_texels(GridShape shape, const std::uint8_t* bits, const double* x, double* y, double* row_dot,
                   Execution execution = Execution::parallel);
 
+// y[t] = (A x)[t] for the listed level-0 texels t (padded indices) only, bitwise as
+// apply_texels writes them (its reference); the other entries of y are not written. For a
+// caller that needs A x where x changed on a few texels (seamed_patch_laplace's strip):
+// serial, since such lists are short (~1-2k texels) next to a pass over the grid.
+void apply_texels_at(GridShape shape, const std::uint8_t* bits, const double* x, const std::int64_t* texels,
+                     std::int64_t count, double* y);
+
 // Conjugate-gradient step on level 0 in one streaming pass: p = z + beta p, then q = A p
 // and row_dot[j] = sum over row j of p * q (four-lane order, above). Bitwise equal to the
 // update followed by apply_texels; the reference runs both as plain loops.
