@@ -182,6 +182,38 @@ TEST(EnrichmentIncrementalUpdate, SingleFunctionNodesKeepExactlyTheNonConstantOn
   for (int a : expected) EXPECT_TRUE(std::count(node_elements[a].begin(), node_elements[a].end(), 2));
 }
 
+// Two functions on one element: A a ramp, B = A + delta g with g orthogonal to 1 and A
+// (a checkerboard) of RMS 1, so B adds a residual of RMS exactly delta to the span of 1 and A.
+// B must keep its nodes exactly when delta exceeds the 1e-6 tolerance, both where the Gram
+// matrix certifies independence at once and where Gram-Schmidt decides near the threshold.
+TEST(EnrichmentIncrementalUpdate, SharedNodesKeepALaterFunctionExactlyAboveTheTolerance) {
+  const Mesh mesh = make_rectangle(1, 1, 1, 1, ElementType::quad8);
+  const int t = 16;
+  std::vector<std::vector<int>> node_elements(mesh.num_nodes(), std::vector<int>{0});
+  std::vector<int> all_nodes(mesh.num_nodes());
+  for (int a = 0; a < mesh.num_nodes(); ++a) all_nodes[a] = a;
+  const auto function = [&](auto value) {
+    EnrichmentFunction f;
+    f.enriched_nodes = all_nodes;
+    ElementTexture texture;
+    texture.element = 0;
+    texture.tile = kernels::make_element_tile(mesh.type, t);
+    for (int j = 0; j < t; ++j)
+      for (int i = 0; i < t; ++i) texture.tile.values[j * t + i] = value(i, j);
+    f.elements.push_back(texture);
+    return f;
+  };
+  const auto ramp = [&](int i, int) { return (i - 0.5 * (t - 1)) / t; };
+  const EnrichmentFunction a = function(ramp);
+  for (const double delta : {1e-2, 1e-5, 1.1e-6, 0.9e-6, 1e-8, 0.0}) {
+    const EnrichmentFunction b = function([&](int i, int j) { return ramp(i, j) + delta * ((i + j) % 2 ? -1.0 : 1.0); });
+    const std::vector<std::vector<int>> kept = independent_enriched_nodes(node_elements, {a, b}, 1e-6);
+    ASSERT_EQ(kept.size(), 2u);
+    EXPECT_EQ(kept[0], all_nodes) << "delta " << delta;
+    EXPECT_EQ(kept[1], delta > 1e-6 ? all_nodes : std::vector<int>{}) << "delta " << delta;
+  }
+}
+
 TEST(EnrichmentIncrementalUpdate, ProgressiveCutAroundACylinderMultigridMatchesCholmod) {
   const Mesh mesh = make_cylinder(1.0, 1.0, 0, 360, 4, 1, ElementType::quad8);
   const Topology topology = build_topology(mesh);

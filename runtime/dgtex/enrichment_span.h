@@ -17,7 +17,9 @@
 // 1 and the earlier kept functions has an RMS below `tolerance` (H is O(1): +-1 data) does
 // not keep the node. Exact dependencies (constant +-1 components, which the Laplace solve
 // sets exactly) leave round-off; near dependencies (fragments, cut pieces running close
-// to each other) are left to the mass test of ShellModel::set_enrichments.
+// to each other) are left to the mass test of ShellModel::set_enrichments. A support whose
+// Gram matrix shows every function independent with a margin over the worst-case rounding
+// skips the Gram-Schmidt (the same answer: all kept; the slinky's test 10 -> 4 ms a step).
 #include <vector>
 
 #include "dgtex/enrichment_function.h"
