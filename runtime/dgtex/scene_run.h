@@ -27,6 +27,10 @@
 // are bitwise those of the plain order (every kernel's result is independent of the thread
 // count). Stage times then overlap: "enrichment" is the update's own wall time, counted in
 // the step that uses it, and the other stages include the slowdown of sharing the cores.
+// Run programs that link the library with OMP_WAIT_POLICY=passive (the `dgtex` tool sets it
+// itself): under libgomp's default the step's idle OpenMP worker spins for milliseconds after
+// each parallel loop, on the core the update needs (spiral1, 2 cores: the update's multigrid
+// set-up took 5.9-6.5 ms a step spinning, 3.5-4.0 ms passive).
 // Not thread-safe; each call uses all OpenMP threads itself (but the update's, above).
 // SceneRun owns a copy of the Scene and the mesh, topology, model, cut manager and
 // simulation built from it. Units: those of the scene (SI: m, kg, s, N).
