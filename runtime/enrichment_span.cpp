@@ -92,8 +92,13 @@ struct SharedSupport {
 Eigen::MatrixXd support_samples(const SharedSupport& support) {
   const auto& tiles = support.tiles;
   Eigen::Index n = 0;
-  for (const kernels::TexelTile* tile : tiles[0])
-    for (std::uint8_t flag : tile->flags) n += !(flag & kernels::inactive);
+  std::vector<char> all_active;  // per element: no inactive texel (quad8), copied whole
+  for (const kernels::TexelTile* tile : tiles[0]) {
+    Eigen::Index active = 0;
+    for (std::uint8_t flag : tile->flags) active += !(flag & kernels::inactive);
+    all_active.push_back(active == static_cast<Eigen::Index>(tile->flags.size()));
+    n += active;
+  }
   Eigen::MatrixXd samples(n, static_cast<Eigen::Index>(tiles.size()) + 1);
   samples.col(0).setOnes();
   for (std::size_t k = 0; k < tiles.size(); ++k) {
@@ -106,8 +111,14 @@ Eigen::MatrixXd support_samples(const SharedSupport& support) {
                                     ": the textures around node " + std::to_string(support.node) +
                                     " differ in size or active texels from function " +
                                     std::to_string(support.functions[0]) + "'s");
+      const std::vector<double>& values = tiles[k][t]->values;
+      if (all_active[t]) {
+        std::copy(values.begin(), values.end(), column + row);
+        row += static_cast<Eigen::Index>(values.size());
+        continue;
+      }
       for (std::size_t p = 0; p < mask.flags.size(); ++p)
-        if (!(mask.flags[p] & kernels::inactive)) column[row++] = tiles[k][t]->values[p];
+        if (!(mask.flags[p] & kernels::inactive)) column[row++] = values[p];
     }
   }
   return samples;
@@ -121,10 +132,30 @@ Eigen::MatrixXd support_samples(const SharedSupport& support) {
 // worst-case rounding of G's sums (n eps relative to sqrt(G_ii G_jj)) and of the eigenvalue,
 // and must clear the drop threshold by 10%, so Gram-Schmidt (span_keeps) would keep every
 // function too: certified supports get its answer without running it, the others run it.
+// The lower triangle of S^T S for the n x columns samples (column-major), eight interleaved
+// sums per entry as in dot: Eigen's product runs at SSE2 width in this build (no -march).
+__attribute__((target_clones("avx512f", "avx2", "default")))
+void gram_lower(const double* samples, std::size_t n, std::size_t columns, double* gram) {
+  std::vector<double> sums(columns * (columns + 1) / 2 * 8, 0.0);
+  const std::size_t blocked = n - n % 8;
+  for (std::size_t k = 0; k < blocked; k += 8) {
+    double* __restrict sum = sums.data();
+    for (std::size_t i = 0; i < columns; ++i)
+      for (std::size_t j = 0; j <= i; ++j, sum += 8)
+        for (int l = 0; l < 8; ++l) sum[l] += samples[i * n + k + l] * samples[j * n + k + l];
+  }
+  double* sum = sums.data();
+  for (std::size_t i = 0; i < columns; ++i)
+    for (std::size_t j = 0; j <= i; ++j, sum += 8) {
+      for (std::size_t k = blocked; k < n; ++k) sum[k - blocked] += samples[i * n + k] * samples[j * n + k];
+      gram[j * columns + i] = ((sum[0] + sum[1]) + (sum[2] + sum[3])) + ((sum[4] + sum[5]) + (sum[6] + sum[7]));
+    }
+}
+
 bool certainly_all_independent(const Eigen::MatrixXd& samples, double threshold) {
   const Eigen::Index columns = samples.cols();
   Eigen::MatrixXd gram = Eigen::MatrixXd::Zero(columns, columns);
-  gram.selfadjointView<Eigen::Lower>().rankUpdate(samples.transpose());
+  gram_lower(samples.data(), static_cast<std::size_t>(samples.rows()), static_cast<std::size_t>(columns), gram.data());
   Eigen::VectorXd scale(columns);
   for (Eigen::Index i = 0; i < columns; ++i) {
     if (!(gram(i, i) > 0) || !std::isfinite(gram(i, i))) return false;
