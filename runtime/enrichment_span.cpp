@@ -124,14 +124,6 @@ Eigen::MatrixXd support_samples(const SharedSupport& support) {
   return samples;
 }
 
-// Whether every function certainly adds to the span of 1 and the earlier ones, read from the
-// Gram matrix G = S^T S of the samples: one pass over them instead of Gram-Schmidt's two per
-// basis vector (the slinky's span test was 21% of its cut update, bound by reading the basis).
-// Function k's residual r_k after the earlier columns is its Schur complement in G, at least
-// G_kk lambda_min(D G D) (D scales G to a unit diagonal). The bound is taken down by the
-// worst-case rounding of G's sums (n eps relative to sqrt(G_ii G_jj)) and of the eigenvalue,
-// and must clear the drop threshold by 10%, so Gram-Schmidt (span_keeps) would keep every
-// function too: certified supports get its answer without running it, the others run it.
 // The lower triangle of S^T S for the n x columns samples (column-major), eight interleaved
 // sums per entry as in dot: Eigen's product runs at SSE2 width in this build (no -march).
 __attribute__((target_clones("avx512f", "avx2", "default")))
@@ -152,6 +144,14 @@ void gram_lower(const double* samples, std::size_t n, std::size_t columns, doubl
     }
 }
 
+// Whether every function certainly adds to the span of 1 and the earlier ones, read from the
+// Gram matrix G = S^T S of the samples: one pass over them instead of Gram-Schmidt's two per
+// basis vector (the slinky's span test was 21% of its cut update, bound by reading the basis).
+// Function k's residual r_k after the earlier columns is its Schur complement in G, at least
+// G_kk lambda_min(D G D) (D scales G to a unit diagonal). The bound is taken down by the
+// worst-case rounding of G's sums (n eps relative to sqrt(G_ii G_jj)) and of the eigenvalue,
+// and must clear the drop threshold by 10%, so Gram-Schmidt (span_keeps) would keep every
+// function too: certified supports get its answer without running it, the others run it.
 bool certainly_all_independent(const Eigen::MatrixXd& samples, double threshold) {
   const Eigen::Index columns = samples.cols();
   Eigen::MatrixXd gram = Eigen::MatrixXd::Zero(columns, columns);
