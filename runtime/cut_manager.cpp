@@ -335,8 +335,7 @@ bool CutManager::update(double time) {
     std::uint64_t h = kFnvSeed;
     const auto w = walls_.find(e);
     if (w != walls_.end()) h = fnv(h, w->second.flags.data(), w->second.flags.size());
-    const std::vector<long long> keys = edge_walls_.keys_of_element(e);
-    if (!keys.empty()) h = fnv(h, keys.data(), keys.size() * sizeof(long long));
+    if (const char* blocked = edge_walls_.of_element(e)) h = fnv(h, blocked, 4 * static_cast<std::size_t>(t));
     return wall_hash_cache[e] = h;
   };
 

@@ -66,7 +66,7 @@ class MeshEdgeWalls {
     const auto it = rows_.find(element);
     return it != rows_.end() ? it->second.data() : nullptr;
   }
-  // Blocked (element, edge, s) of one element, sorted (for change detection).
+  // Blocked (element, edge, s) of one element as keys (element * 4 + edge) * resolution + s, sorted.
   std::vector<long long> keys_of_element(int element) const;
   int resolution() const { return resolution_; }
   // Every (element, edge, s) as one flag, index (element * 4 + edge) * resolution + s.
