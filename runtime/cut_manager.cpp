@@ -410,21 +410,21 @@ bool CutManager::update(double time) {
     for (int e : omega) {
       RegionTile r;
       r.element = e;
+      r.frozen = solve.count(e) == 0;  // then e is known: unknown elements are changed ones
+      // The element's walls, and its previous H where it has one: a frozen tile's data, else
+      // the initial guess (used by the multigrid; CHOLMOD ignores it). Copied once each.
       const auto w = walls_.find(e);
-      r.tile = w != walls_.end() ? w->second : blank;
-      if (solve.count(e)) {
-        // previous H as the initial guess (used by the multigrid; CHOLMOD ignores it)
-        if (const std::vector<double>* previous = solved_values(state.function, e)) r.tile.values = *previous;
-        const auto it = data.find(e);
-        if (it != data.end())
-          for (const auto& [texel, value] : it->second) {
-            r.tile.flags[texel] |= kernels::dirichlet;
-            r.tile.values[texel] = value;
-          }
-      } else {
-        r.frozen = true;
-        r.tile.values = *solved_values(state.function, e);
-      }
+      const TexelTile& walled = w != walls_.end() ? w->second : blank;
+      const std::vector<double>* previous = solved_values(state.function, e);
+      r.tile.width = walled.width, r.tile.height = walled.height;
+      r.tile.flags = walled.flags;
+      r.tile.values = previous ? *previous : walled.values;
+      const auto it = data.find(e);
+      if (!r.frozen && it != data.end())
+        for (const auto& [texel, value] : it->second) {
+          r.tile.flags[texel] |= kernels::dirichlet;
+          r.tile.values[texel] = value;
+        }
       job.region.push_back(std::move(r));
     }
     jobs.push_back(std::move(job));
