@@ -168,7 +168,7 @@ LaplaceSolveStats solve_seamed_patch_laplace(kernels::TexelTile& tile, const std
   };
   // b: values of coupled Dirichlet texels, grid neighbours and seam partners.
   std::vector<double> b(padded, 0.0), x(padded, 0.0), r(padded, 0.0), q(padded, 0.0);
-  std::vector<double> z, p;  // allocated once CG runs (a warm start often meets the tolerance)
+  std::vector<double> z, p;  // once CG runs (a warm start often meets the tolerance); p copies z
   for (int j = 0; j < h; ++j)
     for (int i = 0; i < w; ++i) {
       const int t = tile.index(i, j);
@@ -349,7 +349,7 @@ LaplaceSolveStats solve_seamed_patch_laplace(kernels::TexelTile& tile, const std
     }
   }
   if (relative > options.tolerance) {
-    for (std::vector<double>* padded_vector : {&z, &p, &az, &z_strip}) padded_vector->assign(padded, 0.0);
+    for (std::vector<double>* padded_vector : {&z, &az, &z_strip}) padded_vector->assign(padded, 0.0);
     r_tile.resize(n), z_tile.resize(n);
     factor_strip();
     double rz = precondition();
