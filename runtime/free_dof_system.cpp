@@ -1,6 +1,5 @@
 #include "dgtex/free_dof_system.h"
 
-#include <algorithm>
 #include <stdexcept>
 #include <string>
 
@@ -20,32 +19,40 @@ FreeDofSystem::FreeDofSystem(const BlockAssembly& pattern, const std::vector<cha
       unknown_of_dof_[d] = static_cast<int>(dof_of_unknown_.size());
       dof_of_unknown_.push_back(d);
     }
-  // Collect (column, row, source) for the lower triangle; block rows are node rows, so the
-  // entries of one block row are scattered over three unknown rows.
-  std::vector<std::vector<std::pair<int, std::int64_t>>> per_column(dof_of_unknown_.size());
+  // The lower triangle in compressed columns, in two passes over the blocks: count each
+  // column's entries, then place them. Block rows are node rows, visited in order, and a
+  // row holds at most one block per column, so each column receives its rows in ascending
+  // order without a sort (a per-column sort took ~1.3 ms of each of the slinky's late basis
+  // changes, on the step's thread).
   const auto& start = pattern.row_start();
   const auto& col = pattern.column();
-  for (int rn = 0; rn < pattern.num_nodes(); ++rn)
-    for (std::int64_t k = start[rn]; k < start[rn + 1]; ++k) {
-      if (kept_blocks && !(*kept_blocks)[k]) continue;
-      for (int r = 0; r < 3; ++r)
-        for (int c = 0; c < 3; ++c) {
+  const auto for_each_lower_entry = [&](auto&& visit) {
+    for (int rn = 0; rn < pattern.num_nodes(); ++rn)
+      for (std::int64_t k = start[rn]; k < start[rn + 1]; ++k) {
+        if (kept_blocks && !(*kept_blocks)[k]) continue;
+        for (int r = 0; r < 3; ++r) {
           const int ur = unknown_of_dof_[3 * rn + r];
-          const int uc = unknown_of_dof_[3 * col[k] + c];
-          if (ur < 0 || uc < 0 || ur < uc) continue;
-          per_column[uc].emplace_back(ur, k * 9 + r * 3 + c);
+          if (ur < 0) continue;
+          for (int c = 0; c < 3; ++c) {
+            const int uc = unknown_of_dof_[3 * col[k] + c];
+            if (uc >= 0 && ur >= uc) visit(ur, uc, k * 9 + r * 3 + c);
+          }
         }
-    }
+      }
+  };
   column_start_.assign(dof_of_unknown_.size() + 1, 0);
-  for (size_t j = 0; j < per_column.size(); ++j) {
-    auto& entries = per_column[j];
-    std::sort(entries.begin(), entries.end());
-    for (const auto& [row, source] : entries) {
-      row_index_.push_back(row);
-      slot_source_.push_back(source);
-    }
-    column_start_[j + 1] = static_cast<int>(row_index_.size());
-  }
+  for_each_lower_entry([&](int, int uc, std::int64_t) { ++column_start_[uc + 1]; });
+  for (size_t j = 0; j < dof_of_unknown_.size(); ++j) column_start_[j + 1] += column_start_[j];
+  row_index_.resize(static_cast<size_t>(column_start_.back()));
+  slot_source_.resize(row_index_.size());
+  std::vector<int> next(column_start_.begin(), column_start_.end() - 1);
+  for_each_lower_entry([&](int ur, int uc, std::int64_t source) {
+    const int slot = next[uc]++;
+    if (slot > column_start_[uc] && row_index_[slot - 1] >= ur)
+      throw std::logic_error("FreeDofSystem: the pattern repeats a block or lists a row's blocks out of order");
+    row_index_[slot] = ur;
+    slot_source_[slot] = source;
+  });
 }
 
 void FreeDofSystem::gather(const double* a, double sa, const double* b, double sb, std::vector<double>& values) const {
