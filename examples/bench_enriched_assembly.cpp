@@ -3,6 +3,7 @@
 // for 1 and 6 enrichment functions, each for complete cuts (constant H: cells merge away
 // from the cuts) and partial cuts (harmonic H: texel-resolved near the cuts). Counters:
 // enriched DOFs and quadrature points. Argument pairs: (enrichments, partial?).
+// BM_EnrichedMassAndLoadWeights: the fused mass pass of a basis change on one element.
 // BM_BendingSums*: the frame split's six bending sums of a curved element for one block of
 // 16 stacked points over `cols` reduced functions, as one weighted Gram kernel against six
 // products of weighted rows (the form it replaced).
@@ -18,6 +19,8 @@
 #include "dgtex/harmonic_enrichment.h"
 #include "dgtex/heaviside.h"
 #include "dgtex/kernels/cut_rasterization.h"
+#include "dgtex/kernels/enriched_element_rest_integrals.h"
+#include "dgtex/kernels/enriched_quadrature.h"
 #include "dgtex/kernels/gram_accumulation.h"
 #include "dgtex/mesh_generators.h"
 #include "dgtex/shell_model.h"
@@ -119,6 +122,43 @@ void BM_EnrichedStiffnessPerTexel(benchmark::State& state) {
   counters(state, dense);
 }
 
+// The fused mass and load weights (kernels::enriched_element_mass_and_load_weights) of one
+// element with `count` harmonic partial cuts at T = 256, per-texel quadrature (4 points a
+// texel: 262k points, the slinky's and spiral6's densest case), on the machine's threads.
+void BM_EnrichedMassAndLoadWeights(benchmark::State& state) {
+  Setup& s = setup(static_cast<int>(state.range(0)), true);
+  const int npe = 8;
+  std::vector<kernels::TextureView> views;
+  std::vector<int> node, start = {0};
+  std::vector<double> shift;
+  for (const EnrichmentFunction& f : s.functions) {
+    const kernels::TexelTile& tile = f.elements[0].tile;
+    views.push_back({tile.values.data(), tile.flags.data()});
+    for (int a = 0; a < npe; ++a) node.push_back(100 + static_cast<int>(node.size())), shift.push_back(0.1 * a);
+  }
+  start.push_back(static_cast<int>(views.size()));
+  const std::vector<kernels::ShellSection> sections(1, {1e6, 0.3, 0.01, 1000});
+  const int element = 0;
+  kernels::EnrichedElementBatch batch{ElementType::quad8, 1, &element, s.mesh.elements.data(), s.mesh.positions.data(),
+                                      sections.data(), kResolution, 0, start.data(), views.data(), node.data(),
+                                      shift.data()};
+  batch.width = kernels::enriched_basis_count(batch, 0);
+  kernels::EnrichedQuadratureOptions per_texel;
+  per_texel.adaptive = false;
+  std::vector<std::int64_t> qs;
+  std::vector<double> qp;
+  kernels::enriched_element_quadrature(batch, per_texel, qs, qp);
+  const int W = batch.width;
+  std::vector<double> mass(static_cast<std::size_t>(W) * W), area(W), weights(W);
+  for (auto _ : state) {
+    kernels::enriched_element_mass_and_load_weights(batch, {qs.data(), qp.data()}, mass.data(), area.data(),
+                                                    weights.data());
+    benchmark::ClobberMemory();
+  }
+  state.counters["functions"] = W;
+  state.counters["points"] = static_cast<double>(qs.back());
+}
+
 struct BendingBlock {
   static constexpr int points = 16, sums = 6;
   std::vector<double> rows, weights, weighted_rows;  // 3 rows a point; per sum, its weighted rows
@@ -165,6 +205,7 @@ BENCHMARK(BM_EnrichedSetUp)->Apply(enriched_args);
 BENCHMARK(BM_EnrichedStiffnessLinear)->Apply(enriched_args);
 BENCHMARK(BM_EnrichedStiffnessCorotated)->Apply(enriched_args);
 BENCHMARK(BM_EnrichedStiffnessPerTexel) ->Args({1, 1})->Args({6, 1})->Unit(benchmark::kMillisecond)->Iterations(1);
+BENCHMARK(BM_EnrichedMassAndLoadWeights)->Arg(1)->Arg(6)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_BendingSumsWeightedGrams)->Arg(16)->Arg(32)->Arg(64);
 BENCHMARK(BM_BendingSumsSixProducts)->Arg(16)->Arg(32)->Arg(64);
 
