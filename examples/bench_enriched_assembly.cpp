@@ -124,7 +124,7 @@ void BM_EnrichedStiffnessPerTexel(benchmark::State& state) {
 
 // The fused mass and load weights (kernels::enriched_element_mass_and_load_weights) of one
 // element with `count` harmonic partial cuts at T = 256, per-texel quadrature (4 points a
-// texel: 262k points, the slinky's and spiral6's densest case), on the machine's threads.
+// texel, 262k points: the densest rule), on the machine's threads.
 void BM_EnrichedMassAndLoadWeights(benchmark::State& state) {
   Setup& s = setup(static_cast<int>(state.range(0)), true);
   const int npe = 8;
