@@ -127,7 +127,7 @@ void BM_EnrichedStiffnessPerTexel(benchmark::State& state) {
 // texel, 262k points: the densest rule), on the machine's threads.
 void BM_EnrichedMassAndLoadWeights(benchmark::State& state) {
   Setup& s = setup(static_cast<int>(state.range(0)), true);
-  const int npe = 8;
+  const int npe = kernels::nodes_per_element(ElementType::quad8);
   std::vector<kernels::TextureView> views;
   std::vector<int> node, start = {0};
   std::vector<double> shift;
