@@ -157,6 +157,7 @@ SceneBenchResult run_scene_benchmark(const Scene& scene, const std::string& name
     t.pcg_iterations.push_back(solver.iterations - counted.iterations);
     t.factorizations.push_back(solver.factorizations - counted.factorizations);
     counted = solver;
+    t.cut_update_threads.push_back(run.last_cut_update_threads());
     if (progress) progress(step, steps);
   }
   result.steps = steps;

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <stdexcept>
+#include <string>
 #include <system_error>
 
 #include <omp.h>
@@ -14,6 +15,7 @@
 #include "dgtex/scene_model.h"
 #include "dgtex/texel_memory_estimate.h"
 #include "dgtex/topology.h"
+#include "cut_update_team.h"
 
 namespace dgtex {
 
@@ -45,6 +47,11 @@ TexelFields texel_fields(const Scene& scene, const Mesh& mesh, const CutManager*
 
 SceneRun::SceneRun(const Scene& scene, SceneRunOptions options)
     : scene_(scene), mesh_(build_scene_mesh(scene_)), topology_(build_topology(mesh_)), options_(options) {
+  if (options_.cut_update_threads < 0)
+    throw std::invalid_argument("SceneRun: SceneRunOptions::cut_update_threads is " +
+                                std::to_string(options_.cut_update_threads) +
+                                "; give 0 (balanced step by step) or a thread count of 1 or more");
+  cut_update_team_ = std::make_unique<detail::CutUpdateTeam>(options_.cut_update_threads);
   SceneModel built = build_scene_model(scene_, mesh_);
   model_ = std::move(built.model);
   if (scene_.analysis.is_dynamic()) {
@@ -96,6 +103,7 @@ void SceneRun::step() {
                            "dynamic analysis");
   const double next = time_ + dynamics_.time_step;
   const kernels::ScopedThreadsBusyBeside beside(&cut_update_threads_);
+  last_cut_update_threads_ = 0;
   try {
     if (cuts_) {
       const bool changed = bring_cuts_to(next);
@@ -111,7 +119,10 @@ void SceneRun::step() {
       if (changed) change_basis(std::move(functions), edge_resolution, std::move(edge_flags));
     }
     simulation_->step(dynamics_);
-    if (next_cut_update_.valid()) next_cut_update_.wait();  // both done: the step is over
+    if (next_cut_update_.valid()) {
+      beside_update_ms_ = ms_since(next_cut_update_started_);  // the step's own work beside it
+      next_cut_update_.wait();  // both done: the step is over
+    }
   } catch (...) {
     discard_next_cut_update();  // the cut manager may be ahead: the next step updates again
     throw;
@@ -126,6 +137,7 @@ bool SceneRun::bring_cuts_to(double time) {
     const CutUpdate done = next_cut_update_.get();  // rethrows the update's exception
     if (started_for == time) {
       timings_["enrichment"].add(done.ms);
+      cut_update_team_->record(omp_get_max_threads(), done.ms, beside_update_ms_);
       return done.changed;
     }
   }
@@ -144,10 +156,12 @@ void SceneRun::start_next_cut_update(double time) {
       omp_get_max_threads() < 2 || cuts_->complete())
     return;
   next_cut_update_time_ = time;
-  cut_update_threads_.store(1, std::memory_order_release);
+  const int team = cut_update_team_->size(omp_get_max_threads());
+  cut_update_threads_.store(team, std::memory_order_release);
+  next_cut_update_started_ = std::chrono::steady_clock::now();
   try {
-    next_cut_update_ = std::async(std::launch::async, [this, time] {
-      omp_set_num_threads(1);  // serial kernels: the shell step has the other threads
+    next_cut_update_ = std::async(std::launch::async, [this, time, team] {
+      omp_set_num_threads(team);  // the shell step has the other threads
       struct Done {
         std::atomic<int>& threads;
         ~Done() { threads.store(0, std::memory_order_release); }
@@ -158,6 +172,7 @@ void SceneRun::start_next_cut_update(double time) {
       done.ms = ms_since(start);
       return done;
     });
+    last_cut_update_threads_ = team;
   } catch (const std::system_error&) {
     // No thread to be had: the next step updates the cuts itself.
     cut_update_threads_.store(0, std::memory_order_release);

@@ -92,6 +92,10 @@ TEST(BenchScenes, JsonHasEveryRequestedSceneWithRequiredKeysAndThesisRatios) {
               solver["pcg_iterations"][0].get<int>() + solver["pcg_iterations"][1].get<int>());
     EXPECT_EQ(s["solver"]["factorizations"].get<int>(),
               solver["factorizations"][0].get<int>() + solver["factorizations"][1].get<int>());
+    // Nothing runs beside the first step, nor beside a scene's last (here 2 steps of 300 and 50).
+    ASSERT_EQ(s["cut_update_threads"]["per_step"].size(), 2u);
+    EXPECT_EQ(s["cut_update_threads"]["per_step"][0], 0);
+    EXPECT_LE(s["cut_update_threads"]["steps_beside"].get<int>(), 1);
   }
   // spiral1: Table 5.1 "Spiral 1" (274 / 1.8 / 0.1 ms); ratio = thesis / ours.
   const nlohmann::json& spiral = j["scenes"][0];
@@ -250,6 +254,14 @@ TEST(BenchScenes, OverlappedCutUpdatesGiveTheSameStateAndRunBesideTheStepBefore)
     } else {
       EXPECT_LE(own, t.step[s] + 1e-6) << "step " << s + 1;
       EXPECT_LE(t.enrichment[s], t.step[s - 1] + 1e-6) << "step " << s + 1;
+    }
+    // The update beside steps 2-4 had its own team: one thread at least, one fewer than all.
+    const int threads = omp_get_max_threads();
+    if (s == 0 || threads < 2) {
+      EXPECT_EQ(t.cut_update_threads[s], 0) << "step " << s + 1;
+    } else {
+      EXPECT_GE(t.cut_update_threads[s], 1) << "step " << s + 1;
+      EXPECT_LE(t.cut_update_threads[s], threads - 1) << "step " << s + 1;
     }
   }
 }

@@ -1,12 +1,13 @@
 // SceneRun's overlapped cut updates (dgtex/scene_run.h): the next step's cut update runs
 // beside the current step, so the state must be bitwise that of the plain order after every
-// step, with 1 or 2 threads, for a progressive cut that changes the basis every step
+// step, with 1, 2 or 4 threads (the update's own team balanced or fixed), for a progressive cut that changes the basis every step
 // (spiral6's first segment). After the scene's last step no update is left running
 // ahead: the cut manager's functions are those of the plain run's last step.
 #include <gtest/gtest.h>
 
 #include <omp.h>
 
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -32,11 +33,12 @@ struct Trace {
   std::vector<double> last_functions;  // the cut manager's functions after the last step
 };
 
-Trace run(const Scene& scene, bool overlap, int threads) {
+Trace run(const Scene& scene, bool overlap, int threads, int cut_update_threads = 0) {
   const int saved = omp_get_max_threads();
   omp_set_num_threads(threads);
   SceneRunOptions options;
   options.overlap_cut_updates = overlap;
+  options.cut_update_threads = cut_update_threads;
   Trace trace;
   {
     SceneRun run(scene, options);
@@ -62,14 +64,31 @@ TEST(SceneRunOverlap, OverlappedCutUpdatesGiveThePlainStateAfterEveryStep) {
   const Trace plain = run(scene, false, 2);
   ASSERT_EQ(plain.displacement.size(), 12u);
   EXPECT_GE(plain.basis_changes, 10);  // the cut advances (nearly) every step
-  for (int threads : {2, 1}) {
-    SCOPED_TRACE("threads " + std::to_string(threads));
-    const Trace overlapped = run(scene, true, threads);
+  // 4 threads: the update's team balanced step by step, and fixed at 3 (the step's loops on
+  // one thread beside it).
+  const struct {
+    int threads, cut_update_threads;
+  } cases[] = {{2, 0}, {1, 0}, {4, 0}, {4, 3}};
+  for (const auto& c : cases) {
+    SCOPED_TRACE("threads " + std::to_string(c.threads) + ", cut update threads " +
+                 std::to_string(c.cut_update_threads));
+    const Trace overlapped = run(scene, true, c.threads, c.cut_update_threads);
     EXPECT_EQ(overlapped.basis_changes, plain.basis_changes);
     ASSERT_EQ(overlapped.displacement.size(), plain.displacement.size());
     for (std::size_t s = 0; s < plain.displacement.size(); ++s)
       EXPECT_EQ(overlapped.displacement[s], plain.displacement[s]) << "step " << s + 1;
     // Not one step ahead after the scene's last step.
     EXPECT_EQ(overlapped.last_functions, plain.last_functions);
+  }
+}
+
+TEST(SceneRunOverlap, ANegativeCutUpdateThreadCountIsRefusedByName) {
+  SceneRunOptions options;
+  options.cut_update_threads = -1;
+  try {
+    SceneRun run(short_spiral6(2), options);
+    FAIL() << "expected std::invalid_argument";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("cut_update_threads is -1"), std::string::npos) << e.what();
   }
 }

@@ -54,6 +54,15 @@ nlohmann::json series_json(const std::vector<double>& v) {
   return {{"mean", series_mean(v)}, {"max", series_max(v)}, {"median", series_median(v)}};
 }
 
+// The overlapped cut updates' teams: over the steps that had one beside them (0 when none did).
+nlohmann::json cut_update_threads_json(const std::vector<int>& per_step) {
+  std::vector<double> beside;
+  for (int threads : per_step)
+    if (threads > 0) beside.push_back(threads);
+  return {{"steps_beside", beside.size()}, {"mean", series_mean(beside)}, {"max", series_max(beside)},
+          {"per_step", per_step}};
+}
+
 nlohmann::json counts_json(const SceneCounts& c) {
   return {{"elements", c.elements},
           {"nodes", c.nodes},
@@ -145,7 +154,8 @@ nlohmann::json scene_json(const SceneBenchResult& r) {
                       {"solver",
                        {{"pcg_iterations", total(t.pcg_iterations)},
                         {"factorizations", total(t.factorizations)},
-                        {"per_step", {{"pcg_iterations", t.pcg_iterations}, {"factorizations", t.factorizations}}}}}};
+                        {"per_step", {{"pcg_iterations", t.pcg_iterations}, {"factorizations", t.factorizations}}}}},
+                      {"cut_update_threads", cut_update_threads_json(t.cut_update_threads)}};
   const ThesisTable51Row* row = thesis_table_5_1_row(r.name);
   if (row) {
     const StageRatios q = ratios(*row, r);

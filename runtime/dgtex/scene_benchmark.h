@@ -55,6 +55,8 @@ struct SceneStepTimes {
   // failed included) and numeric factorisations (corotational scenes; a linear scene
   // factorises outside it and counts 0).
   std::vector<std::int64_t> pcg_iterations, factorizations;
+  // Per step, the OpenMP threads of the cut update that ran beside it (0: none did).
+  std::vector<int> cut_update_threads;
 };
 
 struct SceneBenchResult {

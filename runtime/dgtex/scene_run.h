@@ -14,16 +14,17 @@
 //
 // Overlapped cut updates (SceneRunOptions::overlap_cut_updates, the default): the cuts
 // follow their schedule, not the shell, so the next step's cut update can run while this
-// step projects and steps the shell. It runs on a thread of its own with serial kernels,
-// beside this step's OpenMP work, and step() returns once both are done. Why: much of a
+// step projects and steps the shell. It runs on a thread of its own beside this step's
+// OpenMP work, and step() returns once both are done. Why: much of a
 // cut scene's step runs on one thread (the multigrid's small levels, the texel Laplace's
 // set-up, the model rebuild), so the other core was idle (chad, 30 steps on 2 cores:
 // 27-29 -> 33-36 steps/s; examples/bench_scenes_history.md, session 13). Only where the
 // calling thread has more than one OpenMP thread, from the second step on, while another
 // step of the scene (analysis.steps) follows, while some cut has still to grow
 // (CutManager::complete), and where a thread can be started (else the plain order). While
-// the update runs, this step's parallel loops take one thread fewer
-// (dgtex/kernels/threads_busy_beside.h). The results
+// the update runs with a team of its own (one thread on two; on more, balanced step by step
+// against the step's own work: runtime/cut_update_team.h), this step's parallel loops take
+// that many threads fewer (dgtex/kernels/threads_busy_beside.h). The results
 // are bitwise those of the plain order (every kernel's result is independent of the thread
 // count). Stage times then overlap: "enrichment" is the update's own wall time, counted in
 // the step that uses it, and the other stages include the slowdown of sharing the cores.
@@ -35,6 +36,7 @@
 // SceneRun owns a copy of the Scene and the mesh, topology, model, cut manager and
 // simulation built from it. Units: those of the scene (SI: m, kg, s, N).
 #include <atomic>
+#include <chrono>
 #include <cstdint>
 #include <functional>
 #include <future>
@@ -53,8 +55,15 @@
 
 namespace dgtex {
 
+namespace detail {
+class CutUpdateTeam;
+}
+
 struct SceneRunOptions {
   bool overlap_cut_updates = true;  // the next step's cut update beside this step (above)
+  // OpenMP threads of that update: 0 balances them step by step (above); n > 0 fixes n (at
+  // most the step's threads less one). Results do not depend on it.
+  int cut_update_threads = 0;
   // Called once in the set-up of a scene with cuts or creases, after the memory check has
   // passed and before any texel field is allocated, with the fields counted and the memory
   // available (-1: unknown); `dgtex run` prints texel_memory_caution from it.
@@ -87,6 +96,8 @@ class SceneRun {
   double time() const { return time_; }
   int steps_taken() const { return steps_; }
   int basis_changes() const { return basis_changes_; }
+  // OpenMP threads of the cut update that ran beside the last step (0: none ran beside it).
+  int last_cut_update_threads() const { return last_cut_update_threads_; }
   // All stages so far (those of replaced simulations included).
   StageTimings timings() const;
   // The step solver's statistics so far, summed over the simulations of every basis (the
@@ -132,10 +143,16 @@ class SceneRun {
   // The next step's cut update while it runs beside a step (after cuts_: it refers to it,
   // so it is destroyed, i.e. waited for, first).
   std::future<CutUpdate> next_cut_update_;
-  // Threads that update holds (1 while it runs): the step's parallel loops leave them out
+  // Threads that update holds while it runs: the step's parallel loops leave them out
   // (kernels/threads_busy_beside.h).
   std::atomic<int> cut_update_threads_{0};
   double next_cut_update_time_ = 0;
+  // The update's team, balanced against the step's own work beside it (runtime/
+  // cut_update_team.h), and when it started and how long the step's own work took beside it.
+  std::unique_ptr<detail::CutUpdateTeam> cut_update_team_;
+  std::chrono::steady_clock::time_point next_cut_update_started_;
+  double beside_update_ms_ = 0;
+  int last_cut_update_threads_ = 0;
 };
 
 }  // namespace dgtex
