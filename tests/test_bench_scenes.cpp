@@ -53,10 +53,12 @@ fs::path short_spiral(const fs::path& dir, int steps) {
 TEST(BenchScenes, JsonHasEveryRequestedSceneWithRequiredKeysAndThesisRatios) {
   const fs::path dir = fresh_dir("json");
   const Result r = run_cli("bench scenes --scene-dir " + kScenes + " --scenes spiral1,cylinder_buckling --steps 2 --json " +
-                               (dir / "out.json").string() + " --markdown " + (dir / "out.md").string() + " --quiet",
+                               (dir / "out.json").string() + " --markdown " + (dir / "out.md").string() +
+                               " --cut-update-threads 1 --quiet",
                            dir);
   ASSERT_EQ(r.exit_code, 0) << r.stderr_text;
   const nlohmann::json j = read_json(dir / "out.json");
+  EXPECT_EQ(j["cut_update_threads"], 1);
   ASSERT_EQ(j["scenes"].size(), 2u);
   // The machine, and its speed probe before each scene and at the end.
   EXPECT_NE(j["machine"].get<std::string>().find(" cores, "), std::string::npos);
@@ -310,4 +312,8 @@ TEST(BenchScenes, BadInputExitsWithTwoAndNamesTheProblem) {
   EXPECT_EQ(steps.exit_code, 2);
   EXPECT_NE(steps.stderr_text.find("--steps: Value -1 not in range 0 to 2147483647"), std::string::npos)
       << steps.stderr_text;
+  const Result team = run_cli("bench scenes --cut-update-threads -2", dir);
+  EXPECT_EQ(team.exit_code, 2);
+  EXPECT_NE(team.stderr_text.find("--cut-update-threads: Value -2 not in range 0 to 2147483647"), std::string::npos)
+      << team.stderr_text;
 }

@@ -259,7 +259,7 @@ int bench_scenes_command(int argc, char** argv) {
                "dgtex bench scenes"};
   std::vector<std::string> scenes = bench_scene_names();
   std::string scene_dir = example_scene_dir(), json_path, markdown_path;
-  int steps = 0, threads = 0, repeats = 1;
+  int steps = 0, threads = 0, repeats = 1, cut_update_threads = 0;
   bool quiet = false, inline_cut_updates = false;
   app.add_option("--scenes", scenes,
                  "scenes to run: names in --scene-dir (chad, spiral1, spiral6, accordion, slinky, fracture, "
@@ -284,6 +284,12 @@ int bench_scenes_command(int argc, char** argv) {
   app.add_flag("--inline-cut-updates", inline_cut_updates,
                "update the cuts at the start of each step instead of beside the previous step's projection and "
                "shell step (SceneRunOptions::overlap_cut_updates)");
+  app.add_option("--cut-update-threads", cut_update_threads,
+                 "OpenMP threads of the cut update beside each step: 0 balances them step by step against the "
+                 "step's own work (one on two threads), N fixes N (at most --threads less one; "
+                 "SceneRunOptions::cut_update_threads)")
+      ->capture_default_str()
+      ->check(zero_or_more());
   app.add_flag("--quiet", quiet, "no progress on stderr");
   try {
     app.parse(argc, argv);
@@ -311,6 +317,7 @@ int bench_scenes_command(int argc, char** argv) {
                         {"steps", steps},
                         {"threads", omp_get_max_threads()},
                         {"overlap_cut_updates", !inline_cut_updates},
+                        {"cut_update_threads", cut_update_threads},
                         {"omp_wait_policy", omp_wait_policy_name()},
                         {"repeats", repeats},
                         {"targets", {{"steps_per_second", kTargetStepsPerSecond}, {"stage_ratio", kTargetStageRatio}}},
@@ -322,6 +329,7 @@ int bench_scenes_command(int argc, char** argv) {
       if (!quiet) std::fprintf(stderr, "bench scenes: %s (%s) ...%s", entry.name.c_str(), entry.path.c_str(), tty ? "" : "\n");
       SceneRunOptions run_options;
       run_options.overlap_cut_updates = !inline_cut_updates;
+      run_options.cut_update_threads = cut_update_threads;
       std::vector<SceneBenchResult> runs;
       std::vector<double> run_probes_ms;
       for (int run = 1; run <= repeats; ++run) {
