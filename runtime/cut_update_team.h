@@ -2,8 +2,8 @@
 // How many OpenMP threads SceneRun's overlapped cut update gets (the step's parallel loops
 // take the rest). On two threads it is always one each. On more, the update of a T = 256
 // cut scene became the step's bottleneck: on a 16-core Xeon (session 49, `dgtex bench
-// scenes --threads 16`) chad's update took 16-17 ms a step on its one thread while the
-// step's own work took ~6 on the other fifteen. Its multigrid gains from a few threads, not
+// scenes --threads 16`) chad's update took 16-22 ms a step on its one thread while the
+// step's own work took 6-9 on the other fifteen. Its multigrid gains from a few threads, not
 // from many (chad's T = 256 update: 42.5 ms on 1 thread, 29 on 2, 27 on 4, 28 on 8), and a
 // small update (spiral1's) gets slower with a second thread. So the team grows by one while
 // the update takes clearly longer than the step's own work beside it, keeps a thread only if
