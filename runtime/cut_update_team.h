@@ -25,13 +25,13 @@ class CutUpdateTeam {
   explicit CutUpdateTeam(int fixed = 0) : fixed_(fixed > 0), team_(fixed > 0 ? fixed : 1) {}
 
   // The team for an update beside a step of `threads` OpenMP threads: 1 to threads - 1.
-  int size(int threads) const { return std::clamp(team_, 1, std::max(1, threads - 1)); }
+  int size(int threads) const { return std::clamp(team_, 1, largest(threads)); }
 
   // One overlapped step: the update's wall time with the team size(threads) gave it, and
   // that of the step's own work beside it.
   void record(int threads, double update_ms, double beside_ms) {
     if (fixed_ || !(beside_ms > 0)) return;
-    const int team = size(threads), most = std::max(1, threads - 1);
+    const int team = size(threads), most = largest(threads);
     ratio_ = ratio_ > 0 ? smooth(ratio_, update_ms / beside_ms) : update_ms / beside_ms;
     if (static_cast<int>(seen_.size()) <= team) seen_.resize(team + 1);
     Seen& at = seen_[team];
@@ -49,6 +49,7 @@ class CutUpdateTeam {
   static constexpr double kWeight = 0.25;  // of the newest step in the smoothed times
   static constexpr int kStepsToJudge = 3;  // steps at a team size before it is judged
   static double smooth(double old, double newest) { return (1 - kWeight) * old + kWeight * newest; }
+  static int largest(int threads) { return std::max(1, threads - 1); }  // the step keeps one
   struct Seen {
     double ms = 0;  // smoothed update time with this team size
     int count = 0;  // steps it ran with it
