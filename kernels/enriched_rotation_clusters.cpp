@@ -407,15 +407,75 @@ EnrichedRotationClusters enriched_rotation_clusters_reference(const EnrichedElem
 
 void enriched_cluster_rest_stiffness(const EnrichedElementBatch& batch, const EnrichedQuadrature& quadrature,
                                      const EnrichedRotationClusters& clusters, double* rest, Execution execution) {
+  enriched_cluster_rest_stiffness(batch, quadrature, clusters, rest, nullptr, execution);
+}
+
+std::vector<std::int64_t> enriched_cluster_rest_element_start(const EnrichedElementBatch& batch,
+                                                              const EnrichedRotationClusters& clusters) {
+  const RestLayout layout(batch, clusters);
+  std::vector<std::int64_t> start(static_cast<std::size_t>(batch.count) + 1);
+  for (std::int64_t e = 0; e <= batch.count; ++e) start[e] = layout.start[clusters.element_start[e]];
+  return start;
+}
+
+void enriched_cluster_rest_reshift(int planes, std::int64_t clusters, int old_functions, const double* old_rest,
+                                   int functions, const int* from, const int* standard, const double* delta,
+                                   double* rest, Execution execution) {
+  if (planes != 5 && planes != 9) throw std::invalid_argument("enriched_cluster_rest_reshift: planes must be 5 or 9");
+  const int n = functions, n_old = old_functions;
+  const std::int64_t plane = enriched_cluster_packed_blocks(n), old_plane = enriched_cluster_packed_blocks(n_old);
+  const std::int64_t stride = rest_stride(planes == 5, n), old_stride = rest_stride(planes == 5, n_old);
+  // Plane k of block (b, a) is plane transposed[k] of block (a, b): 3 x 3 entries (i, j) ->
+  // (j, i); planar g_12 <-> g_21.
+  int transposed[9];
+  for (int k = 0; k < planes; ++k) transposed[k] = planes == 9 ? k % 3 * 3 + k / 3 : (k == 1 ? 2 : k == 2 ? 1 : k);
+  forall(
+      clusters,
+      [&](std::int64_t c) {
+        const double* in = old_rest + c * old_stride;
+        double* out = rest + c * stride;
+        // Plane k of old block (a, b), any order.
+        const auto old_block = [&](int k, int a, int b) {
+          return a <= b ? in[k * old_plane + packed_row_start(n_old, a) + (b - a)]
+                        : in[transposed[k] * old_plane + packed_row_start(n_old, b) + (a - b)];
+        };
+        for (int f = 0; f < n; ++f)
+          for (int g = f; g < n; ++g) {
+            const int F = from[f], G = from[g];
+            const std::int64_t p = packed_row_start(n, f) + (g - f);
+            for (int k = 0; k < planes; ++k) {
+              double v = old_block(k, F, G);
+              if (delta[g] != 0) v -= delta[g] * old_block(k, F, standard[g]);
+              if (delta[f] != 0) v -= delta[f] * old_block(k, standard[f], G);
+              if (delta[f] != 0 && delta[g] != 0) v += delta[f] * delta[g] * old_block(k, standard[f], standard[g]);
+              out[k * plane + p] = v;
+            }
+          }
+        for (std::int64_t p = packed_row_start(n, n); p < plane; ++p)  // padding
+          for (int k = 0; k < planes; ++k) out[k * plane + p] = 0;
+        const double* old_D = in + planes * old_plane;
+        double* D = out + planes * plane;
+        for (int f = 0; f < n; ++f)
+          for (int d = 0; d < 2; ++d) D[2 * f + d] = old_D[2 * from[f] + d] - delta[f] * old_D[2 * standard[f] + d];
+      },
+      execution);
+}
+
+void enriched_cluster_rest_stiffness(const EnrichedElementBatch& batch, const EnrichedQuadrature& quadrature,
+                                     const EnrichedRotationClusters& clusters, double* rest, const char* compute,
+                                     Execution execution) {
   const RestLayout layout(batch, clusters);
   const std::vector<char>& planar = layout.planar;
-  std::vector<std::int64_t> element_of(static_cast<std::size_t>(clusters.count()));
-  for (std::int64_t e = 0; e < batch.count; ++e)
-    for (std::int64_t c = clusters.element_start[e]; c < clusters.element_start[e + 1]; ++c) element_of[c] = e;
+  std::vector<std::int64_t> todo, todo_element;  // clusters to sum, and their elements
+  for (std::int64_t e = 0; e < batch.count; ++e) {
+    if (compute && !compute[e]) continue;
+    for (std::int64_t c = clusters.element_start[e]; c < clusters.element_start[e + 1]; ++c)
+      todo.push_back(c), todo_element.push_back(e);
+  }
   // Clusters differ much in cost (tip blocks hold few points): handed out dynamically;
   // each writes only its own rest data, so the result does not depend on the threads.
-  auto cluster = [&](std::int64_t c) {
-    const std::int64_t e = element_of[c];
+  auto cluster = [&](std::int64_t i) {
+    const std::int64_t c = todo[i], e = todo_element[i];
     const int n = enriched_basis_count(batch, e);
     const int planes = rest_planes(planar[e]);
     const std::int64_t plane = enriched_cluster_packed_blocks(n);
@@ -439,7 +499,7 @@ void enriched_cluster_rest_stiffness(const EnrichedElementBatch& batch, const En
           for (std::size_t j = 0; j < 3; ++j) out[(i * 3 + j) * plane + p] = K[(3 * a + i) * N3 + 3 * b + j];
       }
   };
-  forall_dynamic(clusters.count(), cluster, execution);
+  forall_dynamic(static_cast<std::int64_t>(todo.size()), cluster, execution);
 }
 
 void enriched_cluster_rotations(const EnrichedElementBatch& batch, const EnrichedRotationClusters& clusters,

@@ -768,7 +768,7 @@ void ShellModel::assemble_stiffness(const double* current, std::vector<double>& 
                                [bytes](double* block) { detail::release_block(block, bytes); });
         }
         w.cluster_rest_size = size;
-        kernels::enriched_cluster_rest_stiffness(xb, element_quad, w.clusters, w.cluster_rest.get(), execution);
+        sum_cluster_rest(xb, element_quad, execution);
       }
       w.cluster_rotations.resize(static_cast<size_t>(w.clusters.count()) * 9);
       kernels::enriched_cluster_rotations(xb, w.clusters, w.cluster_rest.get(), current, w.cluster_rotations.data(),
@@ -816,6 +816,63 @@ void ShellModel::assemble_stiffness(const double* current, std::vector<double>& 
     corrective->assign(num_dofs(), 0.0);
     if (current) assembly_.assemble_vector(vector_locals, corrective->data(), parallel);
   }
+}
+
+namespace {
+
+bool bitwise_equal(const std::vector<double>& a, const std::vector<double>& b) {
+  return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(double)) == 0;
+}
+
+}  // namespace
+
+void ShellModel::sum_cluster_rest(const kernels::EnrichedElementBatch& xb, const kernels::EnrichedQuadrature& quadrature,
+                                  kernels::Execution execution) const {
+  AssemblyWorkspace& w = workspace_;
+  const int npe = mesh_.nodes_per_element();
+  const std::vector<std::int64_t> start = kernels::enriched_cluster_rest_element_start(xb, w.clusters);
+  const std::int64_t count = xb.count;
+  std::vector<char> compute(count, 1);
+  std::vector<ClusterRestStretch> stretches(mesh_.num_elements());
+  for (std::int64_t x = 0; x < count; ++x) {
+    const int e = enriched_elements_[x];
+    ClusterRestStretch& now = stretches[e];
+    now = {element_integrals_[e], w.cluster_rest, start[x], w.clusters.element_start[x + 1] - w.clusters.element_start[x],
+           kernels::enriched_cluster_rest_planes(xb, x)};
+    if (e >= static_cast<int>(cluster_rest_stretches_.size())) continue;
+    const ClusterRestStretch& before = cluster_rest_stretches_[e];
+    if (!before.rest || before.clusters != now.clusters || before.planes != now.planes) continue;
+    const ElementIntegrals &old = *before.integrals, &in = *now.integrals;
+    double* out = w.cluster_rest.get() + now.start;
+    const double* old_rest = before.rest.get() + before.start;
+    if (before.integrals == now.integrals) {
+      std::copy(old_rest, old_rest + (start[x + 1] - start[x]), out);
+      compute[x] = 0;
+      continue;
+    }
+    if (old.values.size() != in.values.size() || old.shifts.size() != in.shifts.size()) continue;
+    bool same_textures = true;
+    for (std::size_t k = 0; k < in.values.size() && same_textures; ++k)
+      same_textures = bitwise_equal(old.values[k], in.values[k]) && old.flags[k] == in.flags[k];
+    if (!same_textures) continue;
+    // The new functions among the old ones (in order: standard, then per texture its nodes).
+    std::vector<int> from(npe), standard(npe);
+    std::vector<double> delta(npe, 0.0);
+    for (int a = 0; a < npe; ++a) from[a] = a, standard[a] = a;
+    bool among = true;
+    for (int i = 0, o = npe; i < static_cast<int>(in.shifts.size()) && among; ++i) {
+      const bool was = !std::isnan(old.shifts[i]), is = !std::isnan(in.shifts[i]);
+      among = was || !is;
+      if (is && was) from.push_back(o), standard.push_back(i % npe), delta.push_back(in.shifts[i] - old.shifts[i]);
+      o += was;
+    }
+    if (!among || static_cast<int>(from.size()) != in.count) continue;
+    kernels::enriched_cluster_rest_reshift(now.planes, now.clusters, old.count, old_rest, in.count, from.data(),
+                                           standard.data(), delta.data(), out, execution);
+    compute[x] = 0;
+  }
+  kernels::enriched_cluster_rest_stiffness(xb, quadrature, w.clusters, w.cluster_rest.get(), compute.data(), execution);
+  cluster_rest_stretches_ = std::move(stretches);  // releases the old rest data
 }
 
 void ShellModel::add_gravity(const double g[3], std::vector<double>& f) const {

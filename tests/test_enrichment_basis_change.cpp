@@ -50,10 +50,11 @@ std::vector<double> random_state(int dofs, unsigned seed) {
   return x;
 }
 
-std::unique_ptr<ShellModel> plain_model(const Mesh& mesh, const Topology& topology) {
+std::unique_ptr<ShellModel> plain_model(const Mesh& mesh, const Topology& topology, int rotation_cluster_texels = 0) {
   std::vector<kernels::ShellSection> sections(mesh.num_elements(), {1e6, 0.3, 0.01, 1000});
   ShellModelOptions options;
   options.penalty = 1.0;
+  options.rotation_cluster_texels = rotation_cluster_texels;
   return std::make_unique<ShellModel>(mesh, topology, sections, std::vector<int>{}, options);
 }
 
@@ -174,6 +175,90 @@ struct TwoEnrichedElements {
     for (int e = 0; e < 2; ++e) batch.width = std::max(batch.width, kernels::enriched_basis_count(batch, e));
   }
 };
+
+// The current positions of a model turned in plane and bent.
+std::vector<double> turned(const ShellModel& m) {
+  std::vector<double> current = m.rest_state();
+  for (std::size_t n = 0; n < current.size() / 3; ++n) {
+    const double x = current[3 * n], y = current[3 * n + 1];
+    current[3 * n] = 0.9 * x - 0.3 * y, current[3 * n + 1] = 0.3 * x + 0.9 * y, current[3 * n + 2] += 0.1 * x * x;
+  }
+  return current;
+}
+
+// A chained model's rotation clusters take the rest data of the elements whose textures did
+// not change from the model before (as it is, or reshifted where the cut moved the shifts of
+// their nodes); its corotated stiffness and forces equal a fresh model's to round-off, and
+// bitwise where nothing was reshifted. Planar plate and a bent one (5 and 9 planes).
+void check_clustered_chain(const Mesh& mesh, const Cut& cut, int steps, double dt) {
+  const Topology topology = build_topology(mesh);
+  CutManager cuts(mesh, topology, {cut}, cholmod_enrichment(32));
+  std::unique_ptr<ShellModel> model = plain_model(mesh, topology, 8);
+  int changes = 0, reshifted = 0;
+  for (int step = 0; step < steps; ++step) {
+    if (!cuts.update(step * dt)) continue;
+    ++changes;
+    SCOPED_TRACE("step " + std::to_string(step));
+    auto next = std::make_unique<ShellModel>(*model);
+    next->set_cut_edge_texels(cuts.edge_walls().resolution(), cuts.edge_walls().flags(mesh.num_elements()));
+    next->set_enrichments(cuts.functions());
+    auto fresh = plain_model(mesh, topology, 8);
+    fresh->set_cut_edge_texels(cuts.edge_walls().resolution(), cuts.edge_walls().flags(mesh.num_elements()));
+    fresh->set_enrichments(cuts.functions());
+    std::vector<double> K, f, K_fresh, f_fresh;
+    next->assemble_stiffness(turned(*next).data(), K, &f);
+    fresh->assemble_stiffness(turned(*fresh).data(), K_fresh, &f_fresh);
+    ASSERT_GT(fresh->num_rotation_clusters(), 0);
+    EXPECT_LE(max_difference(K, K_fresh), 1e-12 * max_abs(K_fresh));
+    EXPECT_LE(max_difference(f, f_fresh), 1e-12 * max_abs(f_fresh));
+    reshifted += !bitwise_equal(K, K_fresh);
+    model = std::move(next);
+  }
+  EXPECT_GE(changes, 3);
+  EXPECT_GE(reshifted, 1);
+}
+
+TEST(BasisChange, ClusteredQuad8ChainTakesTheRestDataOfUnchangedElements) {
+  check_clustered_chain(make_rectangle(3, 3, 3, 3, ElementType::quad8),
+                        progressive({{0, 1.37, 0}, {1.7, 1.61, 0}, {3, 1.45, 0}}, 0.35), 9, 1.0);
+}
+
+TEST(BasisChange, ClusteredBentQuad8ChainTakesTheRestDataOfUnchangedElements) {
+  Mesh mesh = make_rectangle(3, 3, 3, 3, ElementType::quad8);
+  const auto height = [](double x) { return 0.08 * x * x; };
+  for (int v = 0; v < mesh.num_nodes(); ++v) mesh.positions[3 * v + 2] = height(mesh.positions[3 * v]);
+  check_clustered_chain(mesh, progressive({{0, 1.37, height(0)}, {1.7, 1.61, height(1.7)}, {3, 1.45, height(3)}}, 0.35),
+                        9, 1.0);
+}
+
+// Cluster rest data of chosen elements only (the others' are taken from an earlier basis):
+// the chosen ones get the bits of a whole sum, the others are left as they were.
+TEST(BasisChange, ClusterRestDataOfChosenElementsOnly) {
+  const TwoEnrichedElements setup;
+  std::vector<std::int64_t> start;
+  std::vector<double> points;
+  kernels::enriched_element_quadrature(setup.batch, {}, start, points);
+  const kernels::EnrichedQuadrature quadrature{start.data(), points.data()};
+  const kernels::EnrichedRotationClusters clusters = kernels::enriched_rotation_clusters(setup.batch, quadrature, 8, 2);
+  const std::size_t size = static_cast<std::size_t>(kernels::enriched_cluster_rest_size(setup.batch, clusters));
+  std::vector<double> whole(size);
+  kernels::enriched_cluster_rest_stiffness(setup.batch, quadrature, clusters, whole.data());
+  const std::vector<std::int64_t> element_start = kernels::enriched_cluster_rest_element_start(setup.batch, clusters);
+  ASSERT_EQ(element_start.size(), 3u);
+  ASSERT_EQ(element_start[2], static_cast<std::int64_t>(size));
+  for (int chosen = 0; chosen < 2; ++chosen) {
+    const char compute[2] = {chosen == 0, chosen == 1};
+    std::vector<double> rest(size, -7.0);
+    kernels::enriched_cluster_rest_stiffness(setup.batch, quadrature, clusters, rest.data(), compute);
+    for (int e = 0; e < 2; ++e)
+      for (std::int64_t i = element_start[e]; i < element_start[e + 1]; ++i)
+        if (e == chosen) {
+          ASSERT_EQ(std::memcmp(&rest[i], &whole[i], sizeof(double)), 0) << "element " << e << ", entry " << i;
+        } else {
+          ASSERT_EQ(rest[i], -7.0) << "element " << e << ", entry " << i;
+        }
+  }
+}
 
 // The fused kernel against the two kernels.
 TEST(BasisChange, FusedMassAndLoadWeightsEqualTheTwoKernelsBitwise) {

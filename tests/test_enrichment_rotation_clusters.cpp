@@ -148,6 +148,60 @@ TEST(EnrichedRotationClusters, ApproachThePerPointCorotationAsBlocksShrink) {
   EXPECT_LT(previous, 0.02);  // per texel (1/64 of the element)
 }
 
+// A basis change that keeps an element's textures but moves its node shifts and drops a
+// function: its rest data reshifted from the old equals the rest data summed afresh, on a
+// planar element (5 planes) and a curved one (9), for any thread count; the shift terms
+// matter (without them the sums are far off).
+TEST(EnrichedRotationClusters, ReshiftedRestDataEqualsTheRestDataSummedAfresh) {
+  for (const bool curved : {false, true}) {
+    SCOPED_TRACE(curved ? "curved" : "planar");
+    CutQuad8Element one(1, 2);
+    if (curved)
+      for (int v = 0; v < one.mesh.num_nodes(); ++v) one.mesh.positions[3 * v + 2] = 0.3 * std::pow(one.mesh.positions[3 * v], 2);
+    const int planes = kernels::enriched_cluster_rest_planes(one.batch, 0);
+    ASSERT_EQ(planes, curved ? 9 : 5);
+    const kernels::EnrichedRotationClusters clusters =
+        kernels::enriched_rotation_clusters(one.batch, one.quadrature(), 16, 4);
+    const auto rest_of = [&](const kernels::EnrichedElementBatch& batch) {
+      std::vector<double> rest(static_cast<std::size_t>(kernels::enriched_cluster_rest_size(batch, clusters)));
+      kernels::enriched_cluster_rest_stiffness(batch, one.quadrature(), clusters, rest.data());
+      return rest;
+    };
+    const int old_functions = one.n;
+    const std::vector<double> old_rest = rest_of(one.batch);
+    // New shifts on every enriched node; texture 1's node 3 no longer enriched.
+    const std::vector<double> old_shifts = one.shifts;
+    for (std::size_t i = 0; i < one.shifts.size(); ++i) one.shifts[i] += 0.07 * (static_cast<int>(i % 5) - 2) + 0.01;
+    one.nodes[1 * 8 + 3] = -1;
+    const int functions = kernels::enriched_basis_count(one.batch, 0);
+    ASSERT_EQ(functions, old_functions - 1);
+    const std::vector<double> fresh = rest_of(one.batch);
+    std::vector<int> from, standard;
+    std::vector<double> delta, no_delta;
+    for (int a = 0; a < 8; ++a) from.push_back(a), standard.push_back(a), delta.push_back(0.0);
+    for (int i = 0; i < static_cast<int>(one.nodes.size()); ++i) {
+      if (one.nodes[i] < 0) continue;
+      from.push_back(8 + i), standard.push_back(i % 8), delta.push_back(one.shifts[i] - old_shifts[i]);
+    }
+    no_delta.assign(delta.size(), 0.0);
+    const auto reshift = [&](const std::vector<double>& d, kernels::Execution execution) {
+      std::vector<double> rest(fresh.size(), std::nan(""));
+      kernels::enriched_cluster_rest_reshift(planes, clusters.count(), old_functions, old_rest.data(), functions,
+                                             from.data(), standard.data(), d.data(), rest.data(), execution);
+      return rest;
+    };
+    const std::vector<double> serial = reshift(delta, kernels::Execution::serial);
+    EXPECT_LE(max_difference(serial, fresh), 1e-12 * max_abs(fresh));
+    EXPECT_GT(max_difference(reshift(no_delta, kernels::Execution::serial), fresh), 1e-3 * max_abs(fresh));
+    for (int threads : {1, 2, 3}) {
+      omp_set_num_threads(threads);
+      EXPECT_TRUE(testing_support::bitwise_equal(reshift(delta, kernels::Execution::parallel), serial)) << threads;
+    }
+  }
+  EXPECT_THROW(kernels::enriched_cluster_rest_reshift(7, 0, 8, nullptr, 8, nullptr, nullptr, nullptr, nullptr),
+               std::invalid_argument);
+}
+
 TEST(EnrichedRotationClusters, NeverSpanACutAndHoldEveryPointOnce) {
   // One complete cut across the tile (H = +-1 on its two sides).
   const CutQuad8Element one(1, 0, /*per_texel_rule=*/true);

@@ -106,6 +106,10 @@ class ShellModel {
   // Cost: an enriched element whose textures (and enriched nodes and shifts) are bitwise
   // those of the previous call on this model or the model it was copied from keeps its
   // quadrature (and mass and load weights); the results equal a fresh model's bitwise.
+  // With rotation clusters, an element whose textures alone are the same keeps its
+  // clusters' rest sums: bitwise where its functions and shifts are the same too, else
+  // reshifted to the new shifts (equal to a fresh sum to round-off; dropped functions are
+  // left out; a newly enriched node makes it sum afresh).
   void set_enrichments(std::vector<EnrichmentFunction> functions);
   // Texel segments of mesh edges that a cut runs along (MeshEdgeWalls::flags: index
   // (element * 4 + local edge) * resolution + s, s along the element's local edge, either
@@ -314,6 +318,25 @@ class ShellModel {
     std::vector<double> area_weights, mass_weights;  // count
   };
   std::vector<std::shared_ptr<const ElementIntegrals>> element_integrals_;  // per mesh element, may be null
+  // Each enriched element's stretch of the rotation clusters' rest data as last summed, with
+  // the integrals it was summed from (per mesh element; `rest` keeps the whole old rest data
+  // alive until the next rest data replaces the stretches). The next rest data (after
+  // set_enrichments, also on a copy of the model) takes an element's stretch instead of
+  // summing it again where the element's textures are bitwise the same, so its points and
+  // clusters are: as it is where its functions and shifts are the same too (the same
+  // integrals), else reshifted (kernels::enriched_cluster_rest_reshift) where the new
+  // functions are among the old ones. A cut's tip changing a neighbour's textures moves the
+  // shifts of the shared nodes (the slinky: ~0.9 of its 4 elements a basis change).
+  struct ClusterRestStretch {
+    std::shared_ptr<const ElementIntegrals> integrals;
+    std::shared_ptr<const double> rest;
+    std::int64_t start = 0, clusters = 0;
+    int planes = 0;
+  };
+  mutable std::vector<ClusterRestStretch> cluster_rest_stretches_;
+  // Sums the rest data of the clusters into workspace_.cluster_rest, taking the stretches it can.
+  void sum_cluster_rest(const kernels::EnrichedElementBatch& xb, const kernels::EnrichedQuadrature& quadrature,
+                        kernels::Execution execution) const;
   // The kept basis values (keep_basis_values), `width` doubles a point. Per mesh element: the
   // index of its first point among them, or -1 (none kept), and the integrals they belong to:
   // a rebuild that reuses those integrals (a pruned basis keeps a subset of the functions)

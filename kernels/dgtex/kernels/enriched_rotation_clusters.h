@@ -78,6 +78,31 @@ std::int64_t enriched_cluster_rest_size(const EnrichedElementBatch& batch, const
 void enriched_cluster_rest_stiffness(const EnrichedElementBatch& batch, const EnrichedQuadrature& quadrature,
                                      const EnrichedRotationClusters& clusters, double* rest,
                                      Execution execution = Execution::parallel);
+// The same for the elements with compute[e] != 0 only; the other elements' rest data is left
+// as it is. Why: a basis change of a progressive cut leaves some elements' textures and
+// functions bitwise as they were (the slinky: one of its four), and their rest data is
+// then the one summed before (each cluster is summed on its own), which the caller copies in.
+void enriched_cluster_rest_stiffness(const EnrichedElementBatch& batch, const EnrichedQuadrature& quadrature,
+                                     const EnrichedRotationClusters& clusters, double* rest, const char* compute,
+                                     Execution execution = Execution::parallel);
+// One element's rest data after its node shifts changed and some of its functions were
+// dropped, its textures (so its clusters and points) staying the same: the rest data of
+// `clusters` clusters (each enriched_cluster_rest_stride long: `planes` planes of packed
+// blocks, then D_f) of `old_functions` functions in `old_rest` gives that of `functions`
+// in `rest`. Function f of the new basis is function from[f] of the old one (ascending;
+// the standard functions first, from[f] = f); an enriched one is shifted along its node's
+// standard function standard[f] by delta[f] = new shift - old shift, psi_new = psi_old -
+// delta N_a (delta 0 for standard functions). The strain rows are linear in the function,
+// so K_fg -> K_fg - delta_g K_f,a(g) - delta_f K_a(f),g + delta_f delta_g K_a(f),a(g) and
+// D_f -> D_f - delta_f D_a(f): the sums over the points equal those summed afresh up to
+// round-off, at O(n^2) a cluster instead of O(points n^2).
+void enriched_cluster_rest_reshift(int planes, std::int64_t clusters, int old_functions, const double* old_rest,
+                                   int functions, const int* from, const int* standard, const double* delta,
+                                   double* rest, Execution execution = Execution::parallel);
+// Where each element's rest data starts (#elements + 1 offsets into the rest data): an
+// element's clusters are consecutive, so its rest data is one stretch.
+std::vector<std::int64_t> enriched_cluster_rest_element_start(const EnrichedElementBatch& batch,
+                                                              const EnrichedRotationClusters& clusters);
 
 // R_c of every cluster from the current state (#(nodes + virtual nodes) x 3, as for
 // enriched_element_corotated_stiffness).
