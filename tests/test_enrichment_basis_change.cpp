@@ -20,6 +20,7 @@
 #include <cstring>
 #include <memory>
 #include <random>
+#include <utility>
 
 #include "cut_test_support.h"
 #include "enrichment_test_support.h"
@@ -80,6 +81,19 @@ ProjectedState reference_projection(const ShellModel& old_model, const std::vect
   return {project(u), project(v)};
 }
 
+// The models after a cut update: the chained one (as SceneRun does: a copy of `model` takes
+// the new functions) and `fresh`, a plain model given them.
+std::pair<std::unique_ptr<ShellModel>, std::unique_ptr<ShellModel>> chained_and_fresh(const ShellModel& model,
+                                                                                       const CutManager& cuts,
+                                                                                       std::unique_ptr<ShellModel> fresh) {
+  auto next = std::make_unique<ShellModel>(model);
+  for (ShellModel* m : {next.get(), fresh.get()}) {
+    m->set_cut_edge_texels(cuts.edge_walls().resolution(), cuts.edge_walls().flags(m->mesh().num_elements()));
+    m->set_enrichments(cuts.functions());
+  }
+  return {std::move(next), std::move(fresh)};
+}
+
 void check_progressive_cut(const Mesh& mesh, const Cut& cut, int steps, double dt) {
   const Topology topology = build_topology(mesh);
   CutManager cuts(mesh, topology, {cut}, cholmod_enrichment(32));
@@ -90,14 +104,8 @@ void check_progressive_cut(const Mesh& mesh, const Cut& cut, int steps, double d
     if (!cuts.update(step * dt)) continue;
     ++changes;
     SCOPED_TRACE("step " + std::to_string(step));
-    // The chained model (as SceneRun does: a copy takes the new functions)...
-    auto next = std::make_unique<ShellModel>(*model);
-    next->set_cut_edge_texels(cuts.edge_walls().resolution(), cuts.edge_walls().flags(mesh.num_elements()));
-    next->set_enrichments(cuts.functions());
-    // ...equals one built from scratch.
-    auto fresh = plain_model(mesh, topology);
-    fresh->set_cut_edge_texels(cuts.edge_walls().resolution(), cuts.edge_walls().flags(mesh.num_elements()));
-    fresh->set_enrichments(cuts.functions());
+    // The chained model equals one built from scratch.
+    auto [next, fresh] = chained_and_fresh(*model, cuts, plain_model(mesh, topology));
     expect_models_equal_bitwise(*next, *fresh);
     EXPECT_EQ(next->num_enriched_element_quadrature_points(), fresh->num_enriched_element_quadrature_points());
     if (model->num_enriched_elements() > 0 && next->num_enriched_elements() > 1) ++reused_some;
@@ -199,12 +207,7 @@ void check_clustered_chain(const Mesh& mesh, const Cut& cut, int steps, double d
     if (!cuts.update(step * dt)) continue;
     ++changes;
     SCOPED_TRACE("step " + std::to_string(step));
-    auto next = std::make_unique<ShellModel>(*model);
-    next->set_cut_edge_texels(cuts.edge_walls().resolution(), cuts.edge_walls().flags(mesh.num_elements()));
-    next->set_enrichments(cuts.functions());
-    auto fresh = plain_model(mesh, topology, 8);
-    fresh->set_cut_edge_texels(cuts.edge_walls().resolution(), cuts.edge_walls().flags(mesh.num_elements()));
-    fresh->set_enrichments(cuts.functions());
+    auto [next, fresh] = chained_and_fresh(*model, cuts, plain_model(mesh, topology, 8));
     std::vector<double> K, f, K_fresh, f_fresh;
     next->assemble_stiffness(turned(*next).data(), K, &f);
     fresh->assemble_stiffness(turned(*fresh).data(), K_fresh, &f_fresh);
