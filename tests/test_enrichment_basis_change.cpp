@@ -83,9 +83,8 @@ ProjectedState reference_projection(const ShellModel& old_model, const std::vect
 
 // The models after a cut update: the chained one (as SceneRun does: a copy of `model` takes
 // the new functions) and `fresh`, a plain model given them.
-std::pair<std::unique_ptr<ShellModel>, std::unique_ptr<ShellModel>> chained_and_fresh(const ShellModel& model,
-                                                                                       const CutManager& cuts,
-                                                                                       std::unique_ptr<ShellModel> fresh) {
+using ModelPair = std::pair<std::unique_ptr<ShellModel>, std::unique_ptr<ShellModel>>;
+ModelPair chained_and_fresh(const ShellModel& model, const CutManager& cuts, std::unique_ptr<ShellModel> fresh) {
   auto next = std::make_unique<ShellModel>(model);
   for (ShellModel* m : {next.get(), fresh.get()}) {
     m->set_cut_edge_texels(cuts.edge_walls().resolution(), cuts.edge_walls().flags(m->mesh().num_elements()));
@@ -196,8 +195,9 @@ std::vector<double> turned(const ShellModel& m) {
 
 // A chained model's rotation clusters take the rest data of the elements whose textures did
 // not change from the model before (as it is, or reshifted where the cut moved the shifts of
-// their nodes); its corotated stiffness and forces equal a fresh model's to round-off, and
-// bitwise where nothing was reshifted. Planar plate and a bent one (5 and 9 planes).
+// their nodes); its corotated stiffness and forces equal a fresh model's to round-off (bitwise
+// where nothing was reshifted: the steps where they differ count the reshifts, of which
+// there must be some). Planar plate and a bent one (5 and 9 planes).
 void check_clustered_chain(const Mesh& mesh, const Cut& cut, int steps, double dt) {
   const Topology topology = build_topology(mesh);
   CutManager cuts(mesh, topology, {cut}, cholmod_enrichment(32));
