@@ -371,6 +371,33 @@ void ShellModel::install_enrichments(std::vector<EnrichmentFunction> functions, 
   if (build) rebuild();
 }
 
+namespace {
+
+// Where a new basis's local functions are among an old one's, from the shifts of each
+// enrichment x node slot (NaN: the slot's node not enriched; new_shift(i): the new basis's):
+// old_index[f] for each new function f, the standard functions first (old_index[f] = f),
+// then the enriched ones in slot order, whose slots `slot` lists. False where the new basis
+// enriches a slot the old one did not.
+template <class NewShift>
+bool functions_among_old(const std::vector<double>& old_shifts, int npe, NewShift&& new_shift,
+                         std::vector<int>& old_index, std::vector<int>& slot) {
+  old_index.resize(npe);
+  for (int a = 0; a < npe; ++a) old_index[a] = a;
+  slot.clear();
+  for (int i = 0, o = npe; i < static_cast<int>(old_shifts.size()); ++i) {
+    const bool was = !std::isnan(old_shifts[i]);
+    if (!std::isnan(new_shift(i))) {
+      if (!was) return false;
+      old_index.push_back(o);
+      slot.push_back(i);
+    }
+    o += was;
+  }
+  return true;
+}
+
+}  // namespace
+
 void ShellModel::integrate_enriched_elements(const kernels::EnrichedElementBatch& eb, std::vector<double>& mass) {
   const int npe = mesh_.nodes_per_element();
   const int T = resolution_;
@@ -392,28 +419,26 @@ void ShellModel::integrate_enriched_elements(const kernels::EnrichedElementBatch
     const ElementIntegrals* old =
         e < static_cast<int>(element_integrals_.size()) ? element_integrals_[e].get() : nullptr;
     const int first = enrichment_start_[x], k_count = enrichment_start_[x + 1] - first;
-    if (!old || static_cast<int>(old->values.size()) != k_count) continue;
+    if (!old || static_cast<int>(old->quadrature->values.size()) != k_count) continue;
     bool same = true;
     for (int k = 0; k < k_count && same; ++k)
-      same = old->values[k].size() == texels &&
-             std::equal(old->values[k].begin(), old->values[k].end(), textures_[first + k].values,
+      same = old->quadrature->values[k].size() == texels &&
+             std::equal(old->quadrature->values[k].begin(), old->quadrature->values[k].end(),
+                        textures_[first + k].values,
                         [](double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }) &&
-             std::equal(old->flags[k].begin(), old->flags[k].end(), textures_[first + k].flags);
+             std::equal(old->quadrature->flags[k].begin(), old->quadrature->flags[k].end(), textures_[first + k].flags);
     if (!same) continue;
     same_textures[x] = 1;
     // Local function of the new basis -> the old one's: the reuse needs every new function
     // among the old ones, with the same shift.
-    std::vector<int> old_function(npe);
-    for (int a = 0; a < npe; ++a) old_function[a] = a;
-    bool subset = true;
-    for (int i = 0, o = npe; i < k_count * npe && subset; ++i) {
-      const bool was = !std::isnan(old->shifts[i]);
-      if (enriched_node_[first * npe + i] >= 0) {
-        const double shift = enriched_shift_[first * npe + i];
-        subset = was && std::memcmp(&shift, &old->shifts[i], sizeof shift) == 0;
-        old_function.push_back(o);
-      }
-      o += was;
+    const auto new_shift = [&](int i) {
+      return enriched_node_[first * npe + i] >= 0 ? enriched_shift_[first * npe + i] : std::nan("");
+    };
+    std::vector<int> old_function, slot;
+    bool subset = functions_among_old(old->shifts, npe, new_shift, old_function, slot);
+    for (std::size_t f = 0; f < slot.size() && subset; ++f) {
+      const double shift = new_shift(slot[f]);
+      subset = std::memcmp(&shift, &old->shifts[slot[f]], sizeof shift) == 0;
     }
     if (!subset) continue;
     if (keep_basis_values_ && e < static_cast<int>(previous.start.size()) && previous.start[e] >= 0 &&
@@ -483,7 +508,7 @@ void ShellModel::integrate_enriched_elements(const kernels::EnrichedElementBatch
         ++next;
       } else {
         const ElementIntegrals& old = *element_integrals_[todo_element[t]];
-        sub_points.insert(sub_points.end(), old.points.begin(), old.points.end());
+        sub_points.insert(sub_points.end(), old.quadrature->points.begin(), old.quadrature->points.end());
         for (int k = 0; k < textures_of_t; ++k) sub_derivatives.push_back(keep_derivatives ? old.derivatives[k] : nullptr);
       }
       sub_start.push_back(static_cast<std::int64_t>(sub_points.size() / 3));
@@ -504,14 +529,15 @@ void ShellModel::integrate_enriched_elements(const kernels::EnrichedElementBatch
     for (std::int64_t x = 0; x < count; ++x)
       if (!kept_columns[x].empty()) {
         kept_start[x] = points;
-        points += static_cast<std::int64_t>(element_integrals_[enriched_elements_[x]]->points.size() / 3);
+        points += static_cast<std::int64_t>(element_integrals_[enriched_elements_[x]]->quadrature->points.size() / 3);
       }
     basis_values.reset(new double[static_cast<size_t>(points) * W]);
     for (std::int64_t x = 0; x < count; ++x) {
       const std::vector<int>& columns = kept_columns[x];
       if (columns.empty()) continue;
       const int e = enriched_elements_[x], n = static_cast<int>(columns.size());
-      const std::int64_t element_points = static_cast<std::int64_t>(element_integrals_[e]->points.size() / 3);
+      const std::int64_t element_points =
+          static_cast<std::int64_t>(element_integrals_[e]->quadrature->points.size() / 3);
       for (std::int64_t p = 0; p < element_points; ++p) {
         const double* from = previous.values.get() + (previous.start[e] + p) * previous.width;
         double* to = basis_values.get() + (kept_start[x] + p) * W;
@@ -525,16 +551,23 @@ void ShellModel::integrate_enriched_elements(const kernels::EnrichedElementBatch
   for (std::int64_t t = 0; t < todo; ++t) {
     auto entry = std::make_shared<ElementIntegrals>();
     const int x = todo_index[t];
-    for (int k = enrichment_start_[x]; k < enrichment_start_[x + 1]; ++k) {
-      entry->values.emplace_back(textures_[k].values, textures_[k].values + texels);
-      entry->flags.emplace_back(textures_[k].flags, textures_[k].flags + texels);
+    if (same_textures[x]) {
+      entry->quadrature = element_integrals_[todo_element[t]]->quadrature;
+    } else {
+      auto quadrature = std::make_shared<TexturedQuadrature>();
+      for (int k = enrichment_start_[x]; k < enrichment_start_[x + 1]; ++k) {
+        quadrature->values.emplace_back(textures_[k].values, textures_[k].values + texels);
+        quadrature->flags.emplace_back(textures_[k].flags, textures_[k].flags + texels);
+      }
+      quadrature->points.assign(sub_points.begin() + 3 * sub_start[t], sub_points.begin() + 3 * sub_start[t + 1]);
+      entry->quadrature = std::move(quadrature);
+    }
+    for (int k = enrichment_start_[x]; k < enrichment_start_[x + 1]; ++k)
       for (int a = 0; a < npe; ++a)
         entry->shifts.push_back(enriched_node_[k * npe + a] >= 0 ? enriched_shift_[k * npe + a] : std::nan(""));
-    }
     entry->derivatives.assign(sub_derivatives.begin() + todo_start[t], sub_derivatives.begin() + todo_start[t + 1]);
     const int n = kernels::enriched_basis_count(sub, t);
     entry->count = n;
-    entry->points.assign(sub_points.begin() + 3 * sub_start[t], sub_points.begin() + 3 * sub_start[t + 1]);
     entry->mass.resize(static_cast<size_t>(n) * n);
     for (int a = 0; a < n; ++a)
       for (int c = 0; c < n; ++c) entry->mass[a * n + c] = sub_mass[(t * W + a) * W + c];
@@ -553,7 +586,7 @@ void ShellModel::integrate_enriched_elements(const kernels::EnrichedElementBatch
   for (std::int64_t x = 0; x < count; ++x) {
     const ElementIntegrals& in = *reused[x];
     for (const auto& tile : in.derivatives) texture_derivatives_.push_back(tile.get());
-    element_qp_.insert(element_qp_.end(), in.points.begin(), in.points.end());
+    element_qp_.insert(element_qp_.end(), in.quadrature->points.begin(), in.quadrature->points.end());
     element_qp_start_.push_back(static_cast<std::int64_t>(element_qp_.size() / 3));
     const int n = in.count;
     for (int a = 0; a < n; ++a) {
@@ -818,14 +851,6 @@ void ShellModel::assemble_stiffness(const double* current, std::vector<double>& 
   }
 }
 
-namespace {
-
-bool bitwise_equal(const std::vector<double>& a, const std::vector<double>& b) {
-  return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(double)) == 0;
-}
-
-}  // namespace
-
 void ShellModel::sum_cluster_rest(const kernels::EnrichedElementBatch& xb, const kernels::EnrichedQuadrature& quadrature,
                                   kernels::Execution execution) const {
   AssemblyWorkspace& w = workspace_;
@@ -850,23 +875,15 @@ void ShellModel::sum_cluster_rest(const kernels::EnrichedElementBatch& xb, const
       compute[x] = 0;
       continue;
     }
-    if (old.values.size() != in.values.size() || old.shifts.size() != in.shifts.size()) continue;
-    bool same_textures = true;
-    for (std::size_t k = 0; k < in.values.size() && same_textures; ++k)
-      same_textures = bitwise_equal(old.values[k], in.values[k]) && old.flags[k] == in.flags[k];
-    if (!same_textures) continue;
-    // The new functions among the old ones (in order: standard, then per texture its nodes).
-    std::vector<int> from(npe), standard(npe);
+    if (old.quadrature != in.quadrature) continue;  // other textures
+    std::vector<int> from, slot;
+    if (!functions_among_old(old.shifts, npe, [&](int i) { return in.shifts[i]; }, from, slot) ||
+        static_cast<int>(from.size()) != in.count)
+      continue;
+    // Each enriched function moves along its node's standard function by its shift's change.
+    std::vector<int> standard(from.begin(), from.begin() + npe);
     std::vector<double> delta(npe, 0.0);
-    for (int a = 0; a < npe; ++a) from[a] = a, standard[a] = a;
-    bool among = true;
-    for (int i = 0, o = npe; i < static_cast<int>(in.shifts.size()) && among; ++i) {
-      const bool was = !std::isnan(old.shifts[i]), is = !std::isnan(in.shifts[i]);
-      among = was || !is;
-      if (is && was) from.push_back(o), standard.push_back(i % npe), delta.push_back(in.shifts[i] - old.shifts[i]);
-      o += was;
-    }
-    if (!among || static_cast<int>(from.size()) != in.count) continue;
+    for (const int i : slot) standard.push_back(i % npe), delta.push_back(in.shifts[i] - old.shifts[i]);
     kernels::enriched_cluster_rest_reshift(now.planes, now.clusters, old.count, old_rest, in.count, from.data(),
                                            standard.data(), delta.data(), out, execution);
     compute[x] = 0;
@@ -1165,8 +1182,8 @@ std::vector<std::vector<double>> ShellModel::moments_of_fields(const ShellModel&
         source_owner->count == kernels::enriched_basis_count(source.enriched_element_batch(), source_index)) {
       source_kept = source.kept_.values.get() + source.kept_.start[e] * source.kept_.width;
       source_kept_global = source.enriched_global_nodes_.data() + static_cast<std::ptrdiff_t>(source_index) * source.width_;
-      source_points = detail::ParametricPointIndex(source_owner->points.data(),
-                                                   static_cast<std::int64_t>(source_owner->points.size() / 3));
+      const std::vector<double>& points = source_owner->quadrature->points;
+      source_points = detail::ParametricPointIndex(points.data(), static_cast<std::int64_t>(points.size() / 3));
     }
     for (std::int64_t begin = 0; begin < total; begin += span) {
       const std::int64_t count = std::min(span, total - begin);

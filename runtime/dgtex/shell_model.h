@@ -305,15 +305,21 @@ class ShellModel {
   // what they came to; a later rebuild reuses them where the inputs are bitwise equal (a
   // cut advancing changes the textures of the few elements near its tip only). Shared and
   // immutable, so copies of the model share them.
+  // An element's textures and the quadrature they decide, shared by every ElementIntegrals
+  // built on bitwise these textures (a rebuild that only moved shifts or dropped functions),
+  // so that "the same textures" is one pointer comparison.
+  struct TexturedQuadrature {
+    std::vector<std::vector<double>> values;       // per enrichment: texture values
+    std::vector<std::vector<std::uint8_t>> flags;  // per enrichment: texture flags
+    std::vector<double> points;                    // quadrature: (xi1, xi2, weight) per point
+  };
   struct ElementIntegrals {
-    std::vector<std::vector<double>> values;         // per enrichment: texture values
-    std::vector<std::vector<std::uint8_t>> flags;    // per enrichment: texture flags
+    std::shared_ptr<const TexturedQuadrature> quadrature;
     std::vector<double> shifts;                      // per enrichment x npe; NaN: node not enriched
     // Per enrichment: the texel derivatives the adaptive quadrature computed (null: none),
     // read by the mass and the projection moments instead of recomputing them per point.
     std::vector<std::shared_ptr<const kernels::TexelDerivativeTile>> derivatives;
     int count = 0;                                   // local basis functions
-    std::vector<double> points;                      // quadrature: (xi1, xi2, weight) per point
     std::vector<double> mass;                        // count x count
     std::vector<double> area_weights, mass_weights;  // count
   };
@@ -322,10 +328,10 @@ class ShellModel {
   // the integrals it was summed from (per mesh element; `rest` keeps the whole old rest data
   // alive until the next rest data replaces the stretches). The next rest data (after
   // set_enrichments, also on a copy of the model) takes an element's stretch instead of
-  // summing it again where the element's textures are bitwise the same, so its points and
-  // clusters are: as it is where its functions and shifts are the same too (the same
-  // integrals), else reshifted (kernels::enriched_cluster_rest_reshift) where the new
-  // functions are among the old ones. A cut's tip changing a neighbour's textures moves the
+  // summing it again where the element's textures are bitwise the same (the same
+  // TexturedQuadrature), so its points and clusters are: as it is where its functions and
+  // shifts are the same too (the same integrals), else reshifted
+  // (kernels::enriched_cluster_rest_reshift) where the new functions are among the old ones. A cut's tip changing a neighbour's textures moves the
   // shifts of the shared nodes (the slinky: ~0.9 of its 4 elements a basis change).
   struct ClusterRestStretch {
     std::shared_ptr<const ElementIntegrals> integrals;
