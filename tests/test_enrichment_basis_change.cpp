@@ -20,7 +20,10 @@
 #include <cstring>
 #include <memory>
 #include <random>
+#include <string>
 #include <utility>
+
+#include <omp.h>
 
 #include "cut_test_support.h"
 #include "enrichment_test_support.h"
@@ -154,7 +157,8 @@ TEST(BasisChange, ChainedTri6ModelAndProjectionEqualTheReferenceBitwise) {
 // Two quad8 elements of one mesh, each with harmonic partial cuts (the second with two
 // enrichments), some nodes not enriched.
 struct TwoEnrichedElements {
-  static constexpr int t = 32, npe = 8;
+  static constexpr int npe = 8;
+  int t;
   Mesh mesh = make_rectangle(2, 1, 2, 1, ElementType::quad8);
   std::vector<kernels::TexelTile> tiles;
   std::vector<kernels::TextureView> views;
@@ -163,8 +167,11 @@ struct TwoEnrichedElements {
   std::vector<double> shift = std::vector<double>(3 * npe);
   kernels::EnrichedElementBatch batch{};
 
-  TwoEnrichedElements() {
+  // The cuts are placed for T = 32 and scaled to `resolution`.
+  explicit TwoEnrichedElements(int resolution = 32) : t(resolution) {
     auto harmonic = [&](std::vector<kernels::TexelPoint> path) {
+      for (kernels::TexelPoint& point : path)
+        for (double& x : point) x *= t / 32.0;
       kernels::TexelTile walls = kernels::make_element_tile(ElementType::quad8, t);
       const kernels::CutRaster raster = kernels::rasterize_cut(path, walls);
       return harmonic_enrichment(walls, raster).tile;
@@ -263,32 +270,59 @@ TEST(BasisChange, ClusterRestDataOfChosenElementsOnly) {
   }
 }
 
-// The fused kernel against the two kernels.
+// The fused kernel against the two kernels: serial and on 1-3 threads, with the values
+// kept for the caller (all points evaluated, then summed) or not (in waves of at most
+// 64 blocks of points; at T = 128 the per-texel rule needs several waves per element).
 TEST(BasisChange, FusedMassAndLoadWeightsEqualTheTwoKernelsBitwise) {
-  const TwoEnrichedElements setup;
-  const kernels::EnrichedElementBatch& batch = setup.batch;
-  const int width = batch.width;
-  for (bool adaptive : {true, false}) {
-    SCOPED_TRACE(adaptive ? "adaptive quadrature" : "per-texel quadrature");
-    kernels::EnrichedQuadratureOptions options;
-    options.adaptive = adaptive;
-    std::vector<std::int64_t> qs;
-    std::vector<double> qp;
-    kernels::enriched_element_quadrature(batch, options, qs, qp);
-    ASSERT_GT(qs.back(), 2 * kernels::rest_integral_block_points);  // several work items
-    const kernels::EnrichedQuadrature quad{qs.data(), qp.data()};
-    std::vector<double> mass(2 * width * width), area(2 * width), weights(2 * width);
-    kernels::enriched_element_mass(batch, quad, mass.data());
-    kernels::enriched_element_load_weights(batch, quad, area.data(), weights.data());
-    for (auto execution : {kernels::Execution::serial, kernels::Execution::parallel}) {
-      std::vector<double> fused_mass(mass.size(), -1.0), fused_area(area.size(), -1.0), fused_weights(area.size(), -1.0);
-      kernels::enriched_element_mass_and_load_weights(batch, quad, fused_mass.data(), fused_area.data(),
-                                                      fused_weights.data(), execution);
-      EXPECT_TRUE(bitwise_equal(fused_mass, mass));
-      EXPECT_TRUE(bitwise_equal(fused_area, area));
-      EXPECT_TRUE(bitwise_equal(fused_weights, weights));
+  const int saved_threads = omp_get_max_threads();
+  for (const int resolution : {32, 128}) {
+    const TwoEnrichedElements setup(resolution);
+    const kernels::EnrichedElementBatch& batch = setup.batch;
+    const int width = batch.width;
+    for (bool adaptive : {true, false}) {
+      SCOPED_TRACE(std::string(adaptive ? "adaptive" : "per-texel") + " quadrature, T = " + std::to_string(resolution));
+      kernels::EnrichedQuadratureOptions options;
+      options.adaptive = adaptive;
+      std::vector<std::int64_t> qs;
+      std::vector<double> qp;
+      kernels::enriched_element_quadrature(batch, options, qs, qp);
+      ASSERT_GT(qs.back(), 2 * kernels::rest_integral_block_points);  // several work items
+      if (resolution == 128 && !adaptive) {
+        ASSERT_GT(qs[1], 2 * 64 * kernels::rest_integral_block_points);
+      }
+      const kernels::EnrichedQuadrature quad{qs.data(), qp.data()};
+      std::vector<double> mass(2 * width * width), area(2 * width), weights(2 * width);
+      kernels::enriched_element_mass(batch, quad, mass.data());
+      kernels::enriched_element_load_weights(batch, quad, area.data(), weights.data());
+      for (const int threads : {0, 1, 2, 3})
+        for (const bool keep_values : {false, true}) {
+          SCOPED_TRACE((threads == 0 ? std::string("serial") : std::to_string(threads) + " threads") +
+                       (keep_values ? ", values kept" : ""));
+          const kernels::Execution execution = threads == 0 ? kernels::Execution::serial : kernels::Execution::parallel;
+          if (threads > 0) omp_set_num_threads(threads);
+          std::vector<double> fused_mass(mass.size(), -1.0), fused_area(area.size(), -1.0),
+              fused_weights(area.size(), -1.0), values(keep_values ? qs.back() * width : 0, -1.0);
+          kernels::enriched_element_mass_and_load_weights(batch, quad, nullptr, fused_mass.data(), fused_area.data(),
+                                                          fused_weights.data(), execution,
+                                                          keep_values ? values.data() : nullptr);
+          EXPECT_TRUE(bitwise_equal(fused_mass, mass));
+          EXPECT_TRUE(bitwise_equal(fused_area, area));
+          EXPECT_TRUE(bitwise_equal(fused_weights, weights));
+          // The kept values are each point's basis values (spot checks).
+          for (std::int64_t q = 0; keep_values && q < qs.back(); q += 997) {
+            const int e = q < qs[1] ? 0 : 1;
+            kernels::ShapeValues s;
+            kernels::evaluate_shape(ElementType::quad8, qp[3 * q], qp[3 * q + 1], s);
+            kernels::EnrichedShapeValues full;
+            kernels::evaluate_enriched_shape(batch, e, qp[3 * q], qp[3 * q + 1], s, full);
+            ASSERT_EQ(std::memcmp(&values[q * width], full.N, sizeof(double) * full.count), 0) << "point " << q;
+          }
+        }
+      omp_set_num_threads(saved_threads);
     }
   }
+  const TwoEnrichedElements setup;
+  const kernels::EnrichedElementBatch& batch = setup.batch;
   // Shape values at points in shuffled order (the texel cache refills and hits).
   std::mt19937 rng(7);
   std::uniform_real_distribution<double> uniform(-1, 1);

@@ -4,9 +4,9 @@
 // enriched_element_load_weights (enriched_element_kernel.h), which evaluate every point
 // twice and use one thread per element. Here each point's basis values (N only, no
 // derivatives; texel derivatives reused while consecutive points stay in one texel) are
-// evaluated once, in parallel over fixed blocks of points, and then summed serially in
-// point order: the same sums as the two kernels, for any thread count, and a single large
-// element (one-element scenes at T = 256) uses all threads.
+// evaluated once, in parallel over fixed blocks of points, and then summed per element in
+// point order, the elements side by side: the same sums as the two kernels, for any thread
+// count, and a single large element (one-element scenes at T = 256) uses all threads.
 // Shapes as in enriched_element_kernel.h: mass #elements x W x W (times I3), weights
 // #elements x W, padding slots 0. Kernel conventions (dgtex/kernels/forall.h): arrays are
 // the caller's, nothing is kept after a call; thread-safe on distinct outputs.
