@@ -1,7 +1,7 @@
 // Parallel loops of a thread with work running beside it (dgtex/kernels/threads_busy_beside.h):
 // forall, forall_dynamic, forall_then and run_side_by_side leave out the threads that work
-// holds, take them back once the count drops, and a scope restores the thread's previous
-// setting. SceneRun's overlapped cut updates, which set the count, keep the plain bits
+// holds, take them back once the count drops (forall and forall_dynamic within the loop, at
+// their next slice), and a scope restores the thread's previous setting. SceneRun's overlapped cut updates, which set the count, keep the plain bits
 // (test_scene_run_overlap).
 #include <gtest/gtest.h>
 
@@ -101,6 +101,31 @@ TEST_F(ThreadsBusyBeside, SideWorkThatFinishesHandsItsThreadBack) {
   std::thread side([&] { busy.store(0, std::memory_order_release); });
   side.join();
   EXPECT_EQ(loop_teams().forall, 3);
+}
+
+// A loop begun beside side work that finishes while it runs: its later slices run on the
+// whole team, every index exactly once; without side work the loop is one region.
+TEST_F(ThreadsBusyBeside, LoopsTakeTheThreadsBackWhileTheyRun) {
+  constexpr std::int64_t n = 10 * kernels::rejoin_slices;
+  for (const bool dynamic : {false, true}) {
+    SCOPED_TRACE(dynamic ? "forall_dynamic" : "forall");
+    std::atomic<int> busy{2};
+    std::vector<int> team(n, 0), visits(n, 0);
+    const auto body = [&](std::int64_t i) {
+      team[i] = omp_get_num_threads();
+      ++visits[i];  // each index is written by one thread only
+      if (i == 3) busy.store(0, std::memory_order_release);  // the side work ends in the first slice
+    };
+    {
+      const kernels::ScopedThreadsBusyBeside beside(&busy);
+      if (dynamic) kernels::forall_dynamic(n, body);
+      else kernels::forall(n, body);
+    }
+    for (std::int64_t i = 0; i < n; ++i) ASSERT_EQ(visits[i], 1) << "index " << i;
+    EXPECT_EQ(team.front(), 1);  // began beside the side work: one thread of three
+    EXPECT_EQ(team.back(), 3);   // the later slices: the whole team
+    EXPECT_EQ(*std::max_element(team.begin(), team.begin() + n / kernels::rejoin_slices), 1);
+  }
 }
 
 TEST_F(ThreadsBusyBeside, SideBySideRunsInTurnWhenOnlyOneThreadIsFree) {
