@@ -421,12 +421,10 @@ void ShellModel::integrate_enriched_elements(const kernels::EnrichedElementBatch
     const int first = enrichment_start_[x], k_count = enrichment_start_[x + 1] - first;
     if (!old || static_cast<int>(old->quadrature->values.size()) != k_count) continue;
     bool same = true;
-    for (int k = 0; k < k_count && same; ++k)
+    for (int k = 0; k < k_count && same; ++k)  // bitwise, in one memcmp each
       same = old->quadrature->values[k].size() == texels &&
-             std::equal(old->quadrature->values[k].begin(), old->quadrature->values[k].end(),
-                        textures_[first + k].values,
-                        [](double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }) &&
-             std::equal(old->quadrature->flags[k].begin(), old->quadrature->flags[k].end(), textures_[first + k].flags);
+             std::memcmp(old->quadrature->values[k].data(), textures_[first + k].values, texels * sizeof(double)) == 0 &&
+             std::memcmp(old->quadrature->flags[k].data(), textures_[first + k].flags, texels) == 0;
     if (!same) continue;
     same_textures[x] = 1;
     // Local function of the new basis -> the old one's: the reuse needs every new function
@@ -538,11 +536,14 @@ void ShellModel::integrate_enriched_elements(const kernels::EnrichedElementBatch
       const int e = enriched_elements_[x], n = static_cast<int>(columns.size());
       const std::int64_t element_points =
           static_cast<std::int64_t>(element_integrals_[e]->quadrature->points.size() / 3);
-      for (std::int64_t p = 0; p < element_points; ++p) {
-        const double* from = previous.values.get() + (previous.start[e] + p) * previous.width;
-        double* to = basis_values.get() + (kept_start[x] + p) * W;
-        for (int a = 0; a < n; ++a) to[a] = from[columns[a]];
-      }
+      constexpr std::int64_t block = 1024;  // points a work item (a gather from a stride of W)
+      kernels::forall((element_points + block - 1) / block, [&](std::int64_t item) {
+        for (std::int64_t p = item * block; p < std::min(element_points, (item + 1) * block); ++p) {
+          const double* from = previous.values.get() + (previous.start[e] + p) * previous.width;
+          double* to = basis_values.get() + (kept_start[x] + p) * W;
+          for (int a = 0; a < n; ++a) to[a] = from[columns[a]];
+        }
+      });
     }
   }
   kernels::enriched_element_mass_and_load_weights(sub, {sub_start.data(), sub_points.data()}, sub_tiles.data(),

@@ -1,7 +1,7 @@
 // Parallel loops of a thread with work running beside it (dgtex/kernels/threads_busy_beside.h):
 // forall, forall_dynamic, forall_then and run_side_by_side leave out the threads that work
-// holds, take them back once the count drops (forall and forall_dynamic within the loop, at
-// their next slice), and a scope restores the thread's previous setting. SceneRun's overlapped cut updates, which set the count, keep the plain bits
+// holds, take them back once the count drops (forall, forall_dynamic and forall_then within
+// the loop, at their next slice), and a scope restores the thread's previous setting. SceneRun's overlapped cut updates, which set the count, keep the plain bits
 // (test_scene_run_overlap).
 #include <gtest/gtest.h>
 
@@ -104,11 +104,11 @@ TEST_F(ThreadsBusyBeside, SideWorkThatFinishesHandsItsThreadBack) {
 }
 
 // A loop begun beside side work that finishes while it runs: its later slices run on the
-// whole team, every index exactly once; without side work the loop is one region.
+// whole team, every index exactly once (forall_then: its first loop).
 TEST_F(ThreadsBusyBeside, LoopsTakeTheThreadsBackWhileTheyRun) {
   constexpr std::int64_t n = 10 * kernels::rejoin_slices;
-  for (const bool dynamic : {false, true}) {
-    SCOPED_TRACE(dynamic ? "forall_dynamic" : "forall");
+  for (const int kind : {0, 1, 2}) {
+    SCOPED_TRACE(kind == 0 ? "forall" : kind == 1 ? "forall_dynamic" : "forall_then");
     std::atomic<int> busy{2};
     std::vector<int> team(n, 0), visits(n, 0);
     const auto body = [&](std::int64_t i) {
@@ -118,8 +118,9 @@ TEST_F(ThreadsBusyBeside, LoopsTakeTheThreadsBackWhileTheyRun) {
     };
     {
       const kernels::ScopedThreadsBusyBeside beside(&busy);
-      if (dynamic) kernels::forall_dynamic(n, body);
-      else kernels::forall(n, body);
+      if (kind == 0) kernels::forall(n, body);
+      if (kind == 1) kernels::forall_dynamic(n, body);
+      if (kind == 2) kernels::forall_then(n, body, 0, [](std::int64_t) {});
     }
     for (std::int64_t i = 0; i < n; ++i) ASSERT_EQ(visits[i], 1) << "index " << i;
     EXPECT_EQ(team.front(), 1);  // began beside the side work: one thread of three

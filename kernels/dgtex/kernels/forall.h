@@ -70,7 +70,11 @@ void forall_dynamic(std::int64_t n, Body&& body, Execution execution = Execution
 template <class First, class Second>
 void forall_then(std::int64_t n1, First&& first, std::int64_t n2, Second&& second,
                  Execution execution = Execution::parallel) {
-  if (execution == Execution::parallel) {
+  if (execution == Execution::parallel && parallel_team_size() < omp_get_max_threads()) {
+    // Beside busy side work: two loops that can each take threads back (run_rejoining).
+    forall(n1, first, execution);
+    forall(n2, second, execution);
+  } else if (execution == Execution::parallel) {
 #pragma omp parallel num_threads(parallel_team_size())
     {
 #pragma omp for schedule(static)
