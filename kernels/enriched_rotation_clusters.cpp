@@ -472,9 +472,19 @@ void enriched_cluster_rest_stiffness(const EnrichedElementBatch& batch, const En
     for (std::int64_t c = clusters.element_start[e]; c < clusters.element_start[e + 1]; ++c)
       todo.push_back(c), todo_element.push_back(e);
   }
-  // Clusters differ much in cost (tip blocks hold few points): handed out dynamically;
-  // each writes only its own rest data, so the result does not depend on the threads.
-  auto cluster = [&](std::int64_t i) {
+  // Clusters differ much in cost (tip blocks hold few points): handed out dynamically, the
+  // costliest (points x functions^2) first, so that no large one is left for the end while
+  // the other threads wait (the slinky's sums ended with a core idle). Each writes only its
+  // own rest data, so the result does not depend on the threads or the order.
+  std::vector<std::int64_t> order(todo.size()), cost(todo.size());
+  for (std::size_t i = 0; i < todo.size(); ++i) {
+    const std::int64_t n = enriched_basis_count(batch, todo_element[i]);
+    cost[i] = (clusters.point_start[todo[i] + 1] - clusters.point_start[todo[i]]) * n * n;
+    order[i] = static_cast<std::int64_t>(i);
+  }
+  std::stable_sort(order.begin(), order.end(), [&](std::int64_t a, std::int64_t b) { return cost[a] > cost[b]; });
+  auto cluster = [&](std::int64_t k) {
+    const std::int64_t i = order[k];
     const std::int64_t c = todo[i], e = todo_element[i];
     const int n = enriched_basis_count(batch, e);
     const int planes = rest_planes(planar[e]);
