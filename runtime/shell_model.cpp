@@ -284,20 +284,20 @@ void ShellModel::install_enrichments(std::vector<EnrichmentFunction> functions, 
   for (int e = 0; e < ne; ++e)
     for (int a = 0; a < npe; ++a) incident[mesh_.element_nodes(e)[a]].push_back({e, a});
 
-  enrichments_ = std::move(functions);
+  enrichments_ = std::make_shared<std::vector<EnrichmentFunction>>(std::move(functions));
   resolution_ = resolution;
   function_slot_start_.assign(1, 0);
   virtual_node_function_.clear();
   virtual_node_mesh_node_.clear();
   virtual_node_shift_.clear();
   auto texture_of = [&](int i, int element) -> const kernels::TexelTile* {
-    const auto& list = enrichments_[i].elements;
+    const auto& list = (*enrichments_)[i].elements;
     auto it = std::lower_bound(list.begin(), list.end(), element,
                                [](const ElementTexture& et, int e) { return et.element < e; });
     return it != list.end() && it->element == element ? &it->tile : nullptr;
   };
-  for (int i = 0; i < static_cast<int>(enrichments_.size()); ++i) {
-    for (int a : enrichments_[i].enriched_nodes) {
+  for (int i = 0; i < static_cast<int>(enrichments_->size()); ++i) {
+    for (int a : (*enrichments_)[i].enriched_nodes) {
       double sum = 0;
       for (const auto& [e, local] : incident[a]) {
         const kernels::TexelTile* tile = texture_of(i, e);
@@ -324,8 +324,8 @@ void ShellModel::install_enrichments(std::vector<EnrichmentFunction> functions, 
     double shifts[kernels::max_element_nodes];
   };
   std::vector<std::vector<ElementEnrichment>> per_element(ne);
-  for (int i = 0; i < static_cast<int>(enrichments_.size()); ++i)
-    for (const ElementTexture& et : enrichments_[i].elements) {
+  for (int i = 0; i < static_cast<int>(enrichments_->size()); ++i)
+    for (const ElementTexture& et : (*enrichments_)[i].elements) {
       ElementEnrichment ee{&et.tile, {}, {}};
       bool any = false;
       for (int a = 0; a < npe; ++a) {
@@ -640,8 +640,8 @@ void ShellModel::drop_cut_edge_points() {
 }
 
 int ShellModel::virtual_node(int function, int node) const {
-  if (function < 0 || function >= static_cast<int>(enrichments_.size())) return -1;
-  const auto& nodes = enrichments_[function].enriched_nodes;
+  if (function < 0 || function >= static_cast<int>(enrichments_->size())) return -1;
+  const auto& nodes = (*enrichments_)[function].enriched_nodes;
   const auto it = std::lower_bound(nodes.begin(), nodes.end(), node);
   if (it == nodes.end() || *it != node) return -1;
   return mesh_.num_nodes() + function_slot_start_[function] + static_cast<int>(it - nodes.begin());
@@ -981,7 +981,7 @@ void ShellModel::set_enrichments(std::vector<EnrichmentFunction> functions) {
     return node_mass[a][position[row] * functions_at[a].size() + position[column]];
   };
   // The nodes kept per function first; the textures are moved (not copied) only if any go.
-  std::vector<std::vector<int>> kept_nodes(enrichments_.size());
+  std::vector<std::vector<int>> kept_nodes(enrichments_->size());
   int pruned = 0;
   std::vector<std::vector<int>> kept_at(num_nodes());  // per mesh node: its kept virtual nodes so far
   for (int v = nn; v < nn + num_enriched_nodes(); ++v) {  // virtual nodes go function by function
@@ -1008,7 +1008,9 @@ void ShellModel::set_enrichments(std::vector<EnrichmentFunction> functions) {
     return;
   }
   // install_enrichments below replaces every member derived from enrichments_.
-  std::vector<EnrichmentFunction> kept = std::move(enrichments_);
+  std::vector<EnrichmentFunction> kept;
+  if (enrichments_.use_count() == 1) kept = std::move(*enrichments_);  // just installed: no other model shares them
+  else kept = *enrichments_;
   for (size_t i = 0; i < kept.size(); ++i) kept[i].enriched_nodes = std::move(kept_nodes[i]);
   // Functions left without nodes go; the others keep the elements of Omega_i that still
   // touch one of their nodes.

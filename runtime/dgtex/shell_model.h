@@ -140,7 +140,7 @@ class ShellModel {
   bool has_kept_basis_values(int element) const {
     return element >= 0 && element < static_cast<int>(kept_.start.size()) && kept_.start[element] >= 0;
   }
-  const std::vector<EnrichmentFunction>& enrichments() const { return enrichments_; }
+  const std::vector<EnrichmentFunction>& enrichments() const { return *enrichments_; }
   int num_enriched_nodes() const { return static_cast<int>(virtual_node_function_.size()); }  // virtual nodes
   int num_enriched_dofs() const { return 3 * num_enriched_nodes(); }
   // Virtual node of (function i, mesh node a), or -1 if a is not in N_i.
@@ -227,8 +227,10 @@ class ShellModel {
   std::vector<double> plain_edge_size_;
   std::vector<double> area_weights_, mass_weights_;    // #plain elements x npe
 
-  // Enrichment state (see set_enrichments); textures_ point into enrichments_.
-  std::vector<EnrichmentFunction> enrichments_;
+  // Enrichment state (see set_enrichments); textures_ point into enrichments_. Copies of the
+  // model share the functions (a basis change copies the model and then replaces them: the
+  // textures, megabytes, are not copied for nothing); nothing changes them once installed.
+  std::shared_ptr<std::vector<EnrichmentFunction>> enrichments_ = std::make_shared<std::vector<EnrichmentFunction>>();
   int resolution_ = 0;
   std::vector<int> function_slot_start_;    // per function: its first slot (#functions + 1)
   std::vector<int> virtual_node_function_;  // per virtual node: function i
