@@ -16,8 +16,8 @@
 namespace dgtex::kernels {
 namespace {
 
-// Packed blocks per work item of the rotated sum: its 9 partial sums (144 KB) stay in L2
-// while every cluster streams its stretch of the 9 planes.
+// Packed blocks per work item of the rotated sum, at most: its 9 partial sums (144 KB) stay
+// in L2 while every cluster streams its stretch of the 9 planes.
 constexpr std::int64_t cluster_tile_blocks = 2048;
 // Functions per work item of the corrective forces.
 constexpr int cluster_force_tile = 32;
@@ -536,7 +536,13 @@ void enriched_element_clustered_stiffness(const EnrichedElementBatch& batch, con
   const std::vector<double>& frames = layout.frames;
   const std::vector<std::int64_t>& rest_start = layout.start;
   const std::int64_t widest = static_cast<std::int64_t>(W) * (W + 1) / 2;
-  const std::int64_t tiles = (widest + cluster_tile_blocks - 1) / cluster_tile_blocks;
+  // Tiles small enough for two per thread where the elements are fewer than that (spiral6's
+  // one element, 1.6k blocks, ran on one thread of two). Every block sums the clusters in
+  // order whatever its tile, so the tiling does not change the bits.
+  const std::int64_t wanted_items = execution == Execution::parallel ? 2 * parallel_team_size() : 1;
+  const std::int64_t tile_blocks =
+      std::clamp<std::int64_t>((widest * batch.count + wanted_items - 1) / wanted_items, 64, cluster_tile_blocks);
+  const std::int64_t tiles = (widest + tile_blocks - 1) / tile_blocks;
   // Blocks: one work item per tile of an element's packed upper blocks; every cluster adds
   // its rotated stretch of the tile, in cluster order, to a sum that stays in cache, which
   // is then written as blocks (a, c) and their mirrors (c, a). The blocks of the slots
@@ -548,7 +554,7 @@ void enriched_element_clustered_stiffness(const EnrichedElementBatch& batch, con
         const int n = enriched_basis_count(batch, e);
         const std::int64_t packed = static_cast<std::int64_t>(n) * (n + 1) / 2;
         const std::int64_t plane = enriched_cluster_packed_blocks(n);
-        const std::int64_t p0 = item % tiles * cluster_tile_blocks;
+        const std::int64_t p0 = item % tiles * tile_blocks;
         if (p0 == 0)
           for (int a = 0; a < W; ++a)
             for (int c = a < n ? n : 0; c < W; ++c) {
@@ -556,7 +562,7 @@ void enriched_element_clustered_stiffness(const EnrichedElementBatch& batch, con
               std::fill_n(blocks + ((e * W + c) * W + a) * 9, 9, 0.0);
             }
         if (p0 >= packed) return;
-        const int length = static_cast<int>(std::min(packed - p0, cluster_tile_blocks));
+        const int length = static_cast<int>(std::min(packed - p0, tile_blocks));
         static thread_local std::vector<double> acc;
         acc.assign(static_cast<std::size_t>(9) * length, 0.0);
         for (std::int64_t c = clusters.element_start[e]; c < clusters.element_start[e + 1]; ++c) {
