@@ -541,7 +541,7 @@ void enriched_element_clustered_stiffness(const EnrichedElementBatch& batch, con
   // order whatever its tile, so the tiling does not change the bits.
   const std::int64_t wanted_items = execution == Execution::parallel ? 2 * parallel_team_size() : 1;
   const std::int64_t tile_blocks =
-      std::clamp<std::int64_t>((widest * batch.count + wanted_items - 1) / wanted_items, 64, cluster_tile_blocks);
+      std::clamp<std::int64_t>((widest * batch.count + wanted_items - 1) / wanted_items, 16, cluster_tile_blocks);
   const std::int64_t tiles = (widest + tile_blocks - 1) / tile_blocks;
   // Blocks: one work item per tile of an element's packed upper blocks; every cluster adds
   // its rotated stretch of the tile, in cluster order, to a sum that stays in cache, which
