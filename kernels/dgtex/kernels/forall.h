@@ -27,9 +27,9 @@ enum class Execution { serial, parallel };
 constexpr std::int64_t rejoin_slices = 16;
 template <class Loop>
 void run_rejoining(std::int64_t n, Loop&& loop) {
+  const std::int64_t slice = (n + rejoin_slices - 1) / rejoin_slices;
   for (std::int64_t begin = 0; begin < n;) {
     const int team = parallel_team_size();
-    const std::int64_t slice = (n + rejoin_slices - 1) / rejoin_slices;
     const std::int64_t end = team < omp_get_max_threads() && n - begin > slice ? begin + slice : n;
     loop(begin, end, team);
     begin = end;
