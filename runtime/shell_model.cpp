@@ -1260,8 +1260,12 @@ std::vector<std::vector<double>> ShellModel::moments_of_fields(const ShellModel&
           for (int a = a_begin; a < a_end; ++a)
             for (int c = 0; c < 3; ++c) out[f][3 * global[a] + c] = sums[f * run + 3 * (a - a_begin) + c];
       };
-      kernels::forall_then((count + block - 1) / block, evaluate, slices, accumulate,
-                           parallel ? kernels::Execution::parallel : kernels::Execution::serial);
+      // The blocks' costs differ (points the source kept are read, the others evaluated, and
+      // those lie together near the cut): handed out dynamically (spiral6: a core idle beside
+      // the static split of this loop).
+      const kernels::Execution execution = parallel ? kernels::Execution::parallel : kernels::Execution::serial;
+      kernels::forall_dynamic((count + block - 1) / block, evaluate, execution);
+      kernels::forall(slices, accumulate, execution);
     }
   }
   if (points_read_from_source) *points_read_from_source = read_from_source;
