@@ -421,10 +421,12 @@ void ShellModel::integrate_enriched_elements(const kernels::EnrichedElementBatch
     const int first = enrichment_start_[x], k_count = enrichment_start_[x + 1] - first;
     if (!old || static_cast<int>(old->quadrature->values.size()) != k_count) continue;
     bool same = true;
-    for (int k = 0; k < k_count && same; ++k)  // bitwise, in one memcmp each
+    for (int k = 0; k < k_count && same; ++k) {  // bitwise, in one memcmp each
+      const kernels::TextureView& now = textures_[first + k];
       same = old->quadrature->values[k].size() == texels &&
-             std::memcmp(old->quadrature->values[k].data(), textures_[first + k].values, texels * sizeof(double)) == 0 &&
-             std::memcmp(old->quadrature->flags[k].data(), textures_[first + k].flags, texels) == 0;
+             std::memcmp(old->quadrature->values[k].data(), now.values, texels * sizeof(double)) == 0 &&
+             std::memcmp(old->quadrature->flags[k].data(), now.flags, texels) == 0;
+    }
     if (!same) continue;
     same_textures[x] = 1;
     // Local function of the new basis -> the old one's: the reuse needs every new function

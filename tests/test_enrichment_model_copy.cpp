@@ -36,7 +36,8 @@ TEST(EnrichedModelCopy, SharesTheTexturesAndOutlivesTheOriginal) {
 
   // New functions on a copy of the copy: the copy keeps its own.
   ShellModel next(*copy);
-  next.set_enrichments({straight_cut_enrichment(mesh, 32, [](const double* x) { return x[0] + 0.3 * x[1] - 0.6; }, false)});
+  const auto slanted = [](const double* x) { return x[0] + 0.3 * x[1] - 0.6; };
+  next.set_enrichments({straight_cut_enrichment(mesh, 32, slanted, /*aligned=*/false)});
   EXPECT_NE(next.enrichments()[0].elements[0].tile.values, original_values);
   EXPECT_EQ(copy->enrichments()[0].elements[0].tile.values, original_values);
   copy->assemble_stiffness(current.data(), blocks, nullptr);

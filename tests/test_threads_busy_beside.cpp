@@ -1,7 +1,8 @@
 // Parallel loops of a thread with work running beside it (dgtex/kernels/threads_busy_beside.h):
 // forall, forall_dynamic, forall_then and run_side_by_side leave out the threads that work
 // holds, take them back once the count drops (forall, forall_dynamic and forall_then within
-// the loop, at their next slice), and a scope restores the thread's previous setting. SceneRun's overlapped cut updates, which set the count, keep the plain bits
+// the loop, at their next slice), and a scope restores the thread's previous setting.
+// SceneRun's overlapped cut updates, which set the count, keep the plain bits
 // (test_scene_run_overlap).
 #include <gtest/gtest.h>
 
