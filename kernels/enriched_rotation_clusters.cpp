@@ -466,26 +466,23 @@ void enriched_cluster_rest_stiffness(const EnrichedElementBatch& batch, const En
                                      Execution execution) {
   const RestLayout layout(batch, clusters);
   const std::vector<char>& planar = layout.planar;
-  std::vector<std::int64_t> todo, todo_element;  // clusters to sum, and their elements
-  for (std::int64_t e = 0; e < batch.count; ++e) {
-    if (compute && !compute[e]) continue;
-    for (std::int64_t c = clusters.element_start[e]; c < clusters.element_start[e + 1]; ++c)
-      todo.push_back(c), todo_element.push_back(e);
-  }
   // Clusters differ much in cost (tip blocks hold few points): handed out dynamically, the
   // costliest (points x functions^2) first, so that no large one is left for the end while
   // the other threads wait (the slinky's sums ended with a core idle). Each writes only its
   // own rest data, so the result does not depend on the threads or the order.
-  std::vector<std::int64_t> order(todo.size()), cost(todo.size());
-  for (std::size_t i = 0; i < todo.size(); ++i) {
-    const std::int64_t n = enriched_basis_count(batch, todo_element[i]);
-    cost[i] = (clusters.point_start[todo[i] + 1] - clusters.point_start[todo[i]]) * n * n;
-    order[i] = static_cast<std::int64_t>(i);
+  struct Todo {
+    std::int64_t cluster, element, cost;
+  };
+  std::vector<Todo> todo;
+  for (std::int64_t e = 0; e < batch.count; ++e) {
+    if (compute && !compute[e]) continue;
+    const std::int64_t n = enriched_basis_count(batch, e);
+    for (std::int64_t c = clusters.element_start[e]; c < clusters.element_start[e + 1]; ++c)
+      todo.push_back({c, e, (clusters.point_start[c + 1] - clusters.point_start[c]) * n * n});
   }
-  std::stable_sort(order.begin(), order.end(), [&](std::int64_t a, std::int64_t b) { return cost[a] > cost[b]; });
-  auto cluster = [&](std::int64_t k) {
-    const std::int64_t i = order[k];
-    const std::int64_t c = todo[i], e = todo_element[i];
+  std::stable_sort(todo.begin(), todo.end(), [](const Todo& a, const Todo& b) { return a.cost > b.cost; });
+  auto cluster = [&](std::int64_t i) {
+    const std::int64_t c = todo[i].cluster, e = todo[i].element;
     const int n = enriched_basis_count(batch, e);
     const int planes = rest_planes(planar[e]);
     const std::int64_t plane = enriched_cluster_packed_blocks(n);

@@ -1009,10 +1009,9 @@ void ShellModel::set_enrichments(std::vector<EnrichmentFunction> functions) {
     rebuild(&element_mass);
     return;
   }
-  // install_enrichments below replaces every member derived from enrichments_.
-  std::vector<EnrichmentFunction> kept;
-  if (enrichments_.use_count() == 1) kept = std::move(*enrichments_);  // just installed: no other model shares them
-  else kept = *enrichments_;
+  // install_enrichments below replaces every member derived from enrichments_. The
+  // functions were installed by this call, so no copy of the model shares them yet.
+  std::vector<EnrichmentFunction> kept = std::move(*enrichments_);
   for (size_t i = 0; i < kept.size(); ++i) kept[i].enriched_nodes = std::move(kept_nodes[i]);
   // Functions left without nodes go; the others keep the elements of Omega_i that still
   // touch one of their nodes.
