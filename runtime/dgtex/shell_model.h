@@ -303,10 +303,6 @@ class ShellModel {
   };
   mutable AssemblyWorkspace workspace_;
 
-  // What one enriched element's quadrature, mass and load weights were computed from and
-  // what they came to; a later rebuild reuses them where the inputs are bitwise equal (a
-  // cut advancing changes the textures of the few elements near its tip only). Shared and
-  // immutable, so copies of the model share them.
   // An element's textures and the quadrature they decide, shared by every ElementIntegrals
   // built on bitwise these textures (a rebuild that only moved shifts or dropped functions),
   // so that "the same textures" is one pointer comparison.
@@ -315,6 +311,10 @@ class ShellModel {
     std::vector<std::vector<std::uint8_t>> flags;  // per enrichment: texture flags
     std::vector<double> points;                    // quadrature: (xi1, xi2, weight) per point
   };
+  // What one enriched element's quadrature, mass and load weights were computed from and
+  // what they came to; a later rebuild reuses them where the inputs are bitwise equal (a
+  // cut advancing changes the textures of the few elements near its tip only). Shared and
+  // immutable, so copies of the model share them.
   struct ElementIntegrals {
     std::shared_ptr<const TexturedQuadrature> quadrature;
     std::vector<double> shifts;                      // per enrichment x npe; NaN: node not enriched
@@ -333,8 +333,9 @@ class ShellModel {
   // summing it again where the element's textures are bitwise the same (the same
   // TexturedQuadrature), so its points and clusters are: as it is where its functions and
   // shifts are the same too (the same integrals), else reshifted
-  // (kernels::enriched_cluster_rest_reshift) where the new functions are among the old ones. A cut's tip changing a neighbour's textures moves the
-  // shifts of the shared nodes (the slinky: ~0.9 of its 4 elements a basis change).
+  // (kernels::enriched_cluster_rest_reshift) where the new functions are among the old
+  // ones. A cut's tip changing a neighbour's textures moves the shifts of the shared nodes
+  // (the slinky: ~0.9 of its 4 elements a basis change).
   struct ClusterRestStretch {
     std::shared_ptr<const ElementIntegrals> integrals;
     std::shared_ptr<const double> rest;
