@@ -53,7 +53,10 @@ ReducedRun run_reduced() {
       " --quadrature-tolerances 1,1e-2 --texture-sizes 16,32,64 --shell-scene " DGTEX_SOURCE_DIR
       "/examples/scenes/cylinder_buckling.json --shell-steps 3 --shell-tolerances 1e-2,1e-8 --multigrid-size 64"
       " --multigrid-tolerances 1e-1,1e-8 --rotation-scene " DGTEX_SOURCE_DIR
-      "/examples/scenes/accordion.json --rotation-steps 3 --rotation-blocks 64,32 --out " +
+      "/examples/scenes/accordion.json --rotation-steps 3 --rotation-blocks 64,32"
+      " --scene-quadrature-scene " DGTEX_SOURCE_DIR
+      "/examples/scenes/spiral1.json --scene-quadrature-steps 5 --scene-quadrature-tolerances 1,1e-2"
+      " --scene-quadrature-reference 1e-3 --out " +
       run.dir.string() + " > " + (run.dir.string() + ".log") + " 2>&1";
   run.status = std::system(command.c_str());
   std::ifstream in(run.dir / "accuracy.json");
@@ -63,7 +66,7 @@ ReducedRun run_reduced() {
 
 void check_WritesChartsJsonAndTable(const ReducedRun& run) {
   SCOPED_TRACE("WritesChartsJsonAndTable");
-  for (const char* name : {"plate", "quadrature", "texture", "tolerance", "rotation"}) {
+  for (const char* name : {"plate", "quadrature", "texture", "tolerance", "rotation", "scene_quadrature"}) {
     EXPECT_TRUE(fs::exists(run.dir / (std::string("accuracy_") + name + ".png"))) << name;
     const auto& c = run.chart(name);
     for (const char* key : {"title", "time_label", "error_label", "points"}) EXPECT_TRUE(c.contains(key)) << name << key;
@@ -168,6 +171,31 @@ void check_RotationClustersWithinBounds(const ReducedRun& run) {
   EXPECT_GT(points[2].at("clusters").get<double>(), points[1].at("clusters").get<double>());
 }
 
+// A scene's merge tolerance: the reference tolerance has error 0 and the most points; over
+// spiral1's first 5 steps tolerance 1 stays within 1 % of it and 1e-2 within 1e-3
+// (measured: 1.6e-3 and 2.3e-5), fewer points giving the larger error. The time-step point
+// is the scene's own tolerance (1e-2, that run reused) against half the time step.
+void check_SceneQuadratureWithinBounds(const ReducedRun& run) {
+  SCOPED_TRACE("SceneQuadratureWithinBounds");
+  const auto series = by_series(run.chart("scene_quadrature"));
+  ASSERT_EQ(series.size(), 2u);
+  const auto& sweep = series.at("spiral1.json, against tol=0.001");
+  ASSERT_EQ(sweep.size(), 3u);
+  EXPECT_EQ(sweep[0].at("label"), "tol=0.001");
+  EXPECT_EQ(sweep[0].at("error").get<double>(), 0.0);
+  EXPECT_LT(sweep[1].at("quadrature_points").get<double>(), sweep[2].at("quadrature_points").get<double>());
+  EXPECT_LT(sweep[2].at("quadrature_points").get<double>(), sweep[0].at("quadrature_points").get<double>());
+  EXPECT_LT(sweep[1].at("error").get<double>(), 0.01);
+  EXPECT_GT(sweep[2].at("error").get<double>(), 0.0);
+  EXPECT_LT(sweep[2].at("error").get<double>(), 1e-3);
+  EXPECT_LT(sweep[2].at("error").get<double>(), sweep[1].at("error").get<double>());
+  const auto& time_step = series.at("spiral1.json, time step against half of it");
+  ASSERT_EQ(time_step.size(), 1u);
+  EXPECT_EQ(time_step[0].at("label"), "tol=0.01 (the scene's)");
+  EXPECT_GT(time_step[0].at("error").get<double>(), 0.0);
+  EXPECT_EQ(time_step[0].at("ms").get<double>(), sweep[2].at("ms").get<double>());
+}
+
 TEST(BenchAccuracy, ReducedRunMeetsInvariants) {
   const ReducedRun run = run_reduced();
   ASSERT_EQ(run.status, 0) << "see " << run.dir.string() << ".log";
@@ -177,6 +205,7 @@ TEST(BenchAccuracy, ReducedRunMeetsInvariants) {
   check_TipErrorFallsWithTextureResolution(run);
   check_ToleranceErrorsWithinBounds(run);
   check_RotationClustersWithinBounds(run);
+  check_SceneQuadratureWithinBounds(run);
   fs::remove_all(run.dir);
   fs::remove(run.dir.string() + ".log");
 }
@@ -197,6 +226,14 @@ TEST(BenchAccuracyArguments, BadValuesAreRejectedWithExitCode2) {
   // chart then failed as if gnuplot were missing (exit code 1).
   EXPECT_EQ(WEXITSTATUS(std::system((cli + " bench accuracy --charts rotation --rotation-scene " + DGTEX_SOURCE_DIR +
                                      "/examples/scenes/cylinder_buckling.json --out " + out + " 2>/dev/null").c_str())),
+            2);
+  // So does the merge tolerance of a scene's enriched quadrature; and tolerances must be > 0.
+  EXPECT_EQ(WEXITSTATUS(std::system((cli + " bench accuracy --charts scene_quadrature --scene-quadrature-scene " +
+                                     DGTEX_SOURCE_DIR + "/examples/scenes/cylinder_buckling.json --out " + out +
+                                     " 2>/dev/null").c_str())),
+            2);
+  EXPECT_EQ(WEXITSTATUS(std::system((cli + " bench accuracy --charts scene_quadrature --scene-quadrature-tolerances 0"
+                                     " --out " + out + " 2>/dev/null").c_str())),
             2);
   fs::remove_all(out);
 }

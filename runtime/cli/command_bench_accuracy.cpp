@@ -70,11 +70,12 @@ std::string write_chart(const std::string& path, const AccuracyChart& chart, con
 }
 
 std::vector<std::string> split_names(const std::vector<std::string>& names) {
-  static const std::vector<std::string> valid = {"plate", "quadrature", "texture", "tolerance", "rotation"};
+  static const std::vector<std::string> valid = {"plate",     "quadrature", "texture",
+                                                 "tolerance", "rotation",   "scene_quadrature"};
   for (const std::string& n : names)
     if (std::find(valid.begin(), valid.end(), n) == valid.end())
       throw std::invalid_argument("--charts: unknown chart '" + n +
-                                  "'; valid: plate, quadrature, texture, tolerance, rotation");
+                                  "'; valid: plate, quadrature, texture, tolerance, rotation, scene_quadrature");
   return names;
 }
 
@@ -82,9 +83,9 @@ std::vector<std::string> split_names(const std::vector<std::string>& names) {
 
 int bench_accuracy_command(int argc, char** argv) {
   CLI::App app{"Speed against accuracy: error against time for mesh refinement, enriched quadrature, texture "
-               "resolution, solver tolerance and rotation clusters",
+               "resolution, solver tolerance, rotation clusters and a scene's quadrature tolerance",
                "dgtex bench accuracy"};
-  std::vector<std::string> charts = {"plate", "quadrature", "texture", "tolerance", "rotation"};
+  std::vector<std::string> charts = {"plate", "quadrature", "texture", "tolerance", "rotation", "scene_quadrature"};
   std::string out_dir = "accuracy", format = "png", clock = "cpu";
   int threads = 1, repeat = 3;
   PlateAccuracyOptions plate;
@@ -92,9 +93,13 @@ int bench_accuracy_command(int argc, char** argv) {
   TextureAccuracyOptions texture;
   ToleranceAccuracyOptions tolerance;
   RotationAccuracyOptions rotation;
+  SceneQuadratureAccuracyOptions scene_quadrature;
   tolerance.shell_scene = example_scene("cylinder_buckling.json");
   rotation.scene = example_scene("accordion.json");
-  app.add_option("--charts", charts, "plate, quadrature, texture, tolerance, rotation")->delimiter(',')->capture_default_str();
+  scene_quadrature.scene = example_scene("slinky.json");
+  app.add_option("--charts", charts, "plate, quadrature, texture, tolerance, rotation, scene_quadrature")
+      ->delimiter(',')
+      ->capture_default_str();
   app.add_option("--out", out_dir, "output folder (charts, accuracy.json, accuracy.md)")->capture_default_str();
   app.add_option("--format", format, "chart format: png or svg")->capture_default_str()->check(CLI::IsMember({"png", "svg"}));
   app.add_option("--clock", clock, "cpu (process CPU time; robust on a shared machine with 1 thread) or wall")
@@ -124,6 +129,16 @@ int bench_accuracy_command(int argc, char** argv) {
   app.add_option("--rotation-steps", rotation.steps, "steps per rotation run")->capture_default_str();
   app.add_option("--rotation-blocks", rotation.block_texels, "rotation cluster blocks B (texels; per point is the reference)")
       ->delimiter(',')->capture_default_str();
+  app.add_option("--scene-quadrature-scene", scene_quadrature.scene,
+                 "dynamic scene with cuts of the scene quadrature sweep")->capture_default_str();
+  app.add_option("--scene-quadrature-steps", scene_quadrature.steps,
+                 "steps per run of that sweep (0: the scene's own analysis.steps)")->capture_default_str();
+  app.add_option("--scene-quadrature-tolerances", scene_quadrature.tolerances, "merge tolerances of that sweep")
+      ->delimiter(',')->capture_default_str();
+  app.add_option("--scene-quadrature-reference", scene_quadrature.reference_tolerance,
+                 "the tight merge tolerance the sweep's errors are measured against")->capture_default_str();
+  app.add_flag("!--no-time-step-error", scene_quadrature.time_step_error,
+               "scene quadrature chart without the run at half the time step");
   app.add_flag("!--no-shell", tolerance.shell, "tolerance chart without the shell PCG series");
   app.add_flag("!--no-multigrid", tolerance.multigrid, "tolerance chart without the multigrid series");
   try {
@@ -136,7 +151,7 @@ int bench_accuracy_command(int argc, char** argv) {
     split_names(charts);
     plate.repeat = quadrature.repeat = texture.repeat = tolerance.repeat = repeat;
     const AccuracyClock which = clock == "cpu" ? AccuracyClock::cpu : AccuracyClock::wall;
-    plate.clock = quadrature.clock = texture.clock = tolerance.clock = rotation.clock = which;
+    plate.clock = quadrature.clock = texture.clock = tolerance.clock = rotation.clock = scene_quadrature.clock = which;
     omp_set_num_threads(threads);
     create_output_folder(out_dir, "--out");
     const std::string machine = describe_machine_and_probe();
@@ -154,6 +169,7 @@ int bench_accuracy_command(int argc, char** argv) {
       if (name == "texture") results.push_back(run_texture_accuracy(texture, progress));
       if (name == "tolerance") results.push_back(run_tolerance_accuracy(tolerance, progress));
       if (name == "rotation") results.push_back(run_rotation_accuracy(rotation, progress));
+      if (name == "scene_quadrature") results.push_back(run_scene_quadrature_accuracy(scene_quadrature, progress));
     }
     const std::filesystem::path dir(out_dir);
     write_output_file((dir / "accuracy.json").string(), accuracy_charts_json(results, machine, command), "--out");

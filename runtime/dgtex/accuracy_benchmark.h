@@ -1,5 +1,5 @@
 #pragma once
-// Speed against accuracy (dgtex bench accuracy): five sweeps, each a list of (time, error)
+// Speed against accuracy (dgtex bench accuracy): six sweeps, each a list of (time, error)
 // points in one or more series, for charts of error against milliseconds.
 //  - plate:      simply supported square plate under uniform load, quad8 and tri6, n x n
 //                meshes; relative error of the centre deflection against the Navier series;
@@ -17,6 +17,9 @@
 //  - rotation:   rotation clusters of enriched elements (blocks of B texels) in a dynamic
 //                corotated scene, final displacement against per-point rotations; time of
 //                the whole run (accuracy_rotation.cpp).
+//  - scene_quadrature: the merge tolerance of the enriched quadrature in a dynamic scene with
+//                cuts, whole runs; the mesh nodes' final displacement against a tight
+//                tolerance, beside the scene's time-step error (accuracy_scene_quadrature.cpp).
 // Times are milliseconds of the chosen clock (AccuracyClock), best of `repeat` runs where a
 // case is cheap enough to repeat. All sweeps run with the current OpenMP thread count.
 // Plain functions that return their results (nothing kept); each sweep uses all OpenMP
@@ -128,6 +131,25 @@ struct RotationAccuracyOptions {
 // "assembly_wall_ms". std::invalid_argument for steps < 1, a block < 1 or a scene that is
 // not dynamic and corotated; what load_scene and SceneRun throw for a bad scene.
 AccuracyChart run_rotation_accuracy(const RotationAccuracyOptions& options, const AccuracyProgress& progress = {});
+
+struct SceneQuadratureAccuracyOptions {
+  std::string scene = "examples/scenes/slinky.json";  // dynamic, with cuts
+  int steps = 0;  // 0: the scene's own analysis.steps
+  std::vector<double> tolerances = {0.3, 0.1, 0.05, 0.03, 0.01, 1e-3};  // enrichment.quadrature_tolerance
+  double reference_tolerance = 1e-4;
+  bool time_step_error = true;  // also run the scene at half its time step
+  AccuracyClock clock = AccuracyClock::cpu;
+};
+// Series "<scene>, against tol=<reference>": error = |u - u_ref| / |u_ref| of the mesh nodes'
+// displacement after the run (standard DOFs: the enriched ones belong to different bases in
+// general) against the reference tolerance (error 0), ms = the whole run. Series "<scene>,
+// time step against half of it": one point, the scene at its own tolerance against the same
+// scene at half the time step (twice the steps): the error a tolerance need not beat. Extra
+// "quadrature_points" (enriched elements' and edges', at the end) and "assembly_wall_ms".
+// std::invalid_argument for steps < 0, a tolerance <= 0, or a scene that is not dynamic or has
+// no cuts; what load_scene and SceneRun throw for a bad scene.
+AccuracyChart run_scene_quadrature_accuracy(const SceneQuadratureAccuracyOptions& options,
+                                            const AccuracyProgress& progress = {});
 
 // {"charts": [{"name", "title", "time_label", "error_label", "points": [{"series", "label",
 // "ms", "error", extra...}]}], "machine", "command"} as JSON text.
