@@ -238,6 +238,22 @@ TEST(BenchAccuracyArguments, BadValuesAreRejectedWithExitCode2) {
   fs::remove_all(out);
 }
 
+// A sweep whose every run equals its reference (error 0, which a log scale cannot place)
+// still gets its chart: before, gnuplot found no point to scale by and the command failed
+// as if gnuplot were missing (exit code 1).
+TEST(BenchAccuracyCharts, EveryErrorZeroStillDrawsTheChart) {
+  const fs::path out = fs::temp_directory_path() / ("dgtex_bench_accuracy_zero_" + std::to_string(getpid()));
+  const std::string command = std::string(DGTEX_CLI) +
+                              " bench accuracy --charts scene_quadrature --threads 1 --scene-quadrature-scene " +
+                              DGTEX_SOURCE_DIR + "/examples/scenes/spiral1.json --scene-quadrature-steps 2"
+                              " --scene-quadrature-tolerances 1e-2 --scene-quadrature-reference 1e-2"
+                              " --no-time-step-error --out " + out.string() + " > /dev/null 2>&1";
+  EXPECT_EQ(WEXITSTATUS(std::system(command.c_str())), 0);
+  ASSERT_TRUE(fs::exists(out / "accuracy_scene_quadrature.png"));
+  EXPECT_GT(fs::file_size(out / "accuracy_scene_quadrature.png"), 0u);
+  fs::remove_all(out);
+}
+
 // The Navier series gives Timoshenko's 0.00406 q a^4 / D for the square plate (nu-free).
 TEST(BenchAccuracyNavier, SquarePlateCoefficient) {
   const double D = 2.0, q = -3.0, a = 1.5;

@@ -53,18 +53,30 @@ std::string write_chart(const std::string& path, const AccuracyChart& chart, con
             << " at " << std::max(p.ms, 1e-3) << ", graph 0.03 rotate by 90 left offset -0.7, 0 noenhanced font ',8' tc lt "
             << k + 1 << "\n";
         }
+    const auto drawn = [&](const std::string& name) {
+      return std::any_of(chart.points.begin(), chart.points.end(),
+                         [&](const AccuracyPoint& p) { return p.series == name && p.error > 0; });
+    };
+    if (std::none_of(series.begin(), series.end(), drawn)) {
+      // Every run equals its reference, and error 0 has no place on a log scale: with fixed
+      // ranges gnuplot draws the axes and the references instead of failing to scale them.
+      double low = 1e300, high = 0;
+      for (const AccuracyPoint& p : chart.points) low = std::min(low, std::max(p.ms, 1e-3)), high = std::max(high, p.ms);
+      if (!(high > low)) low = 1e-3, high = std::max(1.0, 2 * high);
+      g << "set xrange [" << low / 2 << ":" << high * 2 << "]\nset yrange [1e-16:1]\n"
+        << "set label " << arrow + 1 << " 'every error is 0: the runs equal their references' at graph 0.5, graph 0.5"
+        << " center\nplot 1/0 notitle";
+      return g.str();
+    }
     g << "plot ";
     bool first = true;
     for (std::size_t k = 0; k < series.size(); ++k) {
-      const bool has_points = std::any_of(chart.points.begin(), chart.points.end(),
-                                          [&](const AccuracyPoint& p) { return p.series == series[k] && p.error > 0; });
-      if (!has_points) continue;
+      if (!drawn(series[k])) continue;
       g << (first ? "" : ", ") << "'" << data_file << "' index " << k << " using 1:2 with linespoints lt " << k + 1
         << " pt 7 title " << gnuplot_quoted(series[k]) << ", '' index " << k
         << " using 1:2:3 with labels offset 0.6, 0.6 left font ',8' noenhanced notitle";
       first = false;
     }
-    if (first) g << "1/0 notitle";
     return g.str();
   });
 }
