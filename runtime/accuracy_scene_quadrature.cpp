@@ -1,6 +1,7 @@
 // Scene quadrature sweep of dgtex bench accuracy: what the merge tolerance of the enriched
 // quadrature (enrichment.quadrature_tolerance) costs in accuracy over a whole dynamic scene
 // with cuts, and what it saves in time, set beside the scene's own time-step error.
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <optional>
@@ -15,20 +16,24 @@ namespace dgtex {
 namespace {
 
 struct QuadratureRun {
-  std::vector<double> node_displacement;  // the mesh nodes' (standard) DOFs at the end
+  // The mesh nodes' (standard) DOFs after every `record_every`-th step; the last at the end.
+  std::vector<std::vector<double>> node_path;
   double ms = 0, assembly_wall_ms = 0;
   std::int64_t quadrature_points = 0;  // enriched elements' and edges', at the end
 };
 
 // The scene's first `steps` steps, timed whole (set-up and cut updates included).
-QuadratureRun run_scene(const Scene& scene, int steps, AccuracyClock clock) {
+QuadratureRun run_scene(const Scene& scene, int steps, int record_every, AccuracyClock clock) {
   QuadratureRun out;
   const double start = accuracy_clock_ms(clock);
   SceneRun run(scene);
-  for (int k = 0; k < steps; ++k) run.step();
+  const std::size_t node_dofs = 3 * static_cast<std::size_t>(run.mesh().num_nodes());
+  for (int k = 1; k <= steps; ++k) {
+    run.step();
+    if (k % record_every == 0)
+      out.node_path.emplace_back(run.displacement().begin(), run.displacement().begin() + node_dofs);
+  }
   out.ms = accuracy_clock_ms(clock) - start;
-  const std::vector<double>& u = run.displacement();
-  out.node_displacement.assign(u.begin(), u.begin() + 3 * run.mesh().num_nodes());
   const StageTimings timings = run.timings();
   if (const auto it = timings.find("assembly"); it != timings.end()) out.assembly_wall_ms = it->second.total_ms;
   out.quadrature_points =
@@ -38,18 +43,34 @@ QuadratureRun run_scene(const Scene& scene, int steps, AccuracyClock clock) {
 
 QuadratureRun run_at_tolerance(Scene scene, double tolerance, int steps, AccuracyClock clock) {
   scene.enrichment.quadrature_tolerance = tolerance;
-  return run_scene(scene, steps, clock);
+  return run_scene(scene, steps, 1, clock);
 }
 
-// |u - u_ref| / |u_ref| over the mesh nodes.
-double relative_difference(const QuadratureRun& run, const QuadratureRun& reference) {
-  double diff = 0, norm = 0;
-  for (std::size_t k = 0; k < reference.node_displacement.size(); ++k) {
-    const double d = run.node_displacement[k] - reference.node_displacement[k];
-    diff += d * d;
-    norm += reference.node_displacement[k] * reference.node_displacement[k];
+double squared_distance(const std::vector<double>& a, const std::vector<double>& b) {
+  double sum = 0;
+  for (std::size_t k = 0; k < b.size(); ++k) sum += (a[k] - b[k]) * (a[k] - b[k]);
+  return sum;
+}
+
+// |u - u_ref| / |u_ref| over the mesh nodes after the last step (the chart's error), and
+// the largest |u - u_ref| over the steps against the largest |u_ref| (early steps, where
+// u_ref is near 0, would make a relative figure per step meaningless).
+struct Difference {
+  double final = 0, worst_in_run = 0;
+};
+Difference difference(const QuadratureRun& run, const QuadratureRun& reference) {
+  const std::vector<double> zero(reference.node_path.back().size(), 0.0);
+  auto relative = [](double diff, double norm) { return norm > 0 ? std::sqrt(diff / norm) : std::sqrt(diff); };
+  Difference d;
+  d.final = relative(squared_distance(run.node_path.back(), reference.node_path.back()),
+                     squared_distance(reference.node_path.back(), zero));
+  double worst = 0, largest = 0;
+  for (std::size_t k = 0; k < reference.node_path.size(); ++k) {
+    worst = std::max(worst, squared_distance(run.node_path[k], reference.node_path[k]));
+    largest = std::max(largest, squared_distance(reference.node_path[k], zero));
   }
-  return norm > 0 ? std::sqrt(diff / norm) : std::sqrt(diff);
+  d.worst_in_run = relative(worst, largest);
+  return d;
 }
 
 std::string tolerance_label(double tolerance) {
@@ -86,21 +107,23 @@ AccuracyChart run_scene_quadrature_accuracy(const SceneQuadratureAccuracyOptions
   chart.time_label = accuracy_clock_name(options.clock) + " ms: the whole run (" + std::to_string(steps) +
                      " steps, cut updates included)";
   chart.error_label = "|u - u_ref| / |u_ref| at the mesh nodes after the run";
-  auto report = [&](const AccuracyPoint& p, std::int64_t points) {
+  auto report = [&](const AccuracyPoint& p, std::int64_t points, double worst_in_run) {
     chart.points.push_back(p);
     if (!progress) return;
     char line[240];
-    std::snprintf(line, sizeof line, "scene quadrature (%s) %s: %9.1f ms, %7lld points, error %.3e",
-                  p.series.c_str(), p.label.c_str(), p.ms, static_cast<long long>(points), p.error);
+    std::snprintf(line, sizeof line, "scene quadrature (%s) %s: %9.1f ms, %7lld points, error %.3e (worst in run %.3e)",
+                  p.series.c_str(), p.label.c_str(), p.ms, static_cast<long long>(points), p.error, worst_in_run);
     progress(line);
   };
-  auto point = [](const std::string& series, const std::string& label, const QuadratureRun& run, double error) {
+  auto point = [](const std::string& series, const std::string& label, const QuadratureRun& run,
+                  const Difference& error) {
     AccuracyPoint p;
     p.series = series;
     p.label = label;
     p.ms = run.ms;
-    p.error = error;
-    p.extra = {{"quadrature_points", static_cast<double>(run.quadrature_points)},
+    p.error = error.final;
+    p.extra = {{"worst_error_in_run", error.worst_in_run},
+               {"quadrature_points", static_cast<double>(run.quadrature_points)},
                {"assembly_wall_ms", run.assembly_wall_ms}};
     return p;
   };
@@ -108,12 +131,12 @@ AccuracyChart run_scene_quadrature_accuracy(const SceneQuadratureAccuracyOptions
   const double own_tolerance = scene.enrichment.quadrature_tolerance;
   std::optional<QuadratureRun> own;  // the scene at its own tolerance, if the sweep has it
   const QuadratureRun reference = run_at_tolerance(scene, options.reference_tolerance, steps, options.clock);
-  report(point(tolerance_series, tolerance_label(options.reference_tolerance), reference, 0.0),
-         reference.quadrature_points);
+  report(point(tolerance_series, tolerance_label(options.reference_tolerance), reference, Difference{}),
+         reference.quadrature_points, 0.0);
   for (double t : options.tolerances) {
     const QuadratureRun run = run_at_tolerance(scene, t, steps, options.clock);
-    const double error = relative_difference(run, reference);
-    report(point(tolerance_series, tolerance_label(t), run, error), run.quadrature_points);
+    const Difference error = difference(run, reference);
+    report(point(tolerance_series, tolerance_label(t), run, error), run.quadrature_points, error.worst_in_run);
     if (t == own_tolerance) own = run;
   }
   if (options.time_step_error) {
@@ -121,11 +144,12 @@ AccuracyChart run_scene_quadrature_accuracy(const SceneQuadratureAccuracyOptions
     // the same scene at half the time step (twice the steps, the same end time).
     Scene halved = scene;
     halved.analysis.time_step /= 2;
-    if (!own) own = run_scene(scene, steps, options.clock);
-    const QuadratureRun fine = run_scene(halved, 2 * steps, options.clock);
+    if (!own) own = run_scene(scene, steps, 1, options.clock);
+    const QuadratureRun fine = run_scene(halved, 2 * steps, 2, options.clock);
+    const Difference error = difference(*own, fine);
     report(point(name + ", time step against half of it", tolerance_label(own_tolerance) + " (the scene's)", *own,
-                 relative_difference(*own, fine)),
-           own->quadrature_points);
+                 error),
+           own->quadrature_points, error.worst_in_run);
   }
   return chart;
 }

@@ -145,7 +145,9 @@ struct SceneQuadratureAccuracyOptions {
 // general) against the reference tolerance (error 0), ms = the whole run. Series "<scene>,
 // time step against half of it": one point, the scene at its own tolerance against the same
 // scene at half the time step (twice the steps): the error a tolerance need not beat. Extra
-// "quadrature_points" (enriched elements' and edges', at the end) and "assembly_wall_ms".
+// "worst_error_in_run" (the largest |u - u_ref| at the nodes over the steps, at equal times,
+// over the largest |u_ref|), "quadrature_points" (enriched elements' and edges', at the end)
+// and "assembly_wall_ms".
 // std::invalid_argument for steps < 0, a tolerance <= 0, or a scene that is not dynamic or has
 // no cuts; what load_scene and SceneRun throw for a bad scene.
 AccuracyChart run_scene_quadrature_accuracy(const SceneQuadratureAccuracyOptions& options,
