@@ -51,6 +51,11 @@ double squared_distance(const std::vector<double>& a, const std::vector<double>&
   for (std::size_t k = 0; k < b.size(); ++k) sum += (a[k] - b[k]) * (a[k] - b[k]);
   return sum;
 }
+double squared_norm(const std::vector<double>& a) {
+  double sum = 0;
+  for (double v : a) sum += v * v;
+  return sum;
+}
 
 // |u - u_ref| / |u_ref| over the mesh nodes after the last step (the chart's error), and
 // the largest |u - u_ref| over the steps against the largest |u_ref| (early steps, where
@@ -59,15 +64,14 @@ struct Difference {
   double final = 0, worst_in_run = 0;
 };
 Difference difference(const QuadratureRun& run, const QuadratureRun& reference) {
-  const std::vector<double> zero(reference.node_path.back().size(), 0.0);
   auto relative = [](double diff, double norm) { return norm > 0 ? std::sqrt(diff / norm) : std::sqrt(diff); };
   Difference d;
   d.final = relative(squared_distance(run.node_path.back(), reference.node_path.back()),
-                     squared_distance(reference.node_path.back(), zero));
+                     squared_norm(reference.node_path.back()));
   double worst = 0, largest = 0;
   for (std::size_t k = 0; k < reference.node_path.size(); ++k) {
     worst = std::max(worst, squared_distance(run.node_path[k], reference.node_path[k]));
-    largest = std::max(largest, squared_distance(reference.node_path[k], zero));
+    largest = std::max(largest, squared_norm(reference.node_path[k]));
   }
   d.worst_in_run = relative(worst, largest);
   return d;
