@@ -163,6 +163,8 @@ SceneBenchResult run_scene_benchmark(const Scene& scene, const std::string& name
   result.steps = steps;
   result.scene_steps = scene.analysis.steps;
   result.counts = count(scene, run);
+  result.settings = {scene.analysis.time_step, scene.enrichment.quadrature_tolerance,
+                     scene.enrichment.rotation_cluster_texels};
   result.displacement = run.displacement();
   return result;
 }

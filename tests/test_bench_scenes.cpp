@@ -110,6 +110,12 @@ TEST(BenchScenes, JsonHasEveryRequestedSceneWithRequiredKeysAndThesisRatios) {
               0.1, 1e-12);
   EXPECT_EQ(spiral["counts"]["elements"], 1);
   EXPECT_EQ(spiral["counts"]["nodes"], 8);
+  // The settings its speed depends on, as its scene file sets them (spiral1: dt 1e-3, the
+  // default merge tolerance, rotation blocks of 16 texels; the cylinder: per point).
+  EXPECT_EQ(spiral["accuracy_settings"]["time_step"].get<double>(), 1e-3);
+  EXPECT_EQ(spiral["accuracy_settings"]["quadrature_tolerance"].get<double>(), 1e-2);
+  EXPECT_EQ(spiral["accuracy_settings"]["rotation_cluster_texels"].get<int>(), 16);
+  EXPECT_EQ(j["scenes"][1]["accuracy_settings"]["rotation_cluster_texels"].get<int>(), 0);
   // 2 of the scene's 300 steps: the targets (whole-run means in Table 5.1) are not judged.
   EXPECT_TRUE(spiral["targets_met"].is_null());
   EXPECT_TRUE(spiral["targets_missed"].is_null());
@@ -122,6 +128,9 @@ TEST(BenchScenes, JsonHasEveryRequestedSceneWithRequiredKeysAndThesisRatios) {
   std::getline(markdown, heading);
   EXPECT_EQ(heading.rfind("dgtex bench scenes: " + j["machine"].get<std::string>() + ";", 0), 0u) << heading;
   EXPECT_NE(heading.find("machine probe "), std::string::npos) << heading;
+  std::string text((std::istreambuf_iterator<char>(markdown)), std::istreambuf_iterator<char>());
+  EXPECT_NE(text.find("| 0.001 / 0.01 / 16 |"), std::string::npos) << text;
+  EXPECT_NE(text.find(" / per point |"), std::string::npos) << text;
 }
 
 // --repeats: every run of a scene is listed; the tables and the scene's own keys are the

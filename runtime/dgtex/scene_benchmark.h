@@ -59,6 +59,14 @@ struct SceneStepTimes {
   std::vector<int> cut_update_threads;
 };
 
+// What a scene trades accuracy for speed with (scene file keys): the stages' times mean little
+// without them (the slinky merges its enriched quadrature at 0.1, the others at 1e-2).
+struct SceneAccuracySettings {
+  double time_step = 0;               // analysis.time_step (s)
+  double quadrature_tolerance = 0;    // enrichment.quadrature_tolerance
+  int rotation_cluster_texels = 0;    // enrichment.rotation_cluster_texels (0: per point)
+};
+
 struct SceneBenchResult {
   std::string name;      // bench name (file stem)
   std::string path;      // scene file
@@ -69,6 +77,7 @@ struct SceneBenchResult {
   double setup_ms = 0;   // building mesh, model and simulation, without the time-0 enrichment
   SceneStepTimes times;  // per step (step 1 includes the time-0 enrichment update)
   SceneCounts counts;
+  SceneAccuracySettings settings;
   std::vector<double> displacement;  // final (all DOFs), for identity checks
 
   double steps_per_second() const;          // steps / total step wall time
