@@ -61,7 +61,10 @@ std::string write_chart(const std::string& path, const AccuracyChart& chart, con
       // Every run equals its reference, and error 0 has no place on a log scale: with fixed
       // ranges gnuplot draws the axes and the references instead of failing to scale them.
       double low = 1e300, high = 0;
-      for (const AccuracyPoint& p : chart.points) low = std::min(low, std::max(p.ms, 1e-3)), high = std::max(high, p.ms);
+      for (const AccuracyPoint& p : chart.points) {
+        low = std::min(low, std::max(p.ms, 1e-3));
+        high = std::max(high, p.ms);
+      }
       if (!(high > low)) low = 1e-3, high = std::max(1.0, 2 * high);
       g << "set xrange [" << low / 2 << ":" << high * 2 << "]\nset yrange [1e-16:1]\n"
         << "set label " << arrow + 1 << " 'every error is 0: the runs equal their references' at graph 0.5, graph 0.5"

@@ -239,9 +239,10 @@ std::string markdown_tables(const std::vector<SceneBenchResult>& results) {
     else
       out << "-";
     out << " | " << c.elements << " / " << c.nodes << " / " << c.enrichments << " / " << c.texture_resolution << " / "
-        << c.dofs << " | " << format("%g", r.settings.time_step) << " / " << format("%g", r.settings.quadrature_tolerance)
-        << " / " << (r.settings.rotation_cluster_texels > 0 ? std::to_string(r.settings.rotation_cluster_texels) : "per point")
-        << " | ";
+        << c.dofs << " | ";
+    const SceneAccuracySettings& a = r.settings;
+    out << format("%g", a.time_step) << " / " << format("%g", a.quadrature_tolerance) << " / "
+        << (a.rotation_cluster_texels > 0 ? std::to_string(a.rotation_cluster_texels) : "per point") << " | ";
     if (row) {
       const StageRatios q = ratios(*row, r);
       const std::optional<std::vector<Target>> missed = missed_targets(*row, r);

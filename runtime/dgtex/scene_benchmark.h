@@ -60,11 +60,11 @@ struct SceneStepTimes {
 };
 
 // What a scene trades accuracy for speed with (scene file keys): the stages' times mean little
-// without them (the slinky merges its enriched quadrature at 0.1, the others at 1e-2).
+// without them.
 struct SceneAccuracySettings {
-  double time_step = 0;               // analysis.time_step (s)
-  double quadrature_tolerance = 0;    // enrichment.quadrature_tolerance
-  int rotation_cluster_texels = 0;    // enrichment.rotation_cluster_texels (0: per point)
+  double time_step = 0;             // analysis.time_step (s)
+  double quadrature_tolerance = 0;  // enrichment.quadrature_tolerance
+  int rotation_cluster_texels = 0;  // enrichment.rotation_cluster_texels (0: per point)
 };
 
 struct SceneBenchResult {
