@@ -111,16 +111,9 @@ AccuracyChart run_scene_quadrature_accuracy(const SceneQuadratureAccuracyOptions
   chart.time_label = accuracy_clock_name(options.clock) + " ms: the whole run (" + std::to_string(steps) +
                      " steps, cut updates included)";
   chart.error_label = "|u - u_ref| / |u_ref| at the mesh nodes after the run";
-  auto report = [&](const AccuracyPoint& p, std::int64_t points, double worst_in_run) {
-    chart.points.push_back(p);
-    if (!progress) return;
-    char line[240];
-    std::snprintf(line, sizeof line, "scene quadrature (%s) %s: %9.1f ms, %7lld points, error %.3e (worst in run %.3e)",
-                  p.series.c_str(), p.label.c_str(), p.ms, static_cast<long long>(points), p.error, worst_in_run);
-    progress(line);
-  };
-  auto point = [](const std::string& series, const std::string& label, const QuadratureRun& run,
-                  const Difference& error) {
+  // One point of the chart (and its progress line).
+  auto add = [&](const std::string& series, const std::string& label, const QuadratureRun& run,
+                 const Difference& error) {
     AccuracyPoint p;
     p.series = series;
     p.label = label;
@@ -129,18 +122,24 @@ AccuracyChart run_scene_quadrature_accuracy(const SceneQuadratureAccuracyOptions
     p.extra = {{"worst_error_in_run", error.worst_in_run},
                {"quadrature_points", static_cast<double>(run.quadrature_points)},
                {"assembly_wall_ms", run.assembly_wall_ms}};
-    return p;
+    chart.points.push_back(p);
+    if (!progress) return;
+    char line[240];
+    std::snprintf(line, sizeof line, "scene quadrature (%s) %s: %9.1f ms, %7lld points, error %.3e (worst in run %.3e)",
+                  series.c_str(), label.c_str(), run.ms, static_cast<long long>(run.quadrature_points), error.final,
+                  error.worst_in_run);
+    progress(line);
   };
   const std::string tolerance_series = name + ", against " + tolerance_label(options.reference_tolerance);
   const double own_tolerance = scene.enrichment.quadrature_tolerance;
-  std::optional<QuadratureRun> own;  // the scene at its own tolerance, if the sweep has it
   const QuadratureRun reference = run_at_tolerance(scene, options.reference_tolerance, steps, options.clock);
-  report(point(tolerance_series, tolerance_label(options.reference_tolerance), reference, Difference{}),
-         reference.quadrature_points, 0.0);
+  add(tolerance_series, tolerance_label(options.reference_tolerance), reference, Difference{});
+  // The scene at its own tolerance, where the sweep runs it anyway.
+  std::optional<QuadratureRun> own;
+  if (own_tolerance == options.reference_tolerance) own = reference;
   for (double t : options.tolerances) {
     const QuadratureRun run = run_at_tolerance(scene, t, steps, options.clock);
-    const Difference error = difference(run, reference);
-    report(point(tolerance_series, tolerance_label(t), run, error), run.quadrature_points, error.worst_in_run);
+    add(tolerance_series, tolerance_label(t), run, difference(run, reference));
     if (t == own_tolerance) own = run;
   }
   if (options.time_step_error) {
@@ -150,10 +149,8 @@ AccuracyChart run_scene_quadrature_accuracy(const SceneQuadratureAccuracyOptions
     halved.analysis.time_step /= 2;
     if (!own) own = run_scene(scene, steps, 1, options.clock);
     const QuadratureRun fine = run_scene(halved, 2 * steps, 2, options.clock);
-    const Difference error = difference(*own, fine);
-    report(point(name + ", time step against half of it", tolerance_label(own_tolerance) + " (the scene's)", *own,
-                 error),
-           own->quadrature_points, error.worst_in_run);
+    add(name + ", time step against half of it", tolerance_label(own_tolerance) + " (the scene's)", *own,
+        difference(*own, fine));
   }
   return chart;
 }
