@@ -110,10 +110,10 @@ TEST(BenchScenes, JsonHasEveryRequestedSceneWithRequiredKeysAndThesisRatios) {
               0.1, 1e-12);
   EXPECT_EQ(spiral["counts"]["elements"], 1);
   EXPECT_EQ(spiral["counts"]["nodes"], 8);
-  // The settings its speed depends on, as its scene file sets them (spiral1: dt 1e-3, the
-  // default merge tolerance, rotation blocks of 16 texels; the cylinder: per point).
+  // The settings its speed depends on, as its scene file sets them (spiral1: dt 1e-3, merge
+  // tolerance 0.1, rotation blocks of 16 texels; the cylinder: per point).
   EXPECT_EQ(spiral["accuracy_settings"]["time_step"].get<double>(), 1e-3);
-  EXPECT_EQ(spiral["accuracy_settings"]["quadrature_tolerance"].get<double>(), 1e-2);
+  EXPECT_EQ(spiral["accuracy_settings"]["quadrature_tolerance"].get<double>(), 0.1);
   EXPECT_EQ(spiral["accuracy_settings"]["rotation_cluster_texels"].get<int>(), 16);
   EXPECT_EQ(j["scenes"][1]["accuracy_settings"]["rotation_cluster_texels"].get<int>(), 0);
   // 2 of the scene's 300 steps: the targets (whole-run means in Table 5.1) are not judged.
@@ -129,7 +129,7 @@ TEST(BenchScenes, JsonHasEveryRequestedSceneWithRequiredKeysAndThesisRatios) {
   EXPECT_EQ(heading.rfind("dgtex bench scenes: " + j["machine"].get<std::string>() + ";", 0), 0u) << heading;
   EXPECT_NE(heading.find("machine probe "), std::string::npos) << heading;
   std::string text((std::istreambuf_iterator<char>(markdown)), std::istreambuf_iterator<char>());
-  EXPECT_NE(text.find("| 0.001 / 0.01 / 16 |"), std::string::npos) << text;
+  EXPECT_NE(text.find("| 0.001 / 0.1 / 16 |"), std::string::npos) << text;
   EXPECT_NE(text.find(" / per point |"), std::string::npos) << text;
 }
 
