@@ -8,7 +8,13 @@ namespace dgtex {
 ProjectedState project_onto_basis(const ShellModel& old_model, const std::vector<double>& old_displacement,
                                   const std::vector<double>& old_velocity, const ShellModel& new_model,
                                   const std::vector<char>& fixed) {
-  const FreeDofSystem system(new_model.pattern(), fixed);
+  return project_onto_basis(old_model, old_displacement, old_velocity, new_model,
+                            FreeDofSystem(new_model.pattern(), fixed));
+}
+
+ProjectedState project_onto_basis(const ShellModel& old_model, const std::vector<double>& old_displacement,
+                                  const std::vector<double>& old_velocity, const ShellModel& new_model,
+                                  const FreeDofSystem& system) {
   std::vector<double> values;
   system.gather(new_model.mass_blocks().data(), 1.0, nullptr, 0.0, values);
   SparseCholesky mass;

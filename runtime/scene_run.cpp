@@ -198,9 +198,9 @@ void SceneRun::change_basis(std::vector<EnrichmentFunction> functions, int edge_
   next->set_enrichments(std::move(functions));
   std::vector<char> fixed = scene_fixed_dofs(scene_, *next);
   std::vector<double> force = scene_external_force(scene_, *next);
-  ProjectedState projected =
-      project_onto_basis(*model_, simulation_->displacement(), simulation_->velocity(), *next, fixed);
   auto simulation = std::make_unique<ShellSimulation>(*next, std::move(fixed), std::move(force));
+  ProjectedState projected = project_onto_basis(*model_, simulation_->displacement(), simulation_->velocity(), *next,
+                                                simulation->system());
   // Once an element-local preconditioner has failed (its matrix not positive definite, or
   // too weak), the next bases, much like this one, get the whole pattern from the start
   // instead of wasting an element-local factorisation each (chad and the slinky fell back

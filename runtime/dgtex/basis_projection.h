@@ -11,6 +11,7 @@
 // nothing). Units: those of the model (SI: m, m/s).
 #include <vector>
 
+#include "dgtex/free_dof_system.h"
 #include "dgtex/shell_model.h"
 
 namespace dgtex {
@@ -26,5 +27,11 @@ struct ProjectedState {
 ProjectedState project_onto_basis(const ShellModel& old_model, const std::vector<double>& old_displacement,
                                   const std::vector<double>& old_velocity, const ShellModel& new_model,
                                   const std::vector<char>& fixed);
+// The same with the new model's free-DOF system already built (new_model.pattern() without
+// the held DOFs, as a ShellSimulation of the new model holds it: system()), which it
+// would otherwise build again.
+ProjectedState project_onto_basis(const ShellModel& old_model, const std::vector<double>& old_displacement,
+                                  const std::vector<double>& old_velocity, const ShellModel& new_model,
+                                  const FreeDofSystem& new_system);
 
 }  // namespace dgtex
