@@ -37,11 +37,13 @@ std::string accuracy_charts_json(const std::vector<AccuracyChart>& charts, const
       for (const auto& [key, value] : p.extra) point[key] = value;
       points.push_back(point);
     }
-    list.push_back({{"name", chart.name},
-                    {"title", chart.title},
-                    {"time_label", chart.time_label},
-                    {"error_label", chart.error_label},
-                    {"points", points}});
+    nlohmann::json entry = {{"name", chart.name},
+                            {"title", chart.title},
+                            {"time_label", chart.time_label},
+                            {"error_label", chart.error_label},
+                            {"points", points}};
+    if (!chart.conclusion.empty()) entry["conclusion"] = chart.conclusion;
+    list.push_back(entry);
   }
   return nlohmann::json{{"machine", machine}, {"command", command}, {"charts", list}}.dump(2) + "\n";
 }
@@ -79,6 +81,7 @@ std::string accuracy_charts_markdown(const std::vector<AccuracyChart>& charts, c
       }
       out << "\n";
     }
+    if (!chart.conclusion.empty()) out << "\n" << chart.conclusion << "\n";
   }
   return out.str();
 }

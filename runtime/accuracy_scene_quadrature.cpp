@@ -7,6 +7,8 @@
 #include <optional>
 #include <stdexcept>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "dgtex/accuracy_benchmark.h"
 #include "dgtex/scene_io.h"
@@ -83,6 +85,31 @@ std::string tolerance_label(double tolerance) {
   return text;
 }
 
+// The largest tolerance whose error stays below the time-step error, at the end and over
+// the run. The error is not monotone in the tolerance (which cells merge changes with it),
+// so smaller tolerances are not implied to pass too.
+std::string affordable_tolerance(const std::vector<std::pair<double, Difference>>& swept,
+                                 const Difference& time_step) {
+  const std::pair<double, Difference>* best = nullptr;
+  for (const auto& entry : swept)
+    if (entry.second.final < time_step.final && entry.second.worst_in_run < time_step.worst_in_run &&
+        (!best || entry.first > best->first))
+      best = &entry;
+  char text[320];
+  if (!best) {
+    std::snprintf(text, sizeof text,
+                  "No swept tolerance stays below the time-step error (%.2g at the end, %.2g over the run).",
+                  time_step.final, time_step.worst_in_run);
+  } else {
+    std::snprintf(text, sizeof text,
+                  "The largest swept tolerance below the time-step error at the end and over the run: %g (%.2g and "
+                  "%.2g against %.2g and %.2g).",
+                  best->first, best->second.final, best->second.worst_in_run, time_step.final,
+                  time_step.worst_in_run);
+  }
+  return text;
+}
+
 }  // namespace
 
 AccuracyChart run_scene_quadrature_accuracy(const SceneQuadratureAccuracyOptions& options,
@@ -137,9 +164,11 @@ AccuracyChart run_scene_quadrature_accuracy(const SceneQuadratureAccuracyOptions
   // The scene at its own tolerance, where the sweep runs it anyway.
   std::optional<QuadratureRun> own;
   if (own_tolerance == options.reference_tolerance) own = reference;
+  std::vector<std::pair<double, Difference>> swept;
   for (double t : options.tolerances) {
     const QuadratureRun run = run_at_tolerance(scene, t, steps, options.clock);
-    add(tolerance_series, tolerance_label(t), run, difference(run, reference));
+    swept.emplace_back(t, difference(run, reference));
+    add(tolerance_series, tolerance_label(t), run, swept.back().second);
     if (t == own_tolerance) own = run;
   }
   if (options.time_step_error) {
@@ -149,8 +178,11 @@ AccuracyChart run_scene_quadrature_accuracy(const SceneQuadratureAccuracyOptions
     halved.analysis.time_step /= 2;
     if (!own) own = run_scene(scene, steps, 1, options.clock);
     const QuadratureRun fine = run_scene(halved, 2 * steps, 2, options.clock);
+    const Difference time_step_error = difference(*own, fine);
     add(name + ", time step against half of it", tolerance_label(own_tolerance) + " (the scene's)", *own,
-        difference(*own, fine));
+        time_step_error);
+    chart.conclusion = affordable_tolerance(swept, time_step_error);
+    if (progress) progress("scene quadrature (" + name + "): " + chart.conclusion);
   }
   return chart;
 }

@@ -2,12 +2,14 @@
 
 #include "dgtex/free_dof_system.h"
 #include "dgtex/sparse_cholesky.h"
+#include "api_argument_checks.h"
 
 namespace dgtex {
 
 ProjectedState project_onto_basis(const ShellModel& old_model, const std::vector<double>& old_displacement,
                                   const std::vector<double>& old_velocity, const ShellModel& new_model,
                                   const std::vector<char>& fixed) {
+  detail::check_size("project_onto_basis", "fixed", fixed.size(), "new_model.num_dofs()", new_model.num_dofs());
   return project_onto_basis(old_model, old_displacement, old_velocity, new_model,
                             FreeDofSystem(new_model.pattern(), fixed));
 }
@@ -15,6 +17,13 @@ ProjectedState project_onto_basis(const ShellModel& old_model, const std::vector
 ProjectedState project_onto_basis(const ShellModel& old_model, const std::vector<double>& old_displacement,
                                   const std::vector<double>& old_velocity, const ShellModel& new_model,
                                   const FreeDofSystem& system) {
+  const char* function = "project_onto_basis";
+  detail::check_size(function, "old_displacement", old_displacement.size(), "old_model.num_dofs()",
+                     old_model.num_dofs());
+  if (!old_velocity.empty())
+    detail::check_size(function, "old_velocity", old_velocity.size(), "old_model.num_dofs()", old_model.num_dofs());
+  detail::check_size(function, "new_system.num_dofs()", system.num_dofs(), "new_model.num_dofs()",
+                     new_model.num_dofs());
   std::vector<double> values;
   system.gather(new_model.mass_blocks().data(), 1.0, nullptr, 0.0, values);
   SparseCholesky mass;

@@ -10,6 +10,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <map>
 #include <nlohmann/json.hpp>
 #include <string>
@@ -201,6 +202,15 @@ void check_SceneQuadratureWithinBounds(const ReducedRun& run) {
   EXPECT_EQ(time_step[0].at("label"), "tol=0.1 (the scene's)");
   EXPECT_GT(time_step[0].at("error").get<double>(), 0.0);
   EXPECT_EQ(time_step[0].at("ms").get<double>(), sweep[2].at("ms").get<double>());
+  // Both swept tolerances stay below the time-step error (0.12 over 5 steps): the
+  // conclusion names the larger one, in the JSON and below the Markdown table.
+  const std::string expected = "below the time-step error at the end and over the run: 1 (";
+  ASSERT_TRUE(run.chart("scene_quadrature").contains("conclusion"));
+  EXPECT_NE(run.chart("scene_quadrature").at("conclusion").get<std::string>().find(expected), std::string::npos);
+  std::ifstream table(run.dir / "accuracy.md");
+  const std::string text((std::istreambuf_iterator<char>(table)), std::istreambuf_iterator<char>());
+  EXPECT_NE(text.find(expected), std::string::npos);
+  EXPECT_FALSE(run.chart("rotation").contains("conclusion"));  // the other sweeps conclude nothing
 }
 
 TEST(BenchAccuracy, ReducedRunMeetsInvariants) {

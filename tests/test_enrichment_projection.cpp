@@ -114,6 +114,22 @@ TEST(BasisProjection, AGivenFreeDofSystemGivesTheSameState) {
   EXPECT_EQ(own.displacement, given.displacement);
   EXPECT_EQ(own.velocity, given.velocity);
   for (int d = 0; d < 9; ++d) EXPECT_EQ(given.displacement[d], 0.0) << d;
+  // A system of another model, or a state of the wrong size, is refused by name.
+  const auto plain = plate_model(mesh);
+  EXPECT_THROW(
+      {
+        try {
+          const FreeDofSystem other(plain->pattern(), std::vector<char>(plain->num_dofs(), 0));
+          project_onto_basis(*before, u, v, *after, other);
+        } catch (const std::invalid_argument& e) {
+          EXPECT_NE(std::string(e.what()).find("new_system.num_dofs()"), std::string::npos) << e.what();
+          throw;
+        }
+      },
+      std::invalid_argument);
+  EXPECT_THROW(project_onto_basis(*before, std::vector<double>(3), v, *after, fixed), std::invalid_argument);
+  EXPECT_THROW(project_onto_basis(*before, u, std::vector<double>(3), *after, fixed), std::invalid_argument);
+  EXPECT_THROW(project_onto_basis(*before, u, v, *after, std::vector<char>(3)), std::invalid_argument);
 }
 
 TEST(BasisProjection, AdvancingCutIsContinuousWithProjectionAndJumpsWithout) {

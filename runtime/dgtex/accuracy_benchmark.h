@@ -53,6 +53,8 @@ struct AccuracyChart {
   std::string time_label;   // what `ms` measures
   std::string error_label;  // what `error` measures
   std::vector<AccuracyPoint> points;
+  // What the sweep concludes, in one sentence (empty: nothing beyond the points).
+  std::string conclusion;
   std::vector<std::string> series() const;  // distinct series in order of first appearance
 };
 
@@ -147,17 +149,20 @@ struct SceneQuadratureAccuracyOptions {
 // scene at half the time step (twice the steps): the error a tolerance need not beat. Extra
 // "worst_error_in_run" (the largest |u - u_ref| at the nodes over the steps, at equal times,
 // over the largest |u_ref|), "quadrature_points" (enriched elements' and edges', at the end)
-// and "assembly_wall_ms".
+// and "assembly_wall_ms". With the time-step point, the conclusion names the largest swept
+// tolerance whose error stays below the time-step error, at the end and over the run (or
+// that none does): the coarsest quadrature the scene can afford.
 // std::invalid_argument for steps < 0, a tolerance <= 0, or a scene that is not dynamic or has
 // no cuts; what load_scene and SceneRun throw for a bad scene.
 AccuracyChart run_scene_quadrature_accuracy(const SceneQuadratureAccuracyOptions& options,
                                             const AccuracyProgress& progress = {});
 
 // {"charts": [{"name", "title", "time_label", "error_label", "points": [{"series", "label",
-// "ms", "error", extra...}]}], "machine", "command"} as JSON text.
+// "ms", "error", extra...}], "conclusion" (where there is one)}], "machine", "command"} as
+// JSON text.
 std::string accuracy_charts_json(const std::vector<AccuracyChart>& charts, const std::string& machine,
                                  const std::string& command);
-// One Markdown table per chart (series, label, ms, error, extra columns).
+// One Markdown table per chart (series, label, ms, error, extra columns), its conclusion below it.
 std::string accuracy_charts_markdown(const std::vector<AccuracyChart>& charts, const std::string& machine,
                                      const std::string& command);
 

@@ -21,9 +21,10 @@ struct ProjectedState {
   std::vector<double> velocity;
 };
 
-// old_* are #dofs vectors of old_model; fixed flags the new model's held DOFs (#dofs of
-// new_model). Both models share the mesh. Throws NotPositiveDefinite if the new mass
-// matrix is singular on the free DOFs (an enriched function with no support).
+// old_* are #dofs vectors of old_model (old_velocity may be empty: at rest); fixed flags
+// the new model's held DOFs (#dofs of new_model). Both models share the mesh. Throws
+// std::invalid_argument for other sizes (naming the argument), NotPositiveDefinite if the
+// new mass matrix is singular on the free DOFs (an enriched function with no support).
 ProjectedState project_onto_basis(const ShellModel& old_model, const std::vector<double>& old_displacement,
                                   const std::vector<double>& old_velocity, const ShellModel& new_model,
                                   const std::vector<char>& fixed);
