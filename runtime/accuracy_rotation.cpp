@@ -9,6 +9,7 @@
 #include "dgtex/accuracy_benchmark.h"
 #include "dgtex/scene_io.h"
 #include "dgtex/scene_run.h"
+#include "timed_scene_run.h"
 
 namespace dgtex {
 namespace {
@@ -24,15 +25,14 @@ RotationRun run_scene(const Scene& base, int block_texels, int steps, AccuracyCl
   Scene scene = base;
   scene.enrichment.rotation_cluster_texels = block_texels;
   RotationRun out;
-  const double start = accuracy_clock_ms(clock);
-  SceneRun run(scene);
-  for (int k = 0; k < steps; ++k) run.step();
-  out.ms = accuracy_clock_ms(clock) - start;
-  out.displacement = run.displacement();
-  const StageTimings timings = run.timings();
-  if (const auto it = timings.find("assembly"); it != timings.end()) out.assembly_wall_ms = it->second.total_ms;
-  out.clusters = run.model().num_rotation_clusters();
-  out.cluster_bytes = run.model().rotation_cluster_bytes();
+  const detail::TimedSceneRun timed = detail::run_scene_timed(scene, steps, clock, [&](const SceneRun& run, int k) {
+    if (k < steps) return;
+    out.displacement = run.displacement();
+    out.clusters = run.model().num_rotation_clusters();
+    out.cluster_bytes = run.model().rotation_cluster_bytes();
+  });
+  out.ms = timed.ms;
+  out.assembly_wall_ms = timed.assembly_wall_ms;
   return out;
 }
 

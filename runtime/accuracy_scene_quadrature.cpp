@@ -13,6 +13,7 @@
 #include "dgtex/accuracy_benchmark.h"
 #include "dgtex/scene_io.h"
 #include "dgtex/scene_run.h"
+#include "timed_scene_run.h"
 
 namespace dgtex {
 namespace {
@@ -27,19 +28,15 @@ struct QuadratureRun {
 // The scene's first `steps` steps, timed whole (set-up and cut updates included).
 QuadratureRun run_scene(const Scene& scene, int steps, int record_every, AccuracyClock clock) {
   QuadratureRun out;
-  const double start = accuracy_clock_ms(clock);
-  SceneRun run(scene);
-  const std::size_t node_dofs = 3 * static_cast<std::size_t>(run.mesh().num_nodes());
-  for (int k = 1; k <= steps; ++k) {
-    run.step();
-    if (k % record_every == 0)
-      out.node_path.emplace_back(run.displacement().begin(), run.displacement().begin() + node_dofs);
-  }
-  out.ms = accuracy_clock_ms(clock) - start;
-  const StageTimings timings = run.timings();
-  if (const auto it = timings.find("assembly"); it != timings.end()) out.assembly_wall_ms = it->second.total_ms;
-  out.quadrature_points =
-      run.model().num_enriched_element_quadrature_points() + run.model().num_enriched_edge_quadrature_points();
+  const detail::TimedSceneRun timed = detail::run_scene_timed(scene, steps, clock, [&](const SceneRun& run, int k) {
+    const auto& u = run.displacement();
+    if (k % record_every == 0) out.node_path.emplace_back(u.begin(), u.begin() + 3 * run.mesh().num_nodes());
+    if (k == steps)
+      out.quadrature_points =
+          run.model().num_enriched_element_quadrature_points() + run.model().num_enriched_edge_quadrature_points();
+  });
+  out.ms = timed.ms;
+  out.assembly_wall_ms = timed.assembly_wall_ms;
   return out;
 }
 
