@@ -81,6 +81,17 @@ std::vector<double> random_state(int dofs, unsigned seed) {
   return x;
 }
 
+// One quad8 element whose cut advances from 0.4 to 0.6 of the way: the same DOFs before and
+// after. Built in place (the models keep a reference to the mesh).
+struct AdvancingCut {
+  Mesh mesh = make_rectangle(1, 1, 1, 1, ElementType::quad8);
+  std::unique_ptr<ShellModel> before = plate_model(mesh), after = plate_model(mesh);
+  AdvancingCut() {
+    before->set_enrichments({partial_cut(0.4)});
+    after->set_enrichments({partial_cut(0.6)});
+  }
+};
+
 TEST(BasisProjection, AppearingCutKeepsTheStateExactly) {
   const Mesh mesh = make_rectangle(1, 1, 1, 1, ElementType::quad8);
   auto before = plate_model(mesh);
@@ -101,11 +112,8 @@ TEST(BasisProjection, AppearingCutKeepsTheStateExactly) {
 // A scene run projects with the free-DOF system its new simulation already holds (built
 // once, not twice, per basis change): the same state, bit for bit, with held DOFs.
 TEST(BasisProjection, AGivenFreeDofSystemGivesTheSameState) {
-  const Mesh mesh = make_rectangle(1, 1, 1, 1, ElementType::quad8);
-  auto before = plate_model(mesh);
-  auto after = plate_model(mesh);
-  before->set_enrichments({partial_cut(0.4)});
-  after->set_enrichments({partial_cut(0.6)});
+  const AdvancingCut cut;
+  const ShellModel *before = cut.before.get(), *after = cut.after.get();
   const std::vector<double> u = random_state(before->num_dofs(), 5), v = random_state(before->num_dofs(), 6);
   std::vector<char> fixed(after->num_dofs(), 0);
   for (int d = 0; d < 9; ++d) fixed[d] = 1;  // the first three nodes held
@@ -115,7 +123,7 @@ TEST(BasisProjection, AGivenFreeDofSystemGivesTheSameState) {
   EXPECT_EQ(own.velocity, given.velocity);
   for (int d = 0; d < 9; ++d) EXPECT_EQ(given.displacement[d], 0.0) << d;
   // A system of another model, or a state of the wrong size, is refused by name.
-  const auto plain = plate_model(mesh);
+  const auto plain = plate_model(cut.mesh);
   EXPECT_THROW(
       {
         try {
@@ -133,11 +141,8 @@ TEST(BasisProjection, AGivenFreeDofSystemGivesTheSameState) {
 }
 
 TEST(BasisProjection, AdvancingCutIsContinuousWithProjectionAndJumpsWithout) {
-  const Mesh mesh = make_rectangle(1, 1, 1, 1, ElementType::quad8);
-  auto before = plate_model(mesh);
-  auto after = plate_model(mesh);
-  before->set_enrichments({partial_cut(0.4)});
-  after->set_enrichments({partial_cut(0.6)});
+  const AdvancingCut cut;
+  const ShellModel *before = cut.before.get(), *after = cut.after.get();
   ASSERT_EQ(before->num_dofs(), after->num_dofs());  // same N_i: the DOF numbering carries over
   // An opened cut: standard and enriched DOFs of comparable size.
   const std::vector<double> u = random_state(before->num_dofs(), 3), v = random_state(before->num_dofs(), 4);
