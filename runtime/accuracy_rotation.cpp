@@ -1,7 +1,6 @@
 // Rotation sweep of dgtex bench accuracy: what the rotation clusters of enriched elements
 // (enrichment.rotation_cluster_texels, dgtex/kernels/enriched_rotation_clusters.h) cost in
 // accuracy against the per-point corotation, and what they save in time.
-#include <cmath>
 #include <cstdio>
 #include <stdexcept>
 #include <string>
@@ -9,7 +8,7 @@
 #include "dgtex/accuracy_benchmark.h"
 #include "dgtex/scene_io.h"
 #include "dgtex/scene_run.h"
-#include "timed_scene_run.h"
+#include "accuracy_scene_runs.h"
 
 namespace dgtex {
 namespace {
@@ -60,20 +59,15 @@ AccuracyChart run_rotation_accuracy(const RotationAccuracyOptions& options, cons
   chart.error_label = "|u - u_ref| / |u_ref| vs per-point rotations";
   const std::string series = options.scene.substr(options.scene.find_last_of('/') + 1);
   const RotationRun reference = run_scene(base, 0, options.steps, options.clock);
-  double norm = 0;
-  for (double v : reference.displacement) norm += v * v;
-  norm = std::sqrt(norm);
+  const double reference_norm = detail::squared_norm(reference.displacement);
   auto add = [&](const std::string& label, const RotationRun& run) {
     if (run.displacement.size() != reference.displacement.size())
       throw std::logic_error("rotation accuracy: DOF counts of the runs differ");
-    double diff = 0;
-    for (std::size_t k = 0; k < run.displacement.size(); ++k)
-      diff += (run.displacement[k] - reference.displacement[k]) * (run.displacement[k] - reference.displacement[k]);
     AccuracyPoint p;
     p.series = series;
     p.label = label;
     p.ms = run.ms;
-    p.error = norm > 0 ? std::sqrt(diff) / norm : std::sqrt(diff);
+    p.error = detail::relative_root(detail::squared_distance(run.displacement, reference.displacement), reference_norm);
     p.extra = {{"clusters", static_cast<double>(run.clusters)},
                {"cluster_mb", run.cluster_bytes / 1e6},
                {"assembly_wall_ms", run.assembly_wall_ms}};

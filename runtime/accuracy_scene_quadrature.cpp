@@ -2,7 +2,6 @@
 // quadrature (enrichment.quadrature_tolerance) costs in accuracy over a whole dynamic scene
 // with cuts, and what it saves in time, set beside the scene's own time-step error.
 #include <algorithm>
-#include <cmath>
 #include <cstdio>
 #include <optional>
 #include <stdexcept>
@@ -13,7 +12,7 @@
 #include "dgtex/accuracy_benchmark.h"
 #include "dgtex/scene_io.h"
 #include "dgtex/scene_run.h"
-#include "timed_scene_run.h"
+#include "accuracy_scene_runs.h"
 
 namespace dgtex {
 namespace {
@@ -45,17 +44,6 @@ QuadratureRun run_at_tolerance(Scene scene, double tolerance, int steps, Accurac
   return run_scene(scene, steps, 1, clock);
 }
 
-double squared_distance(const std::vector<double>& a, const std::vector<double>& b) {
-  double sum = 0;
-  for (std::size_t k = 0; k < b.size(); ++k) sum += (a[k] - b[k]) * (a[k] - b[k]);
-  return sum;
-}
-double squared_norm(const std::vector<double>& a) {
-  double sum = 0;
-  for (double v : a) sum += v * v;
-  return sum;
-}
-
 // |u - u_ref| / |u_ref| over the mesh nodes after the last step (the chart's error), and
 // the largest |u - u_ref| over the steps against the largest |u_ref| (early steps, where
 // u_ref is near 0, would make a relative figure per step meaningless).
@@ -63,16 +51,16 @@ struct Difference {
   double final = 0, worst_in_run = 0;
 };
 Difference difference(const QuadratureRun& run, const QuadratureRun& reference) {
-  auto relative = [](double diff, double norm) { return norm > 0 ? std::sqrt(diff / norm) : std::sqrt(diff); };
+  using detail::relative_root, detail::squared_distance, detail::squared_norm;
   Difference d;
-  d.final = relative(squared_distance(run.node_path.back(), reference.node_path.back()),
-                     squared_norm(reference.node_path.back()));
+  d.final = relative_root(squared_distance(run.node_path.back(), reference.node_path.back()),
+                          squared_norm(reference.node_path.back()));
   double worst = 0, largest = 0;
   for (std::size_t k = 0; k < reference.node_path.size(); ++k) {
     worst = std::max(worst, squared_distance(run.node_path[k], reference.node_path[k]));
     largest = std::max(largest, squared_norm(reference.node_path[k]));
   }
-  d.worst_in_run = relative(worst, largest);
+  d.worst_in_run = relative_root(worst, largest);
   return d;
 }
 

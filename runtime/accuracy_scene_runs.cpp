@@ -1,4 +1,6 @@
-#include "timed_scene_run.h"
+#include "accuracy_scene_runs.h"
+
+#include <cmath>
 
 namespace dgtex::detail {
 
@@ -15,6 +17,22 @@ TimedSceneRun run_scene_timed(const Scene& scene, int steps, AccuracyClock clock
   const StageTimings timings = run.timings();
   if (const auto it = timings.find("assembly"); it != timings.end()) out.assembly_wall_ms = it->second.total_ms;
   return out;
+}
+
+double squared_distance(const std::vector<double>& a, const std::vector<double>& b) {
+  double sum = 0;
+  for (std::size_t k = 0; k < a.size(); ++k) sum += (a[k] - b[k]) * (a[k] - b[k]);
+  return sum;
+}
+
+double squared_norm(const std::vector<double>& a) {
+  double sum = 0;
+  for (double v : a) sum += v * v;
+  return sum;
+}
+
+double relative_root(double squared, double squared_scale) {
+  return squared_scale > 0 ? std::sqrt(squared / squared_scale) : std::sqrt(squared);
 }
 
 }  // namespace dgtex::detail

@@ -1,7 +1,9 @@
 #pragma once
-// Internal: a whole scene run timed for the accuracy sweeps that vary a scene setting
-// (rotation clusters, quadrature merge tolerance): set-up, steps and cut updates in one time.
+// Internal: the scene runs of the accuracy sweeps that vary a scene setting (rotation
+// clusters, quadrature merge tolerance): a whole run timed (set-up, steps and cut updates in
+// one time), and the distances their errors are made of.
 #include <functional>
+#include <vector>
 
 #include "dgtex/accuracy_benchmark.h"
 #include "dgtex/scene_run.h"
@@ -17,5 +19,12 @@ struct TimedSceneRun {
 // (1-based; where a sweep reads the state, at the end when k == steps).
 TimedSceneRun run_scene_timed(const Scene& scene, int steps, AccuracyClock clock,
                               const std::function<void(const SceneRun& run, int step)>& after_step);
+
+// |a - b|^2 over a's entries (b holds at least as many), and |a|^2.
+double squared_distance(const std::vector<double>& a, const std::vector<double>& b);
+double squared_norm(const std::vector<double>& a);
+// sqrt(squared / squared_scale): a relative error from the two; the absolute sqrt(squared)
+// where the scale is 0 (a reference at rest).
+double relative_root(double squared, double squared_scale);
 
 }  // namespace dgtex::detail
