@@ -48,7 +48,7 @@ struct AccuracyPoint {
 };
 
 struct AccuracyChart {
-  std::string name;         // plate, quadrature, texture, tolerance
+  std::string name;         // plate, quadrature, texture, tolerance, rotation, scene_quadrature
   std::string title;
   std::string time_label;   // what `ms` measures
   std::string error_label;  // what `error` measures
