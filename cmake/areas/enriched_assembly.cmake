@@ -8,6 +8,11 @@ set_source_files_properties(${CMAKE_CURRENT_SOURCE_DIR}/kernels/gram_accumulatio
                             ${CMAKE_CURRENT_SOURCE_DIR}/kernels/enriched_rotation_clusters.cpp
                             PROPERTIES COMPILE_OPTIONS -ffp-contract=off)
 
+# The merge test of the adaptive enriched quadrature (kernels/enriched_quadrature.cpp) is
+# cloned likewise; without contraction every clone merges the same cells.
+set_source_files_properties(${CMAKE_CURRENT_SOURCE_DIR}/kernels/enriched_quadrature.cpp
+                            PROPERTIES COMPILE_OPTIONS -ffp-contract=off)
+
 # The Gram-Schmidt of the enriched-node test (runtime/enrichment_span.cpp) is cloned for
 # AVX-512, AVX2 and the baseline; without contraction all clones keep or drop the same nodes.
 set_source_files_properties(${CMAKE_CURRENT_SOURCE_DIR}/runtime/enrichment_span.cpp
