@@ -1,9 +1,11 @@
 // Adaptive enriched quadrature (enriched_element_quadrature) on T = 256 textures like the
 // progressive-cut scenes': one quad8 element with the harmonic enrichment of a partial
-// spiral cut (spiral1), four quad8 elements with partial straight cuts (chad-sized), and one
-// with complete cuts (Heaviside). Fast form (1 thread and all threads) against the serial
-// reference twin; both give bitwise the same points (test_enrichment_quadrature_speed).
-// Argument: scene (0 spiral, 1 four elements, 2 complete cuts); reference? (0/1); threads.
+// spiral cut (spiral1), four quad8 elements with partial straight cuts (chad-sized), one
+// with complete cuts (Heaviside) and one with six partial cuts (six textures on one element,
+// as spiral6 has). Fast form (1 thread and all threads) against the serial reference twin;
+// both give bitwise the same points (test_enrichment_quadrature_speed).
+// Argument: scene (0 spiral, 1 four elements, 2 complete cuts, 3 six arcs); reference? (0/1);
+// threads.
 #include <benchmark/benchmark.h>
 #include <omp.h>
 
@@ -76,6 +78,18 @@ std::unique_ptr<Scene> make_scene(int which) {
     textures.push_back({harmonic({{0.6 * t, t}, {0.5 * t, 0.25 * t}})});
     return std::make_unique<Scene>(std::move(textures));
   }
+  if (which == 3) {  // one element with six textures (spiral6's count): a spiral in six arcs
+    std::vector<kernels::TexelTile> arcs;
+    for (int k = 0; k < 6; ++k) {
+      std::vector<kernels::TexelPoint> line;
+      for (int n = 0; n <= 40; ++n) {
+        const double a = M_PI + 3.5 * M_PI * (40 * k + n) / 240.0, r = 0.48 * t * (1 - 0.8 * (40 * k + n) / 240.0);
+        line.push_back({0.5 * t + r * std::cos(a), 0.5 * t + r * std::sin(a)});
+      }
+      arcs.push_back(harmonic(line));
+    }
+    return std::make_unique<Scene>(std::vector<std::vector<kernels::TexelTile>>{std::move(arcs)});
+  }
   kernels::TexelTile walls = kernels::make_element_tile(ElementType::quad8, kResolution);
   const kernels::CutRaster a = kernels::rasterize_cut({{0, 0.3 * t}, {t, 0.6 * t}}, walls);
   const kernels::CutRaster b = kernels::rasterize_cut({{0.2 * t, 0}, {0.4 * t, 0.5 * t}, {0.3 * t, t}}, walls);
@@ -111,9 +125,10 @@ void BM_EnrichedElementQuadrature(benchmark::State& state) {
 
 BENCHMARK(BM_EnrichedElementQuadrature)
     ->ArgNames({"scene", "reference", "threads"})
-    ->ArgsProduct({{0, 1, 2}, {1, 0}, {1}})
+    ->ArgsProduct({{0, 1, 2, 3}, {1, 0}, {1}})
     ->Args({0, 0, 2})
     ->Args({1, 0, 2})
+    ->Args({3, 0, 2})
     ->Unit(benchmark::kMillisecond);
 
 BENCHMARK_MAIN();
