@@ -57,7 +57,7 @@ AccuracyChart run_rotation_accuracy(const RotationAccuracyOptions& options, cons
   chart.time_label = accuracy_clock_name(options.clock) + " ms: the whole run (" + std::to_string(options.steps) +
                      " steps, rest sums of the clusters included)";
   chart.error_label = "|u - u_ref| / |u_ref| vs per-point rotations";
-  const std::string series = options.scene.substr(options.scene.find_last_of('/') + 1);
+  const std::string series = detail::scene_file_name(options.scene);
   const RotationRun reference = run_scene(base, 0, options.steps, options.clock);
   const double reference_norm = detail::squared_norm(reference.displacement);
   auto add = [&](const std::string& label, const RotationRun& run) {

@@ -116,7 +116,7 @@ AccuracyChart run_scene_quadrature_accuracy(const SceneQuadratureAccuracyOptions
     throw std::invalid_argument("scene quadrature accuracy: " + options.scene +
                                 " has no cuts; the merge tolerance applies to the quadrature of cut elements");
   const int steps = options.steps > 0 ? options.steps : scene.analysis.steps;
-  const std::string name = options.scene.substr(options.scene.find_last_of('/') + 1);
+  const std::string name = detail::scene_file_name(options.scene);
   AccuracyChart chart;
   chart.name = "scene_quadrature";
   chart.title = "merge tolerance of the enriched quadrature over a whole scene (" + name + ")";

@@ -19,6 +19,8 @@ TimedSceneRun run_scene_timed(const Scene& scene, int steps, AccuracyClock clock
   return out;
 }
 
+std::string scene_file_name(const std::string& path) { return path.substr(path.find_last_of('/') + 1); }
+
 double squared_distance(const std::vector<double>& a, const std::vector<double>& b) {
   double sum = 0;
   for (std::size_t k = 0; k < a.size(); ++k) sum += (a[k] - b[k]) * (a[k] - b[k]);

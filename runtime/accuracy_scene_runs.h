@@ -1,8 +1,9 @@
 #pragma once
 // Internal: the scene runs of the accuracy sweeps that vary a scene setting (rotation
 // clusters, quadrature merge tolerance): a whole run timed (set-up, steps and cut updates in
-// one time), and the distances their errors are made of.
+// one time), the distances their errors are made of, and the series name of a scene file.
 #include <functional>
+#include <string>
 #include <vector>
 
 #include "dgtex/accuracy_benchmark.h"
@@ -19,6 +20,9 @@ struct TimedSceneRun {
 // (1-based; where a sweep reads the state, at the end when k == steps).
 TimedSceneRun run_scene_timed(const Scene& scene, int steps, AccuracyClock clock,
                               const std::function<void(const SceneRun& run, int step)>& after_step);
+
+// The scene file's name without its folders: the sweep's series name.
+std::string scene_file_name(const std::string& path);
 
 // |a - b|^2 over a's entries (b holds at least as many), and |a|^2.
 double squared_distance(const std::vector<double>& a, const std::vector<double>& b);
