@@ -50,7 +50,7 @@ __attribute__((always_inline)) inline void prefetch_entries(const Scalar* p, int
 }
 
 template <class V, int L, class Scalar>
-__attribute__((always_inline)) inline void solve(int n, const Scalar* __restrict factor, double* __restrict x) {
+__attribute__((always_inline)) inline void solve(int n, int ld, const Scalar* __restrict factor, double* __restrict x) {
   constexpr int NV = lanes / L;
   const bool prefetch = n >= prefetch_min_unknowns;
   // Forward, in blocks of 8 columns: the block's triangle first, then each entry below it
@@ -61,14 +61,14 @@ __attribute__((always_inline)) inline void solve(int n, const Scalar* __restrict
     const Scalar* column[block];
     double y[block];
     for (int k = 0; k < block; ++k) {
-      column[k] = factor + static_cast<std::size_t>(j + k) * n;
+      column[k] = factor + static_cast<std::size_t>(j + k) * ld;
       y[k] = x[j + k] / static_cast<double>(column[k][j + k]);
       x[j + k] = y[k];
       for (int i = j + k + 1; i < j + block; ++i) x[i] = x[i] - static_cast<double>(column[k][i]) * y[k];
     }
     if (prefetch && j + 2 * block <= n)  // the next block's columns, from its first row on
       for (int k = 0; k < block; ++k)
-        prefetch_entries(column[k] + static_cast<std::size_t>(block) * n + j + block, n - j - block);
+        prefetch_entries(column[k] + static_cast<std::size_t>(block) * ld + j + block, n - j - block);
     int i = j + block;
     for (; i + L <= n; i += L) {
       V xi;
@@ -85,16 +85,16 @@ __attribute__((always_inline)) inline void solve(int n, const Scalar* __restrict
       for (int k = 0; k < block; ++k) x[i] = x[i] - static_cast<double>(column[k][i]) * y[k];
   }
   for (; j < n; ++j) {
-    const Scalar* column = factor + static_cast<std::size_t>(j) * n;
+    const Scalar* column = factor + static_cast<std::size_t>(j) * ld;
     const double yj = x[j] / static_cast<double>(column[j]);
     x[j] = yj;
     for (int i = j + 1; i < n; ++i) x[i] = x[i] - static_cast<double>(column[i]) * yj;
   }
   for (int j = n - 1; j >= 0; --j) {
-    const Scalar* below = factor + static_cast<std::size_t>(j) * n + j + 1;
+    const Scalar* below = factor + static_cast<std::size_t>(j) * ld + j + 1;
     const double* xb = x + j + 1;
     const int count = n - j - 1;
-    if (prefetch && j > 0) prefetch_entries(below - n - 1, count + 1);  // column j - 1 below its diagonal
+    if (prefetch && j > 0) prefetch_entries(below - ld - 1, count + 1);  // column j - 1 below its diagonal
     V acc[NV];
     for (int v = 0; v < NV; ++v) acc[v] = V{};
     int q = 0;
@@ -109,32 +109,32 @@ __attribute__((always_inline)) inline void solve(int n, const Scalar* __restrict
     double s[lanes];
     for (int v = 0; v < NV; ++v) __builtin_memcpy(s + v * L, &acc[v], sizeof(V));
     for (int l = 0; q < count; ++q, ++l) s[l] = s[l] + static_cast<double>(below[q]) * xb[q];
-    x[j] = (x[j] - halving_sum(s)) / static_cast<double>(factor[static_cast<std::size_t>(j) * n + j]);
+    x[j] = (x[j] - halving_sum(s)) / static_cast<double>(factor[static_cast<std::size_t>(j) * ld + j]);
   }
 }
 
 template <class Scalar>
-__attribute__((target("avx512f"))) void solve_avx512(int n, const Scalar* factor, double* x) {
-  solve<V8, 8>(n, factor, x);
+__attribute__((target("avx512f"))) void solve_avx512(int n, int ld, const Scalar* factor, double* x) {
+  solve<V8, 8>(n, ld, factor, x);
 }
 template <class Scalar>
-__attribute__((target("avx2"))) void solve_avx2(int n, const Scalar* factor, double* x) {
-  solve<V4, 4>(n, factor, x);
+__attribute__((target("avx2"))) void solve_avx2(int n, int ld, const Scalar* factor, double* x) {
+  solve<V4, 4>(n, ld, factor, x);
 }
 template <class Scalar>
-void solve_baseline(int n, const Scalar* factor, double* x) {
-  solve<V2, 2>(n, factor, x);
+void solve_baseline(int n, int ld, const Scalar* factor, double* x) {
+  solve<V2, 2>(n, ld, factor, x);
 }
 
 template <class Scalar>
-void solve_reference(int n, const Scalar* L, double* x) {
+void solve_reference(int n, int ld, const Scalar* L, double* x) {
   for (int j = 0; j < n; ++j) {
-    const Scalar* column = L + static_cast<std::size_t>(j) * n;
+    const Scalar* column = L + static_cast<std::size_t>(j) * ld;
     x[j] = x[j] / static_cast<double>(column[j]);
     for (int i = j + 1; i < n; ++i) x[i] = x[i] - static_cast<double>(column[i]) * x[j];
   }
   for (int j = n - 1; j >= 0; --j) {
-    const Scalar* column = L + static_cast<std::size_t>(j) * n;
+    const Scalar* column = L + static_cast<std::size_t>(j) * ld;
     double s[lanes] = {};
     for (int i = j + 1; i < n; ++i) {
       double& lane = s[(i - j - 1) % lanes];
@@ -146,15 +146,15 @@ void solve_reference(int n, const Scalar* L, double* x) {
 
 }  // namespace
 
-void dense_cholesky_solve(int n, const double* L, double* x, VectorPath path) {
-  kernel_of(path, solve_avx512<double>, solve_avx2<double>, solve_baseline<double>)(n, L, x);
+void dense_cholesky_solve(int n, int ld, const double* L, double* x, VectorPath path) {
+  kernel_of(path, solve_avx512<double>, solve_avx2<double>, solve_baseline<double>)(n, ld, L, x);
 }
 
-void dense_cholesky_solve(int n, const float* L, double* x, VectorPath path) {
-  kernel_of(path, solve_avx512<float>, solve_avx2<float>, solve_baseline<float>)(n, L, x);
+void dense_cholesky_solve(int n, int ld, const float* L, double* x, VectorPath path) {
+  kernel_of(path, solve_avx512<float>, solve_avx2<float>, solve_baseline<float>)(n, ld, L, x);
 }
 
-void dense_cholesky_solve_reference(int n, const double* L, double* x) { solve_reference(n, L, x); }
-void dense_cholesky_solve_reference(int n, const float* L, double* x) { solve_reference(n, L, x); }
+void dense_cholesky_solve_reference(int n, int ld, const double* L, double* x) { solve_reference(n, ld, L, x); }
+void dense_cholesky_solve_reference(int n, int ld, const float* L, double* x) { solve_reference(n, ld, L, x); }
 
 }  // namespace dgtex::kernels

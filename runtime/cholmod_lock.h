@@ -1,7 +1,6 @@
 #pragma once
 // Internal: one process-wide lock held around every CHOLMOD analysis, factorisation and
-// solve in dgtex (SparseCholesky and Eigen's CholmodSupernodalLLT alike) and every LAPACK
-// call (the dense factorisation of small systems, dense_cholesky.cpp), except the texel
+// solve in dgtex (SparseCholesky and Eigen's CholmodSupernodalLLT alike), except the texel
 // Laplacians of mesh_texel_laplace.cpp (simplicial with AMD) and the multigrid's coarsest
 // level (simplicial in its own order, laplace_multigrid.cpp): they call neither BLAS nor
 // METIS, so the two hazards below cannot arise there.

@@ -1,19 +1,20 @@
 #pragma once
 // Internal to SparseCholesky: the dense factorisation it uses for small systems (a cut
-// single element has 39-450 unknowns, mostly coupled to each other). CHOLMOD's analysis,
+// single element has 39-498 unknowns, mostly coupled to each other). CHOLMOD's analysis,
 // supernodal bookkeeping and OpenMP regions cost more there than the arithmetic: n = 39,
 // analysis + factorisation 0.03-0.12 ms against 0.007 ms for Eigen's blocked LLT, and 0.2-2
 // ms inside a scene step with spinning OpenMP threads; n = 441 (fully dense) 2.9-3.4 ms
-// against 2.2 ms (one run of each, 2-core machine). Since session 18 systems of 128 unknowns
-// and more are factorised by LAPACK's dpotrf (OpenBLAS, serial; under the process-wide BLAS
-// lock, cholmod_lock.h): 1.5x Eigen's LLT at n = 168 and 1.8-1.9x at 441-498 in this
-// baseline x86-64 build (examples/bench_dense_cholesky). The solves are
-// kernels::dense_cholesky_solve (a path per instruction set): Eigen's triangular solves
-// took half the time of dpotrs, and these 3/4 of Eigen's (the accordion's preconditioner,
-// 447 unknowns, 60 -> 45 us an application in its scene).
+// against 2.2 ms (one run of each, 2-core machine). Since session 55 both the
+// factorisation and the solves are dgtex's own kernels (kernels::dense_cholesky_factor,
+// kernels::dense_cholesky_solve: a path per instruction set, the same bits on each). The
+// factorisation replaced Eigen's LLT (below 128 unknowns) and LAPACK's dpotrf (from 128
+// on, serial OpenBLAS under the process-wide BLAS lock): 2-3x Eigen's LLT at 36-168
+// unknowns, 1.2-1.4x dpotrf at 126-256 and as fast at 450, in isolation
+// (examples/bench_dense_cholesky). The solves took 3/4 of Eigen's triangular solves, which
+// took half of dpotrs (the accordion's preconditioner, 447 unknowns, 60 -> 45 us an
+// application in its scene).
+#include <cstdint>
 #include <vector>
-
-#include <Eigen/Dense>
 
 namespace dgtex::detail {
 
@@ -40,9 +41,10 @@ class DenseCholesky {
 
  private:
   int n_ = 0;
+  int ld_ = 0;  // factor_'s leading dimension (kernels::dense_cholesky_padded_rows)
   std::vector<int> column_start_, row_index_;
-  Eigen::MatrixXd factor_;  // the lower triangle of A, then its Cholesky factor L
-  std::vector<float> single_factor_;  // L's lower triangle in float (same layout; upper unused)
+  std::vector<double> factor_;  // the lower triangle of A, then its Cholesky factor L (column-major)
+  std::vector<float> single_factor_;  // L's lower triangle in float (n x n column-major; upper unused)
   bool single_factor_current_ = false;  // single_factor_ holds the current factor
   void fill_lower(const std::vector<double>& values);  // factor_ = the lower triangle of A
 };

@@ -156,8 +156,8 @@ void ShellSimulation::step(const DynamicsOptions& o) {
       timings_["assembly"].add(t.second_ms);
       factorization_wait_ms = t.total_ms - t.second_ms;
     } else {
-      // A pending dense factor (at most 512 unknowns, serial dpotrf: ~1 ms for the
-      // accordion's 450) is factorised first, in turn: beside it the assembly would run on
+      // A pending dense factor (at most 512 unknowns, kernels::dense_cholesky_factor: ~1 ms
+      // for the accordion's 450) is factorised first, in turn: beside it the assembly would run on
       // one thread (the accordion's 6 -> 10 ms), a gain only where the factorisation takes
       // longer than the assembly saves on the other threads (run_side_by_side).
       const auto start = std::chrono::steady_clock::now();

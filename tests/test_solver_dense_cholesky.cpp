@@ -1,19 +1,22 @@
 // SparseCholesky's dense path for small systems (runtime/dense_cholesky.h) against its
 // CHOLMOD path on the same matrices: solutions, errors for indefinite and non-finite
 // matrices, which systems take which path, and the float copy of large factors. Its
-// triangular solves (dgtex/kernels/dense_cholesky_solve.h), with the factor in double and
-// in float, are bitwise their reference on every path the machine supports and Eigen's
-// solves to round-off (double) or to float's rounding of L.
+// factorisation (dgtex/kernels/dense_cholesky_factor.h) and triangular solves
+// (dgtex/kernels/dense_cholesky_solve.h, with the factor in double and in float) are
+// bitwise their references on every path the machine supports, and Eigen's LLT and solves
+// to round-off (double) or to float's rounding of L.
 #include <gtest/gtest.h>
 #include <omp.h>
 
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <random>
 #include <vector>
 
 #include <Eigen/Dense>
 
+#include "dgtex/kernels/dense_cholesky_factor.h"
 #include "dgtex/kernels/dense_cholesky_solve.h"
 #include "dgtex/sparse_cholesky.h"
 #include "vector_path_support.h"
@@ -83,8 +86,8 @@ TEST(DenseCholesky, SolvesLikeCholmodOnSmallSystems) {
 }
 
 TEST(DenseCholesky, DoesNotDependOnTheThreadCount) {
-  // The factor (LAPACK's dpotrf at this size, serial OpenBLAS) must not depend on the
-  // OpenMP thread count.
+  // The factor (kernels::dense_cholesky_factor, serial) must not depend on the OpenMP
+  // thread count.
   const LowerCsc m = lower_csc(random_spd(441, 441, 19u));
   std::vector<double> b(441);
   for (int i = 0; i < 441; ++i) b[i] = std::cos(0.7 * i);
@@ -163,29 +166,95 @@ TEST(DenseCholesky, TriangularSolvesAreBitwiseTheReferenceOnEveryPath) {
     std::vector<double> b(n);
     for (double& v : b) v = u(rng);
     std::vector<double> expected = b;
-    dgtex::kernels::dense_cholesky_solve_reference(n, L.data(), expected.data());
+    dgtex::kernels::dense_cholesky_solve_reference(n, n, L.data(), expected.data());
     const Eigen::VectorXd eigen = a.llt().solve(Eigen::Map<const Eigen::VectorXd>(b.data(), n));
     for (int i = 0; i < n; ++i)
       EXPECT_NEAR(expected[i], eigen[i], 1e-11 * eigen.cwiseAbs().maxCoeff()) << "n = " << n << ", entry " << i;
     // The float factor: L rounded, every other operation as in double.
     const std::vector<float> single(L.data(), L.data() + static_cast<std::size_t>(n) * n);
     std::vector<double> expected_single = b;
-    dgtex::kernels::dense_cholesky_solve_reference(n, single.data(), expected_single.data());
+    dgtex::kernels::dense_cholesky_solve_reference(n, n, single.data(), expected_single.data());
     for (int i = 0; i < n; ++i)
       EXPECT_NEAR(expected_single[i], eigen[i], 1e-5 * eigen.cwiseAbs().maxCoeff()) << "n = " << n << ", entry " << i;
     for (dgtex::kernels::VectorPath path : dgtex::testing_support::supported_vector_paths()) {
       std::vector<double> x = b;
-      dgtex::kernels::dense_cholesky_solve(n, L.data(), x.data(), path);
+      dgtex::kernels::dense_cholesky_solve(n, n, L.data(), x.data(), path);
       EXPECT_EQ(x, expected) << "n = " << n << ", path " << static_cast<int>(path);
       x = b;
-      dgtex::kernels::dense_cholesky_solve(n, single.data(), x.data(), path);
+      dgtex::kernels::dense_cholesky_solve(n, n, single.data(), x.data(), path);
       EXPECT_EQ(x, expected_single) << "float factor, n = " << n << ", path " << static_cast<int>(path);
     }
   }
 }
 
+TEST(DenseCholesky, FactorIsBitwiseTheReferenceOnEveryPathAndEigensToRoundOff) {
+  // Sizes around the panels of 4 columns, the vector widths (2, 4, 8 rows) and the passes of
+  // 2 vectors, and the scenes' 36-168 and 450. The scratch (upper triangle, padding rows)
+  // holds arbitrary finite values: the lower triangle must not depend on them.
+  for (int n : {1, 2, 3, 4, 5, 7, 8, 9, 15, 16, 17, 23, 31, 33, 36, 48, 126, 168, 450}) {
+    const Eigen::MatrixXd a = random_spd(n, n, 7u + n);
+    const int ld = dgtex::kernels::dense_cholesky_padded_rows(n);
+    ASSERT_GE(ld, n);
+    std::mt19937 rng(n);
+    std::uniform_real_distribution<double> u(-1e3, 1e3);
+    std::vector<double> input(static_cast<std::size_t>(ld) * n);
+    for (int j = 0; j < n; ++j)
+      for (int i = 0; i < ld; ++i) input[static_cast<std::size_t>(j) * ld + i] = i >= j && i < n ? a(i, j) : u(rng);
+    const auto lower = [&](const std::vector<double>& factor) {
+      Eigen::MatrixXd l = Eigen::MatrixXd::Zero(n, n);
+      for (int j = 0; j < n; ++j)
+        for (int i = j; i < n; ++i) l(i, j) = factor[static_cast<std::size_t>(j) * ld + i];
+      return l;
+    };
+    std::vector<double> reference = input;
+    ASSERT_EQ(dgtex::kernels::dense_cholesky_factor_reference(n, ld, reference.data()), -1) << n;
+    const Eigen::MatrixXd expected = lower(reference), eigen = a.llt().matrixL();
+    EXPECT_LE((expected - eigen).cwiseAbs().maxCoeff(), 1e-13 * eigen.cwiseAbs().maxCoeff()) << "n = " << n;
+    for (dgtex::kernels::VectorPath path : dgtex::testing_support::supported_vector_paths()) {
+      std::vector<double> factor = input;
+      ASSERT_EQ(dgtex::kernels::dense_cholesky_factor(n, ld, factor.data(), path), -1) << n;
+      const Eigen::MatrixXd l = lower(factor);
+      EXPECT_EQ(std::memcmp(l.data(), expected.data(), sizeof(double) * n * n), 0)
+          << "n = " << n << ", path " << static_cast<int>(path) << ": largest difference "
+          << (l - expected).cwiseAbs().maxCoeff();
+    }
+  }
+}
+
+TEST(DenseCholesky, FactorStopsAtTheFirstUnusablePivotOnEveryPath) {
+  // Column `bad` repeats column 3 in the leading block with its diagonal one lower (pivot
+  // -1), or holds a NaN or infinite diagonal: every path and the reference name that
+  // column, wherever it falls in a panel of 4.
+  const double nan = std::numeric_limits<double>::quiet_NaN(), inf = std::numeric_limits<double>::infinity();
+  for (int n : {9, 50, 131}) {
+    for (int bad : {4, 6, 7}) {
+      for (double diagonal : {-1.0, nan, inf}) {
+        Eigen::MatrixXd a = random_spd(n, n, 29u);
+        if (diagonal == -1.0) {
+          a.row(bad).head(bad) = a.row(3).head(bad);
+          a.col(bad).head(bad) = a.col(3).head(bad);
+          a(bad, bad) = a(3, 3) - 1;
+        } else {
+          a(bad, bad) = diagonal;
+        }
+        const int ld = dgtex::kernels::dense_cholesky_padded_rows(n);
+        std::vector<double> input(static_cast<std::size_t>(ld) * n, 0.0);
+        for (int j = 0; j < n; ++j)
+          for (int i = j; i < n; ++i) input[static_cast<std::size_t>(j) * ld + i] = a(i, j);
+        std::vector<double> reference = input;
+        EXPECT_EQ(dgtex::kernels::dense_cholesky_factor_reference(n, ld, reference.data()), bad)
+            << "n = " << n << ", diagonal " << diagonal;
+        for (dgtex::kernels::VectorPath path : dgtex::testing_support::supported_vector_paths()) {
+          std::vector<double> factor = input;
+          EXPECT_EQ(dgtex::kernels::dense_cholesky_factor(n, ld, factor.data(), path), bad)
+              << "n = " << n << ", diagonal " << diagonal << ", path " << static_cast<int>(path);
+        }
+      }
+    }
+  }
+}
+
 TEST(DenseCholesky, ReportsTheFirstNonPositivePivot) {
-  // Both factorisations: Eigen's LLT (small systems) and LAPACK's dpotrf (128 unknowns on).
   for (int n : {50, 200}) {
     Eigen::MatrixXd a = random_spd(n, n, 13u);
     // Row and column 17 copy row and column 3 in the leading 18 x 18 block, with the

@@ -6,9 +6,11 @@ set_source_files_properties(
   ${CMAKE_CURRENT_SOURCE_DIR}/kernels/shell_edge_kernel.cpp
   PROPERTIES COMPILE_OPTIONS -ffp-contract=off)
 # The block products of the step and its PCG (kernels/block_product.cpp) and the dense
-# preconditioner's solves (kernels/dense_cholesky_solve.cpp) have a path per instruction
-# set; without contraction every path gives the same bits.
+# factorisation and solves of small systems (kernels/dense_cholesky_factor.cpp,
+# kernels/dense_cholesky_solve.cpp) have a path per instruction set; without contraction
+# every path gives the same bits.
 set_source_files_properties(${CMAKE_CURRENT_SOURCE_DIR}/kernels/block_product.cpp
+  ${CMAKE_CURRENT_SOURCE_DIR}/kernels/dense_cholesky_factor.cpp
   ${CMAKE_CURRENT_SOURCE_DIR}/kernels/dense_cholesky_solve.cpp
   PROPERTIES COMPILE_OPTIONS -ffp-contract=off)
 # The material-texture stiffness's rest rows, several points at a time

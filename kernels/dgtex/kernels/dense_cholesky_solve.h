@@ -1,8 +1,8 @@
 #pragma once
 // x = L^-T L^-1 b with a dense Cholesky factor L: the preconditioner of the corotated step
 // for small systems (a cut single element: 39-498 unknowns, factored densely; the accordion
-// applies it 5 times a step). L is n x n column-major (leading dimension n), its lower
-// triangle used.
+// applies it 5 times a step). L is n x n column-major with leading dimension ld >= n, its
+// lower triangle used.
 //
 // Order of the operations (every path, and the reference, round exactly alike: no FMA
 // contraction, lanes never mix): forward, column by column, y_j = y_j / L_jj and then
@@ -22,13 +22,13 @@
 namespace dgtex::kernels {
 
 // x holds b on entry, the solution on return.
-void dense_cholesky_solve(int n, const double* L, double* x, VectorPath path = VectorPath::best);
+void dense_cholesky_solve(int n, int ld, const double* L, double* x, VectorPath path = VectorPath::best);
 // The same with L rounded to float (the stale preconditioner of large dense systems: half
 // the bytes to read). x stays in double and each entry of L is widened exactly, so only the
 // rounding of L differs: the operations and their order are those above.
-void dense_cholesky_solve(int n, const float* L, double* x, VectorPath path = VectorPath::best);
+void dense_cholesky_solve(int n, int ld, const float* L, double* x, VectorPath path = VectorPath::best);
 // The same operations one entry at a time.
-void dense_cholesky_solve_reference(int n, const double* L, double* x);
-void dense_cholesky_solve_reference(int n, const float* L, double* x);
+void dense_cholesky_solve_reference(int n, int ld, const double* L, double* x);
+void dense_cholesky_solve_reference(int n, int ld, const float* L, double* x);
 
 }  // namespace dgtex::kernels
