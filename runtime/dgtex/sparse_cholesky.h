@@ -2,7 +2,7 @@
 // Sparse Cholesky factorisation through CHOLMOD (supernodal). The symbolic analysis (fill
 // reducing ordering, supernodes) is done once per pattern and reused by every numeric
 // factorisation with the same pattern, as in a time loop. Small, mostly dense systems (a
-// cut single element) are factored densely instead (Eigen's LLT, see dense_cholesky.h):
+// cut single element) are factored densely instead (dgtex's own kernel, dense_cholesky.h):
 // up to 128 unknowns, or up to 512 with at least a quarter of the lower triangle stored.
 //
 // Matrices are given as the LOWER triangle in compressed-column form (n x n, 0-based).
