@@ -48,7 +48,8 @@ void DenseCholesky::copy_factor_to_single_precision() {
   single_factor_.resize(static_cast<std::size_t>(n_) * n_);  // allocated once, kept between factors
   for (int j = 0; j < n_; ++j)
     for (int i = j; i < n_; ++i)
-      single_factor_[static_cast<std::size_t>(j) * n_ + i] = static_cast<float>(factor_[static_cast<std::size_t>(j) * ld_ + i]);
+      single_factor_[static_cast<std::size_t>(j) * n_ + i] =
+          static_cast<float>(factor_[static_cast<std::size_t>(j) * ld_ + i]);
   single_factor_current_ = true;
 }
 

@@ -8,9 +8,9 @@
 // factorisation and the solves are dgtex's own kernels (kernels::dense_cholesky_factor,
 // kernels::dense_cholesky_solve: a path per instruction set, the same bits on each). The
 // factorisation replaced Eigen's LLT (below 128 unknowns) and LAPACK's dpotrf (from 128
-// on, serial OpenBLAS under the process-wide BLAS lock): 2-3x Eigen's LLT at 36-168
-// unknowns, 1.2-1.4x dpotrf at 126-256 and as fast at 450, in isolation
-// (examples/bench_dense_cholesky). The solves took 3/4 of Eigen's triangular solves, which
+// on, serial OpenBLAS under the process-wide BLAS lock): about 2x Eigen's LLT at 48-498
+// unknowns, 1.4-1.6x dpotrf at 126-168 and as fast at 441-498, in isolation
+// (examples/bench_dense_cholesky, session 55). The solves took 3/4 of Eigen's triangular solves, which
 // took half of dpotrs (the accordion's preconditioner, 447 unknowns, 60 -> 45 us an
 // application in its scene).
 #include <cstdint>

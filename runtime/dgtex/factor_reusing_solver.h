@@ -37,9 +37,9 @@
 // assembles A_k+1 (FactorReuseOptions::overlap_factorization, factorize_pending()): CHOLMOD
 // factorises on one core, and waiting for it cost ~4 ms of the cylinder scene's ~22 ms step
 // (2 threads). The whole pattern's pending factor is the one passed to that solve. A
-// pending dense factor (dense_factorization_pending(): ~1 ms at 450 unknowns) is factorised in turn
-// before the assembly instead (ShellSimulation::step): beside it the assembly would run on
-// one thread fewer for longer than the factorisation takes.
+// pending dense factor (dense_factorization_pending(): ~1 ms at 450 unknowns) is
+// factorised in turn before the assembly instead (ShellSimulation::step): beside it the
+// assembly would run on one thread fewer for longer than the factorisation takes.
 //
 // Determinism: the factor (CHOLMOD with serial BLAS), the block matrix-vector product
 // and the dot products (fixed chunking, summed in a fixed order) do not depend on the
@@ -157,8 +157,8 @@ class FactorReusingSolver {
   }
   // A factorisation left for factorize_pending() (options().overlap_factorization).
   bool factorization_pending() const { return factorization_pending_; }
-  // ... of a dense factor (SparseCholesky::factors_densely: about 1 ms at 450
-  // unknowns), cheap enough to run in turn before an assembly instead of beside it.
+  // ... of a dense factor (SparseCholesky::factors_densely: about 1 ms at 450 unknowns),
+  // cheap enough to run in turn before an assembly instead of beside it.
   bool dense_factorization_pending() const { return factorization_pending_ && whole_pattern_dense_; }
   // Factorises the matrix gathered by the last solve, if one is pending. Needs no OpenMP
   // team (CHOLMOD with serial BLAS): safe to run beside code that touches neither this

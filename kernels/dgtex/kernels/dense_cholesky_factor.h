@@ -3,9 +3,10 @@
 // 512 unknowns), the factorisation of the step solver and of the basis projection's mass
 // matrix for the cut single elements of the Table 5.1 scenes (36-498 unknowns, a new factor
 // at almost every basis change). A is n x n column-major with leading dimension
-// ld >= dense_cholesky_padded_rows(n); its lower triangle is read and overwritten with L. The strict upper triangle and the rows n..ld-1 are scratch: the
-// paths compute whole vectors of rows there instead of a scalar remainder, so they must
-// hold finite values (zeros, say) and end with unspecified ones.
+// ld >= dense_cholesky_padded_rows(n); its lower triangle is read and overwritten with L.
+// The strict upper triangle and the rows n..ld-1 are scratch: the paths compute whole
+// vectors of rows there instead of a scalar remainder, so they must hold finite values
+// (zeros, say) and end with unspecified ones.
 //
 // Order of the operations (every path, and the reference, round exactly alike: no FMA
 // contraction, lanes never mix): left-looking, column by column,
