@@ -1,7 +1,8 @@
 #pragma once
 // Internal: the scene runs of the accuracy sweeps that vary a scene setting (rotation
 // clusters, quadrature merge tolerance): a whole run timed (set-up, steps and cut updates in
-// one time), the distances their errors are made of, and the series name of a scene file.
+// one time), the distances their errors are made of (also the solver tolerance sweep's),
+// and the series name of a scene file.
 #include <functional>
 #include <string>
 #include <vector>

@@ -12,6 +12,7 @@
 #include "dgtex/laplace_domains.h"
 #include "dgtex/laplace_solver.h"
 #include "dgtex/shell_benchmark.h"
+#include "accuracy_scene_runs.h"
 
 namespace dgtex {
 namespace {
@@ -26,9 +27,7 @@ void shell_points(const ToleranceAccuracyOptions& options, const AccuracyProgres
   const int threads = omp_get_max_threads();
   const std::string series = "shell PCG (" + std::to_string(options.shell_steps) + " steps)";
   const ShellBenchRun reference = run_shell_benchmark(options.shell_scene, options.shell_steps, threads, false);
-  double reference_norm = 0;
-  for (double v : reference.displacement) reference_norm += v * v;
-  reference_norm = std::sqrt(reference_norm);
+  const double reference_norm = detail::squared_norm(reference.displacement);
   auto add = [&](const std::string& label, const ShellBenchRun& run, double error) {
     AccuracyPoint p;
     p.series = series;
@@ -57,10 +56,8 @@ void shell_points(const ToleranceAccuracyOptions& options, const AccuracyProgres
     const ShellBenchRun run = run_shell_benchmark(options.shell_scene, options.shell_steps, threads, true, solver);
     if (run.displacement.size() != reference.displacement.size())
       throw std::logic_error("tolerance accuracy: DOF counts of the runs differ");
-    double diff = 0;
-    for (std::size_t k = 0; k < run.displacement.size(); ++k)
-      diff += (run.displacement[k] - reference.displacement[k]) * (run.displacement[k] - reference.displacement[k]);
-    add(tolerance_label(tol), run, reference_norm > 0 ? std::sqrt(diff) / reference_norm : std::sqrt(diff));
+    add(tolerance_label(tol), run,
+        detail::relative_root(detail::squared_distance(run.displacement, reference.displacement), reference_norm));
   }
 }
 

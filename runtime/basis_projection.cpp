@@ -16,18 +16,18 @@ ProjectedState project_onto_basis(const ShellModel& old_model, const std::vector
 
 ProjectedState project_onto_basis(const ShellModel& old_model, const std::vector<double>& old_displacement,
                                   const std::vector<double>& old_velocity, const ShellModel& new_model,
-                                  const FreeDofSystem& system) {
+                                  const FreeDofSystem& new_system) {
   const char* function = "project_onto_basis";
   detail::check_size(function, "old_displacement", old_displacement.size(), "old_model.num_dofs()",
                      old_model.num_dofs());
   if (!old_velocity.empty())
     detail::check_size(function, "old_velocity", old_velocity.size(), "old_model.num_dofs()", old_model.num_dofs());
-  detail::check_size(function, "new_system.num_dofs()", system.num_dofs(), "new_model.num_dofs()",
+  detail::check_size(function, "new_system.num_dofs()", new_system.num_dofs(), "new_model.num_dofs()",
                      new_model.num_dofs());
   std::vector<double> values;
-  system.gather(new_model.mass_blocks().data(), 1.0, nullptr, 0.0, values);
+  new_system.gather(new_model.mass_blocks().data(), 1.0, nullptr, 0.0, values);
   SparseCholesky mass;
-  mass.analyze(system.size(), system.column_start(), system.row_index());
+  mass.analyze(new_system.size(), new_system.column_start(), new_system.row_index());
   mass.factorize(values);
 
   // Moments of displacement and velocity in one pass over the quadrature points.
@@ -36,9 +36,9 @@ ProjectedState project_onto_basis(const ShellModel& old_model, const std::vector
   const std::vector<std::vector<double>> moments = new_model.moments_of_fields(old_model, fields);
   auto project = [&](const std::vector<double>& moment) {
     std::vector<double> rhs, reduced, solution;
-    system.restrict_vector(moment, rhs);
+    new_system.restrict_vector(moment, rhs);
     mass.solve(rhs, reduced);
-    system.expand_vector(reduced, solution);
+    new_system.expand_vector(reduced, solution);
     return solution;
   };
   ProjectedState state;
