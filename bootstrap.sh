@@ -40,8 +40,8 @@ case "$mode" in
     echo "demo: wrote out/demo (report.json, deformed.vtu, frames/)";;
   test)
     ctest --test-dir "$build_dir" --output-on-failure -j "$(nproc)" --timeout 900
-    # Then the kernel, mesh, scene and texel-solver tests again under ASan + UBSan
-    # (labelled "sanitize" in tests/CMakeLists.txt); -O1 keeps them quick. -g1 keeps the
+    # Then the library's tests and whole example scene runs under ASan + UBSan (labelled
+    # "sanitize" in tests/CMakeLists.txt); -O1 keeps them quick. -g1 keeps the
     # line tables the sanitizers' stack traces need; the build takes ~15 % less than with -g.
     sanitize_dir="${build_dir}-sanitize"
     cmake -S . -B "$sanitize_dir" -G Ninja -DCMAKE_BUILD_TYPE=Debug -DCMAKE_CXX_FLAGS_DEBUG="-O1 -g1" \
