@@ -27,7 +27,7 @@ void shell_points(const ToleranceAccuracyOptions& options, const AccuracyProgres
   const int threads = omp_get_max_threads();
   const std::string series = "shell PCG (" + std::to_string(options.shell_steps) + " steps)";
   const ShellBenchRun reference = run_shell_benchmark(options.shell_scene, options.shell_steps, threads, false);
-  const double reference_norm = detail::squared_norm(reference.displacement);
+  const double reference_squared_norm = detail::squared_norm(reference.displacement);
   auto add = [&](const std::string& label, const ShellBenchRun& run, double error) {
     AccuracyPoint p;
     p.series = series;
@@ -56,8 +56,8 @@ void shell_points(const ToleranceAccuracyOptions& options, const AccuracyProgres
     const ShellBenchRun run = run_shell_benchmark(options.shell_scene, options.shell_steps, threads, true, solver);
     if (run.displacement.size() != reference.displacement.size())
       throw std::logic_error("tolerance accuracy: DOF counts of the runs differ");
-    add(tolerance_label(tol), run,
-        detail::relative_root(detail::squared_distance(run.displacement, reference.displacement), reference_norm));
+    const double squared_error = detail::squared_distance(run.displacement, reference.displacement);
+    add(tolerance_label(tol), run, detail::relative_root(squared_error, reference_squared_norm));
   }
 }
 

@@ -10,9 +10,9 @@
 // factorisation replaced Eigen's LLT (below 128 unknowns) and LAPACK's dpotrf (from 128
 // on, serial OpenBLAS under the process-wide BLAS lock): about 2x Eigen's LLT at 48-498
 // unknowns, 1.4-1.6x dpotrf at 126-168 and as fast at 441-498, in isolation
-// (examples/bench_dense_cholesky, session 55). The solves took 3/4 of Eigen's triangular solves, which
-// took half of dpotrs (the accordion's preconditioner, 447 unknowns, 60 -> 45 us an
-// application in its scene).
+// (examples/bench_dense_cholesky, session 55). The solves took 3/4 of Eigen's triangular
+// solves, which took half of dpotrs (the accordion's preconditioner, 447 unknowns, 60 -> 45
+// us an application in its scene).
 #include <cstdint>
 #include <vector>
 
@@ -43,8 +43,8 @@ class DenseCholesky {
   int n_ = 0;
   int ld_ = 0;  // factor_'s leading dimension (kernels::dense_cholesky_padded_rows)
   std::vector<int> column_start_, row_index_;
-  std::vector<double> factor_;  // the lower triangle of A, then its Cholesky factor L (column-major)
-  std::vector<float> single_factor_;  // L's lower triangle in float (n x n column-major; upper unused)
+  std::vector<double> factor_;  // A's lower triangle, then L (column-major, ld_ x n_)
+  std::vector<float> single_factor_;  // L's lower triangle in float (n x n; upper unused)
   bool single_factor_current_ = false;  // single_factor_ holds the current factor
   void fill_lower(const std::vector<double>& values);  // factor_ = the lower triangle of A
 };
