@@ -227,7 +227,7 @@ TEST(DenseCholesky, FactorStopsAtTheFirstUnusablePivotOnEveryPath) {
   // column, wherever it falls in a panel of 4.
   const double nan = std::numeric_limits<double>::quiet_NaN(), inf = std::numeric_limits<double>::infinity();
   for (int n : {9, 50, 131}) {
-    for (int bad : {4, 6, 7}) {
+    for (int bad : {4, 5, 6, 7}) {
       for (double diagonal : {-1.0, nan, inf}) {
         Eigen::MatrixXd a = random_spd(n, n, 29u);
         if (diagonal == -1.0) {
