@@ -3,6 +3,8 @@
 // for 1 and 6 enrichment functions, each for complete cuts (constant H: cells merge away
 // from the cuts) and partial cuts (harmonic H: texel-resolved near the cuts). Counters:
 // enriched DOFs and quadrature points. Argument pairs: (enrichments, partial?).
+// BM_EnrichedStiffnessClustered: the corotated stiffness under rotation clusters of 16
+// texels (the example scenes' setting) once their rest sums exist: a step's assembly.
 // BM_EnrichedMassAndLoadWeights: the fused mass pass of a basis change on one element.
 // BM_BendingSums*: the frame split's six bending sums of a curved element for one block of
 // 16 stacked points over `cols` reduced functions, as one weighted Gram kernel against six
@@ -107,6 +109,21 @@ void BM_EnrichedStiffnessCorotated(benchmark::State& state) {
   counters(state, *s.model);
 }
 
+void BM_EnrichedStiffnessClustered(benchmark::State& state) {
+  Setup& s = setup(static_cast<int>(state.range(0)), state.range(1) != 0);
+  ShellModelOptions options;
+  options.rotation_cluster_texels = 16;
+  ShellModel clustered(s.mesh, build_topology(s.mesh), std::vector<kernels::ShellSection>(1, {1e6, 0.3, 0.01, 1000}),
+                       {}, options);
+  clustered.set_enrichments(s.functions);
+  std::vector<double> current = clustered.rest_state(), K, f;
+  for (size_t d = 0; d < current.size(); ++d) current[d] += 0.01 * std::sin(0.7 * d);
+  clustered.assemble_stiffness(current.data(), K, &f);  // builds the rest sums, untimed
+  for (auto _ : state) clustered.assemble_stiffness(current.data(), K, &f);
+  counters(state, clustered);
+  state.counters["clusters"] = static_cast<double>(clustered.num_rotation_clusters());
+}
+
 void BM_EnrichedStiffnessPerTexel(benchmark::State& state) {
   // The dense reference: per-texel quadrature everywhere (no merging).
   const int count = static_cast<int>(state.range(0));
@@ -204,6 +221,7 @@ void enriched_args(benchmark::internal::Benchmark* b) {
 BENCHMARK(BM_EnrichedSetUp)->Apply(enriched_args);
 BENCHMARK(BM_EnrichedStiffnessLinear)->Apply(enriched_args);
 BENCHMARK(BM_EnrichedStiffnessCorotated)->Apply(enriched_args);
+BENCHMARK(BM_EnrichedStiffnessClustered)->Apply(enriched_args);
 BENCHMARK(BM_EnrichedStiffnessPerTexel) ->Args({1, 1})->Args({6, 1})->Unit(benchmark::kMillisecond)->Iterations(1);
 BENCHMARK(BM_EnrichedMassAndLoadWeights)->Arg(1)->Arg(6)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_BendingSumsWeightedGrams)->Arg(16)->Arg(32)->Arg(64);
