@@ -63,6 +63,17 @@ std::vector<EnrichmentFunction> enrichments(int count, bool partial, const Mesh&
   return functions;
 }
 
+const kernels::ShellSection kSection{1e6, 0.3, 0.01, 1000};
+
+// The one quad8 element's model under `options`, with `functions` set.
+std::unique_ptr<ShellModel> enriched_model(const Mesh& mesh, const std::vector<EnrichmentFunction>& functions,
+                                           const ShellModelOptions& options) {
+  auto model = std::make_unique<ShellModel>(mesh, build_topology(mesh), std::vector<kernels::ShellSection>(1, kSection),
+                                            std::vector<int>{}, options);
+  model->set_enrichments(functions);
+  return model;
+}
+
 struct Setup {
   Mesh mesh = make_rectangle(1, 1, 1, 1, ElementType::quad8);
   std::unique_ptr<ShellModel> model;
@@ -73,11 +84,8 @@ Setup& setup(int count, bool partial) {
   static std::map<std::pair<int, bool>, Setup> cache;
   Setup& s = cache[{count, partial}];
   if (!s.model) {
-    const Topology topology = build_topology(s.mesh);
-    s.model = std::make_unique<ShellModel>(s.mesh, topology, std::vector<kernels::ShellSection>(1, {1e6, 0.3, 0.01, 1000}),
-                                           std::vector<int>{}, ShellModelOptions{});
     s.functions = enrichments(count, partial, s.mesh);
-    s.model->set_enrichments(s.functions);
+    s.model = enriched_model(s.mesh, s.functions, ShellModelOptions{});
   }
   return s;
 }
@@ -113,15 +121,13 @@ void BM_EnrichedStiffnessClustered(benchmark::State& state) {
   Setup& s = setup(static_cast<int>(state.range(0)), state.range(1) != 0);
   ShellModelOptions options;
   options.rotation_cluster_texels = 16;
-  ShellModel clustered(s.mesh, build_topology(s.mesh), std::vector<kernels::ShellSection>(1, {1e6, 0.3, 0.01, 1000}),
-                       {}, options);
-  clustered.set_enrichments(s.functions);
-  std::vector<double> current = clustered.rest_state(), K, f;
+  const std::unique_ptr<ShellModel> clustered = enriched_model(s.mesh, s.functions, options);
+  std::vector<double> current = clustered->rest_state(), K, f;
   for (size_t d = 0; d < current.size(); ++d) current[d] += 0.01 * std::sin(0.7 * d);
-  clustered.assemble_stiffness(current.data(), K, &f);  // builds the rest sums, untimed
-  for (auto _ : state) clustered.assemble_stiffness(current.data(), K, &f);
-  counters(state, clustered);
-  state.counters["clusters"] = static_cast<double>(clustered.num_rotation_clusters());
+  clustered->assemble_stiffness(current.data(), K, &f);  // builds the rest sums, untimed
+  for (auto _ : state) clustered->assemble_stiffness(current.data(), K, &f);
+  counters(state, *clustered);
+  state.counters["clusters"] = static_cast<double>(clustered->num_rotation_clusters());
 }
 
 void BM_EnrichedStiffnessPerTexel(benchmark::State& state) {
@@ -131,12 +137,10 @@ void BM_EnrichedStiffnessPerTexel(benchmark::State& state) {
   Setup& s = setup(count, partial);
   ShellModelOptions options;
   options.enrichment_quadrature.adaptive = false;
-  ShellModel dense(s.mesh, build_topology(s.mesh), std::vector<kernels::ShellSection>(1, {1e6, 0.3, 0.01, 1000}), {},
-                   options);
-  dense.set_enrichments(s.functions);
+  const std::unique_ptr<ShellModel> dense = enriched_model(s.mesh, s.functions, options);
   std::vector<double> K;
-  for (auto _ : state) dense.assemble_stiffness(nullptr, K, nullptr);
-  counters(state, dense);
+  for (auto _ : state) dense->assemble_stiffness(nullptr, K, nullptr);
+  counters(state, *dense);
 }
 
 // The fused mass and load weights (kernels::enriched_element_mass_and_load_weights) of one
@@ -154,7 +158,7 @@ void BM_EnrichedMassAndLoadWeights(benchmark::State& state) {
     for (int a = 0; a < npe; ++a) node.push_back(100 + static_cast<int>(node.size())), shift.push_back(0.1 * a);
   }
   start.push_back(static_cast<int>(views.size()));
-  const std::vector<kernels::ShellSection> sections(1, {1e6, 0.3, 0.01, 1000});
+  const std::vector<kernels::ShellSection> sections(1, kSection);
   const int element = 0;
   kernels::EnrichedElementBatch batch{ElementType::quad8, 1, &element, s.mesh.elements.data(), s.mesh.positions.data(),
                                       sections.data(), kResolution, 0, start.data(), views.data(), node.data(),
