@@ -1,11 +1,48 @@
 #include "dgtex/kernels/gram_accumulation.h"
 
+#include <immintrin.h>
+
+#include <cmath>
 #include <cstddef>
 #include <stdexcept>
 #include <string>
 
 namespace dgtex::kernels {
 namespace {
+
+typedef double V8 __attribute__((vector_size(64)));
+typedef double V4 __attribute__((vector_size(32)));
+typedef double V2 __attribute__((vector_size(16)));
+
+// c += a b, each lane rounded once (a fused multiply-add); a is a vector or a scalar in
+// every lane. The tiles and the references sum with it alike, so every path gives the same
+// bits: the AVX-512 and AVX2 paths by the FMA instruction, the baseline x86-64 path (no FMA
+// instruction) by the C library's fma per lane, correctly rounded in software where the
+// CPU has no FMA. Fused, the tiles run up to 1.4x faster: they are bound by their multiplies
+// and adds (examples/bench_scenes_history.md, sessions 57-58). Not always_inline (in the
+// tile templates, which have no target, that does not compile): the compiler inlines each
+// into its own path's function. The scalar forms broadcast by intrinsic: a generic
+// fill (a loop, or a - V{}) became eight masked loads a vector in the weighted Grams.
+__attribute__((target("avx512f"))) inline void add_product(V8& c, const V8& a, const V8& b) {
+  c = _mm512_fmadd_pd(a, b, c);
+}
+__attribute__((target("avx512f"))) inline void add_product(V8& c, double a, const V8& b) {
+  c = _mm512_fmadd_pd(_mm512_set1_pd(a), b, c);
+}
+__attribute__((target("avx2,fma"))) inline void add_product(V4& c, const V4& a, const V4& b) {
+  c = _mm256_fmadd_pd(a, b, c);
+}
+__attribute__((target("avx2,fma"))) inline void add_product(V4& c, double a, const V4& b) {
+  c = _mm256_fmadd_pd(_mm256_set1_pd(a), b, c);
+}
+inline void add_product(V2& c, const V2& a, const V2& b) {
+  c[0] = __builtin_fma(a[0], b[0], c[0]);
+  c[1] = __builtin_fma(a[1], b[1], c[1]);
+}
+inline void add_product(V2& c, double a, const V2& b) {
+  c[0] = __builtin_fma(a, b[0], c[0]);
+  c[1] = __builtin_fma(a, b[1], c[1]);
+}
 
 // One tile of G += A^T B: output rows i0..i0+TR, columns c0..c0+L NV; each entry is summed
 // over the rows in order from 0, then stored or added. GCC vector extensions keep the
@@ -24,7 +61,7 @@ __attribute__((always_inline)) inline void product_tile(int rows, int cols, cons
     for (int v = 0; v < NV; ++v) __builtin_memcpy(&b[v], b_row + c0 + v * L, sizeof(V));
     for (int r = 0; r < TR; ++r) {
       const double a = a_row[i0 + r];
-      for (int v = 0; v < NV; ++v) acc[r][v] += a * b[v];
+      for (int v = 0; v < NV; ++v) add_product(acc[r][v], a, b[v]);
     }
   }
   for (int r = 0; r < TR; ++r) {
@@ -57,16 +94,12 @@ __attribute__((always_inline)) inline void product_tiles(int rows, int cols, con
   }
 }
 
-typedef double V8 __attribute__((vector_size(64)));
-typedef double V4 __attribute__((vector_size(32)));
-typedef double V2 __attribute__((vector_size(16)));
-
 __attribute__((target("avx512f"))) void product_avx512(int rows, int cols, const double* A, const double* B,
                                                        double* G, bool overwrite, bool upper) {
   product_tiles<V8, 8, 8, 2>(rows, cols, A, B, G, overwrite, upper);
 }
-__attribute__((target("avx2"))) void product_avx2(int rows, int cols, const double* A, const double* B, double* G,
-                                                  bool overwrite, bool upper) {
+__attribute__((target("avx2,fma"))) void product_avx2(int rows, int cols, const double* A, const double* B,
+                                                      double* G, bool overwrite, bool upper) {
   product_tiles<V4, 4, 4, 2>(rows, cols, A, B, G, overwrite, upper);
 }
 void product_baseline(int rows, int cols, const double* A, const double* B, double* G, bool overwrite, bool upper) {
@@ -98,11 +131,12 @@ __attribute__((always_inline)) inline void weighted_gram_tile(int points, int co
     for (int t = 0; t < TR; ++t)
 #pragma GCC unroll 8
       for (int v = 0; v < NV; ++v) {
-        V product = rows[i0 + t] * b[0][v];
+        // From 0, every row's product fused in (as in the reference).
+        V product = V{};
 #pragma GCC unroll 8
-        for (int r = 1; r < R; ++r) product = product + rows[static_cast<std::size_t>(r) * cols + i0 + t] * b[r][v];
+        for (int r = 0; r < R; ++r) add_product(product, rows[static_cast<std::size_t>(r) * cols + i0 + t], b[r][v]);
 #pragma GCC unroll 8
-        for (int k = 0; k < K; ++k) acc[k][t][v] = acc[k][t][v] + w[k] * product;
+        for (int k = 0; k < K; ++k) add_product(acc[k][t][v], w[k], product);
       }
   }
   for (int k = 0; k < K; ++k)
@@ -141,8 +175,9 @@ __attribute__((target("avx512f"))) void weighted_grams_avx512(int points, int co
                                                               const bool* overwrite) {
   weighted_gram_tiles<V8, 8, 2, 1, 3, 6>(points, cols, A, weights, G, overwrite);
 }
-__attribute__((target("avx2"))) void weighted_grams_avx2(int points, int cols, const double* A, const double* weights,
-                                                         double* const* G, const bool* overwrite) {
+__attribute__((target("avx2,fma"))) void weighted_grams_avx2(int points, int cols, const double* A,
+                                                             const double* weights, double* const* G,
+                                                             const bool* overwrite) {
   weighted_gram_tiles<V4, 4, 2, 1, 3, 6>(points, cols, A, weights, G, overwrite);
 }
 void weighted_grams_baseline(int points, int cols, const double* A, const double* weights, double* const* G,
@@ -150,7 +185,7 @@ void weighted_grams_baseline(int points, int cols, const double* A, const double
   weighted_gram_tiles<V2, 2, 2, 1, 3, 6>(points, cols, A, weights, G, overwrite);
 }
 
-// out[j] += (s * scales[j]) * g[j]: elementwise, so every path rounds alike.
+// out[j] += (s * scales[j]) * g[j], the add fused: elementwise, so every path rounds alike.
 template <class V, int L>
 __attribute__((always_inline)) inline void scaled_row(int count, double s, const double* __restrict scales,
                                                       const double* __restrict g, double* __restrict out) {
@@ -160,18 +195,19 @@ __attribute__((always_inline)) inline void scaled_row(int count, double s, const
     __builtin_memcpy(&c, scales + j, sizeof(V));
     __builtin_memcpy(&x, g + j, sizeof(V));
     __builtin_memcpy(&o, out + j, sizeof(V));
-    o = o + (s * c) * x;
+    const V scale = s * c;
+    add_product(o, scale, x);
     __builtin_memcpy(out + j, &o, sizeof(V));
   }
-  for (; j < count; ++j) out[j] = out[j] + (s * scales[j]) * g[j];
+  for (; j < count; ++j) out[j] = __builtin_fma(s * scales[j], g[j], out[j]);
 }
 
 __attribute__((target("avx512f"))) void scaled_row_avx512(int count, double s, const double* scales, const double* g,
                                                           double* out) {
   scaled_row<V8, 8>(count, s, scales, g, out);
 }
-__attribute__((target("avx2"))) void scaled_row_avx2(int count, double s, const double* scales, const double* g,
-                                                     double* out) {
+__attribute__((target("avx2,fma"))) void scaled_row_avx2(int count, double s, const double* scales,
+                                                         const double* g, double* out) {
   scaled_row<V4, 4>(count, s, scales, g, out);
 }
 void scaled_row_baseline(int count, double s, const double* scales, const double* g, double* out) {
@@ -207,8 +243,8 @@ void accumulate_gram_upper(int rows, int cols, const double* A, double* G, bool 
   accumulate_product(rows, cols, A, A, G, overwrite, true, path);
 }
 
-void add_scaled_row(int count, double s, const double* scales, const double* g, double* out) {
-  kernel_of(VectorPath::best, scaled_row_avx512, scaled_row_avx2, scaled_row_baseline)(count, s, scales, g, out);
+void add_scaled_row(int count, double s, const double* scales, const double* g, double* out, VectorPath path) {
+  kernel_of(path, scaled_row_avx512, scaled_row_avx2, scaled_row_baseline)(count, s, scales, g, out);
 }
 
 void accumulate_product_reference(int rows, int cols, const double* A, const double* B, double* G, bool overwrite,
@@ -217,7 +253,7 @@ void accumulate_product_reference(int rows, int cols, const double* A, const dou
     for (int j = upper ? i : 0; j < cols; ++j) {
       double sum = 0;
       for (int k = 0; k < rows; ++k)
-        sum += A[static_cast<std::size_t>(k) * cols + i] * B[static_cast<std::size_t>(k) * cols + j];
+        sum = std::fma(A[static_cast<std::size_t>(k) * cols + i], B[static_cast<std::size_t>(k) * cols + j], sum);
       double& out = G[static_cast<std::size_t>(i) * cols + j];
       out = overwrite ? sum : out + sum;
     }
@@ -231,11 +267,12 @@ void accumulate_weighted_grams_reference(int points, int rows_per_point, int col
       double sum[max_weighted_grams] = {};
       for (int p = 0; p < points; ++p) {
         const double* rows = A + static_cast<std::size_t>(p) * rows_per_point * cols;
-        double product = rows[i] * rows[j];
-        for (int r = 1; r < rows_per_point; ++r)
-          product = product + rows[static_cast<std::size_t>(r) * cols + i] *
-                                  rows[static_cast<std::size_t>(r) * cols + j];
-        for (int k = 0; k < count; ++k) sum[k] = sum[k] + weights[static_cast<std::size_t>(p) * count + k] * product;
+        double product = 0;
+        for (int r = 0; r < rows_per_point; ++r)
+          product = std::fma(rows[static_cast<std::size_t>(r) * cols + i], rows[static_cast<std::size_t>(r) * cols + j],
+                             product);
+        for (int k = 0; k < count; ++k)
+          sum[k] = std::fma(weights[static_cast<std::size_t>(p) * count + k], product, sum[k]);
       }
       for (int k = 0; k < count; ++k) {
         double& out = G[k][static_cast<std::size_t>(i) * cols + j];

@@ -6,7 +6,8 @@ bool vector_path_supported(VectorPath path) {
   __builtin_cpu_init();
   switch (path) {
     case VectorPath::avx512: return __builtin_cpu_supports("avx512f");
-    case VectorPath::avx2: return __builtin_cpu_supports("avx2");
+    // The AVX2 path of the Gram sums fuses multiply-adds (every AVX2 CPU but a few has FMA).
+    case VectorPath::avx2: return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
     default: return true;
   }
 }

@@ -1,14 +1,15 @@
 // The blocked enriched element stiffness: the Gram accumulation and the products A^T B
-// (dgtex/kernels/gram_accumulation.h) are bitwise the one-entry-at-a-time references on
-// every instruction-set path the machine supports, and the fast stiffness (frame-split
-// sums of the strain rows, blocked products, runs-based group mapping, row-parallel
-// chunk reduction) agrees with the plain per-point reference to round-off for complete
-// cuts (1e-13 relative to max |K|) and to the flat tolerance for harmonic partial cuts
-// (1e-9), on flat and curved elements, writes exact zeros into padding slots, is
-// exactly symmetric, and is bitwise the same for 1, 2 and 4 threads; GramAccumulator (the
-// mass and edge sums) matches the plain sum to round-off, and so do the weighted Gram sums
-// of the bending rows (bitwise their reference on every path). The fused corotated
-// form (F and rotation per point inside the stiffness pass) is bitwise the three kernels.
+// (dgtex/kernels/gram_accumulation.h) are bitwise the one-entry-at-a-time references (every
+// multiply-add fused) on every instruction-set path the machine supports, and the fast
+// stiffness (frame-split sums of the strain rows, blocked products, runs-based group
+// mapping, row-parallel chunk reduction) agrees with the plain per-point reference to
+// round-off for complete cuts (1e-13 relative to max |K|) and to the flat tolerance for
+// harmonic partial cuts (1e-9), on flat and curved elements, writes exact zeros into
+// padding slots, is exactly symmetric, and is bitwise the same for 1, 2 and 4 threads;
+// GramAccumulator (the mass and edge sums) matches the plain sum to round-off, and so do
+// the weighted Gram sums of the bending rows (bitwise their reference on every path); the
+// scaled row gather is bitwise its fused sum on every path. The fused corotated form (F and
+// rotation per point inside the stiffness pass) is bitwise the three kernels.
 #include <gtest/gtest.h>
 #include <omp.h>
 
@@ -148,6 +149,28 @@ TEST(EnrichedGram, WeightedGramsOnEveryPathAreBitwiseTheReference) {
   double* none[1] = {nullptr};
   const bool no[1] = {false};
   EXPECT_THROW(kernels::accumulate_weighted_grams(1, 3, 8, nullptr, nullptr, 7, none, no), std::invalid_argument);
+}
+
+TEST(EnrichedGram, ScaledRowOnEveryPathIsBitwiseTheFusedSum) {
+  // out[j] + (s scales[j]) g[j] with the add fused, for counts that end in a tail shorter
+  // than every vector width.
+  std::mt19937 rng(14);
+  std::uniform_real_distribution<double> u(-1, 1);
+  for (int count : {1, 3, 7, 16, 29, 69}) {
+    std::vector<double> scales(count), g(count), start(count);
+    for (double& x : scales) x = u(rng);
+    for (double& x : g) x = u(rng);
+    for (double& x : start) x = u(rng);
+    const double s = u(rng);
+    std::vector<double> expected = start;
+    for (int j = 0; j < count; ++j) expected[j] = std::fma(s * scales[j], g[j], start[j]);
+    for (kernels::VectorPath path : testing_support::supported_vector_paths()) {
+      std::vector<double> out = start;
+      kernels::add_scaled_row(count, s, scales.data(), g.data(), out.data(), path);
+      for (int j = 0; j < count; ++j)
+        ASSERT_EQ(out[j], expected[j]) << "path " << static_cast<int>(path) << " count " << count << " entry " << j;
+    }
+  }
 }
 
 TEST(EnrichedGram, AccumulatorMatchesThePlainSum) {

@@ -2,7 +2,8 @@
 # the per-point rows it sums (kernels/enriched_element_kernel.cpp) and the rotated cluster
 # blocks (kernels/enriched_rotation_clusters.cpp) have a path per instruction set, chosen at
 # run time. Without contraction into FMA every path rounds exactly like baseline x86-64, so
-# K does not depend on the machine's vector unit.
+# K does not depend on the machine's vector unit. (The Gram sums fuse their multiply-adds,
+# but explicitly and alike on every path and in their references.)
 set_source_files_properties(${CMAKE_CURRENT_SOURCE_DIR}/kernels/gram_accumulation.cpp
                             ${CMAKE_CURRENT_SOURCE_DIR}/kernels/enriched_element_kernel.cpp
                             ${CMAKE_CURRENT_SOURCE_DIR}/kernels/enriched_rotation_clusters.cpp

@@ -2,11 +2,11 @@
 // For the enriched kernels: G += A^T A for a block of stacked rows A (the strain rows
 // of several quadrature points), upper part only, and G += A^T B (accumulate_product),
 // with register tiles and a code path per instruction set (AVX-512, AVX2, baseline
-// x86-64; chosen at run time). Every entry (i, j >= i) is its own sum over the rows in
-// order, started from 0 and then added to G (or stored, `overwrite`), and the file is
-// compiled without FMA contraction: every path rounds exactly alike, so results depend
-// neither on the machine's vector unit nor on the tile shape. Entries below the diagonal
-// are scratch (never read).
+// x86-64 (the AVX2 path needs FMA); chosen at run time). Every entry (i, j >= i) is its own
+// sum over the rows in order, started from 0, each product added by one fused multiply-add
+// (rounded once), and then added to G (or stored, `overwrite`): every path and the
+// references round exactly alike, so results depend neither on the machine's vector unit
+// nor on the tile shape. Entries below the diagonal are scratch (never read).
 // Shapes: A is rows x cols, G cols x cols, both row-major with row stride cols; cols must
 // be a multiple of gram_column_multiple (pad A with zero columns). Thread-safe on distinct
 // outputs; keeps nothing. Units: those of the rows' products.
@@ -39,18 +39,21 @@ void accumulate_product(int rows, int cols, const double* A, const double* B, do
 // row-major), weights point by point (points x count). Why: the bending rows of a curved
 // element's point enter six sums of the frame split (weights t_k t_l of the rotated normal),
 // and one product of the point's rows per entry, scaled into each sum, costs about half of
-// six products of scaled rows. Each entry (i, j >= i): per point in order, P = the sum over
-// its rows in order of a_ri a_rj, then acc_k += w_pk P, from 0; finally stored
-// (overwrite[k]) or added. Every path rounds alike, as above; entries below the diagonal
-// are scratch. Cols a multiple of gram_column_multiple.
+// six products of scaled rows. Each entry (i, j >= i): per point in order, P = the sum from
+// 0 over its rows in order of a_ri a_rj, then acc_k += w_pk P, from 0 (every product added
+// by a fused multiply-add); finally stored (overwrite[k]) or added. Every path rounds alike,
+// as above; entries below the diagonal are scratch. Cols a multiple of
+// gram_column_multiple.
 constexpr int max_weighted_grams = 6;
 void accumulate_weighted_grams(int points, int rows_per_point, int cols, const double* A, const double* weights,
                                int count, double* const* G, const bool* overwrite, VectorPath path = VectorPath::best);
 void accumulate_weighted_grams_reference(int points, int rows_per_point, int cols, const double* A,
                                          const double* weights, int count, double* const* G, const bool* overwrite);
 
-// out[j] += (s * scales[j]) * g[j] for j < count (the scaled gather of a G row into K).
-void add_scaled_row(int count, double s, const double* scales, const double* g, double* out);
+// out[j] += (s * scales[j]) * g[j] for j < count, the add fused (the scaled gather of a G
+// row into K).
+void add_scaled_row(int count, double s, const double* scales, const double* g, double* out,
+                    VectorPath path = VectorPath::best);
 
 // The same sums, one entry at a time (the reference of the tiled paths).
 void accumulate_gram_upper_reference(int rows, int cols, const double* A, double* G, bool overwrite);

@@ -1,7 +1,9 @@
 #pragma once
-// Which instruction-set path a kernel with several runs: AVX-512, AVX2 or baseline x86-64,
-// chosen at run time. Kernels with paths are compiled without FMA contraction and keep
-// lanes apart, so every path rounds alike (bitwise the same results on any machine).
+// Which instruction-set path a kernel with several runs: AVX-512, AVX2 (with FMA) or
+// baseline x86-64, chosen at run time. Kernels with paths are compiled without FMA
+// contraction and keep lanes apart, so every path rounds alike (bitwise the same results on
+// any machine); where one fuses multiply-adds (the Gram sums), it fuses the same operations
+// on every path and in its reference, explicitly.
 // best: the widest the machine supports; the others are for tests and must be supported
 // (vector_path_supported).
 namespace dgtex::kernels {
