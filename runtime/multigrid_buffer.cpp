@@ -23,7 +23,7 @@ constexpr std::size_t max_cached_total = std::size_t{128} << 20;
 constexpr int max_cached_blocks = 64;
 
 bool mapped(std::size_t bytes) {
-#if defined(__linux__) && defined(MADV_HUGEPAGE)
+#if defined(__linux__)
   return bytes >= min_mapped_bytes;
 #else
   (void)bytes;
@@ -47,7 +47,7 @@ std::size_t fresh_capacity(std::size_t bytes) { return mapped(bytes) ? mapped_by
 bool serves(std::size_t capacity, std::size_t needed) { return capacity >= needed && capacity / 2 <= needed; }
 
 void* fresh_block(std::size_t bytes) {
-#if defined(__linux__) && defined(MADV_HUGEPAGE)
+#if defined(__linux__)
   if (mapped(bytes)) {
     const std::size_t size = fresh_capacity(bytes);
     // Over-map by one huge page, then unmap the unaligned head and the tail.
@@ -58,7 +58,10 @@ void* fresh_block(std::size_t bytes) {
     if (aligned > base) munmap(base, aligned - base);
     char* end = aligned + size;
     if (base + size + huge_page > end) munmap(end, base + size + huge_page - end);
-    madvise(aligned, size, MADV_HUGEPAGE);
+    // No madvise(MADV_HUGEPAGE) since session 58: on virtual machines whose free 2 MiB
+    // blocks go back to the host, a fresh huge page is backed again on its first touch, and
+    // the advised blocks made the accordion's first step 290-306 instead of 152-157 ms and a
+    // T = 1024 multigrid solve 667-752 instead of 73-77 ms (multigrid_buffer.h).
     return aligned;
   }
 #endif
@@ -69,7 +72,7 @@ void* fresh_block(std::size_t bytes) {
 
 // capacity: the block's own (block_capacity, or what BlockCache::handed_out recorded).
 void free_block(void* block, std::size_t bytes, std::size_t capacity) noexcept {
-#if defined(__linux__) && defined(MADV_HUGEPAGE)
+#if defined(__linux__)
   if (mapped(bytes)) {
     munmap(block, capacity);
     return;

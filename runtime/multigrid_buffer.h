@@ -6,9 +6,15 @@
 // faults per setup at open T = 1024, ~800 at T = 256 (10% of a whole T = 256 solve).
 // - Released blocks of 64 KiB and more are cached per size (see acquire_zeroed_block), so
 //   repeated solves on tiles of one size reuse them without faults.
-// - Fresh blocks of 1 MiB and more are mapped 2 MiB-aligned and marked for transparent huge
-//   pages (madvise; a no-op where THP is off): 512x fewer faults and fewer TLB misses (alone:
-//   open T = 1024, 1 thread: 221 -> 187 ms, setup 74 -> 57, solve 146 -> 130).
+// - Fresh blocks of 1 MiB and more are mapped 2 MiB-aligned, in whole 2 MiB granules (the
+//   size of a transparent huge page, which the kernel gives them only where THP is
+//   "always"). Until session 58 they were also advised for huge pages (madvise), which had
+//   paid when the host had backed the memory (open T = 1024, 1 thread: 221 -> 187 ms) but
+//   cost far more when it had not: a VM's free 2 MiB blocks go back to the host and are
+//   backed again on first touch. Session 58, this 2-core VM, in one sitting, with the advice
+//   against without it: a T = 1024 multigrid solve 667-752 against 73-77 ms, the
+//   accordion's first step 290-306 against 152-157 ms, the steps/s the same or better
+//   without (examples/bench_scenes_history.md).
 // - Blocks come zeroed (kernel, calloc, or one memset for a cached block), and construct()
 //   without arguments writes nothing, so `MultigridBuffer(n)` is n zeros in one pass at most.
 //   Only a fresh MultigridBuffer(n) is guaranteed zero: never grow one with resize().
@@ -21,18 +27,18 @@
 
 namespace dgtex::detail {
 
-// Zeroed memory for multigrid arrays: bytes >= 1 MiB mapped for huge pages, smaller blocks
-// from calloc. Released blocks of 64 KiB and more are kept (at most 64 blocks and 128 MiB per
-// process, the oldest given back to make room; thread-safe) and handed out again,
-// zero-filled, for the same size (mapped blocks: the same number of huge pages): solves on
-// tiles of one size (bench repeats, the elements of one enrichment) then pay no page faults,
-// munmap/mmap or huge-page compaction after the first setup. A fresh mapped block has an
-// eighth more room (address space only), and a cached mapped block also serves a request of
-// a different size that fits and needs at least half of it: a cut's rest sums, a little
-// larger or smaller from model to model, take the last model's block (the slinky: 124 of
-// 131 blocks from the cache instead of ~10; its system time 0.78-0.84 -> 0.38-0.46 s).
-// A request no cached block serves first gives cached mapped blocks back to the system,
-// oldest first, as much as it maps, so that the mapping gets pages the host has backed.
+// Zeroed memory for multigrid arrays: bytes >= 1 MiB mapped in 2 MiB granules, smaller
+// blocks from calloc. Released blocks of 64 KiB and more are kept (at most 64 blocks and
+// 128 MiB per process, the oldest given back to make room; thread-safe) and handed out
+// again, zero-filled, for the same size (mapped blocks: the same number of granules): solves
+// on tiles of one size (bench repeats, the elements of one enrichment) then pay no page
+// faults or munmap/mmap after the first setup. A fresh mapped block has an eighth more room
+// (address space only), and a cached mapped block also serves a request of a different size
+// that fits and needs at least half of it: a cut's rest sums, a little larger or smaller
+// from model to model, take the last model's block (the slinky: 124 of 131 blocks from the
+// cache instead of ~10; its system time 0.78-0.84 -> 0.38-0.46 s). A request no cached
+// block serves first gives cached mapped blocks back to the system, oldest first, as much
+// as it maps, so that the mapping gets pages the host has backed.
 void* acquire_zeroed_block(std::size_t bytes);
 void release_block(void* block, std::size_t bytes) noexcept;
 
