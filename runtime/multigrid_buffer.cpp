@@ -16,7 +16,7 @@
 namespace dgtex::detail {
 namespace {
 
-constexpr std::size_t huge_page = std::size_t{2} << 20;
+constexpr std::size_t huge_page = std::size_t{2} << 20;  // the mapping granule
 constexpr std::size_t min_mapped_bytes = std::size_t{1} << 20;
 constexpr std::size_t min_cached_bytes = std::size_t{64} << 10;
 constexpr std::size_t max_cached_total = std::size_t{128} << 20;
@@ -33,8 +33,8 @@ bool mapped(std::size_t bytes) {
 
 std::size_t mapped_bytes(std::size_t bytes) { return (bytes + huge_page - 1) / huge_page * huge_page; }
 
-// The size a block is cached under: what it really holds. A mapped block is whole huge
-// pages, so a request a little larger or smaller than the one it was made for can take it
+// The size a block is cached under: what it really holds. A mapped block is whole 2 MiB
+// granules, so a request a little larger or smaller than the one it was made for can take it
 // (a progressive cut's models ask for slightly different sizes from step to step).
 std::size_t block_capacity(std::size_t bytes) { return mapped(bytes) ? mapped_bytes(bytes) : bytes; }
 
