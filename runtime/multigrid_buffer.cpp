@@ -60,8 +60,9 @@ void* fresh_block(std::size_t bytes) {
     if (base + size + huge_page > end) munmap(end, base + size + huge_page - end);
     // No madvise(MADV_HUGEPAGE) since session 58: on virtual machines whose free 2 MiB
     // blocks go back to the host, a fresh huge page is backed again on its first touch, and
-    // the advised blocks made the accordion's first step 290-306 instead of 152-157 ms and a
-    // T = 1024 multigrid solve 667-752 instead of 73-77 ms (multigrid_buffer.h).
+    // the advised blocks made the accordion's first step 247-306 instead of 152-160 ms and
+    // the first T = 1024 multigrid solve of a process 783-881 instead of 74-77 ms
+    // (multigrid_buffer.h).
     return aligned;
   }
 #endif

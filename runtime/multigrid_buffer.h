@@ -12,9 +12,9 @@
 //   paid when the host had backed the memory (open T = 1024, 1 thread: 221 -> 187 ms) but
 //   cost far more when it had not: a VM's free 2 MiB blocks go back to the host and are
 //   backed again on first touch. Session 58, this 2-core VM, in one sitting, with the advice
-//   against without it: a T = 1024 multigrid solve 667-752 against 73-77 ms, the
-//   accordion's first step 290-306 against 152-157 ms, the steps/s the same or better
-//   without (examples/bench_scenes_history.md).
+//   against without it: the first T = 1024 multigrid solve of a process 783-881 against
+//   74-77 ms, the accordion's first step 247-306 against 152-160 ms, the steps/s the same
+//   or better without (examples/bench_scenes_history.md).
 // - Blocks come zeroed (kernel, calloc, or one memset for a cached block), and construct()
 //   without arguments writes nothing, so `MultigridBuffer(n)` is n zeros in one pass at most.
 //   Only a fresh MultigridBuffer(n) is guaranteed zero: never grow one with resize().
