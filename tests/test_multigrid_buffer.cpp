@@ -1,7 +1,7 @@
 // The multigrid's array allocator (runtime/multigrid_buffer.h): every MultigridBuffer(n)
 // holds n zeros, also when its block comes back from the cache with old values in it, for
-// heap-sized, cached and huge-page-mapped sizes; blocks are reused for the same size, mapped
-// ones for any size of as many huge pages, and for a larger request within the room a fresh
+// heap-sized, cached and mapped sizes; blocks are reused for the same size, mapped ones
+// for any size of as many 2 MiB granules, and for a larger request within the room a fresh
 // mapping leaves (an eighth) or a smaller one of at least half their capacity, which they
 // keep when they come back; a request no cached block serves gives cached mapped blocks
 // back to the system before it maps its own.
@@ -22,7 +22,7 @@ bool all_zero(const MultigridBuffer& v) {
 }
 
 TEST(MultigridBuffer, FreshBuffersAreZeroForEverySizeClass) {
-  // Below the cache bound, cached, and mapped for huge pages (>= 1 MiB), odd sizes included.
+  // Below the cache bound, cached, and mapped in 2 MiB granules (>= 1 MiB), odd sizes included.
   for (std::size_t n : {std::size_t{0}, std::size_t{1}, std::size_t{1000}, std::size_t{8192}, std::size_t{70001},
                         std::size_t{131072}, std::size_t{300007}}) {
     for (int round = 0; round < 3; ++round) {
@@ -46,14 +46,14 @@ TEST(MultigridBuffer, ReleasedBlocksAreReusedForTheSameSize) {
   EXPECT_EQ(again.data(), first);  // the cached block, not a new mapping
   EXPECT_TRUE(all_zero(again));
 #if defined(__linux__)
-  // A huge-page mapped block is 2 MiB aligned.
+  // A mapped block is 2 MiB aligned.
   EXPECT_EQ(reinterpret_cast<std::uintptr_t>(again.data()) % (std::uintptr_t{2} << 20), 0u);
 #endif
 }
 
-TEST(MultigridBuffer, MappedBlocksAreReusedForSizesOfAsManyHugePages) {
+TEST(MultigridBuffer, MappedBlocksAreReusedForSizesOfAsManyGranules) {
 #if defined(__linux__)
-  // 1.6 MB and 1.9 MB both take one 2 MiB page; 2.4 MB takes two.
+  // 1.6 MB and 1.9 MB both take one 2 MiB granule; 2.4 MB takes two.
   dgtex::detail::release_cached_blocks();  // blocks of the tests before would serve some
   const double* first = nullptr;
   {
@@ -73,7 +73,7 @@ TEST(MultigridBuffer, MappedBlocksAreReusedForSizesOfAsManyHugePages) {
   EXPECT_EQ(dgtex::detail::cached_block_bytes(), 0u);
   EXPECT_TRUE(all_zero(two_pages));
 #else
-  GTEST_SKIP() << "huge-page mapping is Linux only";
+  GTEST_SKIP() << "mapped blocks are Linux only";
 #endif
 }
 
@@ -83,7 +83,7 @@ TEST(MultigridBuffer, MappedBlocksServeAGrowingCutAndKeepTheirCapacity) {
   dgtex::detail::release_cached_blocks();
   const double* first = nullptr;
   {
-    MultigridBuffer v(15 * per_mib);  // 16 MiB of huge pages asked for, 18 MiB mapped
+    MultigridBuffer v(15 * per_mib);  // 16 MiB of granules asked for, 18 MiB mapped
     first = v.data();
     std::fill(v.begin(), v.end(), -2.0);
   }
@@ -110,7 +110,7 @@ TEST(MultigridBuffer, MappedBlocksServeAGrowingCutAndKeepTheirCapacity) {
   EXPECT_EQ(dgtex::detail::cached_block_bytes(), 0u);
   EXPECT_TRUE(all_zero(other));
 #else
-  GTEST_SKIP() << "huge-page mapping is Linux only";
+  GTEST_SKIP() << "mapped blocks are Linux only";
 #endif
 }
 
