@@ -8,6 +8,7 @@
 #include <unistd.h>
 
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -131,6 +132,7 @@ TEST(BenchScenes, JsonHasEveryRequestedSceneWithRequiredKeysAndThesisRatios) {
   std::string text((std::istreambuf_iterator<char>(markdown)), std::istreambuf_iterator<char>());
   EXPECT_NE(text.find("| 0.001 / 0.1 / 16 |"), std::string::npos) << text;
   EXPECT_NE(text.find(" / per point |"), std::string::npos) << text;
+  EXPECT_EQ(text.find("run by run"), std::string::npos) << "one run: no table of every run\n" << text;
 }
 
 // --repeats: every run of a scene is listed; the tables and the scene's own keys are the
@@ -162,6 +164,21 @@ TEST(BenchScenes, RepeatsShowTheFastestRunAndListEveryRun) {
   std::string heading;
   std::getline(markdown, heading);
   EXPECT_NE(heading.find("the fastest of 3 runs"), std::string::npos) << heading;
+  // The table of every run: the JSON's figures in order (to 0.1), the shown run's in bold.
+  std::string text((std::istreambuf_iterator<char>(markdown)), std::istreambuf_iterator<char>());
+  EXPECT_NE(text.find("| scene | steps/s, run by run | peak step (ms), run by run |"), std::string::npos) << text;
+  auto listed = [&](const char* key) {
+    std::string list;
+    for (std::size_t k = 0; k < 3; ++k) {
+      char value[32];
+      std::snprintf(value, sizeof value, "%.1f", runs[key][k].get<double>());
+      list += (k ? ", " : "") + (k == shown ? "**" + std::string(value) + "**" : std::string(value));
+    }
+    return list;
+  };
+  const std::string row = "| spiral1 | " + listed("steps_per_second") + " | " + listed("peak_step_ms") + " | " +
+                          listed("enrichment_ms_max") + " |";
+  EXPECT_NE(text.find(row), std::string::npos) << row << "\n" << text;
 
   const Result zero = run_cli("bench scenes --scenes spiral1 --repeats 0", dir);
   EXPECT_EQ(zero.exit_code, 2);

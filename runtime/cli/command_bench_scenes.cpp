@@ -186,25 +186,67 @@ nlohmann::json scene_json(const SceneBenchResult& r) {
   return j;
 }
 
-// Every run of a scene (--repeats): the one the tables show, each run's steps/s, peak step
-// and enrichment peak, and whether all runs ended in bitwise the same displacement (the
-// simulation does not depend on timing).
-nlohmann::json runs_json(const std::vector<SceneBenchResult>& runs, std::size_t chosen,
-                         const std::vector<double>& probes_ms) {
-  nlohmann::json j = {{"count", runs.size()}, {"shown", chosen}, {"identical", true}, {"machine_probe_ms", probes_ms}};
+// Each run's steps/s, peak step and enrichment peak, in order (--repeats), and the one shown.
+struct EveryRun {
+  std::vector<double> steps_per_second, peak_step_ms, enrichment_ms_max;
+  std::size_t shown = 0;
+};
+
+EveryRun every_run(const std::vector<SceneBenchResult>& runs, std::size_t chosen) {
+  EveryRun e;
+  e.shown = chosen;
   for (const SceneBenchResult& r : runs) {
-    j["steps_per_second"].push_back(r.steps_per_second());
-    j["peak_step_ms"].push_back(r.peak_step_ms());
-    j["enrichment_ms_max"].push_back(series_max(r.times.enrichment));
-    if (r.displacement != runs[chosen].displacement) j["identical"] = false;
+    e.steps_per_second.push_back(r.steps_per_second());
+    e.peak_step_ms.push_back(r.peak_step_ms());
+    e.enrichment_ms_max.push_back(series_max(r.times.enrichment));
   }
-  return j;
+  return e;
 }
 
 std::string format(const char* fmt, double a) {
   char buffer[64];
   std::snprintf(buffer, sizeof buffer, fmt, a);
   return buffer;
+}
+
+// Every run of a scene (--repeats): the one the tables show, each run's steps/s, peak step
+// and enrichment peak, and whether all runs ended in bitwise the same displacement (the
+// simulation does not depend on timing).
+nlohmann::json runs_json(const std::vector<SceneBenchResult>& runs, std::size_t chosen,
+                         const std::vector<double>& probes_ms) {
+  const EveryRun e = every_run(runs, chosen);
+  nlohmann::json j = {{"count", runs.size()},
+                      {"shown", chosen},
+                      {"identical", true},
+                      {"machine_probe_ms", probes_ms},
+                      {"steps_per_second", e.steps_per_second},
+                      {"peak_step_ms", e.peak_step_ms},
+                      {"enrichment_ms_max", e.enrichment_ms_max}};
+  for (const SceneBenchResult& r : runs)
+    if (r.displacement != runs[chosen].displacement) j["identical"] = false;
+  return j;
+}
+
+// With --repeats, a third table: every run's figures in order, the shown run's in bold. A
+// process's first run also faults in the memory it touches first (chad, session 59: peak
+// step 39.5 ms in the first of three runs, 32.0 and 30.0 in the next two).
+std::string every_run_table(const std::vector<std::string>& names, const std::vector<EveryRun>& runs) {
+  auto list = [](const std::vector<double>& values, std::size_t shown) {
+    std::string text;
+    for (std::size_t k = 0; k < values.size(); ++k) {
+      const std::string value = format("%.1f", values[k]);
+      text += (k ? ", " : "") + (k == shown ? "**" + value + "**" : value);
+    }
+    return text;
+  };
+  std::ostringstream out;
+  out << "\n| scene | steps/s, run by run | peak step (ms), run by run | enrichment peak (ms), run by run |\n"
+      << "|---|---|---|---|\n";
+  for (std::size_t s = 0; s < names.size(); ++s)
+    out << "| " << names[s] << " | " << list(runs[s].steps_per_second, runs[s].shown) << " | "
+        << list(runs[s].peak_step_ms, runs[s].shown) << " | " << list(runs[s].enrichment_ms_max, runs[s].shown)
+        << " |\n";
+  return out.str();
 }
 
 // Two Markdown tables: timings per step, and sizes and ratios against Table 5.1.
@@ -282,8 +324,8 @@ int bench_scenes_command(int argc, char** argv) {
       ->check(zero_or_more());
   app.add_option("--threads", threads, "OpenMP threads (default: all cores)")->check(thread_count());
   app.add_option("--repeats", repeats,
-                 "runs of each scene in a row; the tables show the fastest whole run (steps/s), the JSON every "
-                 "run's steps/s, peak step and enrichment peak (for a shared, noisy machine)")
+                 "runs of each scene in a row; the tables show the fastest whole run (steps/s), and a third table "
+                 "and the JSON every run's steps/s, peak step and enrichment peak (for a shared, noisy machine)")
       ->capture_default_str()
       ->check(at_least_one());
   app.add_option("--json", json_path, "write the results as JSON (rewritten after every scene)")
@@ -319,6 +361,7 @@ int bench_scenes_command(int argc, char** argv) {
   }
 
   std::vector<SceneBenchResult> results;
+  std::vector<EveryRun> every_runs;  // per scene, for the table of every run
   const std::string machine = describe_machine();
   std::vector<double> probes_ms;  // before each scene, and after the last
   nlohmann::json all = {{"machine", machine},
@@ -367,11 +410,12 @@ int bench_scenes_command(int argc, char** argv) {
                              return a.steps_per_second() < b.steps_per_second();
                            }) -
           runs.begin());
-      nlohmann::json every_run = runs_json(runs, chosen, run_probes_ms);
+      nlohmann::json runs_of_scene = runs_json(runs, chosen, run_probes_ms);
+      every_runs.push_back(every_run(runs, chosen));
       SceneBenchResult r = std::move(runs[chosen]);
       all["scenes"].push_back(scene_json(r));
       all["scenes"].back()["machine_probe_ms"] = run_probes_ms[chosen];
-      all["scenes"].back()["runs"] = std::move(every_run);
+      all["scenes"].back()["runs"] = std::move(runs_of_scene);
       results.push_back(std::move(r));
       if (!json_path.empty()) write_output_file(json_path, all.dump(2) + "\n", "--json");
     } catch (const SceneError& e) {
@@ -395,7 +439,12 @@ int bench_scenes_command(int argc, char** argv) {
   probes_ms.push_back(machine_probe_ms());
   all["machine_probe_ms_at_end"] = probes_ms.back();
   const auto [fastest, slowest] = std::minmax_element(probes_ms.begin(), probes_ms.end());
-  const std::string tables = markdown_tables(results);
+  std::string tables = markdown_tables(results);
+  if (repeats > 1) {
+    std::vector<std::string> names;
+    for (const SceneBenchResult& r : results) names.push_back(r.name);
+    tables += every_run_table(names, every_runs);
+  }
   std::string step_count = steps > 0 ? std::to_string(steps) + " steps per scene" : "each scene's own analysis.steps";
   if (repeats > 1) step_count += ", the fastest of " + std::to_string(repeats) + " runs";
   char heading[512];
