@@ -186,14 +186,17 @@ nlohmann::json scene_json(const SceneBenchResult& r) {
   return j;
 }
 
-// Each run's steps/s, peak step and enrichment peak, in order (--repeats), and the one shown.
+// A scene's runs (--repeats): each one's steps/s, peak step and enrichment peak, in order,
+// and the one shown.
 struct EveryRun {
+  std::string scene;
   std::vector<double> steps_per_second, peak_step_ms, enrichment_ms_max;
   std::size_t shown = 0;
 };
 
 EveryRun every_run(const std::vector<SceneBenchResult>& runs, std::size_t chosen) {
   EveryRun e;
+  e.scene = runs[chosen].name;
   e.shown = chosen;
   for (const SceneBenchResult& r : runs) {
     e.steps_per_second.push_back(r.steps_per_second());
@@ -230,7 +233,7 @@ nlohmann::json runs_json(const std::vector<SceneBenchResult>& runs, std::size_t 
 // With --repeats, a third table: every run's figures in order, the shown run's in bold. A
 // process's first run also faults in the memory it touches first (chad, session 59: peak
 // step 39.5 ms in the first of three runs, 32.0 and 30.0 in the next two).
-std::string every_run_table(const std::vector<std::string>& names, const std::vector<EveryRun>& runs) {
+std::string every_run_table(const std::vector<EveryRun>& scenes) {
   auto list = [](const std::vector<double>& values, std::size_t shown) {
     std::string text;
     for (std::size_t k = 0; k < values.size(); ++k) {
@@ -242,10 +245,9 @@ std::string every_run_table(const std::vector<std::string>& names, const std::ve
   std::ostringstream out;
   out << "\n| scene | steps/s, run by run | peak step (ms), run by run | enrichment peak (ms), run by run |\n"
       << "|---|---|---|---|\n";
-  for (std::size_t s = 0; s < names.size(); ++s)
-    out << "| " << names[s] << " | " << list(runs[s].steps_per_second, runs[s].shown) << " | "
-        << list(runs[s].peak_step_ms, runs[s].shown) << " | " << list(runs[s].enrichment_ms_max, runs[s].shown)
-        << " |\n";
+  for (const EveryRun& e : scenes)
+    out << "| " << e.scene << " | " << list(e.steps_per_second, e.shown) << " | " << list(e.peak_step_ms, e.shown)
+        << " | " << list(e.enrichment_ms_max, e.shown) << " |\n";
   return out.str();
 }
 
@@ -440,11 +442,7 @@ int bench_scenes_command(int argc, char** argv) {
   all["machine_probe_ms_at_end"] = probes_ms.back();
   const auto [fastest, slowest] = std::minmax_element(probes_ms.begin(), probes_ms.end());
   std::string tables = markdown_tables(results);
-  if (repeats > 1) {
-    std::vector<std::string> names;
-    for (const SceneBenchResult& r : results) names.push_back(r.name);
-    tables += every_run_table(names, every_runs);
-  }
+  if (repeats > 1) tables += every_run_table(every_runs);
   std::string step_count = steps > 0 ? std::to_string(steps) + " steps per scene" : "each scene's own analysis.steps";
   if (repeats > 1) step_count += ", the fastest of " + std::to_string(repeats) + " runs";
   char heading[512];
