@@ -215,18 +215,17 @@ std::string format(const char* fmt, double a) {
 // Every run of a scene (--repeats): the one the tables show, each run's steps/s, peak step
 // and enrichment peak, and whether all runs ended in bitwise the same displacement (the
 // simulation does not depend on timing).
-nlohmann::json runs_json(const std::vector<SceneBenchResult>& runs, std::size_t chosen,
+nlohmann::json runs_json(const std::vector<SceneBenchResult>& runs, const EveryRun& e,
                          const std::vector<double>& probes_ms) {
-  const EveryRun e = every_run(runs, chosen);
   nlohmann::json j = {{"count", runs.size()},
-                      {"shown", chosen},
+                      {"shown", e.shown},
                       {"identical", true},
                       {"machine_probe_ms", probes_ms},
                       {"steps_per_second", e.steps_per_second},
                       {"peak_step_ms", e.peak_step_ms},
                       {"enrichment_ms_max", e.enrichment_ms_max}};
   for (const SceneBenchResult& r : runs)
-    if (r.displacement != runs[chosen].displacement) j["identical"] = false;
+    if (r.displacement != runs[e.shown].displacement) j["identical"] = false;
   return j;
 }
 
@@ -412,8 +411,8 @@ int bench_scenes_command(int argc, char** argv) {
                              return a.steps_per_second() < b.steps_per_second();
                            }) -
           runs.begin());
-      nlohmann::json runs_of_scene = runs_json(runs, chosen, run_probes_ms);
       every_runs.push_back(every_run(runs, chosen));
+      nlohmann::json runs_of_scene = runs_json(runs, every_runs.back(), run_probes_ms);
       SceneBenchResult r = std::move(runs[chosen]);
       all["scenes"].push_back(scene_json(r));
       all["scenes"].back()["machine_probe_ms"] = run_probes_ms[chosen];
