@@ -62,8 +62,8 @@
 //   7.2 ms (1 thread, best of 3 x 15, same binary). Orphan count and coarse activity are one
 //   row-parallel pass. Setup at T = 1024 before (1 thread, loaded machine, ~45 ms): level
 //   0 -> 1 interpolation + Galerkin 14-18 ms, zero-filling cached blocks ~12 ms, level 1 -> 2
-//   1-6 ms. The first setup of a size also pays huge-page clearing (~40k faults at T = 1024;
-//   the huge-page advice was dropped in session 58, multigrid_buffer.h).
+//   1-6 ms. The first setup of a size also pays for faulting in and clearing its fresh pages
+//   (~40k faults at T = 1024; no huge-page advice since session 58, multigrid_buffer.h).
 // - Session 5 (threads): with OMP_WAIT_POLICY=active, levels from 4096 nodes run parallel
 //   (see parallel_min_nodes): open T = 256 7.0 -> 4.4 ms, T = 512 20.7 -> 19.3 ms (idle
 //   machine, 2 threads). Not with the default policy: on a loaded machine (other processes

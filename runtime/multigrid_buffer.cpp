@@ -16,7 +16,7 @@
 namespace dgtex::detail {
 namespace {
 
-constexpr std::size_t huge_page = std::size_t{2} << 20;  // the mapping granule
+constexpr std::size_t granule = std::size_t{2} << 20;  // mapped blocks: 2 MiB-aligned, whole granules
 constexpr std::size_t min_mapped_bytes = std::size_t{1} << 20;
 constexpr std::size_t min_cached_bytes = std::size_t{64} << 10;
 constexpr std::size_t max_cached_total = std::size_t{128} << 20;
@@ -31,7 +31,7 @@ bool mapped(std::size_t bytes) {
 #endif
 }
 
-std::size_t mapped_bytes(std::size_t bytes) { return (bytes + huge_page - 1) / huge_page * huge_page; }
+std::size_t mapped_bytes(std::size_t bytes) { return (bytes + granule - 1) / granule * granule; }
 
 // The size a block is cached under: what it really holds. A mapped block is whole 2 MiB
 // granules, so a request a little larger or smaller than the one it was made for can take it
@@ -50,14 +50,14 @@ void* fresh_block(std::size_t bytes) {
 #if defined(__linux__)
   if (mapped(bytes)) {
     const std::size_t size = fresh_capacity(bytes);
-    // Over-map by one huge page, then unmap the unaligned head and the tail.
-    void* raw = mmap(nullptr, size + huge_page, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
+    // Over-map by one granule, then unmap the unaligned head and the tail.
+    void* raw = mmap(nullptr, size + granule, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
     if (raw == MAP_FAILED) throw std::bad_alloc();
     char* base = static_cast<char*>(raw);
-    char* aligned = base + (huge_page - reinterpret_cast<std::uintptr_t>(base) % huge_page) % huge_page;
+    char* aligned = base + (granule - reinterpret_cast<std::uintptr_t>(base) % granule) % granule;
     if (aligned > base) munmap(base, aligned - base);
     char* end = aligned + size;
-    if (base + size + huge_page > end) munmap(end, base + size + huge_page - end);
+    if (base + size + granule > end) munmap(end, base + size + granule - end);
     // No madvise(MADV_HUGEPAGE) since session 58: on virtual machines whose free 2 MiB
     // blocks go back to the host, a fresh huge page is backed again on its first touch, and
     // the advised blocks made the accordion's first step 247-306 instead of 152-160 ms and
