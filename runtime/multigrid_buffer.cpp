@@ -46,24 +46,53 @@ std::size_t fresh_capacity(std::size_t bytes) { return mapped(bytes) ? mapped_by
 // A cached mapped block serves a request of at least half its capacity.
 bool serves(std::size_t capacity, std::size_t needed) { return capacity >= needed && capacity / 2 <= needed; }
 
+#if defined(__linux__)
+// `size` bytes (whole granules) of fresh address space, 2 MiB-aligned.
+char* map_granules(std::size_t size) {
+  // Over-map by one granule, then unmap the unaligned head and the tail.
+  void* raw = mmap(nullptr, size + granule, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
+  if (raw == MAP_FAILED) throw std::bad_alloc();
+  char* base = static_cast<char*>(raw);
+  char* aligned = base + (granule - reinterpret_cast<std::uintptr_t>(base) % granule) % granule;
+  if (aligned > base) munmap(base, aligned - base);
+  char* end = aligned + size;
+  if (base + size + granule > end) munmap(end, base + size + granule - end);
+  return aligned;
+}
+
+// Granules faulted in ahead of use (prefault_mapped_blocks): fresh mapped blocks are cut from
+// the front while it lasts. A block cut from it is unmapped like any other (munmap takes
+// part of a mapping).
+struct PrefaultedGranules {
+  std::mutex mutex;
+  char* next = nullptr;
+  char* end = nullptr;
+};
+PrefaultedGranules& prefaulted() {
+  static PrefaultedGranules* instance = new PrefaultedGranules;
+  return *instance;
+}
+void* take_prefaulted(std::size_t size) {
+  PrefaultedGranules& p = prefaulted();
+  const std::lock_guard<std::mutex> lock(p.mutex);
+  if (static_cast<std::size_t>(p.end - p.next) < size) return nullptr;
+  void* block = p.next;
+  p.next += size;
+  return block;
+}
+#endif
+
 void* fresh_block(std::size_t bytes) {
 #if defined(__linux__)
   if (mapped(bytes)) {
     const std::size_t size = fresh_capacity(bytes);
-    // Over-map by one granule, then unmap the unaligned head and the tail.
-    void* raw = mmap(nullptr, size + granule, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
-    if (raw == MAP_FAILED) throw std::bad_alloc();
-    char* base = static_cast<char*>(raw);
-    char* aligned = base + (granule - reinterpret_cast<std::uintptr_t>(base) % granule) % granule;
-    if (aligned > base) munmap(base, aligned - base);
-    char* end = aligned + size;
-    if (base + size + granule > end) munmap(end, base + size + granule - end);
+    if (void* block = take_prefaulted(size)) return block;
     // No madvise(MADV_HUGEPAGE) since session 58: on virtual machines whose free 2 MiB
     // blocks go back to the host, a fresh huge page is backed again on its first touch, and
     // the advised blocks made the accordion's first step 247-306 instead of 152-160 ms and
     // the first T = 1024 multigrid solve of a process 783-881 instead of 74-77 ms
     // (multigrid_buffer.h).
-    return aligned;
+    return map_granules(size);
   }
 #endif
   void* block = std::calloc(bytes == 0 ? 1 : bytes, 1);
@@ -204,7 +233,7 @@ void* acquire_zeroed_block(std::size_t bytes) {
       std::memset(block, 0xff, bytes);  // all-ones bytes: a NaN as double and as float
     return block;
   }
-  if (mapped(bytes)) {
+  if (mapped(bytes) && prefaulted_block_bytes() < fresh_capacity(bytes)) {
     // Cached mapped blocks, oldest first, as much as the new mapping takes, go back to the
     // system first: it hands their pages, which the host has backed, to the new mapping.
     // Kept, they made the accordion's first rest sums (88 MB) fault in pages the host had
@@ -232,6 +261,38 @@ void* acquire_zeroed_block(std::size_t bytes) {
     }
   }
   return block;
+}
+
+void prefault_mapped_blocks(std::size_t bytes) {
+#if defined(__linux__)
+  const std::size_t size = mapped_bytes(bytes);
+  PrefaultedGranules& p = prefaulted();
+  const std::lock_guard<std::mutex> lock(p.mutex);
+  const std::size_t left = static_cast<std::size_t>(p.end - p.next);
+  if (left >= size) return;
+  if (left > 0) munmap(p.next, left);
+  p.next = p.end = nullptr;
+  char* block = map_granules(size);
+  // One call instead of a fault per page (Linux 5.14); else a write per page.
+#ifdef MADV_POPULATE_WRITE
+  if (madvise(block, size, MADV_POPULATE_WRITE) != 0)
+#endif
+    for (std::size_t k = 0; k < size; k += 4096) block[k] = 0;
+  p.next = block;
+  p.end = block + size;
+#else
+  (void)bytes;
+#endif
+}
+
+std::size_t prefaulted_block_bytes() noexcept {
+#if defined(__linux__)
+  PrefaultedGranules& p = prefaulted();
+  const std::lock_guard<std::mutex> lock(p.mutex);
+  return static_cast<std::size_t>(p.end - p.next);
+#else
+  return 0;
+#endif
 }
 
 void release_block(void* block, std::size_t bytes) noexcept {

@@ -41,6 +41,13 @@ namespace dgtex::detail {
 // as it maps, so that the mapping gets pages the host has backed.
 void* acquire_zeroed_block(std::size_t bytes);
 void release_block(void* block, std::size_t bytes) noexcept;
+// Faults in `bytes` (whole 2 MiB granules) now, for fresh mapped blocks to take before they
+// map new memory: the first multigrid solves of a run then touch no page for the first time
+// (dgtex/step_memory.h). Tops up what is left of an earlier call to `bytes`, or keeps it
+// where it is as large. Linux only (elsewhere it does nothing). Throws std::bad_alloc.
+void prefault_mapped_blocks(std::size_t bytes);
+// The prefaulted bytes no block has taken yet.
+std::size_t prefaulted_block_bytes() noexcept;
 
 // While an instance lives on a thread, blocks that thread takes from the cache are not
 // zero-filled (fresh blocks still are): for arrays whose every entry the owner writes before

@@ -13,6 +13,7 @@
 #include "dgtex/kernels/threads_busy_beside.h"
 #include "dgtex/model_error.h"
 #include "dgtex/scene_model.h"
+#include "dgtex/step_memory.h"
 #include "dgtex/texel_memory_estimate.h"
 #include "dgtex/topology.h"
 #include "cut_update_team.h"
@@ -73,6 +74,12 @@ SceneRun::SceneRun(const Scene& scene, SceneRunOptions options)
       const std::int64_t available = available_memory_bytes();
       check_texel_memory(fields, available, scene_.source_name.empty() ? "scene" : scene_.source_name);
       if (options_.before_texel_fields) options_.before_texel_fields(fields, available);
+      if (options_.reserve_step_memory) {
+        // Set-up, not enrichment: the time-0 update counts as the first step's (bench scenes).
+        const auto reserve_start = std::chrono::steady_clock::now();
+        reserve_step_memory(step_memory_bytes(fields, available));
+        stage.exclude(ms_since(reserve_start));
+      }
       if (cuts_) cuts_->update(0.0);
       creases_ = build_crease_functions(mesh_, creases);
     }

@@ -60,6 +60,7 @@ TEST(BenchScenes, JsonHasEveryRequestedSceneWithRequiredKeysAndThesisRatios) {
   ASSERT_EQ(r.exit_code, 0) << r.stderr_text;
   const nlohmann::json j = read_json(dir / "out.json");
   EXPECT_EQ(j["cut_update_threads"], 1);
+  EXPECT_EQ(j["reserve_step_memory"], true);  // the default (dgtex/step_memory.h)
   ASSERT_EQ(j["scenes"].size(), 2u);
   // The machine, and its speed probe before each scene and at the end.
   EXPECT_NE(j["machine"].get<std::string>().find(" cores, "), std::string::npos);
@@ -140,11 +141,13 @@ TEST(BenchScenes, JsonHasEveryRequestedSceneWithRequiredKeysAndThesisRatios) {
 TEST(BenchScenes, RepeatsShowTheFastestRunAndListEveryRun) {
   const fs::path dir = fresh_dir("repeats");
   const Result r = run_cli("bench scenes --scene-dir " + kScenes + " --scenes spiral1 --steps 2 --repeats 3 --json " +
-                               (dir / "out.json").string() + " --markdown " + (dir / "out.md").string() + " --quiet",
+                               (dir / "out.json").string() + " --markdown " + (dir / "out.md").string() +
+                               " --no-memory-reserve --quiet",
                            dir);
   ASSERT_EQ(r.exit_code, 0) << r.stderr_text;
   const nlohmann::json j = read_json(dir / "out.json");
   EXPECT_EQ(j["repeats"], 3);
+  EXPECT_EQ(j["reserve_step_memory"], false);
   ASSERT_EQ(j["scenes"].size(), 1u);
   const nlohmann::json& scene = j["scenes"][0];
   const nlohmann::json& runs = scene["runs"];
@@ -244,6 +247,10 @@ TEST(BenchScenes, TimingDoesNotChangeTheSimulationAndStagesFitInTheStep) {
   for (int s = 0; s < 3; ++s) plain.step();
   EXPECT_EQ(r.displacement, plain.displacement());  // bitwise: same steps, same state
   EXPECT_FALSE(r.overlap_cut_updates);
+  // Memory reserved ahead (dgtex/step_memory.h) changes where the arrays lie, not the results.
+  SceneRunOptions reserved = inline_updates;
+  reserved.reserve_step_memory = true;
+  EXPECT_EQ(run_scene_benchmark(scene, "spiral1", 3, {}, reserved).displacement, plain.displacement());
   ASSERT_EQ(r.steps, 3);
   const SceneStepTimes& t = r.times;
   ASSERT_EQ(t.step.size(), 3u);

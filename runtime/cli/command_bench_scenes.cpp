@@ -311,7 +311,7 @@ int bench_scenes_command(int argc, char** argv) {
   std::vector<std::string> scenes = bench_scene_names();
   std::string scene_dir = example_scene_dir(), json_path, markdown_path;
   int steps = 0, threads = 0, repeats = 1, cut_update_threads = 0;
-  bool quiet = false, inline_cut_updates = false;
+  bool quiet = false, inline_cut_updates = false, no_memory_reserve = false;
   app.add_option("--scenes", scenes,
                  "scenes to run: names in --scene-dir (chad, spiral1, spiral6, accordion, slinky, fracture, "
                  "cylinder_buckling) or paths to .json files")
@@ -335,6 +335,9 @@ int bench_scenes_command(int argc, char** argv) {
   app.add_flag("--inline-cut-updates", inline_cut_updates,
                "update the cuts at the start of each step instead of beside the previous step's projection and "
                "shell step (SceneRunOptions::overlap_cut_updates)");
+  app.add_flag("--no-memory-reserve", no_memory_reserve,
+               "do not fault in the memory of the first steps in each scene's set-up "
+               "(SceneRunOptions::reserve_step_memory: first steps then pay the system's first-touch page faults)");
   app.add_option("--cut-update-threads", cut_update_threads,
                  "OpenMP threads of the cut update beside each step: 0 balances them step by step against the "
                  "step's own work (one on two threads), N fixes N (at most --threads less one; "
@@ -369,6 +372,7 @@ int bench_scenes_command(int argc, char** argv) {
                         {"steps", steps},
                         {"threads", omp_get_max_threads()},
                         {"overlap_cut_updates", !inline_cut_updates},
+                        {"reserve_step_memory", !no_memory_reserve},
                         {"cut_update_threads", cut_update_threads},
                         {"omp_wait_policy", omp_wait_policy_name()},
                         {"repeats", repeats},
@@ -382,6 +386,7 @@ int bench_scenes_command(int argc, char** argv) {
       SceneRunOptions run_options;
       run_options.overlap_cut_updates = !inline_cut_updates;
       run_options.cut_update_threads = cut_update_threads;
+      run_options.reserve_step_memory = !no_memory_reserve;
       std::vector<SceneBenchResult> runs;
       std::vector<double> run_probes_ms;
       for (int run = 1; run <= repeats; ++run) {

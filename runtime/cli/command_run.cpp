@@ -62,13 +62,16 @@ int run_command(int argc, char** argv) {
   app.add_option("--out", out_dir, "output folder (created if missing)")->required()->check(creatable_folder());
   app.add_option("--threads", threads, "OpenMP threads (default: all cores)")->check(thread_count());
   app.add_flag("--quiet", quiet, "no progress line");
-  bool no_render = false, cut_surface_obj = false, save_textures = false, save_final_state = false;
+  bool no_render = false, cut_surface_obj = false, save_textures = false, save_final_state = false,
+       no_memory_reserve = false;
   app.add_flag("--no-render", no_render, "write no PNG frames even if the scene has a render block");
   app.add_flag("--obj", cut_surface_obj, "also write the final cut surface (split along cuts) to DIR/cut_surface.obj");
   app.add_flag("--save-state", save_final_state,
                "write the final state (mesh, displacement, enrichments) to DIR/final.state for dgtex render");
   app.add_flag("--save-textures", save_textures,
                "write the enrichment textures and cut walls of the final state to DIR/textures/enrichment.vdb");
+  app.add_flag("--no-memory-reserve", no_memory_reserve,
+               "do not fault in the memory of the first steps in the set-up (SceneRunOptions::reserve_step_memory)");
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -96,6 +99,7 @@ int run_command(int argc, char** argv) {
       const std::string caution = texel_memory_caution(fields, available);
       if (!caution.empty()) std::fprintf(stderr, "dgtex run: warning: %s: %s\n", scene_path.c_str(), caution.c_str());
     };
+    run_options.reserve_step_memory = !no_memory_reserve;
     run = std::make_unique<SceneRun>(scene, run_options);
     if (progress)
       std::fprintf(stderr, "dgtex run: set up in %.1f s\n",

@@ -45,6 +45,8 @@ class ScopedStage {
   ~ScopedStage() {
     stats_.add(earlier_ms_ + std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start_).count());
   }
+  // Time within the scope that is not the stage's (SceneRun's set-up: reserving memory).
+  void exclude(double ms) { earlier_ms_ -= ms; }
   ScopedStage(const ScopedStage&) = delete;
   ScopedStage& operator=(const ScopedStage&) = delete;
 
