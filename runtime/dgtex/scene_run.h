@@ -71,7 +71,8 @@ struct SceneRunOptions {
   // Then (after before_texel_fields) fault in the memory the first steps will take
   // (reserve_step_memory(step_memory_bytes(fields, available)), dgtex/step_memory.h):
   // process-wide malloc settings, and a set-up longer by ~1.4 us a reserved 4 KiB page
-  // (chad: 96 MiB, 33-36 ms more), for first steps without first-touch page faults.
+  // (chad: 96 MiB, 33-36 ms more), for first steps without first-touch page faults. Memory
+  // that cannot be had is left out (the steps then take theirs as they go).
   bool reserve_step_memory = false;
 };
 
