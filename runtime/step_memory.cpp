@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cstddef>
 #include <cstdlib>
+#include <limits>
 #include <mutex>
 #include <new>
 #include <vector>
@@ -24,7 +25,7 @@ constexpr std::size_t page = 4096;
 // heap and stay in it once freed.
 constexpr std::size_t heap_chunk = std::size_t{16} << 20;
 
-// Heap faulted in by earlier calls (it stays: nothing is trimmed any more).
+// The most heap an earlier call faulted in (it stays: nothing is trimmed any more).
 std::int64_t heap_reserved = 0;
 std::mutex heap_mutex;
 
@@ -32,19 +33,20 @@ void keep_freed_memory() {
   static std::once_flag once;
   std::call_once(once, [] {
     mallopt(M_MMAP_THRESHOLD, 32 << 20);
-    mallopt(M_TRIM_THRESHOLD, 0x7fffffff);
+    mallopt(M_TRIM_THRESHOLD, std::numeric_limits<int>::max());
     mallopt(M_ARENA_MAX, 1);
   });
 }
 
 // Allocated and written page by page, then freed: the pages stay in the heap for the
-// steps' allocations.
+// steps' allocations. A top-up takes all `bytes` again: the chunks first get the free pages
+// an earlier call faulted in (written again, without faults), then new ones.
 void fault_in_heap(std::int64_t bytes) {
   const std::lock_guard<std::mutex> lock(heap_mutex);
   if (bytes <= heap_reserved) return;
   std::vector<char*> chunks;
   bool failed = false;
-  for (std::int64_t taken = heap_reserved; taken < bytes; taken += static_cast<std::int64_t>(heap_chunk)) {
+  for (std::int64_t taken = 0; taken < bytes; taken += static_cast<std::int64_t>(heap_chunk)) {
     char* chunk = static_cast<char*>(std::malloc(heap_chunk));
     if (!chunk) {
       failed = true;
@@ -72,7 +74,6 @@ void reserve_step_memory(std::int64_t bytes) {
 
 std::int64_t step_memory_bytes(const TexelFields& fields, std::int64_t available_bytes) {
   std::int64_t bytes = std::min(6 * texel_memory_lower_bound(fields), 512 * mib);
-
   if (available_bytes >= 0) bytes = std::min(bytes, available_bytes / 4);
   return std::max<std::int64_t>(bytes, 0);
 }

@@ -1,9 +1,12 @@
 // Memory reserved for the first steps (dgtex/step_memory.h): what SceneRun reserves for a
-// scene's texel fields, and chad's first steps with the reservation, which fault in almost
-// no page (20k in its first four steps without it, 41 with it: session 60, 2-core VM).
+// scene's texel fields; a larger reservation tops the heap up to all of it; chad's first
+// steps with the reservation fault in almost no page (20k in its first four steps without
+// it, 41 with it: session 60, 2-core VM).
 #include <gtest/gtest.h>
 
 #include <cstdint>
+#include <cstdlib>
+#include <vector>
 
 #include "dgtex/scene_io.h"
 #include "dgtex/scene_run.h"
@@ -38,6 +41,38 @@ TEST(StepMemory, SixTimesTheFieldsBoundWithinTheCaps) {
   EXPECT_EQ(step_memory_bytes(TexelFields{}, -1), 0);  // no fields
 }
 
+long minor_faults() {
+#if defined(__linux__)
+  rusage usage{};
+  getrusage(RUSAGE_SELF, &usage);
+  return usage.ru_minflt;
+#else
+  return 0;
+#endif
+}
+
+TEST(StepMemory, ALargerReservationTopsTheHeapUpToAllOfIt) {
+#if defined(__SANITIZE_ADDRESS__)
+  GTEST_SKIP() << "ASan's allocator takes no malloc settings";
+#elif !defined(__linux__) || !defined(__GLIBC__)
+  GTEST_SKIP() << "the heap's part of the reservation is glibc's";
+#else
+  reserve_step_memory(48 * mib);   // 32 MiB of heap
+  reserve_step_memory(144 * mib);  // 96 MiB of heap: the first 32 again, and 64 more
+  const long before = minor_faults();
+  std::vector<char*> pieces;
+  for (int k = 0; k < 20; ++k) {  // 80 MiB in pieces below glibc's mmap threshold
+    char* piece = static_cast<char*>(std::malloc(4 * mib));
+    ASSERT_NE(piece, nullptr);
+    for (std::int64_t b = 0; b < 4 * mib; b += 4096) piece[b] = 1;
+    pieces.push_back(piece);
+  }
+  const long faults = minor_faults() - before;
+  for (char* piece : pieces) std::free(piece);
+  EXPECT_LT(faults, 200) << "80 MiB written in the reserved heap (20k pages)";
+#endif
+}
+
 TEST(StepMemory, ChadsFirstStepsFaultInAlmostNoPageWithTheReservation) {
 #if defined(__SANITIZE_ADDRESS__)
   GTEST_SKIP() << "ASan's allocator takes no malloc settings and keeps its own shadow pages";
@@ -47,11 +82,6 @@ TEST(StepMemory, ChadsFirstStepsFaultInAlmostNoPageWithTheReservation) {
   SceneRunOptions options;
   options.reserve_step_memory = true;
   SceneRun run(load_scene(DGTEX_SOURCE_DIR "/examples/scenes/chad.json"), options);
-  auto minor_faults = [] {
-    rusage usage{};
-    getrusage(RUSAGE_SELF, &usage);
-    return usage.ru_minflt;
-  };
   const long before = minor_faults();
   for (int step = 0; step < 4; ++step) run.step();
   EXPECT_LT(minor_faults() - before, 1000) << "page faults in chad's first four steps";
