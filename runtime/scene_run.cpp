@@ -79,7 +79,9 @@ SceneRun::SceneRun(const Scene& scene, SceneRunOptions options)
         // Set-up, not enrichment: the time-0 update counts as the first step's (bench scenes).
         const auto reserve_start = std::chrono::steady_clock::now();
         try {
-          reserve_step_memory(step_memory_bytes(fields, available));
+          const std::int64_t bytes = step_memory_bytes(fields, available);
+          reserve_step_memory(bytes);
+          reserved_step_memory_bytes_ = bytes;
         } catch (const std::bad_alloc&) {
           // Only a head start: without it the steps take their memory as they go.
         }

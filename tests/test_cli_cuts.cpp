@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -52,9 +53,10 @@ TEST(CliCuts, CompletelyCutPieceFallsFreelyWhileTheClampedPartHolds) {
   nlohmann::json scene = cut_strip();
   scene["material"]["youngs_modulus"] = 2e11;  // a stiff cantilever: see below
   scene["material"]["thickness"] = 0.05;
-  const Result r = run_scene(scene, dir, "--save-textures --no-render");
+  const Result r = run_scene(scene, dir, "--save-textures --no-render --no-memory-reserve");
   ASSERT_EQ(r.exit_code, 0) << r.stderr_text;
   const nlohmann::json report = report_of(dir);
+  EXPECT_EQ(report["reserved_step_memory_bytes"], 0);
   EXPECT_EQ(report["counts"]["enrichments"], 1);
   EXPECT_EQ(report["counts"]["enriched_dofs"], 3 * 8);  // the nodes of the one cut element
   EXPECT_EQ(report["counts"]["basis_changes"], 0);       // present from the start
@@ -82,7 +84,8 @@ TEST(CliCuts, SaveTexturesWithoutCutsSaysSoInsteadOfWritingNothingSilently) {
             std::string::npos)
       << r.stderr_text;
   EXPECT_FALSE(fs::exists(dir / "out" / "textures"));
-  EXPECT_TRUE(fs::exists(dir / "out" / "report.json"));
+  ASSERT_TRUE(fs::exists(dir / "out" / "report.json"));
+  EXPECT_EQ(report_of(dir)["reserved_step_memory_bytes"], 0);  // no texel fields to reserve for
 }
 
 TEST(CliCuts, ProgressiveCutChangesTheBasisEveryStepAndReportsItsStages) {
@@ -94,6 +97,9 @@ TEST(CliCuts, ProgressiveCutChangesTheBasisEveryStepAndReportsItsStages) {
   ASSERT_EQ(r.exit_code, 0) << r.stderr_text;
   const nlohmann::json report = report_of(dir);
   EXPECT_EQ(report["counts"]["enrichments"], 1);
+  // The set-up reserved memory for the first steps by default (dgtex/step_memory.h).
+  EXPECT_GT(report["reserved_step_memory_bytes"].get<std::int64_t>(), 0);
+  EXPECT_LE(report["reserved_step_memory_bytes"].get<std::int64_t>(), std::int64_t{512} << 20);
   // The cut grows 0.025 per step (1 texel of the 0.25-wide element at T = 32 is 0.0078):
   // the basis changes on every step while it grows (steps 2..11), then it is complete.
   EXPECT_GE(report["counts"]["basis_changes"].get<int>(), 9);

@@ -259,6 +259,7 @@ int run_command(int argc, char** argv) {
                  solver.stale_factor_failures, solver.solves);
   report["time"] = run->time();
   report["threads"] = omp_get_max_threads();
+  report["reserved_step_memory_bytes"] = run->reserved_step_memory_bytes();
   nlohmann::json probes = nlohmann::json::object();
   for (const Probe& probe : scene.probes) {
     const SurfacePoint p = closest_surface_point(mesh, probe.position.data());

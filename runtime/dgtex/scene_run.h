@@ -102,6 +102,9 @@ class SceneRun {
   double time() const { return time_; }
   int steps_taken() const { return steps_; }
   int basis_changes() const { return basis_changes_; }
+  // Bytes its set-up reserved for the first steps (SceneRunOptions::reserve_step_memory);
+  // 0 when it reserved none.
+  std::int64_t reserved_step_memory_bytes() const { return reserved_step_memory_bytes_; }
   // OpenMP threads of the cut update that ran beside the last step (0: none ran beside it).
   int last_cut_update_threads() const { return last_cut_update_threads_; }
   // All stages so far (those of replaced simulations included).
@@ -145,6 +148,7 @@ class SceneRun {
   double time_ = 0;
   int steps_ = 0;
   int basis_changes_ = 0;
+  std::int64_t reserved_step_memory_bytes_ = 0;
   SceneRunOptions options_;
   // The next step's cut update while it runs beside a step (after cuts_: it refers to it,
   // so it is destroyed, i.e. waited for, first).
