@@ -59,6 +59,7 @@ char* map_granules(std::size_t size) {
   if (base + size + granule > end) munmap(end, base + size + granule - end);
   return aligned;
 }
+#endif
 
 // Granules faulted in ahead of use (prefault_mapped_blocks): fresh mapped blocks are cut from
 // the front while it lasts. A block cut from it is unmapped like any other (munmap takes
@@ -80,19 +81,16 @@ void* take_prefaulted(std::size_t size) {
   p.next += size;
   return block;
 }
-#endif
 
 void* fresh_block(std::size_t bytes) {
 #if defined(__linux__)
   if (mapped(bytes)) {
-    const std::size_t size = fresh_capacity(bytes);
-    if (void* block = take_prefaulted(size)) return block;
     // No madvise(MADV_HUGEPAGE) since session 58: on virtual machines whose free 2 MiB
     // blocks go back to the host, a fresh huge page is backed again on its first touch, and
     // the advised blocks made the accordion's first step 247-306 instead of 152-160 ms and
     // the first T = 1024 multigrid solve of a process 783-881 instead of 74-77 ms
     // (multigrid_buffer.h).
-    return map_granules(size);
+    return map_granules(fresh_capacity(bytes));
   }
 #endif
   void* block = std::calloc(bytes == 0 ? 1 : bytes, 1);
@@ -233,7 +231,9 @@ void* acquire_zeroed_block(std::size_t bytes) {
       std::memset(block, 0xff, bytes);  // all-ones bytes: a NaN as double and as float
     return block;
   }
-  if (mapped(bytes) && prefaulted_block_bytes() < fresh_capacity(bytes)) {
+  // A fresh block: from the prefaulted granules while they last, else newly mapped (or calloc).
+  if (mapped(bytes)) block = take_prefaulted(fresh_capacity(bytes));
+  if (!block && mapped(bytes)) {
     // Cached mapped blocks, oldest first, as much as the new mapping takes, go back to the
     // system first: it hands their pages, which the host has backed, to the new mapping.
     // Kept, they made the accordion's first rest sums (88 MB) fault in pages the host had
@@ -249,7 +249,7 @@ void* acquire_zeroed_block(std::size_t bytes) {
     }
     free_entries(returned, count);
   }
-  block = fresh_block(bytes);
+  if (!block) block = fresh_block(bytes);
   const std::size_t capacity = fresh_capacity(bytes);
   if (capacity != needed) {
     try {
@@ -286,13 +286,9 @@ void prefault_mapped_blocks(std::size_t bytes) {
 }
 
 std::size_t prefaulted_block_bytes() noexcept {
-#if defined(__linux__)
   PrefaultedGranules& p = prefaulted();
   const std::lock_guard<std::mutex> lock(p.mutex);
   return static_cast<std::size_t>(p.end - p.next);
-#else
-  return 0;
-#endif
 }
 
 void release_block(void* block, std::size_t bytes) noexcept {

@@ -73,9 +73,8 @@ void reserve_step_memory(std::int64_t bytes) {
 }
 
 std::int64_t step_memory_bytes(const TexelFields& fields, std::int64_t available_bytes) {
-  std::int64_t bytes = std::min(6 * texel_memory_lower_bound(fields), 512 * mib);
-  if (available_bytes >= 0) bytes = std::min(bytes, available_bytes / 4);
-  return std::max<std::int64_t>(bytes, 0);
+  const std::int64_t bytes = std::min(6 * texel_memory_lower_bound(fields), 512 * mib);
+  return available_bytes >= 0 ? std::min(bytes, available_bytes / 4) : bytes;
 }
 
 }  // namespace dgtex
