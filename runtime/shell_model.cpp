@@ -695,6 +695,33 @@ std::int64_t ShellModel::num_quadrature_points() const {
 
 void ShellModel::assemble_stiffness(const double* current, std::vector<double>& blocks, std::vector<double>* corrective,
                                     Execution execution) const {
+  assemble_stiffness_blocks(current, blocks, corrective, nullptr, execution);
+}
+
+void ShellModel::assemble_stiffness_and_products(const double* current, std::vector<double>& blocks,
+                                                 std::vector<double>* corrective, const AssembledProducts& products,
+                                                 Execution execution) const {
+  if (fuses_stiffness_products()) {
+    assemble_stiffness_blocks(current, blocks, corrective, &products, execution);
+    return;
+  }
+  assemble_stiffness_blocks(current, blocks, corrective, nullptr, execution);
+  const auto multiply = [&](std::int64_t first, std::int64_t last) {
+    if (products.spread2)
+      kernels::block_rows_product_pair(assembly_.rows(), first, last, blocks.data(), products.spread1,
+                                       products.spread2, products.y1, products.y2);
+    else
+      kernels::block_rows_product(assembly_.rows(), first, last, blocks.data(), products.spread1, products.y1);
+  };
+  if (execution == Execution::serial)
+    multiply(0, assembly_.num_nodes());
+  else
+    for_row_ranges(assembly_, multiply);
+}
+
+void ShellModel::assemble_stiffness_blocks(const double* current, std::vector<double>& blocks,
+                                           std::vector<double>* corrective, const AssembledProducts* products,
+                                           Execution execution) const {
   const int ne = static_cast<int>(plain_sections_.size());
   const int nedges = static_cast<int>(plain_edge_size_.size());
   const int npe = mesh_.nodes_per_element();
@@ -847,7 +874,7 @@ void ShellModel::assemble_stiffness(const double* current, std::vector<double>& 
     vector_locals.push_back(textured_forces.data());
   }
   blocks.resize(assembly_.num_blocks() * 9);
-  assembly_.assemble_matrix(matrix_locals, blocks.data(), parallel);
+  assembly_.assemble_matrix(matrix_locals, blocks.data(), parallel, products);
   if (corrective) {
     corrective->assign(num_dofs(), 0.0);
     if (current) assembly_.assemble_vector(vector_locals, corrective->data(), parallel);

@@ -134,6 +134,22 @@ void ShellSimulation::solve_static() {
   }
 }
 
+void ShellSimulation::extrapolate_initial_guess() {
+  // The velocity extrapolated quadratically from the last three steps (linearly from two, v
+  // alone right after set_state). Linear starts PCG ~10x closer than v itself; quadratic
+  // saves another 4-9 % of the iterations on the cylinder scene (100 steps: 786 instead of
+  // 821; 30 steps: 173 instead of 190).
+  const int ndofs = model_.num_dofs();
+  guess_ = v_;
+  if (previous_previous_v_.size() == v_.size())
+    for (int d = 0; d < ndofs; ++d) guess_[d] = 3 * v_[d] - 3 * previous_v_[d] + previous_previous_v_[d];
+  else if (previous_v_.size() == v_.size())
+    for (int d = 0; d < ndofs; ++d) guess_[d] = 2 * v_[d] - previous_v_[d];
+  for (int d = 0; d < ndofs; ++d)
+    if (fixed_[d]) guess_[d] = 0;  // as the solver would set them
+  k_guess_.resize(ndofs);
+}
+
 void ShellSimulation::set_solver_options(const FactorReuseOptions& options) { solver_.set_options(options); }
 
 void ShellSimulation::step(const DynamicsOptions& o) {
@@ -145,11 +161,32 @@ void ShellSimulation::step(const DynamicsOptions& o) {
   corrective_.clear();
   const std::vector<double>* K = nullptr;
   double factorization_wait_ms = 0;  // solver time spent beside the assembly, beyond it
+  const bool reuse = o.corotational && o.reuse_factorization;
+  ku_.resize(ndofs);
+  // With factor reuse, K u and K times the PCG's initial guess (the right-hand side and the
+  // initial residual), formed in the assembly's pass over K where the model can
+  // (ShellModel::fuses_stiffness_products): its rows are still in the cache that summed them
+  // and the assembly's threads are awake (the accordion's pair product took 84-125 us a step
+  // in the solve stage, one thread; 12-17 us fused).
+  const bool fused_products = reuse && model_.fuses_stiffness_products();
   if (o.corotational) {
     const std::vector<double>& rest = model_.rest_state();  // enriched DOFs rest at 0
     current_.resize(ndofs);
     for (int d = 0; d < ndofs; ++d) current_[d] = rest[d] + u_[d];
-    const auto assemble = [&] { model_.assemble_stiffness(current_.data(), corotated_k_, &corrective_); };
+    const auto assemble = [&] {
+      if (!fused_products) {
+        model_.assemble_stiffness(current_.data(), corotated_k_, &corrective_);
+        return;
+      }
+      extrapolate_initial_guess();
+      const std::size_t spread_size = 9 * static_cast<std::size_t>(model_.pattern().num_nodes());
+      spread_pair_.resize(2 * spread_size);
+      kernels::spread_block_vector(model_.pattern().num_nodes(), u_.data(), spread_pair_.data());
+      kernels::spread_block_vector(model_.pattern().num_nodes(), guess_.data(), spread_pair_.data() + spread_size);
+      model_.assemble_stiffness_and_products(
+          current_.data(), corotated_k_, &corrective_,
+          {spread_pair_.data(), spread_pair_.data() + spread_size, ku_.data(), k_guess_.data()});
+    };
     if (o.reuse_factorization && solver_.factorization_pending() && !solver_.dense_factorization_pending()) {
       // The pending factorisation (serial CHOLMOD) on one thread, the assembly on the others.
       const SideBySideTimes t = run_side_by_side([&] { solver_.factorize_pending(); }, assemble);
@@ -175,26 +212,13 @@ void ShellSimulation::step(const DynamicsOptions& o) {
   const double mass_scale = 1 + dt * o.mass_damping;
   const double stiffness_scale = dt * o.stiffness_damping + dt * dt;
   mv_.resize(ndofs);
-  ku_.resize(ndofs);
   rhs_full_.resize(ndofs);
   solver_.multiply_mass(v_, mv_);  // M's scalar diagonal: 1/9 of the traffic
-  const bool reuse = o.corotational && o.reuse_factorization;
-  if (reuse) {
-    // Initial guess: the velocity extrapolated quadratically from the last three steps
-    // (linearly from two, v alone right after set_state). Linear starts PCG ~10x closer
-    // than v itself; quadratic saves another 4-9 % of the iterations on the cylinder scene
-    // (100 steps: 786 instead of 821; 30 steps: 173 instead of 190). K u and K times the
-    // guess share one pass over K.
-    guess_ = v_;
-    if (previous_previous_v_.size() == v_.size())
-      for (int d = 0; d < ndofs; ++d) guess_[d] = 3 * v_[d] - 3 * previous_v_[d] + previous_previous_v_[d];
-    else if (previous_v_.size() == v_.size())
-      for (int d = 0; d < ndofs; ++d) guess_[d] = 2 * v_[d] - previous_v_[d];
-    for (int d = 0; d < ndofs; ++d)
-      if (fixed_[d]) guess_[d] = 0;  // as the solver would set them
-    k_guess_.resize(ndofs);
+  if (reuse && !fused_products) {
+    // K u and K times the guess share one pass over K.
+    extrapolate_initial_guess();
     block_multiply_pair(model_.pattern(), K->data(), u_.data(), guess_.data(), ku_.data(), k_guess_.data());
-  } else {
+  } else if (!reuse) {
     block_multiply(model_.pattern(), K->data(), u_.data(), ku_.data());
   }
   for (int d = 0; d < ndofs; ++d) {

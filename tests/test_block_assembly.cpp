@@ -140,5 +140,46 @@ TEST(BlockAssembly, PatternAndSumsAreTheReferenceOnesBitwiseForAnyThreadCount) {
   }
 }
 
+// The products fused into assemble_matrix are those of the kernels on the assembled
+// matrix, bit for bit, for one vector and for two, on any thread count; the sums are
+// unchanged by them.
+TEST(BlockAssembly, FusedProductsAreTheKernelsProductsOfTheSumBitwise) {
+  const RandomFamilies r = random_families(4);
+  const BlockAssembly pattern(r.num_nodes, r.families);
+  std::vector<const double*> matrices;
+  for (const std::vector<double>& m : r.matrices) matrices.push_back(m.data());
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> uniform(-1.0, 1.0);
+  const std::size_t n = 3 * static_cast<std::size_t>(r.num_nodes);
+  std::vector<double> x1(n), x2(n);
+  for (double& v : x1) v = uniform(rng);
+  for (double& v : x2) v = std::ldexp(uniform(rng), 30);
+  std::vector<double> spread1(3 * n), spread2(3 * n);
+  kernels::spread_block_vector(r.num_nodes, x1.data(), spread1.data());
+  kernels::spread_block_vector(r.num_nodes, x2.data(), spread2.data());
+
+  std::vector<double> sums(pattern.num_blocks() * 9), expected1(n), expected2(n);
+  pattern.assemble_matrix(matrices, sums.data(), false);
+  kernels::block_rows_product(pattern.rows(), 0, r.num_nodes, sums.data(), spread1.data(), expected1.data());
+  kernels::block_rows_product(pattern.rows(), 0, r.num_nodes, sums.data(), spread2.data(), expected2.data());
+  for (int threads : {1, 2, 3}) {
+    omp_set_num_threads(threads);
+    for (bool pair : {false, true}) {
+      std::vector<double> fused_sums(sums.size()), y1(n, 7.0), y2(n, 7.0);
+      const AssembledProducts products{spread1.data(), pair ? spread2.data() : nullptr, y1.data(),
+                                       pair ? y2.data() : nullptr};
+      pattern.assemble_matrix(matrices, fused_sums.data(), true, &products);
+      for (std::size_t i = 0; i < sums.size(); ++i)
+        ASSERT_TRUE(same_bits(fused_sums[i], sums[i])) << threads << " threads, sum entry " << i;
+      for (std::size_t i = 0; i < n; ++i) {
+        ASSERT_TRUE(same_bits(y1[i], expected1[i])) << threads << " threads, pair " << pair << ", A x1 entry " << i;
+        ASSERT_TRUE(same_bits(y2[i], pair ? expected2[i] : 7.0)) << threads << " threads, pair " << pair
+                                                                 << ", A x2 entry " << i;
+      }
+    }
+  }
+  omp_set_num_threads(2);
+}
+
 }  // namespace
 }  // namespace dgtex

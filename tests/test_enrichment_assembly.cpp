@@ -197,6 +197,48 @@ TEST(EnrichedAssembly, SymmetricAndIndependentOfThreadCount) {
   }
 }
 
+// assemble_stiffness_and_products: the stiffness of assemble_stiffness and block_multiply's
+// products of it, bit for bit, whether the model fuses them into its sum (enriched) or
+// multiplies after it (plain), serially and on threads.
+TEST(EnrichedAssembly, StiffnessProductsAreBlockMultiplysBitwiseFusedOrNot) {
+  const std::vector<CutScene> scenes = cut_scenes();
+  const CutScene& scene = scenes.front();
+  const Mesh& mesh = scene.mesh;
+  const Topology topology = build_topology(mesh);
+  const std::vector<kernels::ShellSection> sections(mesh.num_elements(), {1e6, 0.3, 0.01, 1000});
+  const ShellModel plain(mesh, topology, sections, std::vector<int>{}, ShellModelOptions{});
+  ShellModel enriched(mesh, topology, sections, std::vector<int>{}, ShellModelOptions{});
+  enriched.set_enrichments({straight_cut_enrichment(mesh, 16, scene.cut, scene.aligned)});
+  EXPECT_FALSE(plain.fuses_stiffness_products());
+  EXPECT_TRUE(enriched.fuses_stiffness_products());
+  for (const ShellModel* model : std::vector<const ShellModel*>{&plain, &enriched}) {
+    std::vector<double> current = model->rest_state();
+    std::mt19937 rng(12);
+    std::uniform_real_distribution<double> d(-0.05, 0.05);
+    for (double& x : current) x += d(rng);
+    const int dofs = model->num_dofs(), nodes = model->pattern().num_nodes();
+    std::vector<double> x1(dofs), x2(dofs);
+    for (double& x : x1) x = d(rng);
+    for (double& x : x2) x = d(rng);
+    std::vector<double> K, f, y1(dofs), y2(dofs);
+    model->assemble_stiffness(current.data(), K, &f);
+    block_multiply_pair(model->pattern(), K.data(), x1.data(), x2.data(), y1.data(), y2.data());
+    std::vector<double> spread1(9 * static_cast<std::size_t>(nodes)), spread2(spread1.size());
+    kernels::spread_block_vector(nodes, x1.data(), spread1.data());
+    kernels::spread_block_vector(nodes, x2.data(), spread2.data());
+    for (kernels::Execution execution : {kernels::Execution::serial, kernels::Execution::parallel}) {
+      std::vector<double> K2, f2, z1(dofs), z2(dofs);
+      model->assemble_stiffness_and_products(current.data(), K2, &f2,
+                                             {spread1.data(), spread2.data(), z1.data(), z2.data()}, execution);
+      const bool fused = model->fuses_stiffness_products();
+      EXPECT_EQ(K2, K) << "fused " << fused;
+      EXPECT_EQ(f2, f) << "fused " << fused;
+      EXPECT_EQ(z1, y1) << "fused " << fused;
+      EXPECT_EQ(z2, y2) << "fused " << fused;
+    }
+  }
+}
+
 TEST(EnrichedAssembly, MassCentreAndInertiaOfThePiecesAreGeometric) {
   const Material m;
   const double rho_h = m.rho * m.h;

@@ -34,6 +34,18 @@ struct LocalMatrices {
   int factor_rank = 0;             // 0: stored blocks; > 0 (even): factors of this rank
 };
 
+// Products of a matrix being assembled with one or two vectors, for assemble_matrix: y1 = A x1
+// and, where spread2 is given, y2 = A x2 (#nodes x 3 each), the x given spread
+// (kernels::spread_block_vector). Each range of rows is multiplied right after its blocks are
+// summed, by the kernels of kernels/block_product.h: bitwise block_multiply's results, without
+// a second pass over A (whose rows are then still in the cache of the thread that summed them).
+struct AssembledProducts {
+  const double* spread1 = nullptr;
+  const double* spread2 = nullptr;  // null: y1 only
+  double* y1 = nullptr;
+  double* y2 = nullptr;
+};
+
 class BlockAssembly {
  public:
   BlockAssembly() = default;
@@ -47,7 +59,9 @@ class BlockAssembly {
   kernels::BlockRows rows() const { return {row_start_.data(), column_.data()}; }
 
   // values: num_blocks x 9. locals[f] points to family f's local blocks, or is null to skip it.
-  void assemble_matrix(const std::vector<const double*>& locals, double* values, bool parallel = true) const;
+  // products (optional): also the products of the assembled matrix (AssembledProducts).
+  void assemble_matrix(const std::vector<const double*>& locals, double* values, bool parallel = true,
+                       const AssembledProducts* products = nullptr) const;
   // The same sum for a symmetric global matrix (every family's local matrices symmetric):
   // only blocks with column >= row are summed (same fixed order as assemble_matrix, so
   // bitwise its values there, up to the diagonal blocks' lower triangles); each entry

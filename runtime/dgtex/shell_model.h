@@ -175,6 +175,17 @@ class ShellModel {
   // it is the linear model.
   void assemble_stiffness(const double* current_positions, std::vector<double>& blocks,
                           std::vector<double>* corrective, kernels::Execution execution = kernels::Execution::parallel) const;
+  // assemble_stiffness, and the products of the assembled blocks with products' vectors
+  // (AssembledProducts, dgtex/block_assembly.h; bitwise block_multiply's results). Where
+  // fuses_stiffness_products(), each range of rows is multiplied as soon as its blocks are
+  // summed, in the assembly's pass over them; otherwise by a pass of its own afterwards.
+  void assemble_stiffness_and_products(const double* current_positions, std::vector<double>& blocks,
+                                       std::vector<double>* corrective, const AssembledProducts& products,
+                                       kernels::Execution execution = kernels::Execution::parallel) const;
+  // Models with enriched or textured elements. A plain model's stiffness is summed as a
+  // symmetric matrix, whose rows get their lower blocks from other rows' work items, so a
+  // row is complete only once the whole sum is.
+  bool fuses_stiffness_products() const { return !enriched_elements_.empty() || !textured_index_.empty(); }
 
   // Consistent mass blocks (same pattern), assembled at construction.
   const std::vector<double>& mass_blocks() const { return mass_blocks_; }
@@ -270,6 +281,11 @@ class ShellModel {
   std::vector<int> sided_connectivity_;
   std::vector<kernels::ShellSection> sided_sections_;
   kernels::PointSectionBatch textured_batch() const;
+  // assemble_stiffness; the products fused into the sum where given (a model that
+  // fuses_stiffness_products() only).
+  void assemble_stiffness_blocks(const double* current_positions, std::vector<double>& blocks,
+                                 std::vector<double>* corrective, const AssembledProducts* products,
+                                 kernels::Execution execution) const;
 
   // Buffers of assemble_stiffness's plain elements and edges, kept between calls (the
   // calls on one instance are not concurrent, see above). A copy starts empty.

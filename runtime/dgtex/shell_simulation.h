@@ -67,6 +67,9 @@ class ShellSimulation {
   double linear_elastic_energy() const;  // 1/2 u^T K u with the linear K
 
  private:
+  // guess_ (and k_guess_ sized): the PCG's initial guess for the next velocity.
+  void extrapolate_initial_guess();
+
   const ShellModel& model_;
   std::vector<char> fixed_;
   std::vector<double> f_ext_;
@@ -82,6 +85,7 @@ class ShellSimulation {
   std::vector<double> current_, corotated_k_, corrective_, mv_, ku_, rhs_full_, rhs_, v_new_, values_;
   std::vector<double> previous_v_, previous_previous_v_, guess_;  // velocities of the steps before, PCG start
   std::vector<double> k_guess_;             // K guess_
+  std::vector<double> spread_pair_;         // u_ and guess_ spread for the fused products
 
   const std::vector<double>& linear_stiffness();
   std::string enrichment_hint() const;  // appended to "not positive definite" errors
