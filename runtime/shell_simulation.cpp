@@ -166,8 +166,9 @@ void ShellSimulation::step(const DynamicsOptions& o) {
   // With factor reuse, K u and K times the PCG's initial guess (the right-hand side and the
   // initial residual), formed in the assembly's pass over K where the model can
   // (ShellModel::fuses_stiffness_products): its rows are still in the cache that summed them
-  // and the assembly's threads are awake (the accordion's pair product took 84-125 us a step
-  // in the solve stage, one thread; 12-17 us fused).
+  // and the assembly's threads are awake. The accordion: 76-99 us for the pair as a pass of
+  // its own after the assembly (one thread), 7-52 us more assembly fused (README, "Solver
+  // strategy of the corotated dynamic step").
   const bool fused_products = reuse && model_.fuses_stiffness_products();
   if (o.corotational) {
     const std::vector<double>& rest = model_.rest_state();  // enriched DOFs rest at 0
