@@ -152,11 +152,7 @@ void BlockAssembly::assemble_matrix(const std::vector<const double*>& locals, do
         const std::int64_t first = range * rows_per_range;
         const std::int64_t last = std::min<std::int64_t>(first + rows_per_range, num_nodes_);
         for (std::int64_t blk = row_start_[first]; blk < row_start_[last]; ++blk) sum_block(blk);
-        if (products->spread2)
-          kernels::block_rows_product_pair(rows(), first, last, values, products->spread1, products->spread2,
-                                           products->y1, products->y2);
-        else
-          kernels::block_rows_product(rows(), first, last, values, products->spread1, products->y1);
+        products->multiply_rows(rows(), first, last, values);
       },
       execution);
 }

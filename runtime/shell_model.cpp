@@ -707,11 +707,7 @@ void ShellModel::assemble_stiffness_and_products(const double* current, std::vec
   }
   assemble_stiffness_blocks(current, blocks, corrective, nullptr, execution);
   const auto multiply = [&](std::int64_t first, std::int64_t last) {
-    if (products.spread2)
-      kernels::block_rows_product_pair(assembly_.rows(), first, last, blocks.data(), products.spread1,
-                                       products.spread2, products.y1, products.y2);
-    else
-      kernels::block_rows_product(assembly_.rows(), first, last, blocks.data(), products.spread1, products.y1);
+    products.multiply_rows(assembly_.rows(), first, last, blocks.data());
   };
   if (execution == Execution::serial)
     multiply(0, assembly_.num_nodes());

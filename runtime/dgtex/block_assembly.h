@@ -44,6 +44,14 @@ struct AssembledProducts {
   const double* spread2 = nullptr;  // null: y1 only
   double* y1 = nullptr;
   double* y2 = nullptr;
+
+  // Rows [first, last) of the products with the block matrix `values` (pattern `rows`).
+  void multiply_rows(kernels::BlockRows rows, std::int64_t first, std::int64_t last, const double* values) const {
+    if (spread2)
+      kernels::block_rows_product_pair(rows, first, last, values, spread1, spread2, y1, y2);
+    else
+      kernels::block_rows_product(rows, first, last, values, spread1, y1);
+  }
 };
 
 class BlockAssembly {
