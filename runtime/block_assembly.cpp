@@ -125,17 +125,31 @@ BlockAssembly::BlockAssembly(int num_nodes, const std::vector<BlockSourceFamily>
     }
 }
 
+namespace {
+
+// out[target] (Width entries) = the sum of the target's contributions (family, local index)
+// in their fixed order, from the families' local arrays (a null family skipped): a block of
+// assemble_matrix (Width 9) or a node of assemble_vector (Width 3).
+template <int Width>
+inline void sum_contributions(std::int64_t target, const std::vector<std::int64_t>& start,
+                              const std::vector<int>& family, const std::vector<std::int64_t>& local,
+                              const std::vector<const double*>& locals, double* out) {
+  double sum[Width] = {};
+  for (std::int64_t c = start[target]; c < start[target + 1]; ++c) {
+    const double* src = locals[family[c]];
+    if (!src) continue;
+    src += local[c] * Width;
+    for (int k = 0; k < Width; ++k) sum[k] += src[k];
+  }
+  for (int k = 0; k < Width; ++k) out[target * Width + k] = sum[k];
+}
+
+}  // namespace
+
 void BlockAssembly::assemble_matrix(const std::vector<const double*>& locals, double* values, bool parallel,
                                     const AssembledProducts* products) const {
   const auto sum_block = [&](std::int64_t blk) {
-    double sum[9] = {0, 0, 0, 0, 0, 0, 0, 0, 0};
-    for (std::int64_t c = contribution_start_[blk]; c < contribution_start_[blk + 1]; ++c) {
-      const double* src = locals[contribution_family_[c]];
-      if (!src) continue;
-      src += contribution_local_[c] * 9;
-      for (int k = 0; k < 9; ++k) sum[k] += src[k];
-    }
-    for (int k = 0; k < 9; ++k) values[blk * 9 + k] = sum[k];
+    sum_contributions<9>(blk, contribution_start_, contribution_family_, contribution_local_, locals, values);
   };
   const Execution execution = parallel ? Execution::parallel : Execution::serial;
   if (!products) {
@@ -231,14 +245,7 @@ void BlockAssembly::assemble_vector(const std::vector<const double*>& locals, do
   forall(
       num_nodes_,
       [&](std::int64_t node) {
-        double sum[3] = {0, 0, 0};
-        for (std::int64_t c = vector_start_[node]; c < vector_start_[node + 1]; ++c) {
-          const double* src = locals[vector_family_[c]];
-          if (!src) continue;
-          src += vector_local_[c] * 3;
-          for (int k = 0; k < 3; ++k) sum[k] += src[k];
-        }
-        for (int k = 0; k < 3; ++k) out[node * 3 + k] = sum[k];
+        sum_contributions<3>(node, vector_start_, vector_family_, vector_local_, locals, out);
       },
       parallel ? Execution::parallel : Execution::serial);
 }

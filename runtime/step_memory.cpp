@@ -52,7 +52,9 @@ void fault_in_heap(std::int64_t bytes) {
       failed = true;
       break;
     }
-    for (std::size_t k = 0; k < heap_chunk; k += page) chunk[k] = 0;
+    // Volatile: the stores go to memory freed unread below, which a compiler may drop.
+    volatile char* pages = chunk;
+    for (std::size_t k = 0; k < heap_chunk; k += page) pages[k] = 0;
     chunks.push_back(chunk);
   }
   for (char* chunk : chunks) std::free(chunk);
