@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 #include <string>
 
@@ -36,6 +37,41 @@ std::vector<char> element_local_blocks(const std::vector<double>& mass) {
   return kept;
 }
 
+double element_local_dropped_radius(const BlockAssembly& pattern, const std::vector<char>& kept,
+                                    const std::vector<char>& free, const std::vector<double>& mass,
+                                    const ScaledBlockSum& A) {
+  const std::int64_t nodes = pattern.num_nodes();
+  const std::vector<std::int64_t>& row_start = pattern.row_start();
+  const std::vector<int>& column = pattern.column();
+  const std::vector<double>& K = *A.stiffness;
+  std::vector<double> diagonal(3 * static_cast<std::size_t>(nodes), 0.0);
+  for (std::int64_t r = 0; r < nodes; ++r)
+    for (std::int64_t k = row_start[r]; k < row_start[r + 1]; ++k)
+      if (column[k] == r)
+        for (int i = 0; i < 3; ++i) diagonal[3 * r + i] = A.mass_scale * mass[9 * k + 4 * i] + A.stiffness_scale * K[9 * k + 4 * i];
+  for (std::size_t d = 0; d < diagonal.size(); ++d)
+    if (free[d] && !(diagonal[d] > 0)) return std::numeric_limits<double>::infinity();
+  // The dropped blocks have no mass (element_local_blocks): A_ij = stiffness_scale K_ij.
+  std::vector<double> row_radius(static_cast<std::size_t>(nodes), 0.0);
+  kernels::forall(
+      nodes,
+      [&](std::int64_t r) {
+        double sums[3] = {0, 0, 0};
+        for (std::int64_t k = row_start[r]; k < row_start[r + 1]; ++k) {
+          if (kept[k]) continue;
+          const std::int64_t c = column[k];
+          for (int i = 0; i < 3; ++i)
+            for (int j = 0; j < 3; ++j)
+              if (free[3 * r + i] && free[3 * c + j])
+                sums[i] += std::abs(A.stiffness_scale * K[9 * k + 3 * i + j]) /
+                           std::sqrt(diagonal[3 * r + i] * diagonal[3 * c + j]);
+        }
+        row_radius[r] = std::max({sums[0], sums[1], sums[2]});
+      },
+      vector_execution(3 * static_cast<std::size_t>(nodes)));
+  return row_radius.empty() ? 0.0 : *std::max_element(row_radius.begin(), row_radius.end());
+}
+
 FactorReuseStatistics operator+(const FactorReuseStatistics& a, const FactorReuseStatistics& b) {
   FactorReuseStatistics sum = b;
   sum.solves += a.solves;
@@ -67,7 +103,11 @@ double deterministic_dot(const std::vector<double>& x, const std::vector<double>
 
 FactorReusingSolver::FactorReusingSolver(const BlockAssembly& pattern, const FreeDofSystem& system,
                                          const std::vector<double>& mass, FactorReuseOptions options)
-    : pattern_(pattern), system_(system), mass_(mass), options_(options) {
+    : pattern_(pattern),
+      system_(system),
+      mass_(mass),
+      options_(options),
+      element_local_dropped_radius_(std::numeric_limits<double>::quiet_NaN()) {
   const std::int64_t blocks = pattern.num_blocks();
   bool isotropic = static_cast<std::int64_t>(mass.size()) == blocks * 9;
   for (std::int64_t k = 0; isotropic && k < blocks; ++k) {
@@ -91,8 +131,10 @@ FactorReusingSolver::FactorReusingSolver(const BlockAssembly& pattern, const Fre
 }
 
 void FactorReusingSolver::set_options(const FactorReuseOptions& options) {
+  const bool ruled_out = element_local_dropped_radius_ > options.element_local_max_dropped_radius;
   const bool element_local = options.preconditioner_pattern == PreconditionerPattern::element_local &&
-                             element_local_differs_ && !whole_pattern_dense_ && stats_.element_local_fallbacks == 0;
+                             element_local_differs_ && !whole_pattern_dense_ && stats_.element_local_fallbacks == 0 &&
+                             !ruled_out;
   if (element_local != use_element_local_) factor_current_ = false, factorization_pending_ = false;
   use_element_local_ = element_local;
   options_ = options;
@@ -103,6 +145,12 @@ void FactorReusingSolver::fall_back_to_full_pattern() {
   factor_current_ = false;
   ++stats_.element_local_fallbacks;
   element_local_factor_.reset();
+}
+
+void FactorReusingSolver::judge_element_local(const ScaledBlockSum& A) {
+  if (!std::isnan(element_local_dropped_radius_)) return;
+  element_local_dropped_radius_ = dgtex::element_local_dropped_radius(pattern_, element_local_blocks_, free_, mass_, A);
+  if (element_local_dropped_radius_ > options_.element_local_max_dropped_radius) use_element_local_ = false;
 }
 
 void FactorReusingSolver::gather_element_local(const ScaledBlockSum& A) {
@@ -156,6 +204,7 @@ void FactorReusingSolver::factorize_pending() {
 
 void FactorReusingSolver::factorize(const ScaledBlockSum& A, SparseCholesky& cholesky) {
   const auto start = std::chrono::steady_clock::now();
+  if (use_element_local_) judge_element_local(A);
   if (use_element_local_) {
     gather_element_local(A);
     factorize_element_local_values();

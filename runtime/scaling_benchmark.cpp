@@ -6,6 +6,7 @@
 #include <cmath>
 #include <algorithm>
 #include <exception>
+#include <iomanip>
 #include <limits>
 #include <memory>
 #include <random>
@@ -183,16 +184,26 @@ KernelScaling scale_factorization(const Scene& scene, const std::vector<int>& th
   SceneModel built = build_scene_model(scene, mesh);
   const ShellModel& model = *built.model;
   // The matrix the corotated step factorises: FactorReusingSolver's element-local pattern,
-  // or the whole pattern where that one is not positive definite (fracture's tri6 mesh), as
-  // the solver then falls back to it.
+  // or the whole pattern where the solver rules that one out by its dropped radius
+  // (fracture's tri6 mesh) or falls back from it (not positive definite).
   std::vector<double> K, values;
   model.assemble_stiffness(nullptr, K, nullptr);
   const double dt = scene.analysis.time_step;
   const std::vector<char> element_local = element_local_blocks(model.mass_blocks());
+  std::vector<char> free(built.fixed.size());
+  for (std::size_t d = 0; d < free.size(); ++d) free[d] = !built.fixed[d];
+  const double radius =
+      element_local_dropped_radius(model.pattern(), element_local, free, model.mass_blocks(), {1.0, &K, dt * dt});
+  const bool ruled_out = radius > FactorReuseOptions{}.element_local_max_dropped_radius;
   std::unique_ptr<FreeDofSystem> system;
   std::unique_ptr<SparseCholesky> cholesky;
   std::string pattern = "element-local";
-  for (const std::vector<char>* blocks : {&element_local, static_cast<const std::vector<char>*>(nullptr)}) {
+  if (ruled_out) {
+    std::ostringstream why;
+    why << "whole pattern; the element-local one drops couplings of radius " << std::setprecision(2) << radius;
+    pattern = why.str();
+  }
+  for (const std::vector<char>* blocks : {ruled_out ? nullptr : &element_local, static_cast<const std::vector<char>*>(nullptr)}) {
     system = std::make_unique<FreeDofSystem>(model.pattern(), built.fixed, blocks);
     system->gather(model.mass_blocks().data(), 1.0, K.data(), dt * dt, values);
     cholesky = std::make_unique<SparseCholesky>();

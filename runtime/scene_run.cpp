@@ -96,6 +96,7 @@ SceneRun::SceneRun(const Scene& scene, SceneRunOptions options)
     built.external_force = scene_external_force(scene_, *model_);
   }
   simulation_ = std::make_unique<ShellSimulation>(*model_, std::move(built.fixed), std::move(built.external_force));
+  simulation_->set_solver_options(options_.solver);
   // A dynamic scene may leave rigid modes free (a falling shell); a static one may not.
   if (!scene_.analysis.is_dynamic()) simulation_->check_statically_constrained();
 }
@@ -219,11 +220,9 @@ void SceneRun::change_basis(std::vector<EnrichmentFunction> functions, int edge_
   // too weak), the next bases, much like this one, get the whole pattern from the start
   // instead of wasting an element-local factorisation each (chad and the slinky fell back
   // at most of their basis changes before they were found too small for it).
-  if (solver_statistics().element_local_fallbacks > 0) {
-    FactorReuseOptions whole_pattern;
-    whole_pattern.preconditioner_pattern = PreconditionerPattern::full;
-    simulation->set_solver_options(whole_pattern);
-  }
+  FactorReuseOptions solver = options_.solver;
+  if (solver_statistics().element_local_fallbacks > 0) solver.preconditioner_pattern = PreconditionerPattern::full;
+  simulation->set_solver_options(solver);
   simulation->set_state(std::move(projected.displacement), std::move(projected.velocity));
   merge(timings_, simulation_->timings());
   replaced_solver_statistics_ = replaced_solver_statistics_ + simulation_->solver_statistics();

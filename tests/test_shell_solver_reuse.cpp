@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <vector>
 
 #include "dgtex/factor_reusing_solver.h"
@@ -388,6 +389,112 @@ TEST(FactorReuse, FallsBackToTheWholePatternWhenElementLocalIsTooWeak) {
   EXPECT_FALSE(solver.element_local());
   EXPECT_EQ(solver.statistics().element_local_fallbacks, 1);
   EXPECT_EQ(solver.statistics().factorizations, 2);  // element-local once, then A once (reused by solve 2)
+}
+
+TEST(FactorReuse, ElementLocalDroppedRadiusIsTheDefinitionsOnTheDenseMatrix) {
+  // The reference: A formed densely, an entry dropped where its two nodes share no element
+  // (from the mesh, not from the mass blocks), the radius summed entry by entry.
+  CylinderSystem cylinder;
+  const CompressedCylinder& c = cylinder.c;
+  const BlockAssembly& pattern = c.model->pattern();
+  const int nodes = pattern.num_nodes(), n = 3 * nodes;
+  std::vector<char> shared(static_cast<size_t>(nodes) * nodes, 0);
+  const int npe = c.mesh.nodes_per_element();
+  for (int e = 0; e < c.mesh.num_elements(); ++e)
+    for (int a = 0; a < npe; ++a)
+      for (int b = 0; b < npe; ++b)
+        shared[static_cast<size_t>(c.mesh.element_nodes(e)[a]) * nodes + c.mesh.element_nodes(e)[b]] = 1;
+  std::vector<char> free(n);
+  for (int d = 0; d < n; ++d) free[d] = !c.fixed[d];
+  const std::vector<char> kept = element_local_blocks(c.model->mass_blocks());
+  for (double stiffness_scale : {1e-7, 4e-6, 1e-4}) {
+    const ScaledBlockSum A{1.3, &cylinder.K, stiffness_scale};
+    std::vector<double> dense(static_cast<size_t>(n) * n, 0.0), dropped(dense.size(), 0.0);
+    for (int r = 0; r < nodes; ++r)
+      for (std::int64_t k = pattern.row_start()[r]; k < pattern.row_start()[r + 1]; ++k) {
+        const int col = pattern.column()[k];
+        for (int i = 0; i < 3; ++i)
+          for (int j = 0; j < 3; ++j) {
+            const double a = A.mass_scale * c.model->mass_blocks()[9 * k + 3 * i + j] +
+                             A.stiffness_scale * cylinder.K[9 * k + 3 * i + j];
+            dense[static_cast<size_t>(3 * r + i) * n + 3 * col + j] = a;
+            if (!shared[static_cast<size_t>(r) * nodes + col]) dropped[static_cast<size_t>(3 * r + i) * n + 3 * col + j] = a;
+          }
+      }
+    double expected = 0;
+    for (int i = 0; i < n; ++i) {
+      if (!free[i]) continue;
+      double sum = 0;
+      for (int j = 0; j < n; ++j)
+        if (free[j] && dropped[static_cast<size_t>(i) * n + j] != 0)
+          sum += std::abs(dropped[static_cast<size_t>(i) * n + j]) /
+                 std::sqrt(dense[static_cast<size_t>(i) * n + i] * dense[static_cast<size_t>(j) * n + j]);
+      expected = std::max(expected, sum);
+    }
+    ASSERT_GT(expected, 0) << "the cylinder's DG edges couple nodes of no common element";
+    for (int threads : {1, 2, 3}) {
+      omp_set_num_threads(threads);
+      EXPECT_NEAR(element_local_dropped_radius(pattern, kept, free, c.model->mass_blocks(), A), expected,
+                  1e-12 * expected)
+          << "stiffness scale " << stiffness_scale << ", " << threads << " threads";
+    }
+    omp_set_num_threads(2);
+  }
+  // A free DOF without a positive diagonal: A is not positive definite, nothing to weigh.
+  std::vector<double> negative = cylinder.K;
+  for (double& v : negative) v = -v;
+  const ScaledBlockSum indefinite{1.0, &negative, 1.0};
+  EXPECT_EQ(element_local_dropped_radius(pattern, kept, free, c.model->mass_blocks(), indefinite),
+            std::numeric_limits<double>::infinity());
+}
+
+TEST(FactorReuse, ElementLocalIsRuledOutWhereTheDroppedCouplingsOutweighTheMass) {
+  // The fracture scene's plate without its cuts (tri6, clamped at x = 0 and 1). At a time step
+  // of 3e-5 s the step matrix is mostly mass and the element-local factor is kept; at the
+  // scene's 1e-3 s dt^2 K dominates, the couplings the element-local pattern drops reach
+  // a radius of ~1 (its matrix is not positive definite there), so the first factorisation
+  // is of the whole pattern: no element-local factor, no fallback.
+  const Mesh mesh = make_rectangle(1.0, 1.0, 16, 17, ElementType::tri6, TriangleSplit::square);
+  auto clamped = [](const double* x) { return x[0] < 1e-9 || x[0] > 1 - 1e-9; };
+  const auto model = make_model(mesh, Material{1e7, 0.3, 0.01, 500}, 1.0, clamped);
+  std::vector<char> fixed;
+  fix_nodes(mesh, clamped, true, true, true, fixed);
+  const FreeDofSystem system(model->pattern(), fixed);
+  std::vector<double> K, load(model->num_dofs(), 0.0);
+  model->assemble_stiffness(nullptr, K, nullptr);
+  const double g[3] = {0, 0, -9.81};
+  model->add_gravity(g, load);
+  for (double dt : {3e-5, 1e-3}) {
+    SparseCholesky cholesky;
+    FactorReusingSolver solver(model->pattern(), system, model->mass_blocks());
+    ASSERT_TRUE(solver.element_local());
+    EXPECT_TRUE(std::isnan(solver.element_local_dropped_radius()));
+    std::vector<double> x(model->num_dofs(), 0.0);
+    solver.solve(ScaledBlockSum{1 + 2 * dt, &K, dt * dt}, load, x, cholesky);
+    EXPECT_LE(solver.statistics().last_relative_residual, FactorReuseOptions{}.relative_tolerance);
+    const double radius = solver.element_local_dropped_radius();
+    const bool small = dt < 1e-4;
+    std::printf("time step %g s: dropped radius %.3f\n", dt, radius);
+    EXPECT_EQ(radius <= FactorReuseOptions{}.element_local_max_dropped_radius, small);
+    EXPECT_EQ(solver.element_local(), small);
+    EXPECT_EQ(solver.element_local_factor_nonzeros() > 0, small);
+    EXPECT_EQ(cholesky.analyzed(), !small);
+    EXPECT_EQ(solver.statistics().element_local_fallbacks, 0);
+    EXPECT_EQ(solver.statistics().factorizations, 1);
+    // Judged once: options asking for the element-local pattern again do not bring it back.
+    solver.set_options(FactorReuseOptions{});
+    EXPECT_EQ(solver.element_local(), small);
+  }
+  // What the rule saves: tried anyway at 1e-3 s, the element-local matrix is not positive
+  // definite and the solver falls back after an analysis and factorisation of it.
+  FactorReuseOptions always;
+  always.element_local_max_dropped_radius = std::numeric_limits<double>::infinity();
+  SparseCholesky cholesky;
+  FactorReusingSolver tried(model->pattern(), system, model->mass_blocks(), always);
+  std::vector<double> x(model->num_dofs(), 0.0);
+  tried.solve(ScaledBlockSum{1 + 2e-3, &K, 1e-6}, load, x, cholesky);
+  EXPECT_LE(tried.statistics().last_relative_residual, always.relative_tolerance);
+  EXPECT_EQ(tried.statistics().element_local_fallbacks, 1);
 }
 
 TEST(DeterministicDot, IsIndependentOfThreadCount) {

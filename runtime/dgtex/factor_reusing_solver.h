@@ -17,9 +17,12 @@
 // rotation jump (bending, ~t^3), small next to mass and membrane stiffness, so PCG needs
 // only a few more iterations, but nnz(L) drops ~4x (cylinder: 1.15M instead of 4.36M):
 // a factorisation costs ~70 ms instead of ~220, an application ~0.65 ms instead of 2-3.
-// It is a heuristic, so it falls back to the whole pattern for the rest of the run when
-// its matrix is not positive definite or a fresh element-local factor does not reach the
-// tolerance within max_iterations (statistics().element_local_fallbacks counts it).
+// It is a heuristic, so it is tried only where the couplings it drops are small next to A's
+// diagonal (element_local_dropped_radius, judged on the first matrix factorised:
+// FactorReuseOptions::element_local_max_dropped_radius), and it falls back to the whole
+// pattern for the rest of the run when its matrix is not positive definite or a fresh
+// element-local factor does not reach the tolerance within max_iterations
+// (statistics().element_local_fallbacks counts it).
 // Only where the whole pattern's factor is sparse: a small system that SparseCholesky
 // factors densely (SparseCholesky::factors_densely) has a dense factor either way, so the
 // element-local one would only cost iterations (chad, 126 DOFs: 1175 PCG iterations over
@@ -90,6 +93,16 @@ struct FactorReuseOptions {
   // arithmetic stays in double, only the preconditioner is approximated further).
   bool single_precision_preconditioner = true;
   PreconditionerPattern preconditioner_pattern = PreconditionerPattern::element_local;
+  // The element-local pattern only where its dropped couplings' radius
+  // (element_local_dropped_radius) in the first matrix factorised is at most this; above it
+  // the whole pattern from the start. Measured (radius; element-local against whole-pattern
+  // preconditioning): the cylinder scene 0.34, its factor ~4x sparser, ~3x faster to
+  // factorise; the fracture scene's plate without cuts at time steps 1e-4 s: 0.52,
+  // converging but 145 against 46 PCG iterations in 40 steps (4.1 against 3.9 ms a step);
+  // 3e-4 s: 0.80, 377 against 80 (three factorisations against one); 5e-4 s: 0.99, and
+  // the fracture scene itself (1e-3 s, cut): 2.9, not positive definite (a wasted analysis
+  // and factorisation, ~4 ms of its first step).
+  double element_local_max_dropped_radius = 0.5;
   // A solve slower than refactor_after_iterations gathers its own matrix A_k (element-local
   // or whole pattern) and leaves its factorisation pending, to be run by factorize_pending()
   // while the caller assembles the next matrix (on a thread of its own: CHOLMOD runs on one
@@ -167,8 +180,12 @@ class FactorReusingSolver {
   // leaves the next solve to factorise its own matrix (and report it). The whole pattern is
   // factorised into the `cholesky` of the solve that left it pending: it must still exist.
   void factorize_pending();
-  // True while the preconditioner is the element-local factor (no fallback happened).
+  // True while the preconditioner is the element-local factor (not ruled out by its dropped
+  // radius, no fallback happened).
   bool element_local() const { return use_element_local_; }
+  // element_local_dropped_radius of the first matrix factorised while the element-local
+  // pattern was chosen; NaN before (or when it never was).
+  double element_local_dropped_radius() const { return element_local_dropped_radius_; }
   // Non-zeros of the element-local factor L (0 before its first factorisation).
   std::int64_t element_local_factor_nonzeros() const {
     return element_local_factor_ ? element_local_factor_->factor_nonzeros() : 0;
@@ -201,6 +218,7 @@ class FactorReusingSolver {
   bool whole_pattern_dense_ = false;     // SparseCholesky factors the whole pattern densely
   bool large_dense_ = false;             // ... and keeps a float copy of the factor
   bool use_element_local_ = false;
+  double element_local_dropped_radius_;  // NaN until judged (constructor)
 
   // Factorises A (element-local, or the whole pattern into `cholesky`); an element-local
   // matrix that is not positive definite switches to the whole pattern.
@@ -212,6 +230,9 @@ class FactorReusingSolver {
   // Numeric factorisation of values_ (the whole pattern) into `cholesky` (+ float copy).
   void factorize_full_values(SparseCholesky& cholesky);
   void fall_back_to_full_pattern();
+  // At the first factorisation with the element-local pattern: rules it out for good when
+  // A's dropped radius exceeds options_.element_local_max_dropped_radius.
+  void judge_element_local(const ScaledBlockSum& A);
   void precondition(const SparseCholesky& cholesky, const std::vector<double>& r, std::vector<double>& z);
   // spread_ = x spread for the block product kernels.
   void spread(const std::vector<double>& x) const;
@@ -229,6 +250,18 @@ class FactorReusingSolver {
 // element, i.e. the consistent-mass block is non-zero; the DG edge terms' couplings across
 // an edge have none. The pattern of the element-local preconditioner.
 std::vector<char> element_local_blocks(const std::vector<double>& mass);
+
+// How far the element-local pattern is from A: the largest Gershgorin radius of the couplings
+// it drops (blocks with kept[k] == 0) in A scaled to a unit diagonal, i.e. the maximum over
+// free DOFs i of sum_j |A_ij| / sqrt(A_ii A_jj) over the dropped entries to free DOFs j
+// (free: per DOF, 1 for free). By Gershgorin the dropped part lies between -radius D and
+// radius D in the Loewner order (D: A's diagonal), so the element-local matrix is at least
+// A - radius D; the radius grows as the dropped stiffness couplings (dt^2 K across an edge)
+// outweigh the mass they are added to. Infinite when a free diagonal entry of A is not
+// positive. Independent of the thread count (a maximum).
+double element_local_dropped_radius(const BlockAssembly& pattern, const std::vector<char>& kept,
+                                    const std::vector<char>& free, const std::vector<double>& mass,
+                                    const ScaledBlockSum& A);
 
 // Sum of x[i] * y[i] in a fixed order, independent of the thread count.
 double deterministic_dot(const std::vector<double>& x, const std::vector<double>& y);

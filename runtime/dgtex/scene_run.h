@@ -74,6 +74,10 @@ struct SceneRunOptions {
   // (chad: 96 MiB, 33-36 ms more), for first steps without first-touch page faults. Memory
   // that cannot be had is left out (the steps then take theirs as they go).
   bool reserve_step_memory = false;
+  // The corotated step solver's options (dgtex/factor_reusing_solver.h), for the simulation
+  // of every basis; once one has given up its element-local preconditioner, the later ones
+  // take the whole pattern whatever these say.
+  FactorReuseOptions solver;
 };
 
 class SceneRun {

@@ -62,6 +62,9 @@ class ShellSimulation {
   // Solver of the corotated steps: its tolerance and refactorisation policy, and counts.
   void set_solver_options(const FactorReuseOptions& options);
   const FactorReuseStatistics& solver_statistics() const { return solver_.statistics(); }
+  // How far the element-local preconditioner is from the step matrix, once judged
+  // (FactorReusingSolver::element_local_dropped_radius; NaN before).
+  double element_local_dropped_radius() const { return solver_.element_local_dropped_radius(); }
 
   double kinetic_energy() const;
   double linear_elastic_energy() const;  // 1/2 u^T K u with the linear K
