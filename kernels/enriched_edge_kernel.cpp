@@ -207,8 +207,8 @@ void edge_point_rotation(const SideView& plus, const SideView* minus, const int*
 // rotations: one per point, or null; current (with rotations null): each point's rotation
 // formed here from the sides this pass evaluates anyway (edge_point_rotation), or null: linear.
 // rest_sides: the sides' records (enriched_edge_rest_sides) read instead of evaluating them.
-void edge_stiffness(const EnrichedEdgeBatch& b, const EdgeQuadrature& quad, std::int64_t e, const double* rotations,
-                    const double* current, double* blocks, double* forces,
+void edge_stiffness(const EnrichedEdgeBatch& b, const EdgeQuadrature& quad, const EnrichedEdgeLocalLayout& layout,
+                    std::int64_t e, const double* rotations, const double* current, double* blocks, double* forces,
                     const EnrichedEdgeRestSides* rest_sides = nullptr) {
   const int npe = nodes_per_element(b.type);
   const int W = b.elements->width;
@@ -326,25 +326,16 @@ void edge_stiffness(const EnrichedEdgeBatch& b, const EdgeQuadrature& quad, std:
     K->push();
   }
   if (K) K->flush();
-  // Scatter the compact matrix into the padded local layout (side s at offset s W); blocks
-  // of unused slots are not written (0 .. 2W^2 x 9 doubles per edge would dominate).
-  double* out = blocks + e * nb * nb * 9;
-  auto slot = [&](int i) { return i < counts[0] ? i : W + (i - counts[0]); };
+  // The edge's compact local matrix (enriched_edge_local_layout: side 0's functions, then
+  // side 1's), 0 on an edge without points.
+  double* out = blocks + layout.block_start[e] * 9;
   for (int i = 0; i < m; ++i)
     for (int j = 0; j < m; ++j) {
-      double* blk = out + (slot(i) * nb + slot(j)) * 9;
+      double* blk = out + (static_cast<std::int64_t>(i) * m + j) * 9;
       for (int r = 0; r < 3; ++r)
-        for (int c = 0; c < 3; ++c) {
-          const int I = 3 * i + r, J = 3 * j + c;
-          blk[r * 3 + c] = K ? (*K)(I, J) : 0.0;
-        }
+        for (int c = 0; c < 3; ++c) blk[r * 3 + c] = K ? (*K)(3 * i + r, 3 * j + c) : 0.0;
     }
-  if (forces) {
-    double* fo = forces + e * nb * 3;
-    for (int i = 0; i < nb * 3; ++i) fo[i] = 0;
-    for (int i = 0; i < m; ++i)
-      for (int r = 0; r < 3; ++r) fo[slot(i) * 3 + r] = f[3 * i + r];
-  }
+  if (forces) std::copy(f.begin(), f.end(), forces + layout.function_start[e] * 3);
 }
 
 }  // namespace
@@ -367,21 +358,50 @@ void enriched_edge_global_nodes(const EnrichedEdgeBatch& b, std::int64_t e, int*
   side_global_nodes(b, b.edges[4 * e + 2], out + W);
 }
 
+EnrichedEdgeLocalLayout enriched_edge_local_layout(const EnrichedEdgeBatch& b) {
+  EnrichedEdgeLocalLayout layout;
+  layout.widths.resize(static_cast<std::size_t>(b.count));
+  layout.function_start.assign(static_cast<std::size_t>(b.count) + 1, 0);
+  layout.block_start.assign(static_cast<std::size_t>(b.count) + 1, 0);
+  for (std::int64_t e = 0; e < b.count; ++e) {
+    const int* ed = b.edges + 4 * e;
+    const int width = side_basis_count(b, ed[0]) + (ed[2] >= 0 ? side_basis_count(b, ed[2]) : 0);
+    layout.widths[e] = width;
+    layout.function_start[e + 1] = layout.function_start[e] + width;
+    layout.block_start[e + 1] = layout.block_start[e] + static_cast<std::int64_t>(width) * width;
+  }
+  return layout;
+}
+
+void enriched_edge_local_global_nodes(const EnrichedEdgeBatch& b, std::int64_t e, int* out) {
+  const int W = b.elements->width;
+  std::vector<int> padded(2 * static_cast<std::size_t>(W));
+  enriched_edge_global_nodes(b, e, padded.data());
+  const int* ed = b.edges + 4 * e;
+  const int plus = side_basis_count(b, ed[0]), minus = ed[2] >= 0 ? side_basis_count(b, ed[2]) : 0;
+  std::copy_n(padded.begin(), plus, out);
+  std::copy_n(padded.begin() + W, minus, out + plus);
+}
+
 // The edge passes below hand out their edges dynamically (forall_dynamic): a few edges of
 // very different cost (two sides or one, texel-resolving points beside a cut or the
 // standard rule). The slinky's eight took 2.0 ms a step on 2 threads with static chunks,
 // 1.35 dynamically (1 thread: 2.4). Each edge writes only its own blocks, forces or records.
 void enriched_edge_stiffness(const EnrichedEdgeBatch& batch, const EdgeQuadrature& quadrature, const double* rotations,
                              double* blocks, double* forces, Execution execution) {
+  const EnrichedEdgeLocalLayout layout = enriched_edge_local_layout(batch);
   forall_dynamic(
-      batch.count, [&](std::int64_t e) { edge_stiffness(batch, quadrature, e, rotations, nullptr, blocks, forces); },
+      batch.count,
+      [&](std::int64_t e) { edge_stiffness(batch, quadrature, layout, e, rotations, nullptr, blocks, forces); },
       execution);
 }
 
 void enriched_edge_corotated_stiffness(const EnrichedEdgeBatch& batch, const EdgeQuadrature& quadrature,
                                        const double* current, double* blocks, double* forces, Execution execution) {
+  const EnrichedEdgeLocalLayout layout = enriched_edge_local_layout(batch);
   forall_dynamic(
-      batch.count, [&](std::int64_t e) { edge_stiffness(batch, quadrature, e, nullptr, current, blocks, forces); },
+      batch.count,
+      [&](std::int64_t e) { edge_stiffness(batch, quadrature, layout, e, nullptr, current, blocks, forces); },
       execution);
 }
 
@@ -434,9 +454,10 @@ void enriched_edge_rest_sides(const EnrichedEdgeBatch& batch, const EdgeQuadratu
 void enriched_edge_corotated_stiffness(const EnrichedEdgeBatch& batch, const EdgeQuadrature& quadrature,
                                        const EnrichedEdgeRestSides& rest_sides, const double* current,
                                        double* blocks, double* forces, Execution execution) {
+  const EnrichedEdgeLocalLayout layout = enriched_edge_local_layout(batch);
   forall_dynamic(
       batch.count,
-      [&](std::int64_t e) { edge_stiffness(batch, quadrature, e, nullptr, current, blocks, forces, &rest_sides); },
+      [&](std::int64_t e) { edge_stiffness(batch, quadrature, layout, e, nullptr, current, blocks, forces, &rest_sides); },
       execution);
 }
 

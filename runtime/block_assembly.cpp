@@ -1,6 +1,7 @@
 #include "dgtex/block_assembly.h"
 
 #include <algorithm>
+#include <numeric>
 #include <stdexcept>
 #include <string>
 
@@ -13,23 +14,41 @@ using kernels::Execution;
 using kernels::forall;
 
 BlockAssembly::BlockAssembly(int num_nodes, const std::vector<BlockSourceFamily>& families) : num_nodes_(num_nodes) {
-  for (const BlockSourceFamily& f : families) family_width_.push_back(f.width);
+  for (const BlockSourceFamily& f : families) {
+    family_width_.push_back(f.width);
+    const std::size_t expected = f.widths.empty() ? static_cast<std::size_t>(f.count) * f.width
+                                                  : std::accumulate(f.widths.begin(), f.widths.end(), std::size_t{0});
+    if (!f.widths.empty() && f.widths.size() != static_cast<std::size_t>(f.count))
+      throw std::invalid_argument("BlockAssembly: a family of " + std::to_string(f.count) + " sources has " +
+                                  std::to_string(f.widths.size()) + " widths");
+    if (f.global_nodes.size() != expected)
+      throw std::invalid_argument("BlockAssembly: a family's global_nodes has " + std::to_string(f.global_nodes.size()) +
+                                  " entries, its sources take " + std::to_string(expected));
+    uniform_widths_ = uniform_widths_ && f.widths.empty();
+  }
   // Every contribution (row, col, family, local) is visited in (family, local) order, so
   // stable bucketing by row and then by column gives the (row, col, family, local) order
   // of a full sort in linear time (a sort of the slinky's ~0.5M contributions took 4 ms of
-  // every basis change).
+  // every basis change). visit(family, source's global nodes, its width, its first local
+  // function and first local block in the family's arrays).
   auto for_each_source = [&](auto&& visit) {
     for (int f = 0; f < static_cast<int>(families.size()); ++f) {
       const BlockSourceFamily& fam = families[f];
-      for (int s = 0; s < fam.count; ++s) visit(f, fam, s, fam.global_nodes.data() + static_cast<std::int64_t>(s) * fam.width);
+      std::int64_t first_function = 0, first_block = 0;
+      for (int s = 0; s < fam.count; ++s) {
+        const int width = fam.widths.empty() ? fam.width : fam.widths[s];
+        visit(f, fam.global_nodes.data() + first_function, width, first_function, first_block);
+        first_function += width;
+        first_block += static_cast<std::int64_t>(width) * width;
+      }
     }
   };
   std::vector<std::int64_t> row_offset(static_cast<size_t>(num_nodes) + 1, 0);
   vector_start_.assign(static_cast<size_t>(num_nodes) + 1, 0);
-  for_each_source([&](int, const BlockSourceFamily& fam, int, const int* g) {
+  for_each_source([&](int, const int* g, int width, std::int64_t, std::int64_t) {
     std::int64_t used = 0;
-    for (int b = 0; b < fam.width; ++b) used += g[b] >= 0;
-    for (int a = 0; a < fam.width; ++a)
+    for (int b = 0; b < width; ++b) used += g[b] >= 0;
+    for (int a = 0; a < width; ++a)
       if (g[a] >= 0) row_offset[g[a] + 1] += used, vector_start_[g[a] + 1]++;
   });
   for (int r = 0; r < num_nodes; ++r) {
@@ -45,18 +64,17 @@ BlockAssembly::BlockAssembly(int num_nodes, const std::vector<BlockSourceFamily>
   {
     std::vector<std::int64_t> next(row_offset.begin(), row_offset.end() - 1);
     std::vector<std::int64_t> next_vector(vector_start_.begin(), vector_start_.end() - 1);
-    for_each_source([&](int f, const BlockSourceFamily& fam, int s, const int* g) {
-      for (int a = 0; a < fam.width; ++a) {
+    for_each_source([&](int f, const int* g, int width, std::int64_t first_function, std::int64_t first_block) {
+      for (int a = 0; a < width; ++a) {
         if (g[a] < 0) continue;
-        const std::int64_t left = static_cast<std::int64_t>(s) * fam.width + a;
         vector_family_[next_vector[g[a]]] = f;
-        vector_local_[next_vector[g[a]]++] = left;
-        for (int b = 0; b < fam.width; ++b) {
+        vector_local_[next_vector[g[a]]++] = first_function + a;
+        for (int b = 0; b < width; ++b) {
           if (g[b] < 0) continue;
           const std::int64_t i = next[g[a]]++;
           row_column[i] = g[b];
           row_family[i] = f;
-          row_local[i] = left * fam.width + b;
+          row_local[i] = first_block + static_cast<std::int64_t>(a) * width + b;
         }
       }
     });
@@ -97,7 +115,7 @@ BlockAssembly::BlockAssembly(int num_nodes, const std::vector<BlockSourceFamily>
       const std::int64_t c = next[block - first_block]++;
       contribution_family_[c] = row_family[i];
       contribution_local_[c] = row_local[i];
-      if (row_column[i] < row) continue;
+      if (row_column[i] < row || !uniform_widths_) continue;
       const std::int64_t width = families[row_family[i]].width;
       const std::int64_t left = row_local[i] / width;  // s * width + a
       const bool new_entry = entry_family_.size() == static_cast<size_t>(row_entry_start_.back()) ||
@@ -193,6 +211,9 @@ void BlockAssembly::assemble_symmetric_matrix(const std::vector<LocalMatrices>& 
   if (!structurally_symmetric_)
     throw std::logic_error("BlockAssembly::assemble_symmetric_matrix: the pattern is not symmetric (a block (i, j) "
                            "without its (j, i)); use assemble_matrix");
+  if (!uniform_widths_)
+    throw std::logic_error("BlockAssembly::assemble_symmetric_matrix: a family has sources of different widths; use "
+                           "assemble_matrix");
   if (locals.size() != family_width_.size())
     throw std::invalid_argument("BlockAssembly::assemble_symmetric_matrix: " + std::to_string(locals.size()) +
                                 " local families given, the pattern has " + std::to_string(family_width_.size()));

@@ -111,10 +111,10 @@ void ShellModel::rebuild(std::vector<double>* integrated_mass) {
   }
 
   std::vector<BlockSourceFamily> families;
-  families.push_back({num_plain, npe, plain_connectivity_});
+  families.push_back({num_plain, npe, plain_connectivity_, {}});
   // Edges assemble over their merged local basis (shell_edge_stiffness_merged): one slot
   // per distinct node, the unused slots -1.
-  BlockSourceFamily edges{num_plain_edges, 2 * npe, std::vector<int>(static_cast<size_t>(num_plain_edges) * 2 * npe, -1)};
+  BlockSourceFamily edges{num_plain_edges, 2 * npe, std::vector<int>(static_cast<size_t>(num_plain_edges) * 2 * npe, -1), {}};
   const kernels::EdgeBatch plain_edge_batch = edge_batch();
   for (int k = 0; k < num_plain_edges; ++k)
     kernels::shell_edge_merged_nodes(plain_edge_batch, k, edges.global_nodes.data() + static_cast<size_t>(k) * 2 * npe);
@@ -128,19 +128,24 @@ void ShellModel::rebuild(std::vector<double>* integrated_mass) {
     else integrate_enriched_elements(eb, enriched_element_mass);
     kernels::enriched_edge_quadrature(gb, options_.enrichment_quadrature, edge_qp_start_, edge_qp_);
     drop_cut_edge_points();
-    families.push_back({num_enriched_elements(), width_, enriched_global_nodes_});
-    BlockSourceFamily enriched_edges{num_enriched_edges(), 2 * width_,
-                                     std::vector<int>(static_cast<size_t>(num_enriched_edges()) * 2 * width_)};
+    families.push_back({num_enriched_elements(), width_, enriched_global_nodes_, {}});
+    // The edges' local matrices in their compact layout (kernels/enriched_edge_kernel.h).
+    enriched_edge_layout_ = kernels::enriched_edge_local_layout(gb);
+    BlockSourceFamily enriched_edges{num_enriched_edges(), 0,
+                                     std::vector<int>(static_cast<size_t>(enriched_edge_layout_.function_start.back())),
+                                     enriched_edge_layout_.widths};
     for (int k = 0; k < num_enriched_edges(); ++k)
-      kernels::enriched_edge_global_nodes(gb, k, enriched_edges.global_nodes.data() + static_cast<size_t>(k) * 2 * width_);
+      kernels::enriched_edge_local_global_nodes(gb, k,
+                                                enriched_edges.global_nodes.data() + enriched_edge_layout_.function_start[k]);
     families.push_back(std::move(enriched_edges));
   } else {
     element_qp_start_.clear();
     element_qp_.clear();
     edge_qp_start_.clear();
     edge_qp_.clear();
+    enriched_edge_layout_ = {};
   }
-  if (textured) families.push_back({num_textured_elements(), npe, textured_connectivity_});
+  if (textured) families.push_back({num_textured_elements(), npe, textured_connectivity_, {}});
   assembly_ = BlockAssembly(mesh_.num_nodes() + num_enriched_nodes(), families);
   workspace_.element_rest_rows.clear();  // the plain elements and edges may have changed
   workspace_.edge_rest_rows.clear();
@@ -783,9 +788,8 @@ void ShellModel::assemble_stiffness_blocks(const double* current, std::vector<do
                                               forces ? w.edge_forces.data() : nullptr};
 
   // Enriched elements and edges: rotations per (texel-resolving) quadrature point. Their
-  // buffers persist in the workspace: the padded edge blocks are large ((2W)^2 x 9 per
-  // edge) and only their used slots are written, so a fresh zero-filled vector per call
-  // would cost more than the kernels.
+  // buffers persist in the workspace (a fresh zero-filled vector per call would cost more
+  // than filling it); the edges' blocks in their compact layout (enriched_edge_layout_).
   if (!enriched_elements_.empty()) {
     kernels::EnrichedElementBatch xb = enriched_element_batch();
     // The quadrature's texel derivatives: the stiffness kernels sample the textures at every
@@ -797,10 +801,10 @@ void ShellModel::assemble_stiffness_blocks(const double* current, std::vector<do
     const int W = width_;
     double* const enriched_blocks = w.enriched_blocks.resize(static_cast<size_t>(num_enriched_elements()) * W * W * 9);
     double* const enriched_edge_blocks =
-        w.enriched_edge_blocks.resize(static_cast<size_t>(num_enriched_edges()) * 4 * W * W * 9);
+        w.enriched_edge_blocks.resize(static_cast<size_t>(enriched_edge_layout_.block_start.back()) * 9);
     if (forces) {
       w.enriched_forces.resize(static_cast<size_t>(num_enriched_elements()) * W * 3);
-      w.enriched_edge_forces.resize(static_cast<size_t>(num_enriched_edges()) * 2 * W * 3);
+      w.enriched_edge_forces.resize(static_cast<size_t>(enriched_edge_layout_.function_start.back()) * 3);
     }
     // Corotated per cluster of points (rest sums built once per enrichment), or per point:
     // then each point's F and rotation are formed in the stiffness pass (one texture

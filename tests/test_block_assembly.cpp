@@ -181,5 +181,72 @@ TEST(BlockAssembly, FusedProductsAreTheKernelsProductsOfTheSumBitwise) {
   omp_set_num_threads(2);
 }
 
+// Sources of different widths (BlockSourceFamily::widths): each family of the random ones
+// with its unused slots dropped, so every source keeps only its used functions, back to back.
+// The same contributions in the same order: the same pattern and bitwise the same sums as
+// the padded families, for any thread count; the symmetric walk refuses such a family.
+TEST(BlockAssembly, SourcesOfDifferentWidthsSumAsTheirPaddedFamilyBitwise) {
+  const RandomFamilies padded = random_families(4);
+  RandomFamilies compact;
+  compact.num_nodes = padded.num_nodes;
+  for (size_t f = 0; f < padded.families.size(); ++f) {
+    const BlockSourceFamily& fam = padded.families[f];
+    BlockSourceFamily c;
+    c.count = fam.count;
+    std::vector<double> m, vec;
+    for (int s = 0; s < fam.count; ++s) {
+      const int* g = fam.global_nodes.data() + static_cast<size_t>(s) * fam.width;
+      std::vector<int> used;
+      for (int a = 0; a < fam.width; ++a)
+        if (g[a] >= 0) used.push_back(a);
+      c.widths.push_back(static_cast<int>(used.size()));
+      for (int a : used) {
+        c.global_nodes.push_back(g[a]);
+        for (int k = 0; k < 3; ++k) vec.push_back(padded.vectors[f][(static_cast<size_t>(s) * fam.width + a) * 3 + k]);
+        for (int b : used)
+          for (int k = 0; k < 9; ++k)
+            m.push_back(padded.matrices[f][((static_cast<size_t>(s) * fam.width + a) * fam.width + b) * 9 + k]);
+      }
+    }
+    ASSERT_LT(c.global_nodes.size(), fam.global_nodes.size()) << "family " << f << " has no unused slot";
+    compact.families.push_back(std::move(c));
+    compact.matrices.push_back(std::move(m));
+    compact.vectors.push_back(std::move(vec));
+  }
+  const BlockAssembly reference(padded.num_nodes, padded.families), pattern(compact.num_nodes, compact.families);
+  ASSERT_EQ(pattern.row_start(), reference.row_start());
+  ASSERT_EQ(pattern.column(), reference.column());
+  std::vector<const double*> padded_matrices, compact_matrices, padded_vectors, compact_vectors;
+  for (size_t f = 0; f < padded.families.size(); ++f) {
+    padded_matrices.push_back(padded.matrices[f].data());
+    compact_matrices.push_back(compact.matrices[f].data());
+    padded_vectors.push_back(padded.vectors[f].data());
+    compact_vectors.push_back(compact.vectors[f].data());
+  }
+  std::vector<double> expected_matrix(reference.num_blocks() * 9), expected_vector(3 * static_cast<size_t>(padded.num_nodes));
+  reference.assemble_matrix(padded_matrices, expected_matrix.data(), false);
+  reference.assemble_vector(padded_vectors, expected_vector.data(), false);
+  for (int threads : {1, 2, 3}) {
+    omp_set_num_threads(threads);
+    std::vector<double> matrix(expected_matrix.size(), -1.0), vector(expected_vector.size(), -1.0);
+    pattern.assemble_matrix(compact_matrices, matrix.data());
+    pattern.assemble_vector(compact_vectors, vector.data());
+    for (size_t i = 0; i < matrix.size(); ++i) ASSERT_TRUE(same_bits(matrix[i], expected_matrix[i])) << "entry " << i;
+    for (size_t i = 0; i < vector.size(); ++i) ASSERT_TRUE(same_bits(vector[i], expected_vector[i])) << "entry " << i;
+  }
+  omp_set_num_threads(2);
+  std::vector<LocalMatrices> locals;
+  for (const double* m : compact_matrices) locals.push_back({m, 0});
+  std::vector<double> symmetric(expected_matrix.size());
+  EXPECT_THROW(pattern.assemble_symmetric_matrix(locals, symmetric.data()), std::logic_error);
+  // Widths and nodes that do not match are refused.
+  std::vector<BlockSourceFamily> short_nodes = compact.families;
+  short_nodes[0].global_nodes.pop_back();
+  EXPECT_THROW(BlockAssembly(compact.num_nodes, short_nodes), std::invalid_argument);
+  std::vector<BlockSourceFamily> few_widths = compact.families;
+  few_widths[0].widths.pop_back();
+  EXPECT_THROW(BlockAssembly(compact.num_nodes, few_widths), std::invalid_argument);
+}
+
 }  // namespace
 }  // namespace dgtex

@@ -371,12 +371,15 @@ TEST(BasisChange, CorotatedEdgeStiffnessIsTheRotationsThenTheStiffnessBitwise) {
     const double* X = &setup.mesh.positions[3 * n];
     current[3 * n] += X[0] - 0.3 * X[1], current[3 * n + 1] += 0.3 * X[0] + X[1], current[3 * n + 2] += 0.2 * X[0] * X[0];
   }
-  const int nb = 2 * setup.batch.width;
+  const kernels::EnrichedEdgeLocalLayout layout = kernels::enriched_edge_local_layout(edge_batch);
   std::vector<double> rotations(static_cast<size_t>(qs.back()) * 9);
   kernels::enriched_edge_rotations(edge_batch, quad, current.data(), rotations.data(), kernels::Execution::serial);
-  std::vector<double> blocks(count * nb * nb * 9, -1.0), forces(count * nb * 3, -1.0);
+  std::vector<double> blocks(layout.block_start.back() * 9, std::nan("")), forces(layout.function_start.back() * 3, std::nan(""));
   kernels::enriched_edge_stiffness(edge_batch, quad, rotations.data(), blocks.data(), forces.data(),
                                    kernels::Execution::serial);
+  // The compact layout (no padding): every entry written.
+  for (double v : blocks) ASSERT_FALSE(std::isnan(v));
+  for (double v : forces) ASSERT_FALSE(std::isnan(v));
   double turned = 0;  // the state turns the edge frames: largest |R - I|
   for (size_t k = 0; k < rotations.size(); ++k)
     turned = std::max(turned, std::abs(rotations[k] - (k % 9 % 4 == 0 ? 1.0 : 0.0)));
@@ -393,6 +396,13 @@ TEST(BasisChange, CorotatedEdgeStiffnessIsTheRotationsThenTheStiffnessBitwise) {
     kernels::enriched_edge_rest_sides(edge_batch, quad, sides, execution);
     ASSERT_EQ(sides.counts.size(), static_cast<size_t>(2 * count));
     EXPECT_GT(sides.counts[0], TwoEnrichedElements::npe);  // an enriched side
+    // The compact layout holds each edge's two sides' functions, m^2 blocks, back to back.
+    for (std::int64_t e = 0; e < count; ++e) {
+      const int m = sides.counts[2 * e] + sides.counts[2 * e + 1];
+      EXPECT_EQ(layout.widths[e], m) << "edge " << e;
+      EXPECT_EQ(layout.function_start[e + 1] - layout.function_start[e], m) << "edge " << e;
+      EXPECT_EQ(layout.block_start[e + 1] - layout.block_start[e], static_cast<std::int64_t>(m) * m) << "edge " << e;
+    }
     std::vector<double> cached_blocks(blocks.size(), -1.0), cached_forces(forces.size(), -1.0);
     kernels::enriched_edge_corotated_stiffness(edge_batch, quad, sides, current.data(), cached_blocks.data(),
                                                cached_forces.data(), execution);

@@ -20,12 +20,12 @@ namespace {
 // Sources of 6 nodes over a strip of nodes, each overlapping the next by 3, with some slots
 // unused; a second family couples pairs of distant nodes (as edges and virtual nodes do).
 BlockAssembly strip_pattern(int nodes) {
-  BlockSourceFamily elements{0, 6, {}};
+  BlockSourceFamily elements{0, 6, {}, {}};
   for (int first = 0; first + 6 <= nodes; first += 3) {
     for (int a = 0; a < 6; ++a) elements.global_nodes.push_back((first + a) % 5 == 4 ? -1 : first + a);
     ++elements.count;
   }
-  BlockSourceFamily pairs{0, 2, {}};
+  BlockSourceFamily pairs{0, 2, {}, {}};
   for (int a = 0; a + nodes / 2 < nodes; a += 4) {
     pairs.global_nodes.push_back(a);
     pairs.global_nodes.push_back(a + nodes / 2);

@@ -17,11 +17,18 @@
 namespace dgtex {
 
 // One family of sources whose local matrices are stored back to back:
-// local block (a, b) of source s at ((s * width + a) * width + b) * 9.
+// local block (a, b) of source s at ((s * width + a) * width + b) * 9, its local vector rows
+// (assemble_vector) at (s * width + a) * 3.
+// Sources of different widths (widths not empty): source s has widths[s] local functions,
+// global_nodes holds each source's widths[s] nodes back to back, and its local block (a, b)
+// lies at (B_s + a * widths[s] + b) * 9, its vector row a at (F_s + a) * 3, with B_s and F_s
+// the sums of widths[t]^2 and of widths[t] over the sources t < s (no padding to the
+// widest: enriched edges, whose widths differ by up to 3x within a mesh).
 struct BlockSourceFamily {
   int count = 0;                  // number of sources
-  int width = 0;                  // local basis functions per source
-  std::vector<int> global_nodes;  // count x width; -1 marks an unused local slot
+  int width = 0;                  // local basis functions per source (widths empty)
+  std::vector<int> global_nodes;  // count x width (or sum of widths); -1 marks an unused local slot
+  std::vector<int> widths;        // per source, or empty: `width` each
 };
 
 // One family's local matrices for assemble_symmetric_matrix: stored blocks (layout of
@@ -75,7 +82,8 @@ class BlockAssembly {
   // bitwise its values there, up to the diagonal blocks' lower triangles); each entry
   // below the diagonal is its mirror's value, so the result is exactly symmetric. Half the work of assemble_matrix, and
   // factored families are never expanded into memory. Throws std::logic_error if the
-  // pattern is not structurally symmetric, std::invalid_argument for a wrong family count.
+  // pattern is not structurally symmetric or has a family of sources of different widths,
+  // std::invalid_argument for a wrong family count.
   void assemble_symmetric_matrix(const std::vector<LocalMatrices>& locals, double* values, bool parallel = true) const;
   // Node vectors (#nodes x 3) from local vectors (source x width x 3), same order rules.
   void assemble_vector(const std::vector<const double*>& locals, double* out, bool parallel = true) const;
@@ -97,6 +105,7 @@ class BlockAssembly {
   // index of its mirror (col, row). Same summation order per block as assemble_matrix.
   std::vector<int> family_width_;
   bool structurally_symmetric_ = true;
+  bool uniform_widths_ = true;  // no family of sources of different widths (else no walk)
   std::vector<std::int64_t> row_entry_start_, mirror_;
   std::vector<int> entry_family_, entry_function_;           // family, a
   std::vector<std::int64_t> entry_source_, entry_target_start_;  // s * width, CSR over targets

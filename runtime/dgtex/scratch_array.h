@@ -2,15 +2,14 @@
 // Internal (ShellModel's assembly workspace): an array of doubles whose entries are
 // unspecified until written, for kernel outputs of which the kernels write every entry that
 // is read later.
-// Why: the enriched local blocks are padded to the widest basis of the model, and the edge
-// blocks' padding slots are neither written nor read (fracture: 39 MB of enriched edge
-// blocks, 23 % of it used, because one element of 205 has 20 basis functions and most have
-// 7-12; the element kernels write their padding as 0). As a std::vector every page was
-// faulted in and zero-filled at each new model (every basis change); here the memory comes
-// from malloc untouched, so pages that hold only edge-block padding are never faulted in.
-// Fracture's first assembly, after the accordion and the slinky in one process: 70 -> 42-48
-// ms (2-core machine, session 34, three alternations); huge-page blocks from the block
-// cache, which zero whole 2 MiB pages, sat in between.
+// Why: the local blocks are rewritten by every assembly, so zero-filling them at each new
+// model (every basis change), as a std::vector does, is wasted work. It mattered most while
+// the enriched edge blocks were padded to the widest basis of the model (until session 62;
+// fracture: 39 MB, 23 % of it used, because one element of 205 has 20 basis functions and
+// most have 7-12): its first assembly, after the accordion and the slinky in one process,
+// 70 -> 42-48 ms (2-core machine, session 34, three alternations). The edge blocks are
+// compact now (kernels/enriched_edge_kernel.h); the enriched element blocks are still
+// padded, their padding written as 0 by the kernels.
 #include <cstddef>
 #include <cstdlib>
 #include <memory>

@@ -259,6 +259,7 @@ class ShellModel {
   std::vector<double> element_qp_;
   std::vector<int> enriched_edges_;         // #enriched edges x 4
   std::vector<double> enriched_edge_size_;
+  kernels::EnrichedEdgeLocalLayout enriched_edge_layout_;  // compact local matrices per edge
   // Removes enriched edge quadrature points on cut texel segments (set_cut_edge_texels).
   void drop_cut_edge_points();
   std::vector<std::int64_t> edge_qp_start_;
@@ -298,7 +299,7 @@ class ShellModel {
     std::vector<double> element_forces, edge_forces;
     std::vector<double> element_rest_rows, edge_rest_rows, edge_factors;
     std::vector<double> enriched_forces, enriched_edge_forces;
-    // The local blocks: no zero-filling, so pages of enriched edge-block padding are never touched.
+    // The local blocks: rewritten by every assembly, never zero-filled (scratch_array.h).
     detail::ScratchArray element_blocks, edge_blocks, enriched_blocks, enriched_edge_blocks;
     // Rotation clusters (options.rotation_cluster_texels > 0) and their rest sums: built at
     // the first corotated assembly after the enrichment changed (rebuild clears them).

@@ -5,13 +5,14 @@
 // outer boundary of Omega_i (N^a vanishes there but its normal derivative does not, so
 // the enriched functions still enter the hinge term), and clamped boundary edges.
 //
-// Local basis of an edge: side s (0 plus, 1 minus) occupies slots [s W, s W + W) with the
-// side element's local basis (enriched_basis.h order; a non-enriched side has just its npe
-// standard functions), W = elements->width. Outputs: blocks #edges x (2W)^2 x 9, forces
-// #edges x 2W x 3, per-point rotations (one 3x3 per edge quadrature point). Only the blocks
-// of used slot pairs are written (the slots enriched_edge_global_nodes does not mark -1;
-// as 0 on an edge without quadrature points); the others are left as they were
-// (BlockAssembly never reads them). Forces: every slot.
+// Local basis of an edge (enriched_edge_local_layout): its plus side's local basis, then its
+// minus side's (each its element's, enriched_basis.h order; a non-enriched side has just its
+// npe standard functions), m = widths[e] functions in all. Outputs: blocks, each edge's
+// m x m block matrix from block_start[e] (no padding to the widest edge, which left 77 % of
+// fracture's 46 MB of edge blocks unused), forces m x 3 from function_start[e], per-point
+// rotations (one 3x3 per edge quadrature point). Every entry is written (blocks as 0 on an
+// edge without quadrature points). enriched_edge_global_nodes's padded slots (side s at
+// [s W, s W + W), W = elements->width) serve the rotations' reads of current positions.
 //
 // Edge quadrature (t in [-1, 1], in the plus element's direction): the edge is split into
 // T pieces of equal t-length (each piece lies on one border texel per side, the diagonal
@@ -59,6 +60,17 @@ void enriched_edge_quadrature(const EnrichedEdgeBatch& batch, const EnrichedQuad
 
 // Global node of each local slot (2W entries, -1 for unused slots).
 void enriched_edge_global_nodes(const EnrichedEdgeBatch& batch, std::int64_t edge, int* global_nodes);
+
+// The edges' compact local layout: edge e has widths[e] local functions, its blocks from
+// block index block_start[e] ((i, j) at block_start[e] + i widths[e] + j), its force rows
+// from function_start[e] (#edges + 1 entries each): BlockSourceFamily::widths's layout.
+struct EnrichedEdgeLocalLayout {
+  std::vector<int> widths;
+  std::vector<std::int64_t> function_start, block_start;
+};
+EnrichedEdgeLocalLayout enriched_edge_local_layout(const EnrichedEdgeBatch& batch);
+// Global node of each local function of the edge in that layout (widths[e] entries).
+void enriched_edge_local_global_nodes(const EnrichedEdgeBatch& batch, std::int64_t edge, int* global_nodes);
 
 void enriched_edge_stiffness(const EnrichedEdgeBatch& batch, const EdgeQuadrature& quadrature,
                              const double* rotations, double* blocks, double* forces,
