@@ -49,9 +49,15 @@ double element_local_dropped_radius(const BlockAssembly& pattern, const std::vec
     for (std::int64_t k = row_start[r]; k < row_start[r + 1]; ++k)
       if (column[k] == r)
         for (int i = 0; i < 3; ++i) diagonal[3 * r + i] = A.mass_scale * mass[9 * k + 4 * i] + A.stiffness_scale * K[9 * k + 4 * i];
-  for (std::size_t d = 0; d < diagonal.size(); ++d)
-    if (free[d] && !(diagonal[d] > 0)) return std::numeric_limits<double>::infinity();
+  // scale[d] = |stiffness_scale| / sqrt(A_dd) on free DOFs, 0 on fixed ones (not summed).
+  std::vector<double> scale(diagonal.size(), 0.0);
+  for (std::size_t d = 0; d < diagonal.size(); ++d) {
+    if (!free[d]) continue;
+    if (!(diagonal[d] > 0)) return std::numeric_limits<double>::infinity();
+    scale[d] = 1 / std::sqrt(diagonal[d]);
+  }
   // The dropped blocks have no mass (element_local_blocks): A_ij = stiffness_scale K_ij.
+  const double stiffness_scale = std::abs(A.stiffness_scale);
   std::vector<double> row_radius(static_cast<std::size_t>(nodes), 0.0);
   kernels::forall(
       nodes,
@@ -59,16 +65,14 @@ double element_local_dropped_radius(const BlockAssembly& pattern, const std::vec
         double sums[3] = {0, 0, 0};
         for (std::int64_t k = row_start[r]; k < row_start[r + 1]; ++k) {
           if (kept[k]) continue;
-          const std::int64_t c = column[k];
+          const double* s = scale.data() + 3 * static_cast<std::int64_t>(column[k]);
           for (int i = 0; i < 3; ++i)
-            for (int j = 0; j < 3; ++j)
-              if (free[3 * r + i] && free[3 * c + j])
-                sums[i] += std::abs(A.stiffness_scale * K[9 * k + 3 * i + j]) /
-                           std::sqrt(diagonal[3 * r + i] * diagonal[3 * c + j]);
+            sums[i] += std::abs(K[9 * k + 3 * i]) * s[0] + std::abs(K[9 * k + 3 * i + 1]) * s[1] +
+                       std::abs(K[9 * k + 3 * i + 2]) * s[2];
         }
-        row_radius[r] = std::max({sums[0], sums[1], sums[2]});
+        for (int i = 0; i < 3; ++i) row_radius[r] = std::max(row_radius[r], stiffness_scale * sums[i] * scale[3 * r + i]);
       },
-      vector_execution(3 * static_cast<std::size_t>(nodes)));
+      block_product_execution(pattern));
   return row_radius.empty() ? 0.0 : *std::max_element(row_radius.begin(), row_radius.end());
 }
 
