@@ -83,6 +83,12 @@ struct SparseCholesky::Impl {
   mutable std::vector<float> work, top_updates;  // y; per task x top rows accumulators
   mutable std::vector<std::vector<float>> gathered;  // per task (forward, backward) scratch
   mutable std::vector<float> top_scratch;            // the same for the top supernodes
+  // tril(P A P^T) (P the analysis's fill-reducing order) as cholmod_super_numeric takes it,
+  // and per entry the index of its value in the caller's lower triangle. Built with the
+  // analysis, so that a factorisation gathers the values straight into it:
+  // cholmod_factorize forms it anew from a lower-stored A with two transposes each call.
+  cholmod_sparse* permuted = nullptr;
+  std::vector<int> permuted_source;
 
   Impl() {
     cholmod_start(&common);
@@ -93,6 +99,7 @@ struct SparseCholesky::Impl {
   ~Impl() {
     if (factor) cholmod_free_factor(&factor, &common);
     if (matrix) cholmod_free_sparse(&matrix, &common);
+    if (permuted) cholmod_free_sparse(&permuted, &common);
     cholmod_finish(&common);
   }
 };
@@ -113,6 +120,8 @@ void SparseCholesky::analyze(int n, const std::vector<int>& column_start, const 
   Impl& m = *impl_;
   if (m.factor) cholmod_free_factor(&m.factor, &m.common);
   if (m.matrix) cholmod_free_sparse(&m.matrix, &m.common);
+  if (m.permuted) cholmod_free_sparse(&m.permuted, &m.common);
+  m.permuted_source.clear();
   m.dense.reset();
   n_ = n;
   const size_t nnz = row_index.size();
@@ -134,6 +143,39 @@ void SparseCholesky::analyze(int n, const std::vector<int>& column_start, const 
   }
   if (!m.factor || m.common.status < CHOLMOD_OK)
     throw std::runtime_error("CHOLMOD: symbolic analysis failed (status " + std::to_string(m.common.status) + ")");
+  if (m.factor->is_super && m.factor->ordering != CHOLMOD_NATURAL) build_permuted_lower();
+}
+
+void SparseCholesky::build_permuted_lower() {
+  Impl& m = *impl_;
+  const int n = n_;
+  const int* perm = static_cast<const int*>(m.factor->Perm);
+  const int* column_start = static_cast<const int*>(m.matrix->p);
+  const int* row_index = static_cast<const int*>(m.matrix->i);
+  const int nnz = column_start[n];
+  std::vector<int> position(n);  // of an unknown in the factor's order
+  for (int k = 0; k < n; ++k) position[perm[k]] = k;
+  // Entry t (row i >= column j) lands at (max, min) of (position[i], position[j]); its
+  // rows are left unsorted within a column (the numeric factorisation scatters a column
+  // through a map, in any order).
+  m.permuted = cholmod_allocate_sparse(n, n, nnz, /*sorted=*/0, /*packed=*/1, /*stype=*/-1, CHOLMOD_REAL, &m.common);
+  if (!m.permuted) throw std::runtime_error("CHOLMOD: out of memory allocating a " + std::to_string(n) + "x" + std::to_string(n) + " matrix");
+  int* start = static_cast<int*>(m.permuted->p);
+  int* rows = static_cast<int*>(m.permuted->i);
+  std::fill(start, start + n + 1, 0);
+  for (int j = 0; j < n; ++j)
+    for (int t = column_start[j]; t < column_start[j + 1]; ++t)
+      ++start[std::min(position[row_index[t]], position[j]) + 1];
+  for (int c = 0; c < n; ++c) start[c + 1] += start[c];
+  std::vector<int> next(start, start + n);
+  m.permuted_source.resize(nnz);
+  for (int j = 0; j < n; ++j)
+    for (int t = column_start[j]; t < column_start[j + 1]; ++t) {
+      const int a = position[row_index[t]], b = position[j];
+      const int slot = next[std::min(a, b)]++;
+      rows[slot] = std::max(a, b);
+      m.permuted_source[slot] = t;
+    }
 }
 
 void SparseCholesky::factorize(const std::vector<double>& values) {
@@ -144,8 +186,14 @@ void SparseCholesky::factorize(const std::vector<double>& values) {
   }
   if (!m.factor) throw std::logic_error("SparseCholesky::factorize called before analyze");
   if (values.size() != m.matrix->nzmax) throw std::invalid_argument("SparseCholesky::factorize: value count does not match the pattern");
-  std::memcpy(m.matrix->x, values.data(), sizeof(double) * values.size());
-  {
+  if (m.permuted) {
+    double* x = static_cast<double*>(m.permuted->x);
+    for (std::size_t k = 0; k < m.permuted_source.size(); ++k) x[k] = values[m.permuted_source[k]];
+    double beta[2] = {0, 0};
+    const auto lock = detail::lock_cholmod();
+    cholmod_super_numeric(m.permuted, nullptr, beta, m.factor, &m.common);
+  } else {
+    std::memcpy(m.matrix->x, values.data(), sizeof(double) * values.size());
     const auto lock = detail::lock_cholmod();
     cholmod_factorize(m.matrix, m.factor, &m.common);
   }

@@ -67,6 +67,8 @@ class SparseCholesky {
   bool dense() const;
 
  private:
+  // After a supernodal analysis with a fill-reducing order: Impl::permuted and its sources.
+  void build_permuted_lower();
   struct Impl;
   std::unique_ptr<Impl> impl_;
   void build_solve_schedule();  // parallel schedule of solve_single_precision (per analysis)
