@@ -107,11 +107,7 @@ double deterministic_dot(const std::vector<double>& x, const std::vector<double>
 
 FactorReusingSolver::FactorReusingSolver(const BlockAssembly& pattern, const FreeDofSystem& system,
                                          const std::vector<double>& mass, FactorReuseOptions options)
-    : pattern_(pattern),
-      system_(system),
-      mass_(mass),
-      options_(options),
-      element_local_dropped_radius_(std::numeric_limits<double>::quiet_NaN()) {
+    : pattern_(pattern), system_(system), mass_(mass), options_(options) {
   const std::int64_t blocks = pattern.num_blocks();
   bool isotropic = static_cast<std::int64_t>(mass.size()) == blocks * 9;
   for (std::int64_t k = 0; isotropic && k < blocks; ++k) {

@@ -23,7 +23,7 @@ namespace dgtex {
 // global_nodes holds each source's widths[s] nodes back to back, and its local block (a, b)
 // lies at (B_s + a * widths[s] + b) * 9, its vector row a at (F_s + a) * 3, with B_s and F_s
 // the sums of widths[t]^2 and of widths[t] over the sources t < s (no padding to the
-// widest: enriched edges, whose widths differ by up to 3x within a mesh).
+// widest: enriched edges, whose widths vary with their elements' enrichments).
 struct BlockSourceFamily {
   int count = 0;                  // number of sources
   int width = 0;                  // local basis functions per source (widths empty)

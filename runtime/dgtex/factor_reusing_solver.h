@@ -54,6 +54,7 @@
 // Not thread-safe; a solve uses all OpenMP threads. Units: those of the system (SI: kg,
 // N/m, N).
 #include <cstdint>
+#include <limits>
 #include <memory>
 #include <stdexcept>
 #include <vector>
@@ -218,7 +219,7 @@ class FactorReusingSolver {
   bool whole_pattern_dense_ = false;     // SparseCholesky factors the whole pattern densely
   bool large_dense_ = false;             // ... and keeps a float copy of the factor
   bool use_element_local_ = false;
-  double element_local_dropped_radius_;  // NaN until judged (constructor)
+  double element_local_dropped_radius_ = std::numeric_limits<double>::quiet_NaN();  // until judged
 
   // Factorises A (element-local, or the whole pattern into `cholesky`); an element-local
   // matrix that is not positive definite switches to the whole pattern.
