@@ -10,29 +10,12 @@
 #include <vector>
 
 #include "dgtex/sparse_cholesky.h"
+#include "shifted_laplacian_support.h"
 
 using namespace dgtex;
+using dgtex::testing_support::ShiftedLaplacian;
 
 namespace {
-
-// Lower triangle (CSC) of the shifted 5-point Laplacian on an n x n grid: 4 + shift on the
-// diagonal, -1 to each neighbour; eigenvalues in [shift, 8 + shift].
-struct ShiftedLaplacian {
-  int size = 0;
-  std::vector<int> column_start{0}, row_index;
-  std::vector<double> values;
-  ShiftedLaplacian(int n, double shift) : size(n * n) {
-    for (int j = 0; j < n; ++j)
-      for (int i = 0; i < n; ++i) {
-        const int c = j * n + i;
-        row_index.push_back(c);
-        values.push_back(4 + shift);
-        if (i + 1 < n) row_index.push_back(c + 1), values.push_back(-1);
-        if (j + 1 < n) row_index.push_back(c + n), values.push_back(-1);
-        column_start.push_back(static_cast<int>(row_index.size()));
-      }
-  }
-};
 
 TEST(SinglePrecisionSolve, AgreesWithTheDoubleSolveToFloatAccuracy) {
   const double shift = 0.1;

@@ -13,36 +13,15 @@
 
 #include "cholmod_lock.h"  // internal (runtime/)
 #include "dgtex/sparse_cholesky.h"
+#include "shifted_laplacian_support.h"
 
 using namespace dgtex;
+using dgtex::testing_support::ShiftedLaplacian;
 
 namespace {
 
-// Lower triangle (CSC) of a 5-point Laplacian on an n x n grid with 8-point couplings to
-// the diagonal neighbours, so that a fill-reducing order really permutes: diagonal 4 +
-// shift + 0.4, -1 to each edge neighbour, -0.1 to each diagonal one (positive definite for
-// shift > 0).
-struct GridMatrix {
-  int size = 0;
-  std::vector<int> column_start{0}, row_index;
-  std::vector<double> values;
-  GridMatrix(int n, double shift) : size(n * n) {
-    for (int j = 0; j < n; ++j)
-      for (int i = 0; i < n; ++i) {
-        const int c = j * n + i;
-        auto add = [&](int row, double v) { row_index.push_back(row), values.push_back(v); };
-        add(c, 4 + shift + 0.4);
-        if (i + 1 < n) add(c + 1, -1);
-        if (i > 0 && j + 1 < n) add(c + n - 1, -0.1);
-        if (j + 1 < n) add(c + n, -1);
-        if (i + 1 < n && j + 1 < n) add(c + n + 1, -0.1);
-        column_start.push_back(static_cast<int>(row_index.size()));
-      }
-  }
-};
-
 // CHOLMOD alone: analyse (supernodal, default orderings), factorise, solve.
-std::vector<double> cholmod_solution(const GridMatrix& A, const std::vector<double>& b) {
+std::vector<double> cholmod_solution(const ShiftedLaplacian& A, const std::vector<double>& b) {
   const auto lock = detail::lock_cholmod();
   cholmod_common common;
   cholmod_start(&common);
@@ -72,14 +51,14 @@ bool bitwise_equal(const std::vector<double>& a, const std::vector<double>& b) {
 }  // namespace
 
 TEST(SparseCholesky, FactorIsCholmodsOwnBitwiseAlsoWithNewValues) {
-  GridMatrix A(48, 0.05);  // 2304 unknowns: sparse, not factored densely
+  ShiftedLaplacian A(48, 0.05);  // 2304 unknowns: sparse, not factored densely
   ASSERT_FALSE(SparseCholesky::factors_densely(A.size, static_cast<std::int64_t>(A.values.size())));
   std::vector<double> b(A.size);
   for (int k = 0; k < A.size; ++k) b[k] = std::sin(0.37 * k) + 0.5 * std::cos(0.011 * k * k);
   SparseCholesky cholesky;
   cholesky.analyze(A.size, A.column_start, A.row_index);
   for (double scale : {1.0, 2.5}) {
-    GridMatrix scaled = A;  // new values, same pattern: every third diagonal entry scaled
+    ShiftedLaplacian scaled = A;  // new values, same pattern: every third diagonal entry scaled
     for (int j = 0; j < A.size; j += 3) scaled.values[scaled.column_start[j]] *= scale;
     cholesky.factorize(scaled.values);
     std::vector<double> x;
@@ -101,7 +80,7 @@ TEST(SparseCholesky, FactorIsCholmodsOwnBitwiseAlsoWithNewValues) {
 }
 
 TEST(SparseCholesky, ReportsAMatrixThatIsNotPositiveDefinite) {
-  GridMatrix A(48, 0.05);
+  ShiftedLaplacian A(48, 0.05);
   A.values[A.column_start[1000]] = -1.0;  // a negative diagonal entry
   SparseCholesky cholesky;
   cholesky.analyze(A.size, A.column_start, A.row_index);
@@ -113,6 +92,6 @@ TEST(SparseCholesky, ReportsAMatrixThatIsNotPositiveDefinite) {
     EXPECT_LT(e.column(), A.size);
   }
   // The same instance factorises a positive definite matrix of the pattern afterwards.
-  const GridMatrix good(48, 0.05);
+  const ShiftedLaplacian good(48, 0.05);
   EXPECT_NO_THROW(cholesky.factorize(good.values));
 }
