@@ -36,9 +36,12 @@ namespace dgtex::detail {
 // (address space only), and a cached mapped block also serves a request of a different size
 // that fits and needs at least half of it: a cut's rest sums, a little larger or smaller
 // from model to model, take the last model's block (the slinky: 124 of 131 blocks from the
-// cache instead of ~10; its system time 0.78-0.84 -> 0.38-0.46 s). A request no cached
-// block serves first gives cached mapped blocks back to the system, oldest first, as much
-// as it maps, so that the mapping gets pages the host has backed.
+// cache instead of ~10; its system time 0.78-0.84 -> 0.38-0.46 s). A mapped request no
+// cached block serves takes the largest cached mapped block of at least half the size it
+// needs, grown to it with its pages (mremap: only the new tail is faulted in; spiral6's run
+// after its first step 36k -> 10k page faults, the slinky's 33k -> 10k); else it first gives
+// cached mapped blocks back to the system, oldest first, as much as it maps, so that the
+// mapping gets pages the host has backed.
 void* acquire_zeroed_block(std::size_t bytes);
 void release_block(void* block, std::size_t bytes) noexcept;
 // Faults in `bytes` (whole 2 MiB granules) now, for fresh mapped blocks to take before they

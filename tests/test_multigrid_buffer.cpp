@@ -4,8 +4,9 @@
 // for any size of as many 2 MiB granules, and for a larger request within the room a fresh
 // mapping leaves (an eighth) or a smaller one of at least half their capacity, which they
 // keep when they come back; a request no cached block serves gives cached mapped blocks
-// back to the system before it maps its own. Granules faulted in ahead (prefault_mapped_blocks,
-// dgtex/step_memory.h) serve fresh mapped blocks without page faults.
+// back to the system before it maps its own, unless a cached mapped block of at least half
+// its size can be grown to it (its pages kept). Granules faulted in ahead
+// (prefault_mapped_blocks, dgtex/step_memory.h) serve fresh mapped blocks without page faults.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -114,6 +115,56 @@ TEST(MultigridBuffer, MappedBlocksServeAGrowingCutAndKeepTheirCapacity) {
   MultigridBuffer other(3 * per_mib);
   EXPECT_EQ(dgtex::detail::cached_block_bytes(), 0u);
   EXPECT_TRUE(all_zero(other));
+#else
+  GTEST_SKIP() << "mapped blocks are Linux only";
+#endif
+}
+
+// A cut's rest sums outgrow the room of their blocks every few steps (two blocks at a time:
+// the last model's and the next one's). A request that no cached block serves but that a
+// cached mapped block of at least half its size could hold once grown takes that block,
+// moved to a mapping of the request's fresh capacity: its pages come along (only the new
+// tail is faulted in), where a fresh block faulted in every page.
+TEST(MultigridBuffer, ACachedMappedBlockTooSmallForARequestIsGrownWithItsPages) {
+#if defined(__linux__)
+  constexpr std::size_t mib = std::size_t{1} << 20;
+  auto minor_faults = [] {
+    rusage usage{};
+    getrusage(RUSAGE_SELF, &usage);
+    return usage.ru_minflt;
+  };
+  dgtex::detail::release_cached_blocks();
+  const std::size_t small = 15 * mib, large = 20 * mib;
+  {
+    auto* block = static_cast<unsigned char*>(dgtex::detail::acquire_zeroed_block(small));  // 18 MiB mapped
+    std::fill(block, block + small, 0x5a);
+    dgtex::detail::release_block(block, small);
+  }
+  ASSERT_EQ(dgtex::detail::cached_block_bytes(), 18 * mib);
+  unsigned char* grown = nullptr;
+  {
+    const dgtex::detail::SkipCachedBlockZeroing look_at_what_it_holds;
+    grown = static_cast<unsigned char*>(dgtex::detail::acquire_zeroed_block(large));
+  }
+  EXPECT_EQ(dgtex::detail::cached_block_bytes(), 0u);  // the 18 MiB block was taken
+  EXPECT_TRUE(std::all_of(grown, grown + small, [](unsigned char b) { return b == 0x5a; })) << "its old pages";
+  EXPECT_TRUE(std::all_of(grown + 18 * mib, grown + large, [](unsigned char b) { return b == 0; })) << "the new tail";
+  const long faults_before = minor_faults();
+  std::fill(grown, grown + large, 0x33);  // every page written
+  const long faults = minor_faults() - faults_before;
+#if !defined(__SANITIZE_ADDRESS__)  // ASan's shadow pages fault in beside the block's
+  // Only the 5 MiB the old block had never written (1280 pages; a fresh block: 5120).
+  EXPECT_LT(faults, 5 * 256 + 64) << "20 MiB written, 15 of them in the grown block's old pages";
+#else
+  (void)faults;
+#endif
+  dgtex::detail::release_block(grown, large);
+  // Cached with the capacity of a fresh block for 20 MiB (an eighth more, in granules), so
+  // the zeroed buffers of the next models take it as it is.
+  EXPECT_EQ(dgtex::detail::cached_block_bytes(), 24 * mib);
+  MultigridBuffer next(21 * mib / sizeof(double));
+  EXPECT_EQ(reinterpret_cast<const unsigned char*>(next.data()), grown);
+  EXPECT_TRUE(all_zero(next));
 #else
   GTEST_SKIP() << "mapped blocks are Linux only";
 #endif
