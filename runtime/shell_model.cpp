@@ -379,25 +379,31 @@ void ShellModel::install_enrichments(std::vector<EnrichmentFunction> functions, 
 namespace {
 
 // Where a new basis's local functions are among an old one's, from the shifts of each
-// enrichment x node slot (NaN: the slot's node not enriched; new_shift(i): the new basis's):
+// enrichment x node slot (NaN: the slot's node not enriched; new_shift(i): the new basis's),
+// the new basis's enrichment k being the old one's old_enrichment[k] (k itself where null):
 // old_index[f] for each new function f, the standard functions first (old_index[f] = f),
-// then the enriched ones in slot order, whose slots `slot` lists. False where the new basis
-// enriches a slot the old one did not.
+// then the enriched ones in slot order, whose new slots `slot` and old slots `old_slot` list.
+// False where the new basis enriches a slot the old one did not.
 template <class NewShift>
-bool functions_among_old(const std::vector<double>& old_shifts, int npe, NewShift&& new_shift,
-                         std::vector<int>& old_index, std::vector<int>& slot) {
+bool functions_among_old(const std::vector<double>& old_shifts, int npe, int new_enrichments,
+                         const int* old_enrichment, NewShift&& new_shift, std::vector<int>& old_index,
+                         std::vector<int>& slot, std::vector<int>& old_slot) {
+  std::vector<int> old_function(old_shifts.size(), -1);  // per old slot (-1: not enriched)
+  for (int i = 0, o = npe; i < static_cast<int>(old_shifts.size()); ++i)
+    if (!std::isnan(old_shifts[i])) old_function[i] = o++;
   old_index.resize(npe);
   for (int a = 0; a < npe; ++a) old_index[a] = a;
   slot.clear();
-  for (int i = 0, o = npe; i < static_cast<int>(old_shifts.size()); ++i) {
-    const bool was = !std::isnan(old_shifts[i]);
-    if (!std::isnan(new_shift(i))) {
-      if (!was) return false;
-      old_index.push_back(o);
+  old_slot.clear();
+  for (int k = 0; k < new_enrichments; ++k)
+    for (int a = 0; a < npe; ++a) {
+      const int i = k * npe + a, j = (old_enrichment ? old_enrichment[k] : k) * npe + a;
+      if (std::isnan(new_shift(i))) continue;
+      if (old_function[j] < 0) return false;
+      old_index.push_back(old_function[j]);
       slot.push_back(i);
+      old_slot.push_back(j);
     }
-    o += was;
-  }
   return true;
 }
 
@@ -412,6 +418,17 @@ void ShellModel::integrate_enriched_elements(const kernels::EnrichedElementBatch
   // computed from: the textures decide the quadrature; textures, enriched local nodes and
   // shifts the mass and load weights (geometry, section and options are the model's own).
   std::vector<std::shared_ptr<const ElementIntegrals>> reused(count);
+  // Per enriched element, where each of its textures is among those of its old integrals
+  // (bitwise the same values and flags, in order; empty: not all are): their quadrature
+  // serves it. All the old textures (same_textures): the same quadrature record. Fewer, only
+  // in the rebuild of a pruned basis (rebuilding_pruned_basis_): set_enrichments integrates
+  // with every function first and, where the pruning drops one whole (a cut segment just
+  // begun, spiral6's step 167), builds the basis again without it. The quadrature of one
+  // texture more is as fine as the one without it, or finer where that texture varies;
+  // building the other one too took spiral6's step 167 ~6 ms more than its neighbours. It
+  // gets a record without textures, so that no later rebuild takes it (a fresh model given
+  // the kept functions alone builds their own quadrature).
+  std::vector<std::vector<int>> texture_from(count);
   std::vector<char> same_textures(count, 0);
   const size_t texels = static_cast<size_t>(T) * T;
   // Kept basis values of the integrals reused below (the first build of a pruned basis):
@@ -423,45 +440,62 @@ void ShellModel::integrate_enriched_elements(const kernels::EnrichedElementBatch
     const int e = enriched_elements_[x];
     const ElementIntegrals* old =
         e < static_cast<int>(element_integrals_.size()) ? element_integrals_[e].get() : nullptr;
+    if (!old) continue;
     const int first = enrichment_start_[x], k_count = enrichment_start_[x + 1] - first;
-    if (!old || static_cast<int>(old->quadrature->values.size()) != k_count) continue;
-    bool same = true;
-    for (int k = 0; k < k_count && same; ++k) {  // bitwise, in one memcmp each
-      const kernels::TextureView& now = textures_[first + k];
-      same = old->quadrature->values[k].size() == texels &&
-             std::memcmp(old->quadrature->values[k].data(), now.values, texels * sizeof(double)) == 0 &&
-             std::memcmp(old->quadrature->flags[k].data(), now.flags, texels) == 0;
+    const TexturedQuadrature& old_quadrature = *old->quadrature;
+    const int old_count = static_cast<int>(old_quadrature.values.size());
+    if (old_count != k_count && !(rebuilding_pruned_basis_ && old_count > k_count)) continue;
+    const auto same_texture = [&](int o, const kernels::TextureView& now) {  // one memcmp each
+      return old_quadrature.values[o].size() == texels &&
+             std::memcmp(old_quadrature.values[o].data(), now.values, texels * sizeof(double)) == 0 &&
+             std::memcmp(old_quadrature.flags[o].data(), now.flags, texels) == 0;
+    };
+    std::vector<int>& from = texture_from[x];
+    for (int k = 0, o = 0; k < k_count; ++k, ++o) {
+      while (o < old_count && !same_texture(o, textures_[first + k])) ++o;
+      if (o == old_count) break;
+      from.push_back(o);
     }
-    if (!same) continue;
-    same_textures[x] = 1;
+    if (static_cast<int>(from.size()) != k_count) {
+      from.clear();
+      continue;
+    }
+    same_textures[x] = k_count == old_count;
     // Local function of the new basis -> the old one's: the reuse needs every new function
     // among the old ones, with the same shift.
     const auto new_shift = [&](int i) {
       return enriched_node_[first * npe + i] >= 0 ? enriched_shift_[first * npe + i] : std::nan("");
     };
-    std::vector<int> old_function, slot;
-    bool subset = functions_among_old(old->shifts, npe, new_shift, old_function, slot);
+    std::vector<int> old_function, slot, old_slot;
+    bool subset = functions_among_old(old->shifts, npe, k_count, from.data(), new_shift, old_function, slot, old_slot);
     for (std::size_t f = 0; f < slot.size() && subset; ++f) {
       const double shift = new_shift(slot[f]);
-      subset = std::memcmp(&shift, &old->shifts[slot[f]], sizeof shift) == 0;
+      subset = std::memcmp(&shift, &old->shifts[old_slot[f]], sizeof shift) == 0;
     }
     if (!subset) continue;
     if (keep_basis_values_ && e < static_cast<int>(previous.start.size()) && previous.start[e] >= 0 &&
         previous.owner[e].get() == old)
       kept_columns[x] = old_function;
-    if (static_cast<int>(old_function.size()) == old->count) {
+    if (same_textures[x] && static_cast<int>(old_function.size()) == old->count) {
       reused[x] = element_integrals_[e];
       continue;
     }
-    // Nodes only dropped (set_enrichments' pruning rebuilds with fewer nodes): the mass and
-    // weights of the remaining functions are those entries of the old ones, the same bits,
-    // since each entry sums over the same points in the same order whatever other functions
-    // the element has.
+    // Functions only dropped (set_enrichments' pruning rebuilds with fewer nodes, or without
+    // some textures): the mass and weights of the remaining functions are those entries of
+    // the old ones, the same bits, since each entry sums over the same points in the same
+    // order whatever other functions the element has.
     auto kept = std::make_shared<ElementIntegrals>(*old);
     const int n = static_cast<int>(old_function.size());
     kept->count = n;
-    for (int k = 0; k < k_count * npe; ++k)
-      if (enriched_node_[first * npe + k] < 0) kept->shifts[k] = std::nan("");
+    kept->shifts.resize(static_cast<size_t>(k_count) * npe);
+    for (int i = 0; i < k_count * npe; ++i) kept->shifts[i] = new_shift(i);
+    if (!same_textures[x]) {
+      auto quadrature = std::make_shared<TexturedQuadrature>();  // without textures (above)
+      quadrature->points = old_quadrature.points;
+      kept->quadrature = std::move(quadrature);
+      kept->derivatives.clear();
+      for (int k = 0; k < k_count; ++k) kept->derivatives.push_back(old->derivatives[from[k]]);
+    }
     kept->mass.resize(static_cast<size_t>(n) * n);
     kept->area_weights.resize(n);
     kept->mass_weights.resize(n);
@@ -482,7 +516,8 @@ void ShellModel::integrate_enriched_elements(const kernels::EnrichedElementBatch
   const std::vector<int>& todo_element = todo_batch.element;
   const std::vector<int>& todo_start = todo_batch.enrichment_start;
   const std::int64_t todo = sub.count;
-  // Quadrature: reused where only the shifts changed.
+  // Quadrature: reused where the textures are among the old ones (only the shifts changed, or
+  // whole functions were dropped).
   std::vector<std::int64_t> sub_start(1, 0);
   std::vector<double> sub_points;
   // Texel derivatives of the quadrature, per texture of sub, kept up to a memory budget (48
@@ -494,7 +529,7 @@ void ShellModel::integrate_enriched_elements(const kernels::EnrichedElementBatch
   {
     std::vector<int> quad_index;
     for (std::int64_t t = 0; t < todo; ++t)
-      if (!same_textures[todo_index[t]]) quad_index.push_back(static_cast<int>(t));
+      if (texture_from[todo_index[t]].empty()) quad_index.push_back(static_cast<int>(t));
     const detail::EnrichedSubBatch quad_batch(sub, quad_index);
     const kernels::EnrichedElementBatch& qb = quad_batch.batch;
     const std::vector<int>& q_start = quad_batch.enrichment_start;
@@ -513,8 +548,10 @@ void ShellModel::integrate_enriched_elements(const kernels::EnrichedElementBatch
         ++next;
       } else {
         const ElementIntegrals& old = *element_integrals_[todo_element[t]];
+        const std::vector<int>& from = texture_from[todo_index[t]];
         sub_points.insert(sub_points.end(), old.quadrature->points.begin(), old.quadrature->points.end());
-        for (int k = 0; k < textures_of_t; ++k) sub_derivatives.push_back(keep_derivatives ? old.derivatives[k] : nullptr);
+        for (int k = 0; k < textures_of_t; ++k)
+          sub_derivatives.push_back(keep_derivatives ? old.derivatives[from[k]] : nullptr);
       }
       sub_start.push_back(static_cast<std::int64_t>(sub_points.size() / 3));
     }
@@ -563,7 +600,7 @@ void ShellModel::integrate_enriched_elements(const kernels::EnrichedElementBatch
       entry->quadrature = element_integrals_[todo_element[t]]->quadrature;
     } else {
       auto quadrature = std::make_shared<TexturedQuadrature>();
-      for (int k = enrichment_start_[x]; k < enrichment_start_[x + 1]; ++k) {
+      for (int k = enrichment_start_[x]; k < enrichment_start_[x + 1] && texture_from[x].empty(); ++k) {
         quadrature->values.emplace_back(textures_[k].values, textures_[k].values + texels);
         quadrature->flags.emplace_back(textures_[k].flags, textures_[k].flags + texels);
       }
@@ -907,7 +944,9 @@ void ShellModel::sum_cluster_rest(const kernels::EnrichedElementBatch& xb, const
     }
     if (old.quadrature != in.quadrature) continue;  // other textures
     std::vector<int> from, slot;
-    if (!functions_among_old(old.shifts, npe, [&](int i) { return in.shifts[i]; }, from, slot) ||
+    std::vector<int> old_slot;  // = slot: the same record, the same textures
+    if (!functions_among_old(old.shifts, npe, static_cast<int>(in.shifts.size()) / npe, nullptr,
+                             [&](int i) { return in.shifts[i]; }, from, slot, old_slot) ||
         static_cast<int>(from.size()) != in.count)
       continue;
     // Each enriched function moves along its node's standard function by its shift's change.
@@ -1056,6 +1095,12 @@ void ShellModel::set_enrichments(std::vector<EnrichmentFunction> functions) {
     f.elements = std::move(elements);
     functions_left.push_back(std::move(f));
   }
+  // This rebuild alone keeps the first build's quadrature where whole functions went.
+  rebuilding_pruned_basis_ = true;
+  struct Reset {
+    bool& flag;
+    ~Reset() { flag = false; }
+  } reset{rebuilding_pruned_basis_};
   install_enrichments(std::move(functions_left));
   pruned_enriched_nodes_ = pruned;
 }

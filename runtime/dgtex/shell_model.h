@@ -106,6 +106,10 @@ class ShellModel {
   // Cost: an enriched element whose textures (and enriched nodes and shifts) are bitwise
   // those of the previous call on this model or the model it was copied from keeps its
   // quadrature (and mass and load weights); the results equal a fresh model's bitwise.
+  // Where the pruning drops whole functions, the elements that lose them keep the quadrature
+  // integrated with them (as fine or finer) and the remaining functions' entries of its mass
+  // and load weights, instead of integrating again (a fresh model given the same functions
+  // does the same).
   // With rotation clusters, an element whose textures alone are the same keeps its
   // clusters' rest sums: bitwise where its functions and shifts are the same too, else
   // reshifted to the new shifts (equal to a fresh sum to round-off; dropped functions are
@@ -322,7 +326,9 @@ class ShellModel {
 
   // An element's textures and the quadrature they decide, shared by every ElementIntegrals
   // built on bitwise these textures (a rebuild that only moved shifts or dropped functions),
-  // so that "the same textures" is one pointer comparison.
+  // so that "the same textures" is one pointer comparison. Without textures: the quadrature
+  // of a pruned basis whose element lost a whole function, built for the textures it had
+  // (integrate_enriched_elements), which no later rebuild takes.
   struct TexturedQuadrature {
     std::vector<std::vector<double>> values;       // per enrichment: texture values
     std::vector<std::vector<std::uint8_t>> flags;  // per enrichment: texture flags
@@ -375,6 +381,9 @@ class ShellModel {
   };
   bool keep_basis_values_ = false;
   KeptBasisValues kept_;
+  // While set_enrichments builds a pruned basis again: an element whose textures are some of
+  // those its integrals of the first build had (functions dropped whole) keeps their quadrature.
+  bool rebuilding_pruned_basis_ = false;
   // Per element enrichment (like textures_): its ElementIntegrals' texel derivatives or null.
   std::vector<const kernels::TexelDerivativeTile*> texture_derivatives_;
   // Fills element_qp_start_/element_qp_, the enriched load weights and `mass` (#enriched
