@@ -451,10 +451,14 @@ void ShellModel::integrate_enriched_elements(const kernels::EnrichedElementBatch
              std::memcmp(old_quadrature.flags[o].data(), now.flags, texels) == 0;
     };
     std::vector<int>& from = texture_from[x];
-    for (int k = 0, o = 0; k < k_count; ++k, ++o) {
-      while (o < old_count && !same_texture(o, textures_[first + k])) ++o;
-      if (o == old_count) break;
-      from.push_back(o);
+    const int skippable = old_count - k_count;  // old textures of dropped functions
+    for (int k = 0, o = 0; k < k_count && o < old_count; ++o) {
+      if (same_texture(o, textures_[first + k])) {
+        from.push_back(o);
+        ++k;
+      } else if (o - k >= skippable) {
+        break;  // more old textures passed over than functions were dropped
+      }
     }
     if (static_cast<int>(from.size()) != k_count) {
       from.clear();
