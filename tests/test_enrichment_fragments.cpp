@@ -103,6 +103,10 @@ std::unique_ptr<ShellModel> smooth_function_model(const Mesh& mesh, const LevelF
   return enriched_model(mesh, std::move(functions), min_mass_ratio);
 }
 
+// A near copy of the first function with a step of 0.02 along x = 0.3 that the first one
+// does not have: dropped at every node, but its quadrature resolves the step.
+double stepped_copy(const double* x) { return std::sin(8 * x[0]) + (x[0] > 0.3 ? 0.02 : 0.0); }
+
 }  // namespace
 
 // Each function alone adds much to N^a (the old test looked at that only), but the second
@@ -137,17 +141,16 @@ TEST(EnrichmentFragments, ANearCopyOfAnEarlierFunctionAtANodeIsDropped) {
   EXPECT_EQ(other->num_enriched_nodes(), 2 * mesh.num_nodes());
 }
 
-// Where the pruning drops a whole function (here a near copy of the first one with a step of
-// 0.02 along x = 0.3 that the first one does not have), the basis built again without it
-// keeps the quadrature integrated with it: the one of all functions, which resolves the step,
-// and the kept function's mass and load weights are those integrals' entries, bitwise,
-// instead of a second integration on the kept textures' own quadrature (spiral6's step 167
-// took ~6 ms more than its neighbours for it).
+// Where the pruning drops a whole function (here stepped_copy), the basis built again
+// without it keeps the quadrature integrated with it: the one of all functions, which
+// resolves the step, and the kept function's mass and load weights are those integrals'
+// entries, bitwise, instead of a second integration on the kept textures' own quadrature
+// (spiral6's step 167 took ~6 ms more than its neighbours for it).
 TEST(EnrichmentFragments, ABasisThatLosesAWholeFunctionKeepsTheQuadratureOfAllFunctions) {
   const Mesh mesh = make_rectangle(1, 0.5, 2, 1, ElementType::quad8);
-  const LevelFunction stepped_copy = [](const double* x) { return std::sin(8 * x[0]) + (x[0] > 0.3 ? 0.02 : 0.0); };
-  const auto all = smooth_function_model(mesh, &stepped_copy, 0.0);
-  const auto pruned = smooth_function_model(mesh, &stepped_copy, 1e-3);
+  const LevelFunction stepped = stepped_copy;
+  const auto all = smooth_function_model(mesh, &stepped, 0.0);
+  const auto pruned = smooth_function_model(mesh, &stepped, 1e-3);
   const auto first_only = smooth_function_model(mesh, nullptr, 1e-3);
   std::printf("quadrature points: both functions %lld, pruned to the first %lld, the first alone %lld\n",
               static_cast<long long>(all->num_enriched_element_quadrature_points()),
@@ -188,15 +191,15 @@ TEST(EnrichmentFragments, ABasisThatLosesAWholeFunctionKeepsTheQuadratureOfAllFu
 // prunes as before; each result equals a fresh model's given the same functions, bitwise.
 TEST(EnrichmentFragments, ALaterBasisOfAModelThatLostAWholeFunctionEqualsAFreshOneBitwise) {
   const Mesh mesh = make_rectangle(1, 0.5, 2, 1, ElementType::quad8);
-  const LevelFunction stepped_copy = [](const double* x) { return std::sin(8 * x[0]) + (x[0] > 0.3 ? 0.02 : 0.0); };
-  const auto model = smooth_function_model(mesh, &stepped_copy, 1e-3);
+  const LevelFunction stepped = stepped_copy;
+  const auto model = smooth_function_model(mesh, &stepped, 1e-3);
   ASSERT_EQ(model->enrichments().size(), 1u);
   const auto first_only = smooth_function_model(mesh, nullptr, 1e-3);
   model->set_enrichments(first_only->enrichments());
   expect_models_equal_bitwise(*model, *first_only);
-  const auto pruned = smooth_function_model(mesh, &stepped_copy, 1e-3);
+  const auto pruned = smooth_function_model(mesh, &stepped, 1e-3);
   std::vector<EnrichmentFunction> both = first_only->enrichments();
-  both.push_back(smooth_enrichment(mesh, 32, stepped_copy));
+  both.push_back(smooth_enrichment(mesh, 32, stepped));
   model->set_enrichments(std::move(both));
   ASSERT_EQ(model->enrichments().size(), 1u);
   expect_models_equal_bitwise(*model, *pruned);

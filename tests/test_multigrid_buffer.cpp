@@ -23,6 +23,14 @@ namespace {
 
 using dgtex::detail::MultigridBuffer;
 
+#if defined(__linux__)
+long minor_faults() {
+  rusage usage{};
+  getrusage(RUSAGE_SELF, &usage);
+  return usage.ru_minflt;
+}
+#endif
+
 bool all_zero(const MultigridBuffer& v) {
   return std::all_of(v.begin(), v.end(), [](double x) { return x == 0.0 && !std::signbit(x); });
 }
@@ -128,11 +136,6 @@ TEST(MultigridBuffer, MappedBlocksServeAGrowingCutAndKeepTheirCapacity) {
 TEST(MultigridBuffer, ACachedMappedBlockTooSmallForARequestIsGrownWithItsPages) {
 #if defined(__linux__)
   constexpr std::size_t mib = std::size_t{1} << 20;
-  auto minor_faults = [] {
-    rusage usage{};
-    getrusage(RUSAGE_SELF, &usage);
-    return usage.ru_minflt;
-  };
   dgtex::detail::release_cached_blocks();
   const std::size_t small = 15 * mib, large = 20 * mib;
   {
@@ -173,11 +176,6 @@ TEST(MultigridBuffer, ACachedMappedBlockTooSmallForARequestIsGrownWithItsPages) 
 TEST(MultigridBuffer, PrefaultedGranulesServeFreshMappedBlocksWithoutPageFaults) {
 #if defined(__linux__)
   constexpr std::size_t mib = std::size_t{1} << 20, per_mib = mib / sizeof(double);
-  auto minor_faults = [] {
-    rusage usage{};
-    getrusage(RUSAGE_SELF, &usage);
-    return usage.ru_minflt;
-  };
   dgtex::detail::release_cached_blocks();  // no cached block may serve the request below
   dgtex::detail::prefault_mapped_blocks(7 * mib);
   EXPECT_EQ(dgtex::detail::prefaulted_block_bytes(), 8 * mib);  // whole granules
