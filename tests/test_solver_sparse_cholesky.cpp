@@ -13,9 +13,11 @@
 
 #include "cholmod_lock.h"  // internal (runtime/)
 #include "dgtex/sparse_cholesky.h"
+#include "enrichment_test_support.h"
 #include "shifted_laplacian_support.h"
 
 using namespace dgtex;
+using dgtex::testing_support::bitwise_equal;
 using dgtex::testing_support::ShiftedLaplacian;
 
 namespace {
@@ -42,10 +44,6 @@ std::vector<double> cholmod_solution(const ShiftedLaplacian& A, const std::vecto
   cholmod_free_sparse(&matrix, &common);
   cholmod_finish(&common);
   return x;
-}
-
-bool bitwise_equal(const std::vector<double>& a, const std::vector<double>& b) {
-  return a.size() == b.size() && std::memcmp(a.data(), b.data(), sizeof(double) * a.size()) == 0;
 }
 
 }  // namespace
