@@ -49,7 +49,7 @@ double element_local_dropped_radius(const BlockAssembly& pattern, const std::vec
     for (std::int64_t k = row_start[r]; k < row_start[r + 1]; ++k)
       if (column[k] == r)
         for (int i = 0; i < 3; ++i) diagonal[3 * r + i] = A.mass_scale * mass[9 * k + 4 * i] + A.stiffness_scale * K[9 * k + 4 * i];
-  // scale[d] = |stiffness_scale| / sqrt(A_dd) on free DOFs, 0 on fixed ones (not summed).
+  // scale[d] = 1 / sqrt(A_dd) on free DOFs, 0 on fixed ones (not summed).
   std::vector<double> scale(diagonal.size(), 0.0);
   for (std::size_t d = 0; d < diagonal.size(); ++d) {
     if (!free[d]) continue;

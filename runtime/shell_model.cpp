@@ -604,10 +604,11 @@ void ShellModel::integrate_enriched_elements(const kernels::EnrichedElementBatch
       entry->quadrature = element_integrals_[todo_element[t]]->quadrature;
     } else {
       auto quadrature = std::make_shared<TexturedQuadrature>();
-      for (int k = enrichment_start_[x]; k < enrichment_start_[x + 1] && texture_from[x].empty(); ++k) {
-        quadrature->values.emplace_back(textures_[k].values, textures_[k].values + texels);
-        quadrature->flags.emplace_back(textures_[k].flags, textures_[k].flags + texels);
-      }
+      if (texture_from[x].empty())  // else old points for fewer textures: a record without them
+        for (int k = enrichment_start_[x]; k < enrichment_start_[x + 1]; ++k) {
+          quadrature->values.emplace_back(textures_[k].values, textures_[k].values + texels);
+          quadrature->flags.emplace_back(textures_[k].flags, textures_[k].flags + texels);
+        }
       quadrature->points.assign(sub_points.begin() + 3 * sub_start[t], sub_points.begin() + 3 * sub_start[t + 1]);
       entry->quadrature = std::move(quadrature);
     }
