@@ -130,12 +130,14 @@ void SparseCholesky::analyze(int n, const std::vector<int>& column_start, const 
     m.dense->set_pattern(n, column_start, row_index);
     return;
   }
-  // stype -1: only the lower triangle is stored and used.
-  m.matrix = cholmod_allocate_sparse(n, n, nnz, /*sorted=*/1, /*packed=*/1, /*stype=*/-1, CHOLMOD_REAL, &m.common);
+  // stype -1: only the lower triangle is stored and used. The analysis reads the pattern
+  // alone; values are allocated only where the factorisation reads this matrix (without
+  // permuted: 8 bytes a stored entry, 1.4 MB for fracture's step matrix, 4.4 MB for the
+  // cylinder's, that the usual path never touches).
+  m.matrix = cholmod_allocate_sparse(n, n, nnz, /*sorted=*/1, /*packed=*/1, /*stype=*/-1, CHOLMOD_PATTERN, &m.common);
   if (!m.matrix) throw std::runtime_error("CHOLMOD: out of memory allocating a " + std::to_string(n) + "x" + std::to_string(n) + " matrix");
   std::memcpy(m.matrix->p, column_start.data(), sizeof(int) * (n + 1));
   std::memcpy(m.matrix->i, row_index.data(), sizeof(int) * nnz);
-  std::memset(m.matrix->x, 0, sizeof(double) * nnz);
   m.schedule = SolveSchedule{};
   {
     const auto lock = detail::lock_cholmod();
@@ -143,7 +145,12 @@ void SparseCholesky::analyze(int n, const std::vector<int>& column_start, const 
   }
   if (!m.factor || m.common.status < CHOLMOD_OK)
     throw std::runtime_error("CHOLMOD: symbolic analysis failed (status " + std::to_string(m.common.status) + ")");
-  if (m.factor->is_super && m.factor->ordering != CHOLMOD_NATURAL) build_permuted_lower();
+  if (m.factor->is_super && m.factor->ordering != CHOLMOD_NATURAL) {
+    build_permuted_lower();
+  } else if (!cholmod_sparse_xtype(CHOLMOD_REAL, m.matrix, &m.common)) {
+    throw std::runtime_error("CHOLMOD: out of memory allocating the values of a " + std::to_string(n) + "x" +
+                             std::to_string(n) + " matrix");
+  }
 }
 
 void SparseCholesky::build_permuted_lower() {
