@@ -10,6 +10,7 @@
 #include <sstream>
 #include <stdexcept>
 #include <thread>
+#include <vector>
 
 namespace dgtex {
 
@@ -51,6 +52,35 @@ double machine_probe_ms(int repeats) {
   return best;
 }
 
+double machine_probe_all_threads_ms(int threads, int repeats) {
+  if (threads < 1)
+    throw std::invalid_argument("machine_probe_all_threads_ms: threads must be >= 1, got " + std::to_string(threads));
+  if (repeats < 1)
+    throw std::invalid_argument("machine_probe_all_threads_ms: repeats must be >= 1, got " + std::to_string(repeats));
+  double best = std::numeric_limits<double>::infinity();
+  for (int r = 0; r < repeats; ++r) {
+    std::vector<double> ms(threads, 0.0);
+#pragma omp parallel num_threads(threads)
+    {
+#pragma omp barrier
+      ms[omp_get_thread_num()] = machine_probe_ms(1);
+    }
+    best = std::min(best, *std::max_element(ms.begin(), ms.end()));
+  }
+  return best;
+}
+
+std::string shared_cores_warning(double one_core_ms, double all_threads_ms, int threads, double tolerance) {
+  if (threads < 2 || all_threads_ms <= (1 + tolerance) * one_core_ms) return {};
+  char text[320];
+  std::snprintf(text, sizeof text,
+                "the host did not give each of the %d threads a core of its own: the probe took %.1f ms on one "
+                "thread, %.1f ms on %d at once (more than %.0f %% longer); multithreaded figures are below this "
+                "machine's",
+                threads, one_core_ms, all_threads_ms, threads, 100 * tolerance);
+  return text;
+}
+
 std::string probe_drift_warning(const std::vector<double>& probes_ms, double tolerance) {
   if (probes_ms.size() < 2) return {};
   const auto [fastest, slowest] = std::minmax_element(probes_ms.begin(), probes_ms.end());
@@ -64,8 +94,13 @@ std::string probe_drift_warning(const std::vector<double>& probes_ms, double tol
 }
 
 std::string describe_machine_and_probe() {
-  char probe[64];
-  std::snprintf(probe, sizeof probe, ", one-core probe %.1f ms", machine_probe_ms());
+  char probe[128];
+  const int threads = omp_get_max_threads();
+  if (threads > 1)
+    std::snprintf(probe, sizeof probe, ", one-core probe %.1f ms (%d threads at once: %.1f ms)", machine_probe_ms(),
+                  threads, machine_probe_all_threads_ms(threads));
+  else
+    std::snprintf(probe, sizeof probe, ", one-core probe %.1f ms", machine_probe_ms());
   return describe_machine() + probe;
 }
 

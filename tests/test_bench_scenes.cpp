@@ -65,7 +65,11 @@ TEST(BenchScenes, JsonHasEveryRequestedSceneWithRequiredKeysAndThesisRatios) {
   // The machine, and its speed probe before each scene and at the end.
   EXPECT_NE(j["machine"].get<std::string>().find(" cores, "), std::string::npos);
   EXPECT_GT(j["machine_probe_ms_at_end"].get<double>(), 0);
-  for (const nlohmann::json& s : j["scenes"]) EXPECT_GT(s["machine_probe_ms"].get<double>(), 0);
+  EXPECT_GT(j["machine_probe_all_threads_ms_at_end"].get<double>(), 0);
+  for (const nlohmann::json& s : j["scenes"]) {
+    EXPECT_GT(s["machine_probe_ms"].get<double>(), 0);
+    EXPECT_GT(s["machine_probe_all_threads_ms"].get<double>(), 0);
+  }
   EXPECT_EQ(j["scenes"][0]["name"], "spiral1");
   EXPECT_EQ(j["scenes"][1]["name"], "cylinder_buckling");
   for (const nlohmann::json& s : j["scenes"]) {
@@ -130,6 +134,8 @@ TEST(BenchScenes, JsonHasEveryRequestedSceneWithRequiredKeysAndThesisRatios) {
   std::getline(markdown, heading);
   EXPECT_EQ(heading.rfind("dgtex bench scenes: " + j["machine"].get<std::string>() + ";", 0), 0u) << heading;
   EXPECT_NE(heading.find("machine probe "), std::string::npos) << heading;
+  const std::string all_threads = " ms (each of " + std::to_string(j["threads"].get<int>()) + " threads at once)";
+  EXPECT_NE(heading.find(all_threads), std::string::npos) << heading;
   std::string text((std::istreambuf_iterator<char>(markdown)), std::istreambuf_iterator<char>());
   EXPECT_NE(text.find("| 0.001 / 0.1 / 16 |"), std::string::npos) << text;
   EXPECT_NE(text.find(" / per point |"), std::string::npos) << text;
@@ -152,7 +158,8 @@ TEST(BenchScenes, RepeatsShowTheFastestRunAndListEveryRun) {
   const nlohmann::json& scene = j["scenes"][0];
   const nlohmann::json& runs = scene["runs"];
   EXPECT_EQ(runs["count"], 3);
-  for (const char* key : {"steps_per_second", "peak_step_ms", "enrichment_ms_max", "machine_probe_ms"})
+  for (const char* key :
+       {"steps_per_second", "peak_step_ms", "enrichment_ms_max", "machine_probe_ms", "machine_probe_all_threads_ms"})
     ASSERT_EQ(runs[key].size(), 3u) << key;
   const std::size_t shown = runs["shown"].get<std::size_t>();
   ASSERT_LT(shown, 3u);
@@ -162,6 +169,8 @@ TEST(BenchScenes, RepeatsShowTheFastestRunAndListEveryRun) {
   EXPECT_EQ(scene["peak_step_ms"].get<double>(), runs["peak_step_ms"][shown].get<double>());
   EXPECT_EQ(scene["timings_ms"]["enrichment"]["max"].get<double>(), runs["enrichment_ms_max"][shown].get<double>());
   EXPECT_EQ(scene["machine_probe_ms"].get<double>(), runs["machine_probe_ms"][shown].get<double>());
+  EXPECT_EQ(scene["machine_probe_all_threads_ms"].get<double>(),
+            runs["machine_probe_all_threads_ms"][shown].get<double>());
   EXPECT_TRUE(runs["identical"].get<bool>());
   std::ifstream markdown(dir / "out.md");
   std::string heading;

@@ -30,10 +30,44 @@ TEST(BenchmarkMachine, ProbeTimesItsWorkloadAndRejectsNoRuns) {
   EXPECT_GT(ms, 0.1);
   EXPECT_LT(ms, 2000.0);
   EXPECT_THROW(machine_probe_ms(0), std::invalid_argument);
-  // The charts' heading: the description, then the probe.
-  const std::string heading = describe_machine_and_probe();
-  EXPECT_EQ(heading.rfind(describe_machine() + ", one-core probe ", 0), 0u) << heading;
-  EXPECT_EQ(heading.substr(heading.size() - 3), " ms") << heading;
+}
+
+TEST(BenchmarkMachine, AllThreadsProbeTimesTheWorkloadOnEveryThreadAndRejectsBadArguments) {
+  for (int threads : {1, 2}) {
+    const double ms = machine_probe_all_threads_ms(threads, 1);
+    EXPECT_TRUE(std::isfinite(ms)) << threads;
+    EXPECT_GT(ms, 0.1) << threads;
+    EXPECT_LT(ms, 2000.0) << threads;
+  }
+  EXPECT_THROW(machine_probe_all_threads_ms(0), std::invalid_argument);
+  EXPECT_THROW(machine_probe_all_threads_ms(2, 0), std::invalid_argument);
+}
+
+TEST(BenchmarkMachine, ChartHeadingNamesTheMachineAndBothProbes) {
+  const int saved = omp_get_max_threads();
+  omp_set_num_threads(1);
+  const std::string one = describe_machine_and_probe();
+  omp_set_num_threads(2);
+  const std::string two = describe_machine_and_probe();
+  const std::string machine_with_two = describe_machine();
+  omp_set_num_threads(saved);
+  // The description, then the one-core probe; with threads, the probe on all of them too.
+  EXPECT_NE(one.find(", one-core probe "), std::string::npos) << one;
+  EXPECT_EQ(one.substr(one.size() - 3), " ms") << one;
+  EXPECT_EQ(one.find("at once"), std::string::npos) << one;
+  EXPECT_EQ(two.rfind(machine_with_two + ", one-core probe ", 0), 0u) << two;
+  EXPECT_NE(two.find(" ms (2 threads at once: "), std::string::npos) << two;
+  EXPECT_EQ(two.substr(two.size() - 4), " ms)") << two;
+}
+
+TEST(BenchmarkMachine, SharedCoresWarningOnlyWhenThreadsLoseBeyondTheTolerance) {
+  EXPECT_EQ(shared_cores_warning(8.5, 8.9, 2), "");
+  EXPECT_EQ(shared_cores_warning(8.0, 10.0, 2), "");  // 25 % longer: at the tolerance
+  EXPECT_EQ(shared_cores_warning(8.0, 16.0, 1), "");  // one thread: nothing shared
+  EXPECT_EQ(shared_cores_warning(8.0, 11.0, 2, 0.5), "");
+  // Session 64's host: 8.3 ms alone, 12.4 ms for one of two threads at once.
+  const std::string shared = shared_cores_warning(8.3, 12.4, 2);
+  EXPECT_NE(shared.find("8.3 ms on one thread, 12.4 ms on 2 at once"), std::string::npos) << shared;
 }
 
 TEST(BenchmarkMachine, DriftWarningOnlyWhenProbesMoveBeyondTheTolerance) {
