@@ -534,7 +534,10 @@ MeshLaplaceStats solve_mesh_texel_laplace(std::vector<RegionTile>& tiles, Elemen
   // links the larger root under the smaller, so parent[v] <= v and one forward pass
   // flattens every texel to its root.
   const int t = tiles.front().tile.width, tt = t * t;
-  std::vector<char> is_free(n), is_data(n), tile_has_data(tiles.size(), 0), is_uncut(tiles.size(), 0);
+  std::vector<char> is_free(n), is_data(n), is_uncut(tiles.size(), 0);
+  // Per unfrozen tile, its data (Dirichlet) texels in texel order: the data its free texels
+  // meet is found from these few (a cut's raster) instead of from every free texel.
+  std::vector<std::vector<int>> dirichlet_texels(tiles.size());
   // An uncut element's flags: only its shape's inactive texels (no walls, no data).
   std::vector<std::uint8_t> uncut(tt, 0);
   if (type == ElementType::tri6)
@@ -548,15 +551,15 @@ MeshLaplaceStats solve_mesh_texel_laplace(std::vector<RegionTile>& tiles, Elemen
     is_uncut[l] = !frozen && tiles[l].tile.flags == uncut;
     char* free_texel = is_free.data() + static_cast<std::size_t>(l) * tt;
     char* data_texel = is_data.data() + static_cast<std::size_t>(l) * tt;
-    char any_data = 0;
     for (int k = 0; k < tt; ++k) {
       const bool active = !(flags[k] & kernels::inactive);
       const bool data = active && (frozen || (flags[k] & kernels::dirichlet));
       data_texel[k] = data;
       free_texel[k] = active && !data;
-      any_data |= data;
     }
-    tile_has_data[l] = any_data;
+    if (!frozen)  // a frozen tile has no free texels to meet its data
+      for (int k = 0; k < tt; ++k)
+        if (data_texel[k]) dirichlet_texels[l].push_back(k);
   }
   std::vector<int> parent(n);
   // The in-tile sets of an uncut tile, relative to its first texel: every uncut tile has the
@@ -610,20 +613,16 @@ MeshLaplaceStats solve_mesh_texel_laplace(std::vector<RegionTile>& tiles, Elemen
     graph.for_each_coupling_across_edges(l, [&](int v, int w) {
       if (is_free[v] && is_data[w]) meet(parent[v], graph.value(w));
     });
-    if (!tile_has_data[l]) continue;  // then no texel of the tile is data
+    // Free neighbours in the tile of each data texel (free implies active).
     const std::uint8_t* flags = tiles[l].tile.flags.data();
     const double* values = tiles[l].tile.values.data();
-    for (int j = 0; j < t; ++j)
-      for (int i = 0; i < t; ++i) {
-        const int k = j * t + i, v = l * tt + k;
-        if (!is_free[v]) continue;
-        const int root = parent[v];
-        // Neighbours in the tile (data implies active).
-        if (i + 1 < t && is_data[v + 1] && !(flags[k] & kernels::wall_east)) meet(root, values[k + 1]);
-        if (i > 0 && is_data[v - 1] && !(flags[k - 1] & kernels::wall_east)) meet(root, values[k - 1]);
-        if (j + 1 < t && is_data[v + t] && !(flags[k] & kernels::wall_north)) meet(root, values[k + t]);
-        if (j > 0 && is_data[v - t] && !(flags[k - t] & kernels::wall_north)) meet(root, values[k - t]);
-      }
+    for (const int k : dirichlet_texels[l]) {
+      const int i = k % t, j = k / t, v = l * tt + k;
+      if (i + 1 < t && is_free[v + 1] && !(flags[k] & kernels::wall_east)) meet(parent[v + 1], values[k]);
+      if (i > 0 && is_free[v - 1] && !(flags[k - 1] & kernels::wall_east)) meet(parent[v - 1], values[k]);
+      if (j + 1 < t && is_free[v + t] && !(flags[k] & kernels::wall_north)) meet(parent[v + t], values[k]);
+      if (j > 0 && is_free[v - t] && !(flags[k - t] & kernels::wall_north)) meet(parent[v - t], values[k]);
+    }
   }
   // node -> unknown or -1; allocated with the first unknown (a settled region, like
   // fracture's 148 uncut tiles, touches none of its pages: they cost ~2.5 us each fresh).
