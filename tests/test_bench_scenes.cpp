@@ -62,7 +62,8 @@ TEST(BenchScenes, JsonHasEveryRequestedSceneWithRequiredKeysAndThesisRatios) {
   EXPECT_EQ(j["cut_update_threads"], 1);
   EXPECT_EQ(j["reserve_step_memory"], true);  // the default (dgtex/step_memory.h)
   ASSERT_EQ(j["scenes"].size(), 2u);
-  // The machine, and its speed probe before each scene and at the end.
+  // The machine, and its speed probes (one core, every thread at once) before each scene's
+  // run and at the end.
   EXPECT_NE(j["machine"].get<std::string>().find(" cores, "), std::string::npos);
   EXPECT_GT(j["machine_probe_ms_at_end"].get<double>(), 0);
   EXPECT_GT(j["machine_probe_all_threads_ms_at_end"].get<double>(), 0);

@@ -21,9 +21,10 @@ double machine_probe_ms(int repeats = 3);
 // run): the slowest thread's time, the best of `repeats` runs. Where the host gives every
 // thread a core of its own this equals machine_probe_ms; a core shared with another tenant
 // (a busy SMT sibling, time stolen by the hypervisor) makes it longer, which the one-core
-// probe cannot see. Session 64's host: one core 8.3-8.7 ms as in session 63, two at once
-// 10.2-12.4 ms, and every scene 35-40 % slower than in session 63. Throws
-// std::invalid_argument for threads < 1 or repeats < 1.
+// probe cannot see (session 64's host at one moment: 8.3-8.7 ms alone, 10.2-12.4 ms for a
+// thread of two at once). Neither probe sees contention for memory or cache: through that
+// session's slow runs (scenes 25-40 % slower than in session 63) both read as in session 63.
+// Throws std::invalid_argument for threads < 1 or repeats < 1.
 double machine_probe_all_threads_ms(int threads, int repeats = 3);
 
 // A warning when the probe on all threads at once took more than `tolerance` longer than
