@@ -740,6 +740,12 @@ LaplaceSolveStats LaplaceMultigrid::solve(kernels::TexelTile& tile, std::vector<
       [&](std::int64_t j64) {
         const int j = static_cast<int>(j64);
         double b2 = 0;
+        // The initial guess of unknown t from tile value k (x = 0 already): with a warm start,
+        // the texel's value where it is finite and not 0.
+        const auto take_guess = [&](std::int64_t t, int k) {
+          const double guess = tile.values[k];
+          if (o.warm_start && std::isfinite(guess) && guess != 0.0) fine.x[t] = guess, row_has_guess[j] = 1;
+        };
         for (int i = 0; i < g.nx; ++i) {
           const std::int64_t t = g.at(i, j);
           // Four unknowns coupled to four unknowns each: b = r = 0 (b2 += 0 changes nothing),
@@ -747,11 +753,8 @@ LaplaceSolveStats LaplaceMultigrid::solve(kernels::TexelTile& tile, std::vector<
           // instructions a texel without a guess to read.
           if ((i & 3) == 0 && i + 4 <= g.nx && kernels::four_interior_texels(&h.bits[t])) {
             for (int l = 0; l < 4; ++l) fine.b[t + l] = fine.r[t + l] = fine.x[t + l] = 0.0;
-            if (o.warm_start) {
-              const double* guess = tile.values.data() + tile.index(i, j);
-              for (int l = 0; l < 4; ++l)
-                if (std::isfinite(guess[l]) && guess[l] != 0.0) fine.x[t + l] = guess[l], row_has_guess[j] = 1;
-            }
+            if (o.warm_start)
+              for (int l = 0; l < 4; ++l) take_guess(t + l, tile.index(i + l, j));
             i += 3;
             continue;
           }
@@ -783,10 +786,7 @@ LaplaceSolveStats LaplaceMultigrid::solve(kernels::TexelTile& tile, std::vector<
           fine.b[t] = b;
           fine.r[t] = b;
           b2 += b * b;
-          if (o.warm_start && std::isfinite(tile.values[k]) && tile.values[k] != 0.0) {
-            fine.x[t] = tile.values[k];
-            row_has_guess[j] = 1;
-          }
+          take_guess(t, k);
         }
         h.row_partial[j] = b2;
       },
