@@ -54,6 +54,10 @@ SceneRun::SceneRun(const Scene& scene, SceneRunOptions options)
                                 std::to_string(options_.cut_update_threads) +
                                 "; give 0 (balanced step by step) or a thread count of 1 or more");
   cut_update_team_ = std::make_unique<detail::CutUpdateTeam>(options_.cut_update_threads);
+  // The malloc settings of the reservation below before the OpenMP threads allocate (the cut
+  // tracing runs on them), so that they too take the heap it faults in.
+  const bool reserves = options_.reserve_step_memory && (!scene_.cuts.empty() || !scene_.creases.empty());
+  if (reserves) prepare_step_memory();
   SceneModel built = build_scene_model(scene_, mesh_);
   model_ = std::move(built.model);
   if (scene_.analysis.is_dynamic()) {
@@ -75,7 +79,7 @@ SceneRun::SceneRun(const Scene& scene, SceneRunOptions options)
       const std::int64_t available = available_memory_bytes();
       check_texel_memory(fields, available, scene_.source_name.empty() ? "scene" : scene_.source_name);
       if (options_.before_texel_fields) options_.before_texel_fields(fields, available);
-      if (options_.reserve_step_memory) {
+      if (reserves) {
         // Set-up, not enrichment: the time-0 update counts as the first step's (bench scenes).
         const auto reserve_start = std::chrono::steady_clock::now();
         try {

@@ -65,6 +65,12 @@ void fault_in_heap(std::int64_t bytes) {
 
 }  // namespace
 
+void prepare_step_memory() {
+#if defined(__GLIBC__)
+  keep_freed_memory();
+#endif
+}
+
 void reserve_step_memory(std::int64_t bytes) {
   if (bytes <= 0) return;
 #if defined(__GLIBC__)

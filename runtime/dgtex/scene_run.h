@@ -70,9 +70,11 @@ struct SceneRunOptions {
   std::function<void(const TexelFields& fields, std::int64_t available_bytes)> before_texel_fields;
   // Then (after before_texel_fields) fault in the memory the first steps will take
   // (reserve_step_memory(step_memory_bytes(fields, available)), dgtex/step_memory.h):
-  // process-wide malloc settings, and a set-up longer by ~1.4 us a reserved 4 KiB page
-  // (chad: 96 MiB, 33-36 ms more), for first steps without first-touch page faults. Memory
-  // that cannot be had is left out (the steps then take theirs as they go).
+  // process-wide malloc settings (made first thing in the set-up, prepare_step_memory, so
+  // that the threads tracing the cuts share the heap reserved later), and a set-up longer by
+  // ~1.4 us a reserved 4 KiB page (chad: 96 MiB, 33-36 ms more), for first steps without
+  // first-touch page faults. Memory that cannot be had is left out (the steps then take
+  // theirs as they go).
   bool reserve_step_memory = false;
   // The corotated step solver's options (dgtex/factor_reusing_solver.h), for the simulation
   // of every basis; once one has given up its element-local preconditioner, the later ones

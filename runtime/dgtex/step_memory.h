@@ -16,9 +16,10 @@
 // - `bytes` of heap are faulted in now (2/3) and of the 2 MiB blocks of the Laplace
 //   multigrid (1/3), or topped up to that where an earlier call reserved less.
 // With another C library than glibc only the multigrid's part is reserved. Thread-safe;
-// call it before the threads that run the steps start, for them to share the reserved heap
-// (SceneRunOptions::reserve_step_memory does so in the set-up of a SceneRun: the `dgtex`
-// tool's `run` and `bench scenes`). Throws std::bad_alloc where the memory is not to be had.
+// call it (or prepare_step_memory) before the threads that run the steps allocate, for
+// them to share the reserved heap (SceneRunOptions::reserve_step_memory does so in the
+// set-up of a SceneRun: the `dgtex` tool's `run` and `bench scenes`). Throws
+// std::bad_alloc where the memory is not to be had.
 #include <cstdint>
 
 #include "dgtex/texel_memory_estimate.h"
@@ -26,6 +27,14 @@
 namespace dgtex {
 
 void reserve_step_memory(std::int64_t bytes);
+
+// reserve_step_memory's malloc settings alone (the first item above), for a caller that
+// reserves once it knows how much: called before any thread but the caller allocates, every
+// thread shares the heap the reservation faults in later. A thread that allocated before
+// them keeps a heap of its own, which no reservation reaches (SceneRun's OpenMP worker once
+// it had traced cuts: fracture's time-0 update then faulted in 1.2k pages, the accordion's
+// first step 2.9k; session 65). Thread-safe; settings already made stay.
+void prepare_step_memory();
 
 // What SceneRun reserves for a scene's texel fields: 6 times their lower bound
 // (texel_memory_lower_bound; chad: 16 -> 96 MiB), at most 512 MiB and a quarter of the
