@@ -87,6 +87,10 @@ TEST(BenchScenes, JsonHasEveryRequestedSceneWithRequiredKeysAndThesisRatios) {
     EXPECT_GT(s["timings_ms"]["solve"]["mean"].get<double>(), 0);
     // steps/s is the inverse of the mean whole-step time.
     EXPECT_NEAR(s["steps_per_second"].get<double>() * s["timings_ms"]["step"]["mean"].get<double>(), 1e3, 1e-6);
+    // The steps slower than the peak-step target (30 steps/s), counted from the steps' times.
+    int slower = 0;
+    for (const nlohmann::json& ms : s["per_step_ms"]["step"]) slower += 1e3 / ms.get<double>() < 30;
+    EXPECT_EQ(s["steps_slower_than_target"].get<int>(), slower);
     for (const char* key : {"elements", "nodes", "dofs", "free_dofs", "nonzeros", "enrichments"})
       EXPECT_TRUE(s["counts"].contains(key)) << key;
     // The solver's counts per step add up to the totals; the first step factorises, and
@@ -159,8 +163,8 @@ TEST(BenchScenes, RepeatsShowTheFastestRunAndListEveryRun) {
   const nlohmann::json& scene = j["scenes"][0];
   const nlohmann::json& runs = scene["runs"];
   EXPECT_EQ(runs["count"], 3);
-  for (const char* key :
-       {"steps_per_second", "peak_step_ms", "enrichment_ms_max", "machine_probe_ms", "machine_probe_all_threads_ms"})
+  for (const char* key : {"steps_per_second", "peak_step_ms", "steps_slower_than_target", "enrichment_ms_max",
+                          "machine_probe_ms", "machine_probe_all_threads_ms"})
     ASSERT_EQ(runs[key].size(), 3u) << key;
   const std::size_t shown = runs["shown"].get<std::size_t>();
   ASSERT_LT(shown, 3u);
@@ -168,6 +172,7 @@ TEST(BenchScenes, RepeatsShowTheFastestRunAndListEveryRun) {
     EXPECT_GE(runs["steps_per_second"][shown].get<double>(), other.get<double>());
   EXPECT_EQ(scene["steps_per_second"].get<double>(), runs["steps_per_second"][shown].get<double>());
   EXPECT_EQ(scene["peak_step_ms"].get<double>(), runs["peak_step_ms"][shown].get<double>());
+  EXPECT_EQ(scene["steps_slower_than_target"].get<int>(), runs["steps_slower_than_target"][shown].get<int>());
   EXPECT_EQ(scene["timings_ms"]["enrichment"]["max"].get<double>(), runs["enrichment_ms_max"][shown].get<double>());
   EXPECT_EQ(scene["machine_probe_ms"].get<double>(), runs["machine_probe_ms"][shown].get<double>());
   EXPECT_EQ(scene["machine_probe_all_threads_ms"].get<double>(),
@@ -179,18 +184,21 @@ TEST(BenchScenes, RepeatsShowTheFastestRunAndListEveryRun) {
   EXPECT_NE(heading.find("the fastest of 3 runs"), std::string::npos) << heading;
   // The table of every run: the JSON's figures in order (to 0.1), the shown run's in bold.
   std::string text((std::istreambuf_iterator<char>(markdown)), std::istreambuf_iterator<char>());
-  EXPECT_NE(text.find("| scene | steps/s, run by run | peak step (ms), run by run |"), std::string::npos) << text;
-  auto listed = [&](const char* key) {
+  EXPECT_NE(text.find("| scene | steps/s, run by run | peak step (ms), run by run | steps slower than 33.3 ms, run "
+                      "by run |"),
+            std::string::npos)
+      << text;
+  auto listed = [&](const char* key, const char* number_format = "%.1f") {
     std::string list;
     for (std::size_t k = 0; k < 3; ++k) {
       char value[32];
-      std::snprintf(value, sizeof value, "%.1f", runs[key][k].get<double>());
+      std::snprintf(value, sizeof value, number_format, runs[key][k].get<double>());
       list += (k ? ", " : "") + (k == shown ? "**" + std::string(value) + "**" : std::string(value));
     }
     return list;
   };
   const std::string row = "| spiral1 | " + listed("steps_per_second") + " | " + listed("peak_step_ms") + " | " +
-                          listed("enrichment_ms_max") + " |";
+                          listed("steps_slower_than_target", "%.0f") + " | " + listed("enrichment_ms_max") + " |";
   EXPECT_NE(text.find(row), std::string::npos) << row << "\n" << text;
 
   const Result zero = run_cli("bench scenes --scenes spiral1 --repeats 0", dir);
@@ -226,6 +234,7 @@ TEST(BenchScenes, CountsMatchTheReportOfDgtexRun) {
     EXPECT_EQ(missed.count(name), value < target ? 1u : 0u) << name << " = " << value;
     missed.erase(name);
   };
+  const bool peak_missed = missed.count("steps_per_second_at_peak") == 1;
   falls_short("steps_per_second", s["steps_per_second"], 30);
   falls_short("steps_per_second_at_peak", s["steps_per_second_at_peak"], 30);
   falls_short("enrichment_ratio", s["ratio_to_table_5_1"]["enrichment"], 20);
@@ -240,6 +249,11 @@ TEST(BenchScenes, CountsMatchTheReportOfDgtexRun) {
   const std::size_t verdict = text.find(" | no: ");
   ASSERT_NE(verdict, std::string::npos) << text;
   EXPECT_NE(text.find("assembly", verdict), std::string::npos) << text;
+  // A missed peak step says how many steps were slower than the target; met, none was.
+  const int slower = s["steps_slower_than_target"].get<int>();
+  EXPECT_EQ(peak_missed, slower > 0);
+  const std::string peak_verdict = "peak step (" + std::to_string(slower) + " of 3 steps over 33.3 ms)";
+  EXPECT_EQ(text.find(peak_verdict, verdict) != std::string::npos, peak_missed) << peak_verdict << "\n" << text;
   // The solver's totals over the run's three bases (a basis change every step) agree too.
   EXPECT_EQ(report["solver"]["solves"], 3);
   EXPECT_EQ(report["solver"]["pcg_iterations"], b["scenes"][0]["solver"]["pcg_iterations"]);
