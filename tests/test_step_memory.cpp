@@ -8,6 +8,7 @@
 
 #include <cstdint>
 #include <cstdlib>
+#include <string>
 #include <vector>
 
 #include "dgtex/scene_io.h"
@@ -53,6 +54,16 @@ TEST(StepMemory, SixTimesTheFieldsBoundWithinTheCaps) {
 #endif
 }
 
+// Page faults in the first `steps` steps of an example scene run with the reservation.
+[[maybe_unused]] long faults_in_first_steps(const std::string& scene, int steps) {
+  SceneRunOptions options;
+  options.reserve_step_memory = true;
+  SceneRun run(load_scene(std::string(DGTEX_SOURCE_DIR "/examples/scenes/") + scene), options);
+  const long before = minor_faults();
+  for (int step = 0; step < steps; ++step) run.step();
+  return minor_faults() - before;
+}
+
 TEST(StepMemory, ALargerReservationTopsTheHeapUpToAllOfIt) {
 #if defined(__SANITIZE_ADDRESS__)
   GTEST_SKIP() << "ASan's allocator takes no malloc settings";
@@ -82,12 +93,7 @@ TEST(StepMemory, ChadsFirstStepsFaultInAlmostNoPageWithTheReservation) {
 #elif !defined(__linux__) || !defined(__GLIBC__)
   GTEST_SKIP() << "the heap's part of the reservation is glibc's";
 #else
-  SceneRunOptions options;
-  options.reserve_step_memory = true;
-  SceneRun run(load_scene(DGTEX_SOURCE_DIR "/examples/scenes/chad.json"), options);
-  const long before = minor_faults();
-  for (int step = 0; step < 4; ++step) run.step();
-  EXPECT_LT(minor_faults() - before, 1000) << "page faults in chad's first four steps";
+  EXPECT_LT(faults_in_first_steps("chad.json", 4), 1000) << "page faults in chad's first four steps";
 #endif
 }
 
@@ -103,12 +109,7 @@ TEST(StepMemory, ThreadsThatTracedCutsBeforeTheReservationShareItsHeap) {
   // first step then faulted in 2.9k pages (its worker thread's rest sums), 10 with the
   // settings made first (SceneRun calls prepare_step_memory before anything else).
   omp_set_num_threads(2);  // a worker thread, also on a machine of one core
-  SceneRunOptions options;
-  options.reserve_step_memory = true;
-  SceneRun run(load_scene(DGTEX_SOURCE_DIR "/examples/scenes/accordion.json"), options);
-  const long before = minor_faults();
-  for (int step = 0; step < 2; ++step) run.step();
-  EXPECT_LT(minor_faults() - before, 500) << "page faults in the accordion's first two steps";
+  EXPECT_LT(faults_in_first_steps("accordion.json", 2), 500) << "page faults in the accordion's first two steps";
 #endif
 }
 
