@@ -11,13 +11,23 @@
 
 using namespace dgtex;
 
-TEST(BenchmarkMachine, DescriptionNamesTheCoresAndThreads) {
+namespace {
+
+// describe() with the OpenMP thread count set to `threads` (restored after).
+template <class Describe>
+std::string with_threads(int threads, Describe describe) {
   const int saved = omp_get_max_threads();
-  omp_set_num_threads(1);
-  const std::string one = describe_machine();
-  omp_set_num_threads(3);
-  const std::string three = describe_machine();
+  omp_set_num_threads(threads);
+  const std::string text = describe();
   omp_set_num_threads(saved);
+  return text;
+}
+
+}  // namespace
+
+TEST(BenchmarkMachine, DescriptionNamesTheCoresAndThreads) {
+  const std::string one = with_threads(1, describe_machine);
+  const std::string three = with_threads(3, describe_machine);
   EXPECT_NE(one.find(" cores, 1 thread"), std::string::npos) << one;
   EXPECT_NE(three.find(" cores, 3 threads"), std::string::npos) << three;
 }
@@ -44,13 +54,9 @@ TEST(BenchmarkMachine, AllThreadsProbeTimesTheWorkloadOnEveryThreadAndRejectsBad
 }
 
 TEST(BenchmarkMachine, ChartHeadingNamesTheMachineAndBothProbes) {
-  const int saved = omp_get_max_threads();
-  omp_set_num_threads(1);
-  const std::string one = describe_machine_and_probe();
-  omp_set_num_threads(2);
-  const std::string two = describe_machine_and_probe();
-  const std::string machine_with_two = describe_machine();
-  omp_set_num_threads(saved);
+  const std::string one = with_threads(1, describe_machine_and_probe);
+  const std::string two = with_threads(2, describe_machine_and_probe);
+  const std::string machine_with_two = with_threads(2, describe_machine);
   // The description, then the one-core probe; with threads, the probe on all of them too.
   EXPECT_NE(one.find(", one-core probe "), std::string::npos) << one;
   EXPECT_EQ(one.substr(one.size() - 3), " ms") << one;
