@@ -23,6 +23,7 @@
 #include "dgtex/sparse_cholesky.h"
 #include "dgtex/stage_timer.h"
 #include "dgtex/topology.h"
+#include "thread_count_guard.h"
 
 namespace dgtex {
 
@@ -50,6 +51,7 @@ double end_time(const Scene& scene) {
 // Best (smallest) wall time of `repeats` calls of `body` at each thread count.
 template <class Body>
 std::vector<double> best_times(const std::vector<int>& threads, int repeats, Body&& body) {
+  const detail::ThreadCountGuard restore;
   std::vector<double> best;
   for (int t : threads) {
     omp_set_num_threads(t);
@@ -239,6 +241,7 @@ KernelScaling scale_scene_steps(const Scene& scene, int steps, const std::vector
   k.family = "scene_step";
   k.threads = threads;
   std::vector<double> first;
+  const detail::ThreadCountGuard restore;
   for (int t : threads) {
     omp_set_num_threads(t);
     SceneRun run(scene);
@@ -270,6 +273,7 @@ BatchThroughput measure_batch_throughput(const Scene& scene, int runs, int steps
   b.solo_threads = solo_threads;
 
   std::vector<std::vector<double>> results;
+  const detail::ThreadCountGuard restore;
   omp_set_num_threads(solo_threads);
   Clock::time_point start = Clock::now();
   for (int r = 0; r < runs; ++r) results.push_back(simulate());

@@ -12,6 +12,7 @@
 #include "dgtex/scene_model.h"
 #include "dgtex/shell_simulation.h"
 #include "dgtex/stage_timer.h"
+#include "thread_count_guard.h"
 
 namespace dgtex {
 
@@ -70,6 +71,7 @@ ShellBenchRun run_shell_benchmark(const std::string& scene_path, int steps, int 
   const Mesh mesh = build_scene_mesh(scene);
   SceneModel setup = build_scene_model(scene, mesh);
   const ShellModel& model = *setup.model;
+  const detail::ThreadCountGuard restore;
   omp_set_num_threads(threads);
   ShellSimulation sim(model, setup.fixed, setup.external_force);
   sim.set_solver_options(solver);

@@ -18,6 +18,7 @@
 #include "dgtex/scaling_benchmark.h"
 #include "dgtex/scene_io.h"
 #include "dgtex/scene_run.h"
+#include "thread_count_support.h"
 
 namespace fs = std::filesystem;
 using namespace dgtex;
@@ -33,9 +34,14 @@ fs::path fresh_dir(const std::string& name) { return test::fresh_dir("dgtex_benc
 
 }  // namespace
 
+// Each family sets the thread counts it times and then gives the caller's count back (5
+// here, a count none of them times).
 TEST(BenchScaling, KernelResultsAreBitwiseEqualForEveryThreadCount) {
+  const test::ThreadCountGuard restore;
+  omp_set_num_threads(5);
   const std::vector<int> threads = {1, 2, 3};
   const KernelScaling polar = scale_polar_decomposition(5000, threads, 1);
+  EXPECT_EQ(omp_get_max_threads(), 5) << "polar decomposition";
   EXPECT_EQ(polar.family, "polar_decomposition");
   ASSERT_EQ(polar.ms.size(), 3u);
   EXPECT_TRUE(polar.identical_across_threads);
@@ -44,14 +50,17 @@ TEST(BenchScaling, KernelResultsAreBitwiseEqualForEveryThreadCount) {
   const KernelScaling assembly = scale_assembly(load_scene(kScenes + "/spiral1.json"), true, threads, 1);
   EXPECT_TRUE(assembly.identical_across_threads);
   EXPECT_NE(assembly.workload.find("1 complete-cut enrichments"), std::string::npos) << assembly.workload;
+  EXPECT_EQ(omp_get_max_threads(), 5) << "assembly";
 
   const KernelScaling steps = scale_scene_steps(load_scene(kScenes + "/spiral1.json"), 1, {1, 2});
   EXPECT_TRUE(steps.identical_across_threads);
   ASSERT_EQ(steps.ms.size(), 2u);
+  EXPECT_EQ(omp_get_max_threads(), 5) << "scene steps";
 
   const KernelScaling enrichment = scale_enrichment_solve(load_scene(kScenes + "/spiral1.json"), {1, 2}, 1);
   ASSERT_EQ(enrichment.ms.size(), 2u);
   EXPECT_NE(enrichment.workload.find("1 solves"), std::string::npos) << enrichment.workload;
+  EXPECT_EQ(omp_get_max_threads(), 5) << "enrichment solve";
   EXPECT_THROW(scale_enrichment_solve(load_scene(kScenes + "/cylinder_buckling.json"), {1}, 1), std::invalid_argument);
   EXPECT_THROW(scale_polar_decomposition(10, {0}, 1), std::invalid_argument);
 }
@@ -76,7 +85,10 @@ TEST(BenchScaling, FactorizationTakesTheWholePatternWhereTheSolverDoes) {
 // state as a plain SceneRun.
 TEST(BenchScaling, BatchMembersEndExactlyWhereARunAloneEnds) {
   const Scene scene = load_scene(kScenes + "/spiral1.json");
+  const test::ThreadCountGuard restore;
+  omp_set_num_threads(3);
   const BatchThroughput b = measure_batch_throughput(scene, 2, 2, 2);
+  EXPECT_EQ(omp_get_max_threads(), 3) << "the caller's thread count, given back";
   EXPECT_EQ(b.runs, 2);
   EXPECT_GT(b.solo_ms, 0);
   EXPECT_GT(b.batch_ms, 0);
@@ -100,7 +112,6 @@ TEST(BenchScaling, ConcurrentRunsWithCholmodEndExactlyWhereARunAloneEnds) {
     EXPECT_TRUE(b.identical) << name;
     EXPECT_EQ(b.max_relative_difference, 0.0) << name;
   }
-  omp_set_num_threads(2);
 }
 
 // A scene a chosen family cannot use is refused before any family runs, naming the scene

@@ -8,22 +8,11 @@
 #include <vector>
 
 #include "dgtex/benchmark_machine.h"
+#include "thread_count_support.h"
 
 using namespace dgtex;
 
-namespace {
-
-// describe() with the OpenMP thread count set to `threads` (restored after).
-template <class Describe>
-std::string with_threads(int threads, Describe describe) {
-  const int saved = omp_get_max_threads();
-  omp_set_num_threads(threads);
-  const std::string text = describe();
-  omp_set_num_threads(saved);
-  return text;
-}
-
-}  // namespace
+using test::with_threads;
 
 TEST(BenchmarkMachine, DescriptionNamesTheCoresAndThreads) {
   const std::string one = with_threads(1, describe_machine);

@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "dgtex/block_assembly.h"
+#include "thread_count_support.h"
 
 namespace dgtex {
 namespace {
@@ -112,7 +113,7 @@ TEST(BlockAssembly, PatternAndSumsAreTheReferenceOnesBitwiseForAnyThreadCount) {
       symmetric.push_back({r.matrices[f].data(), 0});
     }
     for (int threads : {1, 2, 3}) {
-      omp_set_num_threads(threads);
+      const test::ThreadCountGuard set_threads(threads);
       std::vector<double> general(pattern.num_blocks() * 9), mirrored(general.size()), out(node_vector.size());
       pattern.assemble_matrix(matrices, general.data());
       pattern.assemble_symmetric_matrix(symmetric, mirrored.data());
@@ -136,7 +137,6 @@ TEST(BlockAssembly, PatternAndSumsAreTheReferenceOnesBitwiseForAnyThreadCount) {
       }
       for (size_t i = 0; i < out.size(); ++i) ASSERT_TRUE(same_bits(out[i], node_vector[i])) << "node vector entry " << i;
     }
-    omp_set_num_threads(2);
   }
 }
 
@@ -163,7 +163,7 @@ TEST(BlockAssembly, FusedProductsAreTheKernelsProductsOfTheSumBitwise) {
   kernels::block_rows_product(pattern.rows(), 0, r.num_nodes, sums.data(), spread1.data(), expected1.data());
   kernels::block_rows_product(pattern.rows(), 0, r.num_nodes, sums.data(), spread2.data(), expected2.data());
   for (int threads : {1, 2, 3}) {
-    omp_set_num_threads(threads);
+    const test::ThreadCountGuard set_threads(threads);
     for (bool pair : {false, true}) {
       std::vector<double> fused_sums(sums.size()), y1(n, 7.0), y2(n, 7.0);
       const AssembledProducts products{spread1.data(), pair ? spread2.data() : nullptr, y1.data(),
@@ -178,7 +178,6 @@ TEST(BlockAssembly, FusedProductsAreTheKernelsProductsOfTheSumBitwise) {
       }
     }
   }
-  omp_set_num_threads(2);
 }
 
 // Sources of different widths (BlockSourceFamily::widths): each family of the random ones
@@ -227,14 +226,13 @@ TEST(BlockAssembly, SourcesOfDifferentWidthsSumAsTheirPaddedFamilyBitwise) {
   reference.assemble_matrix(padded_matrices, expected_matrix.data(), false);
   reference.assemble_vector(padded_vectors, expected_vector.data(), false);
   for (int threads : {1, 2, 3}) {
-    omp_set_num_threads(threads);
+    const test::ThreadCountGuard set_threads(threads);
     std::vector<double> matrix(expected_matrix.size(), -1.0), vector(expected_vector.size(), -1.0);
     pattern.assemble_matrix(compact_matrices, matrix.data());
     pattern.assemble_vector(compact_vectors, vector.data());
     for (size_t i = 0; i < matrix.size(); ++i) ASSERT_TRUE(same_bits(matrix[i], expected_matrix[i])) << "entry " << i;
     for (size_t i = 0; i < vector.size(); ++i) ASSERT_TRUE(same_bits(vector[i], expected_vector[i])) << "entry " << i;
   }
-  omp_set_num_threads(2);
   std::vector<LocalMatrices> locals;
   for (const double* m : compact_matrices) locals.push_back({m, 0});
   std::vector<double> symmetric(expected_matrix.size());

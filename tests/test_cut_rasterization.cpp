@@ -13,6 +13,7 @@
 
 #include "dgtex/kernels/cut_rasterization.h"
 #include "dgtex/kernels/flood_fill.h"
+#include "thread_count_support.h"
 
 using namespace dgtex::kernels;
 
@@ -149,21 +150,19 @@ TEST(CutRasterization, PathIsConnectedAndStaysNearTheSegment) {
 TEST(CutRasterization, ParallelMatchesReferenceBitwiseForAnyThreadCount) {
   std::mt19937 rng(3);
   std::uniform_real_distribution<double> coord(-10.0, 138.0);
-  const int saved = omp_get_max_threads();
   for (int trial = 0; trial < 20; ++trial) {
     std::vector<TexelPoint> line(trial % 2 ? 50 : 300);  // serial and threaded paths
     for (auto& p : line) p = {coord(rng), coord(rng)};
     TexelTile ref_tile(128, 128);
     const CutRaster ref = rasterize_cut_reference(line, ref_tile);
     for (int threads : {1, 2, 4}) {
-      omp_set_num_threads(threads);
+      const dgtex::test::ThreadCountGuard set_threads(threads);
       TexelTile tile(128, 128);
       const CutRaster par = rasterize_cut(line, tile, Execution::parallel);
       ASSERT_TRUE(same_edges(ref, par)) << "trial " << trial << " threads " << threads;
       ASSERT_EQ(ref_tile.flags, tile.flags);
     }
   }
-  omp_set_num_threads(saved);
 }
 
 TEST(CutRasterization, CutAlongElementEdgeSetsNoWalls) {

@@ -13,6 +13,7 @@
 #include "dgtex/cut_manager.h"
 #include "dgtex/mesh_generators.h"
 #include "dgtex/topology.h"
+#include "thread_count_support.h"
 
 using namespace dgtex;
 using namespace dgtex::testing_support;
@@ -22,8 +23,7 @@ namespace {
 // Every function's values, elements and nodes after each update time, in one list.
 std::vector<double> run(const Mesh& mesh, const std::vector<Cut>& cuts, const EnrichmentOptions& options,
                         const std::vector<double>& times, int threads, int& solves, int& graph_solves) {
-  const int saved = omp_get_max_threads();
-  omp_set_num_threads(threads);
+  const test::ThreadCountGuard set_threads(threads);
   const Topology topology = build_topology(mesh);
   CutManager manager(mesh, topology, cuts, options);
   std::vector<double> out;
@@ -40,7 +40,6 @@ std::vector<double> run(const Mesh& mesh, const std::vector<Cut>& cuts, const En
       }
     }
   }
-  omp_set_num_threads(saved);
   return out;
 }
 
@@ -127,9 +126,8 @@ TEST(CutsConcurrentSolves, TheFirstFailingCutIsReportedForAnyThreadCount) {
   late_failure.push_back({1.5, 1.0, 2.0});
   const std::vector<Cut> cuts = {points_cut({{0.1, 0.35, 0}, {2.6, 0.6, 0}}), points_cut(late_failure),
                                  points_cut({{0.2, 1.5, 0}, {2.7, 1.3, 0}}), points_cut({{1.5, 1.0, 0}})};
-  const int saved = omp_get_max_threads();
   for (int threads : {1, 2, 4}) {
-    omp_set_num_threads(threads);
+    const test::ThreadCountGuard set_threads(threads);
     try {
       CutManager manager(mesh, topology, cuts, cholmod_enrichment(16));
       ADD_FAILURE() << "expected an error for cuts[1] with " << threads << " threads";
@@ -138,5 +136,4 @@ TEST(CutsConcurrentSolves, TheFirstFailingCutIsReportedForAnyThreadCount) {
       EXPECT_NE(m.find("cuts[1].points[400]: off the surface"), std::string::npos) << m;
     }
   }
-  omp_set_num_threads(saved);
 }

@@ -30,6 +30,7 @@
 #include "cut_element_fixture.h"
 #include "shell_test_support.h"
 #include "vector_path_support.h"
+#include "thread_count_support.h"
 
 using namespace dgtex;
 
@@ -243,7 +244,7 @@ void check_against_reference(const PaddedElement& one, double tolerance) {
           }
     for (int i = 3 * one.n; i < 3 * W; ++i) ASSERT_EQ(f[i], 0.0);
     for (int threads : {1, 2, 4}) {
-      omp_set_num_threads(threads);
+      const test::ThreadCountGuard set_threads(threads);
       std::vector<double> K2(K.size(), std::nan("")), f2(f.size(), std::nan(""));
       kernels::enriched_element_stiffness(one.batch, one.quadrature(), rotations, K2.data(), f2.data());
       EXPECT_EQ(K2, K) << threads << " threads";
@@ -293,7 +294,7 @@ TEST(EnrichedBlockedStiffness, FusedCorotationIsBitwiseTheSeparateKernels) {
   for (double x : f) fmax = std::max(fmax, std::abs(x));
   ASSERT_GT(fmax, 0.0);
   for (int threads : {1, 2, 4}) {
-    omp_set_num_threads(threads);
+    const test::ThreadCountGuard set_threads(threads);
     std::vector<double> K2(K.size(), std::nan("")), f2(f.size(), std::nan(""));
     kernels::enriched_element_corotated_stiffness(one.batch, one.quadrature(), current.data(), K2.data(), f2.data());
     EXPECT_EQ(K2, K) << threads << " threads";

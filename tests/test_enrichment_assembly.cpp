@@ -15,6 +15,7 @@
 #include "dgtex/kernels/cut_rasterization.h"
 #include "enrichment_test_support.h"
 #include "shell_test_support.h"
+#include "thread_count_support.h"
 
 using namespace dgtex;
 using namespace dgtex::testing_support;
@@ -185,7 +186,7 @@ TEST(EnrichedAssembly, SymmetricAndIndependentOfThreadCount) {
     std::vector<double> reference_K, reference_f;
     model.assemble_stiffness(current.data(), reference_K, &reference_f, kernels::Execution::serial);
     for (int threads : {1, 2, 4}) {
-      omp_set_num_threads(threads);
+      const test::ThreadCountGuard set_threads(threads);
       std::vector<double> K2, f2, K3;
       model.assemble_stiffness(current.data(), K2, &f2);
       EXPECT_EQ(K2, reference_K) << scene.name << ", " << threads << " threads";
@@ -193,7 +194,6 @@ TEST(EnrichedAssembly, SymmetricAndIndependentOfThreadCount) {
       model.assemble_stiffness(nullptr, K3, nullptr);
       EXPECT_EQ(K3, K) << scene.name << ", " << threads << " threads";
     }
-    omp_set_num_threads(2);
   }
 }
 

@@ -40,6 +40,7 @@
 #include "dgtex/mesh_generators.h"
 #include "dgtex/sparse_cholesky.h"
 #include "dgtex/topology.h"
+#include "thread_count_support.h"
 
 using namespace dgtex;
 using namespace dgtex::testing_support;
@@ -274,7 +275,6 @@ TEST(BasisChange, ClusterRestDataOfChosenElementsOnly) {
 // kept for the caller (all points evaluated, then summed) or not (in waves of at most
 // 64 blocks of points; at T = 128 the per-texel rule needs several waves per element).
 TEST(BasisChange, FusedMassAndLoadWeightsEqualTheTwoKernelsBitwise) {
-  const int saved_threads = omp_get_max_threads();
   for (const int resolution : {32, 128}) {
     const TwoEnrichedElements setup(resolution);
     const kernels::EnrichedElementBatch& batch = setup.batch;
@@ -293,6 +293,7 @@ TEST(BasisChange, FusedMassAndLoadWeightsEqualTheTwoKernelsBitwise) {
       const kernels::EnrichedQuadrature quad{qs.data(), qp.data()};
       std::vector<double> mass(2 * width * width), area(2 * width), weights(2 * width);
       kernels::enriched_element_mass(batch, quad, mass.data());
+      const test::ThreadCountGuard restore;  // the counts set below, until the next quadrature
       kernels::enriched_element_load_weights(batch, quad, area.data(), weights.data());
       for (const int threads : {0, 1, 2, 3})
         for (const bool keep_values : {false, true}) {
@@ -318,7 +319,6 @@ TEST(BasisChange, FusedMassAndLoadWeightsEqualTheTwoKernelsBitwise) {
             ASSERT_EQ(std::memcmp(&values[q * width], full.N, sizeof(double) * full.count), 0) << "point " << q;
           }
         }
-      omp_set_num_threads(saved_threads);
     }
   }
   const TwoEnrichedElements setup;

@@ -19,6 +19,7 @@
 #include "dgtex/mesh_generators.h"
 #include "cut_element_fixture.h"
 #include "shell_test_support.h"
+#include "thread_count_support.h"
 
 using namespace dgtex;
 
@@ -53,7 +54,7 @@ void compare_with_reference(const CutQuad8Element& one, double tolerance) {
           for (int j = 0; j < 3; ++j) ASSERT_EQ(K[(a * W + c) * 9 + i * 3 + j], K[(c * W + a) * 9 + j * 3 + i]);
     // Parallel forms bitwise equal to the serial one for any thread count.
     for (int threads : {1, 2, 3}) {
-      omp_set_num_threads(threads);
+      const test::ThreadCountGuard set_threads(threads);
       std::vector<double> K2(K.size()), f2(f.size());
       kernels::enriched_element_stiffness(one.batch, one.quadrature(), rotations, K2.data(), f2.data());
       EXPECT_EQ(K2, K) << threads << " threads";
@@ -88,7 +89,7 @@ TEST(EnrichedFastStiffness, DeformationGradientsIndependentOfThreads) {
   kernels::enriched_element_deformation_gradients(one.batch, one.quadrature(), current.data(), F.data(),
                                                   kernels::Execution::serial);
   for (int threads : {1, 2, 3}) {
-    omp_set_num_threads(threads);
+    const test::ThreadCountGuard set_threads(threads);
     std::vector<double> F2(F.size());
     kernels::enriched_element_deformation_gradients(one.batch, one.quadrature(), current.data(), F2.data());
     EXPECT_EQ(F2, F) << threads << " threads";

@@ -15,6 +15,7 @@
 
 #include "enrichment_test_support.h"
 #include "shell_test_support.h"
+#include "thread_count_support.h"
 
 using namespace dgtex;
 using namespace dgtex::testing_support;
@@ -122,14 +123,11 @@ TEST(KeptBasisValues, TheNextProjectionReadsTheSourcesValuesAtSharedPointsBitwis
   EXPECT_LT(read, next.num_enriched_element_quadrature_points());
   // The sums are split among the threads by basis function: the same bits for any count.
   const std::vector<double> u = random_values(source->num_dofs(), 5);
-  const int saved = omp_get_max_threads();
-  omp_set_num_threads(1);
-  const auto one = next.moments_of_fields(*source, {&u});
+  const auto one = test::with_threads(1, [&] { return next.moments_of_fields(*source, {&u}); });
   for (int threads : {2, 3}) {
-    omp_set_num_threads(threads);
+    const test::ThreadCountGuard set_threads(threads);
     EXPECT_TRUE(bitwise_equal(next.moments_of_fields(*source, {&u})[0], one[0])) << threads << " threads";
   }
-  omp_set_num_threads(saved);
 }
 
 TEST(KeptBasisValues, APrunedSourceGivesItsKeptColumnsToTheNextProjection) {

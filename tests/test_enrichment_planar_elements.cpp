@@ -14,6 +14,7 @@
 #include "dgtex/kernels/enriched_rotation_clusters.h"
 #include "cut_element_fixture.h"
 #include "shell_test_support.h"
+#include "thread_count_support.h"
 
 using namespace dgtex;
 
@@ -141,10 +142,9 @@ TEST(PlanarEnrichedElements, LinearStiffnessAgreesWithTheReferenceFlatTiltedAndW
   EXPECT_LE(max_difference(tilted, turned), 1e-12 * max_abs(flat));
   // Bitwise independent of the thread count on the planar path too.
   for (int threads : {1, 2, 3}) {
-    omp_set_num_threads(threads);
+    const test::ThreadCountGuard set_threads(threads);
     EXPECT_EQ(linear_stiffness(one, false), tilted) << threads << " threads";
   }
-  omp_set_num_threads(omp_get_num_procs());
   // Warped out of its plane (every midside node lifted): the general path, same reference.
   for (int a = 4; a < 8; ++a) one.mesh.positions[3 * one.mesh.element_nodes(0)[a] + 2] += 0.05 * (a % 2 ? 1 : -1);
   double E[9];
@@ -249,11 +249,10 @@ TEST(PlanarEnrichedElements, PlanarAndCurvedElementsShareABatch) {
   kernels::enriched_element_stiffness_reference(batch, quad, nullptr, linear_ref.data(), unused_forces.data());
   EXPECT_LE(max_difference(linear, linear_ref), 1e-9 * max_abs(linear_ref));
   for (int threads : {1, 2, 3}) {
-    omp_set_num_threads(threads);
+    const test::ThreadCountGuard set_threads(threads);
     std::vector<double> K_threads, f_threads;
     clustered_stiffness(K_threads, f_threads);
     EXPECT_EQ(K_threads, K) << threads << " threads";
     EXPECT_EQ(f_threads, f) << threads << " threads";
   }
-  omp_set_num_threads(omp_get_num_procs());
 }

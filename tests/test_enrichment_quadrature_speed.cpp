@@ -22,6 +22,7 @@
 #include "dgtex/kernels/enriched_quadrature.h"
 #include "dgtex/kernels/texel_derivative_rows.h"
 #include "dgtex/mesh_generators.h"
+#include "thread_count_support.h"
 
 using namespace dgtex;
 
@@ -80,16 +81,14 @@ std::int64_t expect_fast_equals_reference(const Batch& b, bool adaptive, double 
   EXPECT_TRUE(bitwise_equal(start, ref_start)) << what << ": serial start offsets differ";
   EXPECT_TRUE(bitwise_equal(points, ref_points)) << what << ": serial points differ (" << points.size() / 3 << " vs "
                                                  << ref_points.size() / 3 << " points)";
-  const int saved = omp_get_max_threads();
   for (int threads : {1, 2, 3}) {
-    omp_set_num_threads(threads);
+    const test::ThreadCountGuard set_threads(threads);
     start.assign(3, -7);  // stale contents must not survive
     points.assign(5, -7.0);
     kernels::enriched_element_quadrature(b.batch(), options, start, points, kernels::Execution::parallel);
     EXPECT_TRUE(bitwise_equal(start, ref_start)) << what << ": start offsets differ with " << threads << " threads";
     EXPECT_TRUE(bitwise_equal(points, ref_points)) << what << ": points differ with " << threads << " threads";
   }
-  omp_set_num_threads(saved);
   return ref_start.back();
 }
 

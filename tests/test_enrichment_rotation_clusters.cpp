@@ -23,6 +23,7 @@
 #include "multigrid_buffer.h"         // internal (runtime/)
 #include "rotation_cluster_memory.h"  // internal (runtime/)
 #include "shell_test_support.h"
+#include "thread_count_support.h"
 
 using namespace dgtex;
 
@@ -98,7 +99,7 @@ TEST(EnrichedRotationClusters, AgreeWithTheReferenceAndIgnoreTheThreadCount) {
           }
         }
   for (int threads : {1, 2, 3}) {
-    omp_set_num_threads(threads);
+    const test::ThreadCountGuard set_threads(threads);
     const Clustered parallel = clustered(one, clusters, current, kernels::Execution::parallel);
     EXPECT_EQ(parallel.K, serial.K) << threads << " threads";
     EXPECT_EQ(parallel.f, serial.f) << threads << " threads";
@@ -198,7 +199,7 @@ TEST(EnrichedRotationClusters, ReshiftedRestDataEqualsTheRestDataSummedAfresh) {
     EXPECT_LE(max_difference(serial, fresh), 1e-12 * max_abs(fresh));
     EXPECT_GT(max_difference(reshift(no_delta, kernels::Execution::serial), fresh), 1e-3 * max_abs(fresh));
     for (int threads : {1, 2, 3}) {
-      omp_set_num_threads(threads);
+      const test::ThreadCountGuard set_threads(threads);
       EXPECT_TRUE(testing_support::bitwise_equal(reshift(delta, kernels::Execution::parallel), serial)) << threads;
     }
   }
@@ -267,7 +268,6 @@ TEST(EnrichedRotationClusters, NeverSpanTheCutOfAnyOfTheElementsTextures) {
 // thread count.
 TEST(EnrichedRotationClusters, BuildAsTheReferenceForAnyThreadCount) {
   constexpr int T = 32, elements = 3;
-  const int threads_before = omp_get_max_threads();
   for (ElementType type : {ElementType::quad8, ElementType::tri6}) {
     const bool tri = type == ElementType::tri6;
     std::mt19937 rng(tri ? 5 : 7);
@@ -321,7 +321,7 @@ TEST(EnrichedRotationClusters, BuildAsTheReferenceForAnyThreadCount) {
           kernels::enriched_rotation_clusters_reference(batch, quad, block, tip);
       ASSERT_GT(reference.count(), elements * (block == T ? 1 : 4));
       for (int threads : {1, 2, 3}) {
-        omp_set_num_threads(threads);
+        const test::ThreadCountGuard set_threads(threads);
         for (kernels::Execution execution : {kernels::Execution::serial, kernels::Execution::parallel}) {
           const kernels::EnrichedRotationClusters fast =
               kernels::enriched_rotation_clusters(batch, quad, block, tip, execution);
@@ -332,7 +332,6 @@ TEST(EnrichedRotationClusters, BuildAsTheReferenceForAnyThreadCount) {
           EXPECT_EQ(fast.points, reference.points) << where;
         }
       }
-      omp_set_num_threads(threads_before);
     }
   }
 }

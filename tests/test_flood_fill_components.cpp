@@ -9,6 +9,7 @@
 #include "dgtex/kernels/cut_rasterization.h"
 #include "dgtex/kernels/flood_fill.h"
 #include "dgtex/kernels/multigrid_unknowns.h"
+#include "thread_count_support.h"
 
 using namespace dgtex::kernels;
 
@@ -26,7 +27,6 @@ TexelTile random_tile(int w, int h, double wall_probability, double inactive_pro
 }  // namespace
 
 TEST(FloodFill, ParallelMatchesReferenceOnRandomWalls) {
-  const int saved = omp_get_max_threads();
   unsigned seed = 1;
   for (int size : {1, 7, 64, 256})
     for (double p : {0.0, 0.2, 0.45, 0.6, 0.9})
@@ -38,13 +38,12 @@ TEST(FloodFill, ParallelMatchesReferenceOnRandomWalls) {
         ASSERT_EQ(label_components(tile, serial, Execution::serial), count);
         ASSERT_EQ(serial, reference);
         for (int threads : {1, 2, 4}) {
-          omp_set_num_threads(threads);
+          const dgtex::test::ThreadCountGuard set_threads(threads);
           std::vector<int> parallel;
           ASSERT_EQ(label_components(tile, parallel), count) << "size " << size << " p " << p << " threads " << threads;
           ASSERT_EQ(parallel, reference) << "size " << size << " p " << p << " threads " << threads;
         }
       }
-  omp_set_num_threads(saved);
 }
 
 TEST(FloodFill, LabelsAreNumberedByTheirSmallestTexel) {

@@ -21,6 +21,7 @@
 #include "dgtex/mesh_texel_laplace.h"
 #include "dgtex/topology.h"
 #include "region_test_support.h"
+#include "thread_count_support.h"
 
 using namespace dgtex;
 
@@ -72,12 +73,11 @@ Solved solve(LaplaceSolver solver, int threads) {
   const Mesh mesh = make_rectangle(2, 1, 2, 1, ElementType::quad8);
   const ElementAdjacency adjacency(mesh, build_topology(mesh));
   Solved out{boxed_region(mesh), {}};
-  const int saved = omp_get_max_threads();
-  omp_set_num_threads(threads);
   LaplaceMultigridOptions options;
   options.tolerance = 1e-12;
-  out.stats = solve_mesh_texel_laplace(out.region, mesh.type, adjacency, MeshEdgeWalls(T), solver, options);
-  omp_set_num_threads(saved);
+  out.stats = test::with_threads(threads, [&] {
+    return solve_mesh_texel_laplace(out.region, mesh.type, adjacency, MeshEdgeWalls(T), solver, options);
+  });
   return out;
 }
 
@@ -216,10 +216,8 @@ TEST(LaplaceMeshComponents, CombTeethAndABoxAcrossTheElementEdgeJoin) {
       SCOPED_TRACE(std::string(solver == LaplaceSolver::multigrid ? "multigrid" : "cholmod") + ", " +
                    std::to_string(threads) + " threads");
       std::vector<RegionTile> region = start;
-      const int saved = omp_get_max_threads();
-      omp_set_num_threads(threads);
-      const MeshLaplaceStats stats = solve_mesh_texel_laplace(region, mesh.type, adjacency, MeshEdgeWalls(T), solver, options);
-      omp_set_num_threads(saved);
+      const MeshLaplaceStats stats = test::with_threads(
+          threads, [&] { return solve_mesh_texel_laplace(region, mesh.type, adjacency, MeshEdgeWalls(T), solver, options); });
       EXPECT_EQ(stats.multigrid, solver == LaplaceSolver::multigrid);
       EXPECT_EQ(stats.constant_components, 2);
       EXPECT_EQ(stats.solved_components, 1);

@@ -22,6 +22,7 @@
 #include "dgtex/laplace_domains.h"
 #include "dgtex/laplace_multigrid.h"
 #include "dgtex/laplace_solver.h"
+#include "thread_count_support.h"
 
 namespace dgtex {
 namespace {
@@ -64,7 +65,7 @@ void expect_cholmods_solution_on_any_thread_count(const TexelTile& tile, const s
   options.tolerance = 1e-11;
   std::vector<double> one_thread;
   for (int threads : {1, 2}) {
-    omp_set_num_threads(threads);
+    const test::ThreadCountGuard set_threads(threads);
     TexelTile solved = tile;
     solve_laplace_multigrid(solved, options);
     if (threads == 2) {

@@ -15,6 +15,7 @@
 #include "dgtex/kernels/multigrid_unknowns.h"
 #include "dgtex/laplace_domains.h"
 #include "dgtex/laplace_multigrid.h"
+#include "thread_count_support.h"
 
 namespace dgtex {
 namespace {
@@ -110,7 +111,7 @@ class MultigridStencil9Interpolation : public ::testing::TestWithParam<LaplaceDo
 
 TEST_P(MultigridStencil9Interpolation, ParallelEqualsSerialBitwise) {
   const TexelTile tile = make_laplace_domain(GetParam(), 512);
-  omp_set_num_threads(2);
+  const test::ThreadCountGuard set_threads(2);
   const ThreeLevels serial(tile, Execution::serial), parallel(tile, Execution::parallel);
   for (int k = 0; k < 8; ++k) EXPECT_EQ(serial.p2[k], parallel.p2[k]) << "weight array " << k;
 }

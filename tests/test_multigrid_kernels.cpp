@@ -20,6 +20,7 @@
 #include "dgtex/laplace_multigrid.h"
 #include "dgtex/laplace_problem.h"
 #include "multigrid_rows.h"  // internal: the row loops and their two forms
+#include "thread_count_support.h"
 
 namespace dgtex {
 namespace {
@@ -64,7 +65,7 @@ struct TwoLevels {
 class MultigridKernels : public ::testing::TestWithParam<LaplaceDomain> {};
 
 TEST_P(MultigridKernels, ParallelFormsEqualReferenceBitwise) {
-  omp_set_num_threads(2);
+  const test::ThreadCountGuard set_threads(2);
   TwoLevels L(make_laplace_domain(GetParam(), 96));
   // Smoothers.
   for (int color = 0; color < 2; ++color) {
@@ -188,10 +189,8 @@ TEST_P(MultigridKernels, SolveIsIndependentOfThreadCount) {
   TexelTile one = problem, two = problem, serial = problem;
   LaplaceMultigridOptions options;
   options.warm_start = false;
-  omp_set_num_threads(1);
-  solve_laplace_multigrid(one, options);
-  omp_set_num_threads(2);
-  solve_laplace_multigrid(two, options);
+  test::with_threads(1, [&] { solve_laplace_multigrid(one, options); });
+  test::with_threads(2, [&] { solve_laplace_multigrid(two, options); });
   options.execution = Execution::serial;
   solve_laplace_multigrid(serial, options);
   EXPECT_EQ(one.values, two.values);
@@ -200,10 +199,8 @@ TEST_P(MultigridKernels, SolveIsIndependentOfThreadCount) {
   TexelTile robust_one = problem, robust_two = problem, robust_serial = problem;
   options.coarse_solve_tolerance = 0.02;
   options.execution = Execution::parallel;
-  omp_set_num_threads(1);
-  solve_laplace_multigrid(robust_one, options);
-  omp_set_num_threads(2);
-  solve_laplace_multigrid(robust_two, options);
+  test::with_threads(1, [&] { solve_laplace_multigrid(robust_one, options); });
+  test::with_threads(2, [&] { solve_laplace_multigrid(robust_two, options); });
   options.execution = Execution::serial;
   solve_laplace_multigrid(robust_serial, options);
   EXPECT_EQ(robust_one.values, robust_two.values);
@@ -211,7 +208,7 @@ TEST_P(MultigridKernels, SolveIsIndependentOfThreadCount) {
 }
 
 TEST_P(MultigridKernels, FusedSweepsEqualColourByColourReference) {
-  omp_set_num_threads(2);
+  const test::ThreadCountGuard set_threads(2);
   TwoLevels L(make_laplace_domain(GetParam(), 100));  // 100 rows: blocks of 32 plus a partial one
   for (Execution ex : {Execution::serial, Execution::parallel}) {
     for (bool forward : {true, false}) {
@@ -238,7 +235,7 @@ TEST_P(MultigridKernels, FusedSweepsEqualColourByColourReference) {
 }
 
 TEST_P(MultigridKernels, FusedConjugateGradientStepsEqualReference) {
-  omp_set_num_threads(2);
+  const test::ThreadCountGuard set_threads(2);
   TwoLevels L(make_laplace_domain(GetParam(), 100));
   const double alpha = 0.37, beta = -0.61;
   for (Execution ex : {Execution::serial, Execution::parallel}) {
@@ -288,7 +285,7 @@ TEST_P(MultigridKernels, OperatorAtListedTexelsEqualsTheWholeGridProduct) {
 }
 
 TEST_P(MultigridKernels, RedBlackTransfersMatchReferencesAndFullForms) {
-  omp_set_num_threads(2);
+  const test::ThreadCountGuard set_threads(2);
   TwoLevels L(make_laplace_domain(GetParam(), 96));
   for (int color = 0; color < 2; ++color) {
     std::vector<double> r1(L.x.size(), 0.0), r2 = r1, full = r1;
@@ -339,7 +336,7 @@ TEST_P(MultigridKernels, RedBlackTransfersMatchReferencesAndFullForms) {
 }
 
 TEST_P(MultigridKernels, FastClassificationEqualsFloodFillReference) {
-  omp_set_num_threads(2);
+  const test::ThreadCountGuard set_threads(2);
   for (TexelElementShape shape : {TexelElementShape::quad, TexelElementShape::tri}) {
     const TexelTile tile = make_laplace_domain(GetParam(), 80, shape);
     std::vector<std::uint8_t> ref, serial, parallel;
@@ -412,7 +409,7 @@ TEST(MultigridClassification, LargeRandomTilesWithLongRunsEqualReferenceInEveryF
     EXPECT_EQ(classify_laplace_texels(tile, serial, Execution::serial), zr);
     EXPECT_EQ(ref, serial) << "tile " << k << " (" << w << "x" << h << ")";
     for (int threads : {2, 3}) {
-      omp_set_num_threads(threads);
+      const test::ThreadCountGuard set_threads(threads);
       std::vector<std::uint8_t> parallel(7, 0xff);  // resized (not cleared) by the kernel
       EXPECT_EQ(classify_laplace_texels(tile, parallel, Execution::parallel), zr);
       EXPECT_EQ(ref, parallel) << "tile " << k << ", " << threads << " threads";
@@ -461,11 +458,11 @@ TEST(LaplaceTileValidation, NamesTheFirstDirichletTexelWithANonFiniteValue) {
 // form this machine runs gives the baseline's bits, row by row, with a partial group at the
 // end of every row (width 101).
 TEST_P(MultigridKernels, RowLoopFormsAgreeBitwise) {
-  if (!detail::avx2_supported()) GTEST_SKIP() << "no AVX2: only the baseline form runs here";
+  if (!kernels::detail::avx2_supported()) GTEST_SKIP() << "no AVX2: only the baseline form runs here";
   TwoLevels L(make_laplace_domain(GetParam(), 101));
-  std::vector<const detail::TexelRowKernels*> forms = {&detail::texel_rows(detail::RowPath::baseline),
-                                                       &detail::texel_rows(detail::RowPath::avx2)};
-  if (detail::avx512_supported()) forms.push_back(&detail::texel_rows(detail::RowPath::avx512));
+  std::vector<const kernels::detail::TexelRowKernels*> forms = {&kernels::detail::texel_rows(kernels::detail::RowPath::baseline),
+                                                       &kernels::detail::texel_rows(kernels::detail::RowPath::avx2)};
+  if (kernels::detail::avx512_supported()) forms.push_back(&kernels::detail::texel_rows(kernels::detail::RowPath::avx512));
   const std::uint8_t* bits = L.bits.data();
   std::vector<double> out[3], sums[3];
   // Runs `body(form, out, sums)` for every form from the same inputs and compares.
@@ -533,10 +530,10 @@ TEST_P(MultigridKernels, RowLoopFormsAgreeBitwise) {
   // 9-point rows, double and float.
   const GridShape c = L.coarse;
   for (int f = 0; f < 2; ++f) {
-    const auto path = f == 0 ? detail::RowPath::baseline : detail::RowPath::avx2;
+    const auto path = f == 0 ? kernels::detail::RowPath::baseline : kernels::detail::RowPath::avx2;
     out[f] = L.xc;
     sums[f] = std::vector<double>(L.xc.size(), 0.0);
-    const auto& rows = detail::stencil9_rows<double>(path);
+    const auto& rows = kernels::detail::stencil9_rows<double>(path);
     for (int ci = 0; ci < 2; ++ci)
       for (int j = 0; j < c.ny; ++j) rows.smooth_color(c, L.A().view(), L.bc.data(), out[f].data(), j, ci);
     for (int j = 0; j < c.ny; ++j) rows.residual(c, L.A().view(), L.bc.data(), L.xc.data(), sums[f].data(), j);
@@ -550,10 +547,10 @@ TEST_P(MultigridKernels, RowLoopFormsAgreeBitwise) {
   const std::vector<float> bf = to_float(L.bc);
   std::vector<float> xf[2], rf[2];
   for (int f = 0; f < 2; ++f) {
-    const auto path = f == 0 ? detail::RowPath::baseline : detail::RowPath::avx2;
+    const auto path = f == 0 ? kernels::detail::RowPath::baseline : kernels::detail::RowPath::avx2;
     xf[f] = to_float(L.xc);
     rf[f].assign(L.xc.size(), 0.0f);
-    const auto& rows = detail::stencil9_rows<float>(path);
+    const auto& rows = kernels::detail::stencil9_rows<float>(path);
     for (int ci = 0; ci < 2; ++ci)
       for (int j = 0; j < c.ny; ++j) rows.smooth_color(c, a_float, bf.data(), xf[f].data(), j, ci);
     for (int j = 0; j < c.ny; ++j) rows.residual(c, a_float, bf.data(), xf[f].data(), rf[f].data(), j);
@@ -572,9 +569,9 @@ TEST_P(MultigridKernels, RowLoopFormsAgreeBitwise) {
   std::vector<double> bc[2], xd[2], x9[2];
   std::vector<float> bcf[2], x9f[2];
   for (int f = 0; f < 2; ++f) {
-    const auto path = f == 0 ? detail::RowPath::baseline : detail::RowPath::avx2;
-    const auto& transfer = detail::texel_transfer_rows<double>(path);
-    const auto& transfer_float = detail::texel_transfer_rows<float>(path);
+    const auto path = f == 0 ? kernels::detail::RowPath::baseline : kernels::detail::RowPath::avx2;
+    const auto& transfer = kernels::detail::texel_transfer_rows<double>(path);
+    const auto& transfer_float = kernels::detail::texel_transfer_rows<float>(path);
     bc[f].assign(L.xc.size(), 0.0);
     bcf[f].assign(L.xc.size(), 0.0f);
     xd[f] = L.x;
@@ -588,9 +585,9 @@ TEST_P(MultigridKernels, RowLoopFormsAgreeBitwise) {
     for (int j = 0; j < g.ny; ++j) {
       transfer.prolong_correction_red(g, c, L.P().view(), L.xc.data(), active.data(), xd[f].data(), j);
       transfer_float.prolong_correction_red(g, c, p_float, xcf.data(), active.data(), x_from_float.data(), j);
-      detail::stencil9_rows<double>(path).prolong_correction(g, c, L.P().view(), L.xc.data(), active.data(),
+      kernels::detail::stencil9_rows<double>(path).prolong_correction(g, c, L.P().view(), L.xc.data(), active.data(),
                                                               x9[f].data(), j);
-      detail::stencil9_rows<float>(path).prolong_correction(g, c, p_float, xcf.data(), active.data(), x9f[f].data(),
+      kernels::detail::stencil9_rows<float>(path).prolong_correction(g, c, p_float, xcf.data(), active.data(), x9f[f].data(),
                                                              j);
     }
     xd[f].insert(xd[f].end(), x_from_float.begin(), x_from_float.end());
@@ -605,9 +602,9 @@ TEST_P(MultigridKernels, RowLoopFormsAgreeBitwise) {
 // The fused row pairs against the two calls they replace, at widths below one group of 8,
 // of whole groups and with partial groups, on a tile with walls and Dirichlet texels.
 TEST(MultigridRowPairs, GiveTheTwoCallsBitsAtEveryWidth) {
-  std::vector<const detail::TexelRowKernels*> forms = {&detail::texel_rows(detail::RowPath::baseline)};
-  if (detail::avx2_supported()) forms.push_back(&detail::texel_rows(detail::RowPath::avx2));
-  if (detail::avx512_supported()) forms.push_back(&detail::texel_rows(detail::RowPath::avx512));
+  std::vector<const kernels::detail::TexelRowKernels*> forms = {&kernels::detail::texel_rows(kernels::detail::RowPath::baseline)};
+  if (kernels::detail::avx2_supported()) forms.push_back(&kernels::detail::texel_rows(kernels::detail::RowPath::avx2));
+  if (kernels::detail::avx512_supported()) forms.push_back(&kernels::detail::texel_rows(kernels::detail::RowPath::avx512));
   for (int w : {5, 8, 13, 16, 24, 37}) {
     TexelTile tile(w, 11);
     for (int j = 0; j < 11; ++j) {

@@ -18,6 +18,7 @@
 #include "dgtex/laplace_domains.h"
 #include "dgtex/laplace_multigrid.h"
 #include "multigrid_buffer.h"
+#include "thread_count_support.h"
 
 namespace dgtex {
 namespace {
@@ -75,7 +76,7 @@ struct FloatLevels {
 template <class Vector, class Parallel>
 void expect_equal_for_thread_counts(const Vector& reference, Parallel parallel, const char* what) {
   for (int threads : {1, 2}) {
-    omp_set_num_threads(threads);
+    const test::ThreadCountGuard set_threads(threads);
     EXPECT_EQ(parallel(), reference) << what << ", " << threads << " threads";
   }
 }
@@ -184,14 +185,13 @@ TEST_P(MultigridSinglePrecision, FloatKernelsEqualReferencesBitwise) {
       return out;
     }, "prolong_correction_red");
   }
-  omp_set_num_threads(2);
 }
 
 TEST_P(MultigridSinglePrecision, FloatSetupIsTheDoubleSetupRoundedAndThreadIndependent) {
   FloatLevels L(make_laplace_domain(GetParam(), 97));
   // Parallel float setup (1 and 2 threads) equals the serial one bitwise.
   for (int threads : {1, 2}) {
-    omp_set_num_threads(threads);
+    const test::ThreadCountGuard set_threads(threads);
     std::vector<std::vector<float>> p1(8, std::vector<float>(L.coarse.padded_size(), 0.0f)),
         a1(5, std::vector<float>(L.coarse.padded_size(), 0.0f)),
         p2(8, std::vector<float>(L.coarser.padded_size(), 0.0f)),
@@ -206,7 +206,6 @@ TEST_P(MultigridSinglePrecision, FloatSetupIsTheDoubleSetupRoundedAndThreadIndep
     EXPECT_EQ(p2, L.p2) << threads << " threads";
     EXPECT_EQ(a2, L.a2) << threads << " threads";
   }
-  omp_set_num_threads(2);
   // The double interpolation rounded: the edge weights (pass 1) exactly, the cell-centre
   // weights (pass 2, formed from the rounded edge weights) to float precision.
   std::vector<std::vector<double>> pd(8, std::vector<double>(L.coarse.padded_size(), 0.0));
@@ -256,9 +255,7 @@ TEST_P(MultigridSinglePrecision, SolvesMatchTheDoubleCycleAndDirectSolution) {
       EXPECT_LT(largest, 1e-8);
     }
     TexelTile one = problem, serial = problem;
-    omp_set_num_threads(1);
-    solve_laplace_multigrid(one, options);
-    omp_set_num_threads(2);
+    test::with_threads(1, [&] { solve_laplace_multigrid(one, options); });
     options.execution = Execution::serial;
     solve_laplace_multigrid(serial, options);
     EXPECT_EQ(one.values, single.values);

@@ -14,6 +14,7 @@
 #include "dgtex/kernels/multigrid_galerkin.h"
 #include "dgtex/kernels/multigrid_unknowns.h"
 #include "dgtex/laplace_domains.h"
+#include "thread_count_support.h"
 
 namespace dgtex {
 namespace {
@@ -83,7 +84,7 @@ void expect_levels_equal_references(const TexelTile& tile, int levels, Execution
 class MultigridUniformRegions : public ::testing::TestWithParam<LaplaceDomain> {};
 
 TEST_P(MultigridUniformRegions, SetupKernelsEqualGeneralReferencesBitwise) {
-  omp_set_num_threads(2);
+  const test::ThreadCountGuard set_threads(2);
   for (int size : {96, 157}) {
     const TexelTile tile = make_laplace_domain(GetParam(), size);
     const std::string what = std::string(laplace_domain_name(GetParam())) + " T=" + std::to_string(size);

@@ -11,6 +11,7 @@
 #include "dgtex/laplace_domains.h"
 #include "dgtex/laplace_multigrid.h"
 #include "multigrid_buffer.h"
+#include "thread_count_support.h"
 
 namespace dgtex {
 namespace {
@@ -48,7 +49,7 @@ TEST_P(MultigridUnzeroedBlocks, PoisonedBlocksGiveTheSameSolution) {
   // T = 256: level-0 and level-1 arrays are large enough (>= 64 KiB) to come from the cache.
   const kernels::TexelTile problem = make_laplace_domain(GetParam(), 256);
   for (int threads : {1, 2}) {
-    omp_set_num_threads(threads);
+    const test::ThreadCountGuard set_threads(threads);
     for (double coarse_tolerance : {0.0, 0.02}) {
       LaplaceMultigridOptions options;
       options.coarse_solve_tolerance = coarse_tolerance;

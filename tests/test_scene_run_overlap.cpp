@@ -13,6 +13,7 @@
 
 #include "dgtex/scene_io.h"
 #include "dgtex/scene_run.h"
+#include "thread_count_support.h"
 
 using namespace dgtex;
 
@@ -34,8 +35,7 @@ struct Trace {
 };
 
 Trace run(const Scene& scene, bool overlap, int threads, int cut_update_threads = 0) {
-  const int saved = omp_get_max_threads();
-  omp_set_num_threads(threads);
+  const test::ThreadCountGuard set_threads(threads);
   SceneRunOptions options;
   options.overlap_cut_updates = overlap;
   options.cut_update_threads = cut_update_threads;
@@ -53,7 +53,6 @@ Trace run(const Scene& scene, bool overlap, int threads, int cut_update_threads 
         trace.last_functions.insert(trace.last_functions.end(), t.tile.values.begin(), t.tile.values.end());
     }
   }
-  omp_set_num_threads(saved);
   return trace;
 }
 

@@ -13,6 +13,7 @@
 #include "dgtex/scene_run.h"
 #include "dgtex/scratch_array.h"
 #include "multigrid_buffer.h"
+#include "thread_count_support.h"
 
 using namespace dgtex;
 
@@ -78,7 +79,7 @@ TEST_P(ShellAssemblyScratchBlocks, PoisonedBlocksGiveTheSameStates) {
   // as 0.
   const std::string name = GetParam();
   const int steps = name == "spiral6" ? 8 : 2;
-  omp_set_num_threads(2);
+  const test::ThreadCountGuard set_threads(2);
   const std::vector<std::vector<double>> leftovers = run(name, steps);
   std::vector<std::vector<double>> poisoned;
   {

@@ -18,6 +18,7 @@
 #include "dgtex/kernels/shell_element_kernel.h"
 #include "dgtex/mesh_validation.h"
 #include "shell_test_support.h"
+#include "thread_count_support.h"
 
 using namespace dgtex;
 using namespace dgtex::testing_support;
@@ -215,13 +216,12 @@ TEST(EdgeFactorsAssembly, ModelStiffnessEqualsTheBlockAssemblyAndIsThreadIndepen
                   type == ElementType::quad8 ? "quad8" : "tri6", corotated ? " corotated" : "", error,
                   asymmetry_before, scale);
       for (int threads : {1, 2, 4}) {
-        omp_set_num_threads(threads);
+        const test::ThreadCountGuard set_threads(threads);
         std::vector<double> K2, f2;
         model->assemble_stiffness(state, K2, &f2);
         EXPECT_EQ(K2, K) << threads << " threads";
         EXPECT_EQ(f2, f) << threads << " threads";
       }
-      omp_set_num_threads(2);
     }
   }
 }

@@ -11,6 +11,7 @@
 #include "dgtex/model_error.h"
 #include "dgtex/shell_simulation.h"
 #include "shell_test_support.h"
+#include "thread_count_support.h"
 
 using namespace dgtex;
 using namespace dgtex::testing_support;
@@ -239,7 +240,7 @@ TEST_P(PerElement, AssemblyIsIndependentOfThreadCountAndMatchesReference) {
   fix_nodes(mesh, [](const double* x) { return x[1] < 1e-9; }, true, true, true, fixed);
   std::vector<double> reference_u;
   for (int threads : {1, 2, 4}) {
-    omp_set_num_threads(threads);
+    const test::ThreadCountGuard set_threads(threads);
     std::vector<double> K, f;
     model->assemble_stiffness(current.data(), K, &f);
     EXPECT_EQ(K, reference_K) << threads << " threads";
@@ -255,7 +256,6 @@ TEST_P(PerElement, AssemblyIsIndependentOfThreadCountAndMatchesReference) {
     if (reference_u.empty()) reference_u = sim.displacement();
     EXPECT_EQ(sim.displacement(), reference_u) << threads << " threads";
   }
-  omp_set_num_threads(2);
 }
 
 INSTANTIATE_TEST_SUITE_P(Elements, PerElement, ::testing::Values(ElementType::quad8, ElementType::tri6),

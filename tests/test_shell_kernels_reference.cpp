@@ -14,6 +14,7 @@
 #include "dgtex/mesh_generators.h"
 #include "dgtex/topology.h"
 #include "shell_test_support.h"
+#include "thread_count_support.h"
 
 using namespace dgtex;
 using kernels::ElementType;
@@ -78,7 +79,7 @@ TEST_P(Kernels, ElementStiffnessMatchesReference) {
     double* force = rotations ? f.data() : nullptr;
     kernels::shell_element_stiffness(batch, rotations, K.data(), force, Execution::serial);
     kernels::shell_element_stiffness_reference(batch, rotations, Kref.data(), rotations ? fref.data() : nullptr);
-    omp_set_num_threads(3);
+    const test::ThreadCountGuard set_threads(3);
     kernels::shell_element_stiffness(batch, rotations, Kpar.data(), rotations ? fpar.data() : nullptr, Execution::parallel);
     EXPECT_LE(max_difference(K, Kref), 1e-13 * max_abs(Kref)) << (rotations ? "corotated" : "linear");
     EXPECT_EQ(K, Kpar);
@@ -101,7 +102,7 @@ TEST_P(Kernels, EdgeStiffnessMatchesReference) {
     std::vector<double> f(batch.count * nb * 3), fref(f.size()), fpar(f.size());
     kernels::shell_edge_stiffness(batch, rotations, K.data(), rotations ? f.data() : nullptr, Execution::serial);
     kernels::shell_edge_stiffness_reference(batch, rotations, Kref.data(), rotations ? fref.data() : nullptr);
-    omp_set_num_threads(3);
+    const test::ThreadCountGuard set_threads(3);
     kernels::shell_edge_stiffness(batch, rotations, Kpar.data(), rotations ? fpar.data() : nullptr, Execution::parallel);
     EXPECT_LE(max_difference(K, Kref), 1e-13 * max_abs(Kref)) << (rotations ? "corotated" : "linear");
     EXPECT_EQ(K, Kpar);

@@ -14,6 +14,7 @@
 #include "dgtex/factor_reusing_solver.h"
 #include "dgtex/shell_simulation.h"
 #include "shell_test_support.h"
+#include "thread_count_support.h"
 
 using namespace dgtex;
 using namespace dgtex::testing_support;
@@ -137,7 +138,7 @@ TEST(FactorReuse, ResultIsBitwiseIndependentOfThreadCountAcrossRefactorisations)
   std::vector<double> reference;
   long reference_factorizations = 0;
   for (int threads : {1, 2, 4}) {
-    omp_set_num_threads(threads);
+    const test::ThreadCountGuard set_threads(threads);
     ShellSimulation sim(*c.model, c.fixed, c.load);
     sim.set_solver_options(often);
     for (int s = 0; s < 10; ++s) sim.step(c.options);
@@ -149,7 +150,6 @@ TEST(FactorReuse, ResultIsBitwiseIndependentOfThreadCountAcrossRefactorisations)
     EXPECT_EQ(sim.displacement(), reference) << threads << " threads";
     EXPECT_EQ(sim.solver_statistics().factorizations, reference_factorizations) << threads << " threads";
   }
-  omp_set_num_threads(2);
 }
 
 TEST(FactorReuse, DenseFactorisationsInTurnGiveTheSameBitsAtAnyThreadCount) {
@@ -167,7 +167,7 @@ TEST(FactorReuse, DenseFactorisationsInTurnGiveTheSameBitsAtAnyThreadCount) {
   often.refactor_after_iterations = 1;
   std::vector<double> reference;
   for (int threads : {1, 2, 4}) {
-    omp_set_num_threads(threads);
+    const test::ThreadCountGuard set_threads(threads);
     ShellSimulation sim(*c.model, c.fixed, load);
     sim.set_solver_options(often);
     for (int s = 0; s < 10; ++s) {
@@ -180,7 +180,6 @@ TEST(FactorReuse, DenseFactorisationsInTurnGiveTheSameBitsAtAnyThreadCount) {
     if (reference.empty()) reference = sim.displacement();
     EXPECT_EQ(sim.displacement(), reference) << threads << " threads";
   }
-  omp_set_num_threads(2);
 }
 
 TEST(FactorReuse, StalePreconditionerIsReplacedAndTheBoundStillHolds) {
@@ -433,12 +432,11 @@ TEST(FactorReuse, ElementLocalDroppedRadiusIsTheDefinitionsOnTheDenseMatrix) {
     }
     ASSERT_GT(expected, 0) << "the cylinder's DG edges couple nodes of no common element";
     for (int threads : {1, 2, 3}) {
-      omp_set_num_threads(threads);
+      const test::ThreadCountGuard set_threads(threads);
       EXPECT_NEAR(element_local_dropped_radius(pattern, kept, free, c.model->mass_blocks(), A), expected,
                   1e-12 * expected)
           << "stiffness scale " << stiffness_scale << ", " << threads << " threads";
     }
-    omp_set_num_threads(2);
   }
   // A free DOF without a positive diagonal: A is not positive definite, nothing to weigh.
   std::vector<double> negative = cylinder.K;
@@ -500,16 +498,14 @@ TEST(FactorReuse, ElementLocalIsRuledOutWhereTheDroppedCouplingsOutweighTheMass)
 TEST(DeterministicDot, IsIndependentOfThreadCount) {
   std::vector<double> x(100003), y(x.size());
   for (size_t i = 0; i < x.size(); ++i) x[i] = std::sin(0.1 * i), y[i] = std::cos(0.37 * i) * 1e3;
-  omp_set_num_threads(1);
-  const double one = deterministic_dot(x, y);
+  const double one = test::with_threads(1, [&] { return deterministic_dot(x, y); });
   for (int threads : {2, 3, 4}) {
-    omp_set_num_threads(threads);
+    const test::ThreadCountGuard set_threads(threads);
     EXPECT_EQ(deterministic_dot(x, y), one) << threads << " threads";
   }
   double naive = 0;
   for (size_t i = 0; i < x.size(); ++i) naive += x[i] * y[i];
   EXPECT_NEAR(one, naive, 1e-9 * std::abs(naive) + 1e-9);
-  omp_set_num_threads(2);
 }
 
 }  // namespace

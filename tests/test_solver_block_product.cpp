@@ -18,6 +18,7 @@
 #include "dgtex/shell_model.h"
 #include "shell_test_support.h"
 #include "vector_path_support.h"
+#include "thread_count_support.h"
 
 using namespace dgtex;
 using dgtex::testing_support::random_values;
@@ -138,9 +139,8 @@ TEST(BlockProduct, BlockMultiplyIsTheReferenceOnOneAndTwoThreads) {
   std::vector<double> expected(3 * nodes), expected2(3 * nodes);
   kernels::block_rows_product_reference(pattern.rows(), 0, nodes, blocks.data(), x.data(), expected.data());
   kernels::block_rows_product_reference(pattern.rows(), 0, nodes, blocks.data(), x2.data(), expected2.data());
-  const int threads = omp_get_max_threads();
   for (int t : {1, 2}) {
-    omp_set_num_threads(t);
+    const test::ThreadCountGuard set_threads(t);
     std::vector<double> y(3 * nodes), y1(3 * nodes), y2(3 * nodes);
     block_multiply(pattern, blocks.data(), x.data(), y.data());
     block_multiply_pair(pattern, blocks.data(), x.data(), x2.data(), y1.data(), y2.data());
@@ -148,7 +148,6 @@ TEST(BlockProduct, BlockMultiplyIsTheReferenceOnOneAndTwoThreads) {
     EXPECT_EQ(y1, expected) << t << " threads";
     EXPECT_EQ(y2, expected2) << t << " threads";
   }
-  omp_set_num_threads(threads);
 }
 
 }  // namespace

@@ -13,6 +13,7 @@
 
 #include "cholmod_lock.h"  // internal (runtime/)
 #include "dgtex/sparse_cholesky.h"
+#include "thread_count_support.h"
 
 namespace {
 
@@ -54,7 +55,7 @@ TEST(CholmodLock, SupernodalFactorisationStartsNoOpenMpThreads) {
   // A 5-point Laplacian on 120 x 120 nodes plus the identity: CHOLMOD's supernodes reach
   // hundreds of columns, where it would open its teams. One OpenMP thread for dgtex's own
   // loops, so any thread that appears is CHOLMOD's.
-  omp_set_num_threads(1);
+  const dgtex::test::ThreadCountGuard set_threads(1);
   const int side = 120, n = side * side;
   std::vector<int> column_start{0}, row_index;
   std::vector<double> values;

@@ -20,6 +20,7 @@
 #include "dgtex/kernels/dense_cholesky_solve.h"
 #include "dgtex/sparse_cholesky.h"
 #include "vector_path_support.h"
+#include "thread_count_support.h"
 
 namespace {
 
@@ -93,12 +94,11 @@ TEST(DenseCholesky, DoesNotDependOnTheThreadCount) {
   for (int i = 0; i < 441; ++i) b[i] = std::cos(0.7 * i);
   std::vector<std::vector<double>> x;
   for (int threads : {1, 2, 4}) {
-    omp_set_num_threads(threads);
+    const dgtex::test::ThreadCountGuard set_threads(threads);
     bool dense = false;
     x.push_back(solve_with(512, m, b, &dense));
     EXPECT_TRUE(dense);
   }
-  omp_set_num_threads(omp_get_num_procs());
   EXPECT_EQ(x[0], x[1]);
   EXPECT_EQ(x[0], x[2]);
 }

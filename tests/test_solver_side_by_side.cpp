@@ -8,12 +8,13 @@
 #include <stdexcept>
 
 #include "dgtex/side_by_side.h"
+#include "thread_count_support.h"
 
 using namespace dgtex;
 
 TEST(SideBySide, RunsBothTasksOnDistinctThreadsWithSerialInnerLoops) {
   for (int threads : {1, 2, 4}) {
-    omp_set_num_threads(threads);
+    const test::ThreadCountGuard set_threads(threads);
     int first_thread = -1, second_thread = -1, first_inner = 0, second_inner = 0;
     const SideBySideTimes t = run_side_by_side(
         [&] {
@@ -38,7 +39,7 @@ TEST(SideBySide, RunsBothTasksOnDistinctThreadsWithSerialInnerLoops) {
 
 TEST(SideBySide, RethrowsAfterBothTasksFinished) {
   for (int threads : {1, 2}) {
-    omp_set_num_threads(threads);
+    const test::ThreadCountGuard set_threads(threads);
     std::atomic<bool> second_done{false};
     EXPECT_THROW(run_side_by_side([] { throw std::runtime_error("first failed"); }, [&] { second_done = true; }),
                  std::runtime_error);

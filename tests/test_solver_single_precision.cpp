@@ -11,6 +11,7 @@
 
 #include "dgtex/sparse_cholesky.h"
 #include "shifted_laplacian_support.h"
+#include "thread_count_support.h"
 
 using namespace dgtex;
 using dgtex::testing_support::ShiftedLaplacian;
@@ -51,13 +52,12 @@ TEST(SinglePrecisionSolve, IsBitwiseIndependentOfThreadCount) {
   std::vector<double> b(A.size), reference, x;
   for (int k = 0; k < A.size; ++k) b[k] = std::cos(0.05 * k);
   for (int threads : {1, 2, 3, 4}) {
-    omp_set_num_threads(threads);
+    const test::ThreadCountGuard set_threads(threads);
     cholesky.solve_single_precision(b, threads == 1 ? reference : x);
     if (threads > 1) {
       EXPECT_EQ(x, reference) << threads << " threads";
     }
   }
-  omp_set_num_threads(2);
 }
 
 }  // namespace

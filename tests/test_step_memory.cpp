@@ -14,6 +14,7 @@
 #include "dgtex/scene_io.h"
 #include "dgtex/scene_run.h"
 #include "dgtex/step_memory.h"
+#include "thread_count_support.h"
 
 #if defined(__linux__)
 #include <sys/resource.h>
@@ -108,7 +109,7 @@ TEST(StepMemory, ThreadsThatTracedCutsBeforeTheReservationShareItsHeap) {
   // to one keeps a heap of its own, which the reservation does not reach: the accordion's
   // first step then faulted in 2.9k pages (its worker thread's rest sums), 10 with the
   // settings made first (SceneRun calls prepare_step_memory before anything else).
-  omp_set_num_threads(2);  // a worker thread, also on a machine of one core
+  const test::ThreadCountGuard set_threads(2);  // a worker thread, also on a machine of one core
   EXPECT_LT(faults_in_first_steps("accordion.json", 2), 500) << "page faults in the accordion's first two steps";
 #endif
 }

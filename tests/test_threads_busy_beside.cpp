@@ -15,6 +15,7 @@
 
 #include "dgtex/kernels/forall.h"
 #include "dgtex/side_by_side.h"
+#include "thread_count_support.h"
 
 using namespace dgtex;
 
@@ -42,12 +43,8 @@ Teams loop_teams() {
 
 class ThreadsBusyBeside : public ::testing::Test {
  protected:
-  void SetUp() override {
-    saved_ = omp_get_max_threads();
-    omp_set_num_threads(3);
-  }
-  void TearDown() override { omp_set_num_threads(saved_); }
-  int saved_ = 1;
+  void SetUp() override { omp_set_num_threads(3); }
+  const test::ThreadCountGuard restore_;
 };
 
 }  // namespace
@@ -131,7 +128,7 @@ TEST_F(ThreadsBusyBeside, LoopsTakeTheThreadsBackWhileTheyRun) {
 }
 
 TEST_F(ThreadsBusyBeside, SideBySideRunsInTurnWhenOnlyOneThreadIsFree) {
-  omp_set_num_threads(2);
+  const test::ThreadCountGuard set_threads(2);
   const std::thread::id caller = std::this_thread::get_id();
   std::thread::id first_ran_on, second_ran_on;
   std::atomic<int> busy{1};

@@ -16,7 +16,8 @@
 // OpenMP thread each ("batch"); scenes per second both ways, and whether every run ends
 // in bitwise the same displacement (results do not depend on the thread count).
 // Plain functions that return their results (nothing kept); they set the OpenMP thread
-// count themselves, so run one at a time. Times in ms.
+// count themselves, so run one at a time, and restore the caller's count before they
+// return. Times in ms.
 #include <cstdint>
 #include <string>
 #include <vector>

@@ -5,7 +5,8 @@
 // GFLOP/s of the assembly (counted with shell_assembly_flops, below), next to an Eigen
 // dense matrix product measured in the same process as the attainable reference.
 // Plain functions that return their measurements (nothing kept); they set the OpenMP
-// thread count themselves, so run one at a time. Times in ms, rates per second.
+// thread count themselves, so run one at a time, and restore the caller's count before
+// they return. Times in ms, rates per second.
 #include <cstdint>
 #include <string>
 #include <vector>
