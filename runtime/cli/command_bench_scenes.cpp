@@ -225,16 +225,30 @@ std::string format(const char* fmt, double a) {
   return buffer;
 }
 
+// The machine probes, in the order taken (before each run, and after the last): one core
+// alone, and every thread at once (a core shared with another tenant shows only there).
+struct ProbeReadings {
+  std::vector<double> one_core_ms, all_threads_ms;
+
+  void take(int threads) {
+    one_core_ms.push_back(machine_probe_ms());
+    all_threads_ms.push_back(machine_probe_all_threads_ms(threads));
+  }
+  void append(const ProbeReadings& later) {
+    one_core_ms.insert(one_core_ms.end(), later.one_core_ms.begin(), later.one_core_ms.end());
+    all_threads_ms.insert(all_threads_ms.end(), later.all_threads_ms.begin(), later.all_threads_ms.end());
+  }
+};
+
 // Every run of a scene (--repeats): the one the tables show, each run's steps/s, peak step
 // and enrichment peak, and whether all runs ended in bitwise the same displacement (the
 // simulation does not depend on timing).
-nlohmann::json runs_json(const std::vector<SceneBenchResult>& runs, const EveryRun& e,
-                         const std::vector<double>& probes_ms, const std::vector<double>& all_threads_probes_ms) {
+nlohmann::json runs_json(const std::vector<SceneBenchResult>& runs, const EveryRun& e, const ProbeReadings& probes) {
   nlohmann::json j = {{"count", runs.size()},
                       {"shown", e.shown},
                       {"identical", true},
-                      {"machine_probe_ms", probes_ms},
-                      {"machine_probe_all_threads_ms", all_threads_probes_ms},
+                      {"machine_probe_ms", probes.one_core_ms},
+                      {"machine_probe_all_threads_ms", probes.all_threads_ms},
                       {"steps_per_second", e.steps_per_second},
                       {"peak_step_ms", e.peak_step_ms},
                       {"steps_slower_than_target", e.steps_slower_than_target},
@@ -390,9 +404,7 @@ int bench_scenes_command(int argc, char** argv) {
   std::vector<EveryRun> every_runs;  // per scene, for the table of every run
   const std::string machine = describe_machine();
   const int threads_used = omp_get_max_threads();
-  // Before each run and after the last: the one-core probe, and the same on every thread at
-  // once (a core shared with another tenant shows only there).
-  std::vector<double> probes_ms, all_threads_probes_ms;
+  ProbeReadings probes;  // of the whole command
   nlohmann::json all = {{"machine", machine},
                         {"steps", steps},
                         {"threads", threads_used},
@@ -413,14 +425,11 @@ int bench_scenes_command(int argc, char** argv) {
       run_options.cut_update_threads = cut_update_threads;
       run_options.reserve_step_memory = !no_memory_reserve;
       std::vector<SceneBenchResult> runs;
-      std::vector<double> run_probes_ms, run_all_threads_probes_ms;
+      ProbeReadings run_probes;  // of this scene's runs
       for (int run = 1; run <= repeats; ++run) {
         const std::string label = repeats > 1 ? entry.name + " run " + std::to_string(run) + "/" + std::to_string(repeats)
                                               : entry.name;
-        run_probes_ms.push_back(machine_probe_ms());
-        probes_ms.push_back(run_probes_ms.back());
-        run_all_threads_probes_ms.push_back(machine_probe_all_threads_ms(threads_used));
-        all_threads_probes_ms.push_back(run_all_threads_probes_ms.back());
+        run_probes.take(threads_used);
         runs.push_back(run_scene_benchmark(
             scene, entry.name, steps,
             [&](int step, int total) {
@@ -444,11 +453,12 @@ int bench_scenes_command(int argc, char** argv) {
                            }) -
           runs.begin());
       every_runs.push_back(every_run(runs, chosen));
-      nlohmann::json runs_of_scene = runs_json(runs, every_runs.back(), run_probes_ms, run_all_threads_probes_ms);
+      nlohmann::json runs_of_scene = runs_json(runs, every_runs.back(), run_probes);
+      probes.append(run_probes);
       SceneBenchResult r = std::move(runs[chosen]);
       all["scenes"].push_back(scene_json(r));
-      all["scenes"].back()["machine_probe_ms"] = run_probes_ms[chosen];
-      all["scenes"].back()["machine_probe_all_threads_ms"] = run_all_threads_probes_ms[chosen];
+      all["scenes"].back()["machine_probe_ms"] = run_probes.one_core_ms[chosen];
+      all["scenes"].back()["machine_probe_all_threads_ms"] = run_probes.all_threads_ms[chosen];
       all["scenes"].back()["runs"] = std::move(runs_of_scene);
       results.push_back(std::move(r));
       if (!json_path.empty()) write_output_file(json_path, all.dump(2) + "\n", "--json");
@@ -470,12 +480,13 @@ int bench_scenes_command(int argc, char** argv) {
     }
   }
   // The host's speed at the end too: a probe that moved during the run says the machine did.
-  probes_ms.push_back(machine_probe_ms());
-  all["machine_probe_ms_at_end"] = probes_ms.back();
-  all_threads_probes_ms.push_back(machine_probe_all_threads_ms(threads_used));
-  all["machine_probe_all_threads_ms_at_end"] = all_threads_probes_ms.back();
-  const auto [fastest, slowest] = std::minmax_element(probes_ms.begin(), probes_ms.end());
-  const auto [fastest_all, slowest_all] = std::minmax_element(all_threads_probes_ms.begin(), all_threads_probes_ms.end());
+  probes.take(threads_used);
+  all["machine_probe_ms_at_end"] = probes.one_core_ms.back();
+  all["machine_probe_all_threads_ms_at_end"] = probes.all_threads_ms.back();
+  const std::vector<double>& one_core_ms = probes.one_core_ms;
+  const std::vector<double>& all_threads_ms = probes.all_threads_ms;
+  const auto [fastest, slowest] = std::minmax_element(one_core_ms.begin(), one_core_ms.end());
+  const auto [fastest_all, slowest_all] = std::minmax_element(all_threads_ms.begin(), all_threads_ms.end());
   std::string tables = markdown_tables(results);
   if (repeats > 1) tables += every_run_table(every_runs);
   std::string step_count = steps > 0 ? std::to_string(steps) + " steps per scene" : "each scene's own analysis.steps";
@@ -487,13 +498,13 @@ int bench_scenes_command(int argc, char** argv) {
                 machine.c_str(), step_count.c_str(), inline_cut_updates ? "inline" : "overlapped", *fastest, *slowest,
                 *fastest_all, *slowest_all, threads_used);
   std::printf("%s%s", heading, tables.c_str());
-  const std::string drift = probe_drift_warning(probes_ms);
+  const std::string drift = probe_drift_warning(one_core_ms);
   if (!drift.empty()) std::fprintf(stderr, "dgtex bench scenes: warning: %s\n", drift.c_str());
   // The probe pair whose threads lost the most against one core.
   std::size_t worst = 0;
-  for (std::size_t k = 1; k < probes_ms.size(); ++k)
-    if (all_threads_probes_ms[k] / probes_ms[k] > all_threads_probes_ms[worst] / probes_ms[worst]) worst = k;
-  const std::string shared = shared_cores_warning(probes_ms[worst], all_threads_probes_ms[worst], threads_used);
+  for (std::size_t k = 1; k < one_core_ms.size(); ++k)
+    if (all_threads_ms[k] / one_core_ms[k] > all_threads_ms[worst] / one_core_ms[worst]) worst = k;
+  const std::string shared = shared_cores_warning(one_core_ms[worst], all_threads_ms[worst], threads_used);
   if (!shared.empty()) std::fprintf(stderr, "dgtex bench scenes: warning: %s\n", shared.c_str());
   try {
     if (!json_path.empty()) write_output_file(json_path, all.dump(2) + "\n", "--json");
