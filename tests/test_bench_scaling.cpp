@@ -37,8 +37,7 @@ fs::path fresh_dir(const std::string& name) { return test::fresh_dir("dgtex_benc
 // Each family sets the thread counts it times and then gives the caller's count back (5
 // here, a count none of them times).
 TEST(BenchScaling, KernelResultsAreBitwiseEqualForEveryThreadCount) {
-  const test::ThreadCountGuard restore;
-  omp_set_num_threads(5);
+  const test::ThreadCountGuard set_threads(5);
   const std::vector<int> threads = {1, 2, 3};
   const KernelScaling polar = scale_polar_decomposition(5000, threads, 1);
   EXPECT_EQ(omp_get_max_threads(), 5) << "polar decomposition";
@@ -85,8 +84,7 @@ TEST(BenchScaling, FactorizationTakesTheWholePatternWhereTheSolverDoes) {
 // state as a plain SceneRun.
 TEST(BenchScaling, BatchMembersEndExactlyWhereARunAloneEnds) {
   const Scene scene = load_scene(kScenes + "/spiral1.json");
-  const test::ThreadCountGuard restore;
-  omp_set_num_threads(3);
+  const test::ThreadCountGuard set_threads(3);
   const BatchThroughput b = measure_batch_throughput(scene, 2, 2, 2);
   EXPECT_EQ(omp_get_max_threads(), 3) << "the caller's thread count, given back";
   EXPECT_EQ(b.runs, 2);

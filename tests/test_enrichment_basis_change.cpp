@@ -293,8 +293,8 @@ TEST(BasisChange, FusedMassAndLoadWeightsEqualTheTwoKernelsBitwise) {
       const kernels::EnrichedQuadrature quad{qs.data(), qp.data()};
       std::vector<double> mass(2 * width * width), area(2 * width), weights(2 * width);
       kernels::enriched_element_mass(batch, quad, mass.data());
-      const test::ThreadCountGuard restore;  // the counts set below, until the next quadrature
       kernels::enriched_element_load_weights(batch, quad, area.data(), weights.data());
+      const test::ThreadCountGuard restore;  // the counts set below, until the next quadrature
       for (const int threads : {0, 1, 2, 3})
         for (const bool keep_values : {false, true}) {
           SCOPED_TRACE((threads == 0 ? std::string("serial") : std::to_string(threads) + " threads") +

@@ -43,8 +43,7 @@ Teams loop_teams() {
 
 class ThreadsBusyBeside : public ::testing::Test {
  protected:
-  void SetUp() override { omp_set_num_threads(3); }
-  const test::ThreadCountGuard restore_;
+  const test::ThreadCountGuard three_threads_{3};
 };
 
 }  // namespace
