@@ -56,7 +56,8 @@ SceneRun::SceneRun(const Scene& scene, SceneRunOptions options)
   cut_update_team_ = std::make_unique<detail::CutUpdateTeam>(options_.cut_update_threads);
   // The malloc settings of the reservation below before the OpenMP threads allocate (the cut
   // tracing runs on them), so that they too take the heap it faults in.
-  const bool reserves = options_.reserve_step_memory && (!scene_.cuts.empty() || !scene_.creases.empty());
+  const bool enriched = !scene_.cuts.empty() || !scene_.creases.empty();
+  const bool reserves = options_.reserve_step_memory && enriched;
   if (reserves) prepare_step_memory();
   SceneModel built = build_scene_model(scene_, mesh_);
   model_ = std::move(built.model);
@@ -66,7 +67,7 @@ SceneRun::SceneRun(const Scene& scene, SceneRunOptions options)
     dynamics_.mass_damping = scene_.analysis.damping.mass;
     dynamics_.stiffness_damping = scene_.analysis.damping.stiffness;
   }
-  if (!scene_.cuts.empty() || !scene_.creases.empty()) {
+  if (enriched) {
     {
       ScopedStage stage(timings_, "enrichment");
       if (!scene_.cuts.empty())

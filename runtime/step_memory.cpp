@@ -73,8 +73,8 @@ void prepare_step_memory() {
 
 void reserve_step_memory(std::int64_t bytes) {
   if (bytes <= 0) return;
+  prepare_step_memory();
 #if defined(__GLIBC__)
-  keep_freed_memory();
   fault_in_heap(bytes - bytes / 3);
 #endif
   detail::prefault_mapped_blocks(static_cast<std::size_t>(bytes / 3));
