@@ -151,9 +151,8 @@ int bench_scaling_command(int argc, char** argv) {
   std::string scene_path = example_scene("cylinder_buckling.json"), cut_scene_path = example_scene("chad.json");
   std::vector<std::string> families = kFamilies, batch_scenes;
   std::string json_path, chart_path, markdown_path;
-  // 20 scene steps: over 5 (steps 2-6), chad's speed-up read 0.99-1.11x at 2 threads, over 20
-  // 1.43-1.56x (sessions 13, 23 and 67): its first steps, whose cut update runs inline, are
-  // the slowest of its run.
+  // 20 scene steps: over 5 (steps 2-6, its second step's cut update inline), chad's speed-up
+  // read 0.99-1.11x at 2 threads (sessions 13, 23 and 67), over 20 1.09-1.56x (session 67).
   int repeats = 3, steps = 20, batch_runs = 0, batch_steps = 5;
   std::int64_t polar_count = 1 << 20;
   app.add_option("--threads-list", threads, "OpenMP thread counts (default: 1 to the number of cores)")
