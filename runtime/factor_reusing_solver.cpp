@@ -9,6 +9,7 @@
 
 #include "dgtex/kernels/forall.h"
 #include "dgtex/shell_model.h"
+#include "api_argument_checks.h"
 
 namespace dgtex {
 
@@ -358,8 +359,8 @@ void FactorReusingSolver::solve(const ScaledBlockSum& A, const std::vector<doubl
   }
   if (iterations < 0)
     throw std::runtime_error("FactorReusingSolver: no convergence to relative residual " +
-                             std::to_string(options_.relative_tolerance) + " even with a fresh factor (residual " +
-                             std::to_string(residual) + "); the system is ill-conditioned");
+                             detail::short_number(options_.relative_tolerance) + " even with a fresh factor (residual " +
+                             detail::short_number(residual) + "); the system is ill-conditioned");
   // Judged by the factor now held (a fresh one after a failed attempt).
   const int refactor_after =
       large_dense_ ? options_.large_dense_refactor_after_iterations : options_.refactor_after_iterations;

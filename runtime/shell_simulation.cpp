@@ -126,7 +126,7 @@ void ShellSimulation::solve_static() {
       cholesky_.factorize(values);
     } catch (const NotPositiveDefinite& e) {
       throw ModelError("stiffness not positive definite (penalty too low?): penalty = " +
-                       std::to_string(model_.options().penalty) + "; " + e.what() + enrichment_hint());
+                       detail::short_number(model_.options().penalty) + "; " + e.what() + enrichment_hint());
     }
     system_.restrict_vector(f_ext_, rhs);
     cholesky_.solve(rhs, x);
@@ -250,7 +250,7 @@ void ShellSimulation::step(const DynamicsOptions& o) {
     }
   } catch (const NotPositiveDefinite& e) {
     throw ModelError("dynamic system matrix not positive definite (penalty too low?): penalty = " +
-                     std::to_string(model_.options().penalty) + "; " + e.what() + enrichment_hint());
+                     detail::short_number(model_.options().penalty) + "; " + e.what() + enrichment_hint());
   }
   for (int d = 0; d < ndofs; ++d) u_[d] += dt * v_[d];
   time_ += dt;
