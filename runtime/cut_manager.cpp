@@ -6,7 +6,9 @@
 #include <cstdio>
 #include <exception>
 #include <filesystem>
+#include <iomanip>
 #include <set>
+#include <sstream>
 #include <stdexcept>
 
 #include <omp.h>
@@ -237,6 +239,15 @@ CutManager::CutManager(const Mesh& mesh, const Topology& topology, const std::ve
     if (failure) std::rethrow_exception(failure);
   // Boundaries closer than half a texel (of a mean-sized element) are merged.
   const double texel = cut_point_tolerance(mesh) * 4.0 / resolution_;
+  // A segment shorter than a texel would have no texels of its own, and a length below the
+  // spacing of doubles at the cut's arc length would never advance the segmentation.
+  if (options_.new_cut_length && *options_.new_cut_length < texel) {
+    std::ostringstream message;
+    message << std::setprecision(6) << "enrichment.new_cut_length: a cut segment cannot be shorter than a texel, got "
+            << *options_.new_cut_length << "; expected " << texel << " or more (the mean element edge / "
+            << "texture_resolution " << resolution_ << ")";
+    throw std::invalid_argument(message.str());
+  }
   boundaries_ = segment_cut_paths(paths_, cuts_, options_, 0.5 * texel);
   node_elements_.assign(mesh.num_nodes(), {});
   for (int e = 0; e < mesh.num_elements(); ++e)

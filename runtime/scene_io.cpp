@@ -26,6 +26,7 @@ constexpr double kMaxMagnitude = 1e30;
 constexpr int kMaxDivisions = 100000;
 constexpr long long kMaxGeneratedCells = 10000000;
 constexpr int kMaxSteps = 1000000000;
+constexpr size_t kMaxFileNameBytes = 255;  // NAME_MAX of ext4, XFS, Btrfs, tmpfs
 
 std::string one_line(std::string text) {
   std::replace(text.begin(), text.end(), '\n', ' ');
@@ -52,6 +53,15 @@ std::string number_text(double x) {
   out.precision(17);
   out << x;
   return out.str();
+}
+
+// "" for a regular file, else why a file name (resolved) does not name one: a folder or a
+// device such as /dev/null exists but is no file to read.
+std::string not_a_file(const std::string& resolved) {
+  std::error_code error;
+  if (std::filesystem::is_regular_file(resolved, error)) return "";
+  return (std::filesystem::exists(resolved, error) ? "not a regular file (resolved to " : "no such file (resolved to ") +
+         resolved + ")";
 }
 
 std::string child(const std::string& path, const std::string& key) { return path.empty() ? key : path + "." + key; }
@@ -81,21 +91,30 @@ std::string join(const std::vector<std::string>& words, const std::string& separ
 double norm(const Vec3& v) { return std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]); }
 Vec3 difference(const Vec3& a, const Vec3& b) { return {a[0] - b[0], a[1] - b[1], a[2] - b[2]}; }
 
-// Rejects duplicate keys while nlohmann parses (it would silently keep the last one),
-// tracking the JSON path of every object so the message can name it.
-class DuplicateKeyCheck {
+// Checks made while nlohmann parses, each naming the JSON path where it fails: duplicate keys
+// (nlohmann would silently keep the last one), nesting deeper than any scene needs (each
+// level keeps its path here and printing a value recurses per level: 80,000 levels
+// overflowed the stack), and NUL characters in keys and strings (a file name or a message
+// would end at them).
+class ParseTimeChecks {
  public:
-  explicit DuplicateKeyCheck(std::string source) : source_(std::move(source)) {}
+  explicit ParseTimeChecks(std::string source) : source_(std::move(source)) {}
 
   bool operator()(int, json::parse_event_t event, json& parsed) {
     switch (event) {
       case json::parse_event_t::object_start:
       case json::parse_event_t::array_start:
+        if (frames_.size() == kMaxNesting)
+          throw SceneError(source_, current_path(), "nested too deeply", "",
+                           "expected at most " + std::to_string(kMaxNesting) + " levels of objects and arrays");
         frames_.push_back({event == json::parse_event_t::array_start, 0, "", {}, current_path()});
         break;
       case json::parse_event_t::key: {
         Frame& top = frames_.back();
         top.key = parsed.get<std::string>();
+        if (top.key.find('\0') != std::string::npos)
+          throw SceneError(source_, child(top.path, escaped(top.key)), "a key with a NUL character", "",
+                           "expected a key without NUL characters");
         if (!top.keys.insert(top.key).second)
           throw SceneError(source_, child(top.path, top.key), "duplicate key", "",
                            "each key may appear only once in an object");
@@ -107,6 +126,9 @@ class DuplicateKeyCheck {
         element_done();
         break;
       case json::parse_event_t::value:
+        if (parsed.is_string() && parsed.get_ref<const std::string&>().find('\0') != std::string::npos)
+          throw SceneError(source_, current_path(), "a string with a NUL character", value_text(parsed),
+                           "expected text without NUL characters");
         element_done();
         break;
     }
@@ -114,6 +136,9 @@ class DuplicateKeyCheck {
   }
 
  private:
+  // Scene files nest 5 levels deep at most (boundary[0].select.plane.normal[0]).
+  static constexpr std::size_t kMaxNesting = 32;
+
   struct Frame {
     bool is_array;
     size_t index;
@@ -122,6 +147,11 @@ class DuplicateKeyCheck {
     std::string path;
   };
 
+  // A key as JSON would write it (control characters escaped), without the quotes.
+  static std::string escaped(const std::string& key) {
+    const std::string quoted = json(key).dump(-1, ' ', false, json::error_handler_t::replace);
+    return quoted.substr(1, quoted.size() - 2);
+  }
   std::string current_path() const {
     if (frames_.empty()) return "";
     const Frame& top = frames_.back();
@@ -135,34 +165,42 @@ class DuplicateKeyCheck {
   std::vector<Frame> frames_;
 };
 
+// "source:line:column" of text's byte at offset (0-based), compiler-style, so editors can
+// jump to the spot.
+std::string source_line_column(const std::string& source, const std::string& text, size_t offset) {
+  size_t line = 1, col = 1;
+  for (size_t i = 0; i < offset && i < text.size(); ++i) {
+    if (text[i] == '\n') {
+      ++line;
+      col = 1;
+    } else {
+      ++col;
+    }
+  }
+  return source + ":" + std::to_string(line) + ":" + std::to_string(col);
+}
+
 json parse_json_text(const std::string& text, const std::string& source) {
   try {
-    return json::parse(text, DuplicateKeyCheck(source), /*allow_exceptions=*/true, /*ignore_comments=*/false);
+    return json::parse(text, ParseTimeChecks(source), /*allow_exceptions=*/true, /*ignore_comments=*/false);
   } catch (const json::parse_error& e) {
     // nlohmann: "[json.exception.parse_error.101] parse error at line L, column C: detail".
     std::string detail = e.what();
     const size_t column = detail.find(", column ");
     const size_t colon = column == std::string::npos ? std::string::npos : detail.find(": ", column);
     if (colon != std::string::npos) detail = detail.substr(colon + 2);
-    // Locate the byte nlohmann stopped at (1-based) as line:column.
-    size_t line = 1, col = 1;
-    for (size_t i = 0; i + 1 < e.byte && i < text.size(); ++i) {
-      if (text[i] == '\n') {
-        ++line;
-        col = 1;
-      } else {
-        ++col;
-      }
-    }
-    // Compiler-style "file:line:column: ..." so editors can jump to the spot.
-    throw SceneError(source + ":" + std::to_string(line) + ":" + std::to_string(col),
+    // e.byte: the 1-based byte nlohmann stopped at.
+    throw SceneError(source_line_column(source, text, e.byte > 0 ? e.byte - 1 : 0),
                      "invalid JSON: " + detail + " (comments, trailing commas, NaN and Infinity are not JSON)");
   } catch (const json::exception& e) {
-    // e.g. "[json.exception.out_of_range.406] number overflow parsing '1e400'".
+    // e.g. "[json.exception.out_of_range.406] number overflow parsing '1e400'": no byte
+    // offset, so the spot is where the quoted token first appears.
     std::string detail = e.what();
     const size_t bracket = detail.find("] ");
     if (bracket != std::string::npos) detail = detail.substr(bracket + 2);
-    throw SceneError(source, "invalid JSON: " + detail);
+    const size_t open = detail.find('\''), close = detail.rfind('\'');
+    const size_t at = open < close ? text.find(detail.substr(open + 1, close - open - 1)) : std::string::npos;
+    throw SceneError(at == std::string::npos ? source : source_line_column(source, text, at), "invalid JSON: " + detail);
   }
 }
 
@@ -339,10 +377,8 @@ class SceneReader {
       std::filesystem::path resolved(name);
       if (resolved.is_relative() && !base_dir_.empty()) resolved = std::filesystem::path(base_dir_) / resolved;
       mesh.file = resolved.lexically_normal().string();
-      std::error_code error;
-      if (!std::filesystem::is_regular_file(mesh.file, error))
-        fail(child(path, "file"), "no such file (resolved to " + mesh.file + ")", *file,
-             "relative paths are resolved against the scene file's folder");
+      if (const std::string problem = not_a_file(mesh.file); !problem.empty())
+        fail(child(path, "file"), problem, *file, "relative paths are resolved against the scene file's folder");
       if (const json* e = find(v, "element")) mesh.element = element_type(*e, child(path, "element"));
       return mesh;
     }
@@ -538,9 +574,8 @@ class SceneReader {
     std::filesystem::path resolved(name);
     if (resolved.is_relative() && !base_dir_.empty()) resolved = std::filesystem::path(base_dir_) / resolved;
     t.image = resolved.lexically_normal().string();
-    std::error_code error;
-    if (name.empty() || !std::filesystem::is_regular_file(t.image, error))
-      fail(child(path, "image"), "no such file (resolved to " + t.image + ")", image,
+    if (const std::string problem = name.empty() ? "empty file name" : not_a_file(t.image); !problem.empty())
+      fail(child(path, "image"), problem, image,
            "a grayscale or RGB PNG; relative paths are resolved against the scene file's folder");
     t.range = numbers<2>(require(v, path, "range", "[min, max]"), child(path, "range"));
     for (int k = 0; k < 2; ++k)
@@ -714,6 +749,9 @@ class SceneReader {
       o.report = string(*r, child(path, "report"));
       if (o.report.empty() || o.report == "." || o.report == ".." || o.report.find_first_of("/\\") != std::string::npos)
         fail(child(path, "report"), "not a plain file name", *r, "expected a file name such as \"report.json\" (it is written inside the output folder)");
+      if (o.report.size() > kMaxFileNameBytes)
+        fail(child(path, "report"), "a file name of " + std::to_string(o.report.size()) + " bytes", *r,
+             "expected at most " + std::to_string(kMaxFileNameBytes) + " bytes (the file-name limit of Linux file systems)");
     }
     return o;
   }

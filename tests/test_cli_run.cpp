@@ -104,6 +104,35 @@ TEST(CliRun, BadInputExitsWithCodeTwoAndOneLine) {
   expect_rejected("clusters", accordion.dump(), "enrichment.rotation_cluster_texels = 1", "DGTEX_MEMORY_LIMIT_MB=4096");
 }
 
+// A report named like another output would overwrite it (deformed.vtu) or fail to be
+// written after the whole run (frames, a folder): refused before the output folder exists.
+TEST(CliRun, AReportNamedLikeAnotherOutputIsRefusedBeforeTheRun) {
+  for (const std::string name : {"deformed.vtu", "final.state", "frames", "textures"}) {
+    nlohmann::json plate = nlohmann::json::parse(scene("0.3", "1", kClampedLeft));
+    plate["output"] = {{"report", name}};
+    const fs::path dir = fresh_dir("report_" + name);
+    std::ofstream(dir / "scene.json") << plate.dump();
+    const Result r = dgtex::test::run_cli(
+        "run " + (dir / "scene.json").string() + " --out " + (dir / "out").string() + " --quiet", dir);
+    EXPECT_EQ(r.exit_code, 2) << r.stderr_text;
+    EXPECT_NE(r.stderr_text.find("scene.json: output.report: the name of "), std::string::npos) << r.stderr_text;
+    EXPECT_NE(r.stderr_text.find("got \"" + name + "\""), std::string::npos) << r.stderr_text;
+    EXPECT_EQ(std::count(r.stderr_text.begin(), r.stderr_text.end(), '\n'), 1) << r.stderr_text;
+    EXPECT_FALSE(fs::exists(dir / "out")) << name;
+  }
+}
+
+// A segment length below the spacing of doubles never advanced the segmentation: the run
+// hung in its set-up. Shorter than a texel, a segment has no texels of its own.
+TEST(CliRun, ACutSegmentShorterThanATexelIsRefused) {
+  nlohmann::json spiral;
+  std::ifstream(std::string(DGTEX_SOURCE_DIR) + "/examples/scenes/spiral1.json") >> spiral;
+  spiral["enrichment"]["new_cut_length"] = 1e-300;
+  spiral.erase("render");
+  expect_rejected("new_cut_length", spiral.dump(),
+                  "enrichment.new_cut_length: a cut segment cannot be shorter than a texel, got 1e-300; expected ");
+}
+
 // fracture.json at T = 4096: at least 346.3 GiB of texel fields (dgtex/texel_memory_estimate.h).
 // Without the check the system killed such a run minutes in; now one line, at once.
 TEST(CliRun, CutsWhoseTexelFieldsCannotFitAreRefusedNamingTheResolution) {

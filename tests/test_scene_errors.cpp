@@ -290,6 +290,20 @@ TEST(SceneErrors, ProbesAndOutput) {
   expect_error(with(valid_scene(), "/probes/0/name"_json_pointer, ""), "probes[0].name", "\"\"", "non-empty");
   expect_error(with(valid_scene(), "/output"_json_pointer, {{"report", "../escape.json"}}), "output.report",
                "\"../escape.json\"", "plain file name");
+  // A name no Linux file system takes would fail only when the report is written, after the run.
+  expect_error(with(valid_scene(), "/output"_json_pointer, {{"report", std::string(256, 'r') + ".json"}}),
+               "output.report", "", "a file name of 261 bytes");
+  EXPECT_EQ(error_of_text(with(valid_scene(), "/output"_json_pointer, {{"report", std::string(250, 'r') + ".json"}}).dump()),
+            "");
+}
+
+TEST(SceneErrors, FilesThatAreFoldersOrDevices) {
+  // They exist, so "no such file" would mislead.
+  expect_error(with(valid_scene(), "/mesh"_json_pointer, {{"file", "/dev/null"}}), "mesh.file", "\"/dev/null\"",
+               "not a regular file (resolved to /dev/null)");
+  expect_error(with(valid_scene(), "/mesh"_json_pointer, {{"file", "/"}}), "mesh.file", "\"/\"", "not a regular file");
+  expect_error(with(valid_scene(), "/mesh"_json_pointer, {{"file", "/nonexistent/m.obj"}}), "mesh.file", "",
+               "no such file (resolved to /nonexistent/m.obj)");
 }
 
 TEST(SceneErrors, MalformedJsonReportsLineAndColumn) {
@@ -304,6 +318,34 @@ TEST(SceneErrors, MalformedJsonReportsLineAndColumn) {
   EXPECT_NE(error_of_text("{\"mesh\": {},}").find("invalid JSON"), std::string::npos);
   EXPECT_NE(error_of_text("").find("invalid JSON"), std::string::npos);
   EXPECT_NE(error_of_text("{\"penalty\": 1e400}").find("number overflow"), std::string::npos);
+  // nlohmann reports no position for an overflowing number; the literal's first place is it.
+  EXPECT_EQ(error_of_text("{\n  \"mesh\": {},\n  \"penalty\": -1e400}").rfind("bad.json:3:14: invalid JSON: number overflow", 0),
+            0u)
+      << error_of_text("{\n  \"mesh\": {},\n  \"penalty\": -1e400}");
+}
+
+TEST(SceneErrors, NestingDeeperThanAnySceneIsRefusedWhileParsing) {
+  // 100,000 levels took gigabytes of paths and overflowed the stack printing the value.
+  for (const int depth : {33, 100000}) {
+    const std::string text =
+        "{\"material\": {\"thickness\": " + std::string(depth, '[') + std::string(depth, ']') + "}}";
+    const std::string message = error_of_text(text);
+    EXPECT_EQ(message.rfind("bad.json: material.thickness[0][0]", 0), 0u) << message.substr(0, 200);
+    EXPECT_NE(message.find(": nested too deeply; expected at most 32 levels of objects and arrays"), std::string::npos)
+        << message.substr(0, 200);
+  }
+  // 32 levels are read (and refused for their type, not their depth).
+  const std::string deep32 = "{\"material\": {\"thickness\": " + std::string(30, '[') + std::string(30, ']') + "}}";
+  EXPECT_EQ(error_of_text(deep32).find("nested too deeply"), std::string::npos) << error_of_text(deep32);
+}
+
+TEST(SceneErrors, NulCharactersInKeysAndStrings) {
+  // A NUL would end the file name at it (output.report "x.json\0y" wrote x.json) or cut the
+  // message short.
+  const std::string key = error_of_text(std::string("{\"mesh\": {}, \"pen\\u0000alty\": 1}"));
+  EXPECT_EQ(key, "bad.json: pen\\u0000alty: a key with a NUL character; expected a key without NUL characters");
+  expect_error(with(valid_scene(), "/output"_json_pointer, {{"report", std::string("x.json\0y", 8)}}), "output.report",
+               "\"x.json\\u0000y\"", "a string with a NUL character");
 }
 
 TEST(SceneErrors, DuplicateKeysAreRejected) {

@@ -88,6 +88,7 @@ int run_command(int argc, char** argv) {
   std::unique_ptr<SceneRun> run;
   try {
     scene = load_scene(scene_path);
+    check_report_name(scene);
     // The set-up (cut tracing, the first enrichment solves, the model) can take minutes
     // at a high texture_resolution: say so, then how long it took.
     const auto setup_start = std::chrono::steady_clock::now();

@@ -8,10 +8,16 @@
 #include <system_error>
 #include <vector>
 
+#include "dgtex/scene_io.h"
+
 namespace fs = std::filesystem;
 
 namespace dgtex::cli {
 namespace {
+
+// What `dgtex run` writes into its output folder besides the report.
+constexpr const char* kRunOutputFiles[] = {"deformed.vtu", "cut_surface.obj", "final.state", "textures/enrichment.vdb"};
+constexpr const char* kRunOutputFolders[] = {"frames", "textures"};
 
 bool is_writable(const fs::path& path) { return ::access(path.c_str(), W_OK) == 0; }
 
@@ -85,11 +91,22 @@ bool remove_file(const fs::path& path) {
 
 }  // namespace
 
+void check_report_name(const Scene& scene) {
+  const std::string& name = scene.output.report;
+  for (const char* taken : kRunOutputFiles)
+    if (name == taken)
+      throw SceneError(scene.source_name, "output.report", "the name of another output of dgtex run", "\"" + name + "\"",
+                       "expected another file name, such as \"report.json\"");
+  for (const char* taken : kRunOutputFolders)
+    if (name == taken)
+      throw SceneError(scene.source_name, "output.report", "the name of an output folder of dgtex run", "\"" + name + "\"",
+                       "expected another file name, such as \"report.json\"");
+}
+
 int remove_earlier_run_outputs(const std::string& folder, const std::string& report_name) {
   const fs::path out(folder);
   int removed = 0;
-  for (const char* name : {"deformed.vtu", "cut_surface.obj", "final.state", "textures/enrichment.vdb"})
-    removed += remove_file(out / name);
+  for (const char* name : kRunOutputFiles) removed += remove_file(out / name);
   removed += remove_file(out / report_name);
   std::vector<fs::path> frames;  // listed first: removing while iterating may skip entries
   std::error_code error;

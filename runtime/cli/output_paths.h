@@ -5,6 +5,8 @@
 #include <CLI/CLI.hpp>
 #include <string>
 
+#include "dgtex/scene.h"
+
 namespace dgtex::cli {
 
 // Accepts a path whose folder exists and may be written to, and which is not itself a
@@ -19,6 +21,11 @@ CLI::Validator creatable_folder();
 // Creates FOLDER and its parents (nothing when it exists); throws std::invalid_argument naming
 // OPTION ("--out"), the folder and why it cannot be created.
 void create_output_folder(const std::string& folder, const char* option);
+
+// Throws SceneError naming output.report where the scene's report would take the name of
+// another output of `dgtex run` (deformed.vtu, cut_surface.obj, final.state, the folders
+// frames and textures): it would overwrite that output, or fail to be written at the end.
+void check_report_name(const Scene& scene);
 
 // Removes what an earlier `dgtex run` into FOLDER wrote, so that a run never leaves
 // another run's files beside its own (a longer run's later frames, or the report of a run
