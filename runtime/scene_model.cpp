@@ -5,6 +5,7 @@
 #include "dgtex/boundary_selection.h"
 #include "dgtex/material_texture.h"
 #include "dgtex/mesh_generators.h"
+#include "dgtex/model_memory_estimate.h"
 #include "dgtex/obj_import.h"
 #include "dgtex/scene_io.h"
 #include "dgtex/scene_mesh_checks.h"
@@ -18,6 +19,9 @@ Mesh build_scene_mesh(const Scene& scene) {
   validate_scene(scene);
   const MeshSpec& m = scene.mesh;
   const ElementType type = m.element.value_or(ElementType::quad8);
+  // A model that cannot fit is refused before its mesh is built (a file's once it is read).
+  if (const std::int64_t elements = generated_element_count(m); elements >= 0)
+    check_model_memory(scene, type, elements, available_memory_bytes());
   switch (m.source) {
     case MeshSource::rectangle:
       return make_rectangle(m.size[0], m.size[1], m.divisions[0], m.divisions[1], type, m.triangles);
@@ -26,7 +30,11 @@ Mesh build_scene_mesh(const Scene& scene) {
                            m.triangles);
     case MeshSource::hemisphere:
       return make_hemisphere(m.radius, m.hole_deg, m.divisions[0], m.divisions[1], type, m.triangles);
-    case MeshSource::file: return load_obj(m.file);
+    case MeshSource::file: {
+      Mesh mesh = load_obj(m.file);
+      check_model_memory(scene, mesh.type, mesh.num_elements(), available_memory_bytes());
+      return mesh;
+    }
   }
   return {};
 }

@@ -133,6 +133,22 @@ TEST(CliRun, ACutSegmentShorterThanATexelIsRefused) {
                   "enrichment.new_cut_length: a cut segment cannot be shorter than a texel, got 1e-300; expected ");
 }
 
+// The plate's 16 x 16 quad8 elements: a model bound of 24 MiB (dgtex/model_memory_estimate.h).
+// With 40 MiB to use it runs after a caution; with 20 it is refused before its mesh exists.
+TEST(CliRun, AModelNearOrBeyondTheMemoryIsCautionedOrRefused) {
+  const std::string plate = std::string(DGTEX_SOURCE_DIR) + "/examples/scenes/clamped_plate.json";
+  const fs::path dir = fresh_dir("model_memory");
+  const Result near = dgtex::test::run_cli("run " + plate + " --out " + (dir / "near").string() + " --quiet --no-render",
+                                           dir, "DGTEX_MEMORY_LIMIT_MB=40");
+  EXPECT_EQ(near.exit_code, 0) << near.stderr_text;
+  EXPECT_NE(near.stderr_text.find("dgtex run: warning: " + plate + ": mesh.divisions [16, 16]: the model of its 256 "
+                                  "elements needs at least 24 MiB of the 40 MiB of memory available"),
+            std::string::npos)
+      << near.stderr_text;
+  expect_rejected("model_memory_beyond", std::string(std::istreambuf_iterator<char>(std::ifstream(plate).rdbuf()), {}),
+                  "mesh.divisions: 256 quad8 elements need at least 24 MiB", "DGTEX_MEMORY_LIMIT_MB=20");
+}
+
 // fracture.json at T = 4096: at least 346.3 GiB of texel fields (dgtex/texel_memory_estimate.h).
 // Without the check the system killed such a run minutes in; now one line, at once.
 TEST(CliRun, CutsWhoseTexelFieldsCannotFitAreRefusedNamingTheResolution) {

@@ -19,6 +19,7 @@
 #include "dgtex/mesh_error.h"
 #include "dgtex/mesh_output.h"
 #include "dgtex/model_error.h"
+#include "dgtex/model_memory_estimate.h"
 #include "dgtex/scene_io.h"
 #include "dgtex/scene_run.h"
 #include "dgtex/shell_state.h"
@@ -96,6 +97,8 @@ int run_command(int argc, char** argv) {
     // Near the memory limit the set-up can run for minutes before the system kills it: say
     // so before the fields are allocated (a scene that cannot fit at all is refused).
     SceneRunOptions run_options;
+    const std::string model_caution = model_memory_caution(scene, available_memory_bytes());
+    if (!model_caution.empty()) std::fprintf(stderr, "dgtex run: warning: %s: %s\n", scene_path.c_str(), model_caution.c_str());
     run_options.before_texel_fields = [&](const TexelFields& fields, std::int64_t available) {
       const std::string caution = texel_memory_caution(fields, available);
       if (!caution.empty()) std::fprintf(stderr, "dgtex run: warning: %s: %s\n", scene_path.c_str(), caution.c_str());

@@ -1,0 +1,54 @@
+#include "dgtex/model_memory_estimate.h"
+
+#include <string>
+
+#include "dgtex/scene_io.h"
+#include "dgtex/texel_memory_estimate.h"
+
+namespace dgtex {
+
+std::int64_t model_memory_lower_bound(ElementType type, std::int64_t elements) {
+  return elements * (type == ElementType::tri6 ? kTri6ModelBytesPerElement : kQuad8ModelBytesPerElement);
+}
+
+std::int64_t generated_element_count(const MeshSpec& mesh) {
+  if (mesh.source == MeshSource::file) return -1;
+  const std::int64_t cells = static_cast<std::int64_t>(mesh.divisions[0]) * mesh.divisions[1];
+  return mesh.element.value_or(ElementType::quad8) == ElementType::tri6 ? 2 * cells : cells;
+}
+
+void check_model_memory(const Scene& scene, ElementType type, std::int64_t elements, std::int64_t available_bytes) {
+  if (available_bytes < 0) return;
+  const std::int64_t needed = model_memory_lower_bound(type, elements);
+  if (needed <= available_bytes) return;
+  const bool generated = scene.mesh.source != MeshSource::file;
+  const std::int64_t fitting = available_bytes / model_memory_lower_bound(type, 1);
+  const std::string kind = type == ElementType::tri6 ? "tri6" : "quad8";
+  const std::string problem = std::to_string(elements) + " " + kind + " elements need at least " +
+                              memory_size_text(needed) + " for the model and its factor (" +
+                              std::to_string(model_memory_lower_bound(type, 1) / 1024) + " KiB an element), more than the " +
+                              memory_size_text(available_bytes) + " of memory available";
+  const std::string got = generated ? "[" + std::to_string(scene.mesh.divisions[0]) + ", " +
+                                          std::to_string(scene.mesh.divisions[1]) + "]"
+                                    : "\"" + scene.mesh.file + "\"";
+  const std::string valid = "expected a mesh of at most " + std::to_string(fitting) + " " + kind +
+                            " elements (the most that could fit on this machine)";
+  throw SceneError(scene.source_name.empty() ? "scene" : scene.source_name, generated ? "mesh.divisions" : "mesh.file",
+                   problem, got, valid);
+}
+
+std::string model_memory_caution(const Scene& scene, std::int64_t available_bytes) {
+  const std::int64_t elements = generated_element_count(scene.mesh);
+  if (elements < 0 || available_bytes < 0) return "";
+  const ElementType type = scene.mesh.element.value_or(ElementType::quad8);
+  const std::int64_t needed = model_memory_lower_bound(type, elements);
+  // Beyond the memory available check_model_memory refuses the scene instead.
+  if (2 * needed <= available_bytes || needed > available_bytes) return "";
+  return "mesh.divisions [" + std::to_string(scene.mesh.divisions[0]) + ", " + std::to_string(scene.mesh.divisions[1]) +
+         "]: the model of its " + std::to_string(elements) + " elements needs at least " + memory_size_text(needed) +
+         " of the " + memory_size_text(available_bytes) +
+         " of memory available, and runs measured 1.2-1.9x that bound; the run may be killed for memory (fewer "
+         "divisions are safer)";
+}
+
+}  // namespace dgtex
