@@ -91,6 +91,20 @@ std::string join(const std::vector<std::string>& words, const std::string& separ
 double norm(const Vec3& v) { return std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]); }
 Vec3 difference(const Vec3& a, const Vec3& b) { return {a[0] - b[0], a[1] - b[1], a[2] - b[2]}; }
 
+// Whether two cuts or creases run along the same polyline, in either direction.
+bool same_path(const Cut& a, const Cut& b) {
+  if (a.kind != b.kind) return false;
+  auto same_points = [](const auto& p, const auto& q, auto&& equal) {
+    if (p.size() != q.size()) return false;
+    return std::equal(p.begin(), p.end(), q.begin(), equal) || std::equal(p.begin(), p.end(), q.rbegin(), equal);
+  };
+  if (a.kind == Cut::Kind::points)
+    return same_points(a.points, b.points, [](const Vec3& x, const Vec3& y) { return x == y; });
+  return same_points(a.surface_points, b.surface_points, [](const CutSurfacePoint& x, const CutSurfacePoint& y) {
+    return x.element == y.element && x.xi == y.xi;
+  });
+}
+
 // Checks made while nlohmann parses, each naming the JSON path where it fails: duplicate keys
 // (nlohmann would silently keep the last one), nesting deeper than any scene needs (each
 // level keeps its path here and printing a value recurses per level: 80,000 levels
@@ -239,7 +253,12 @@ class SceneReader {
     if (const json* v = find(root, "creases")) {  // creases: the cut point forms, never progressive
       for_each_item(*v, "creases", [&](const json& e, const std::string& p) {
         check_keys(e, p, {"points", "surface_points"});
-        scene.creases.push_back(read_cut(e, p));
+        Cut crease = read_cut(e, p);
+        // Two creases along one path would give two identical functions: a singular stiffness.
+        for (size_t k = 0; k < scene.creases.size(); ++k)
+          if (same_path(scene.creases[k], crease))
+            fail(p, "the same path as " + item("creases", k), e, "expected each crease once");
+        scene.creases.push_back(std::move(crease));
       });
     }
     if (const json* v = find(root, "enrichment")) scene.enrichment = read_enrichment(*v, "enrichment");

@@ -339,6 +339,22 @@ TEST(SceneErrors, NestingDeeperThanAnySceneIsRefusedWhileParsing) {
   EXPECT_EQ(error_of_text(deep32).find("nested too deeply"), std::string::npos) << error_of_text(deep32);
 }
 
+// Two creases along one path give two identical functions: the stiffness was singular and
+// the run ended with "penalty too low?".
+TEST(SceneErrors, ACreaseListedTwiceIsRefused) {
+  json twice = valid_scene();
+  twice["creases"] = {{{"points", {{0.5, 0, 0}, {0.5, 1, 0}}}}, {{"points", {{0.2, 0, 0}, {0.2, 1, 0}}}},
+                      {{"points", {{0.5, 1, 0}, {0.5, 0, 0}}}}};
+  expect_error(twice, "creases[2]", "{\"points\":[[0.5,1,0],[0.5,0,0]]}", "the same path as creases[0]");
+  json surface = valid_scene();
+  const json crease = {{"surface_points", {{{"element", 0}, {"xi", {0, -1}}}, {{"element", 0}, {"xi", {0, 1}}}}}};
+  surface["creases"] = {crease, crease};
+  expect_error(surface, "creases[1]", "", "the same path as creases[0]");
+  json different = valid_scene();
+  different["creases"] = {{{"points", {{0.5, 0, 0}, {0.5, 1, 0}}}}, {{"points", {{0.5, 0, 0}, {0.5, 0.9, 0}}}}};
+  EXPECT_EQ(error_of_text(different.dump()), "");
+}
+
 TEST(SceneErrors, NulCharactersInKeysAndStrings) {
   // A NUL would end the file name at it (output.report "x.json\0y" wrote x.json) or cut the
   // message short.
