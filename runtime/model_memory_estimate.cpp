@@ -22,16 +22,16 @@ void check_model_memory(const Scene& scene, ElementType type, std::int64_t eleme
   const std::int64_t needed = model_memory_lower_bound(type, elements);
   if (needed <= available_bytes) return;
   const bool generated = scene.mesh.source != MeshSource::file;
-  const std::int64_t fitting = available_bytes / model_memory_lower_bound(type, 1);
+  const std::int64_t per_element = model_memory_lower_bound(type, 1);
   const std::string kind = type == ElementType::tri6 ? "tri6" : "quad8";
   const std::string problem = std::to_string(elements) + " " + kind + " elements need at least " +
                               memory_size_text(needed) + " for the model and its factor (" +
-                              std::to_string(model_memory_lower_bound(type, 1) / 1024) + " KiB an element), more than the " +
+                              std::to_string(per_element / 1024) + " KiB an element), more than the " +
                               memory_size_text(available_bytes) + " of memory available";
   const std::string got = generated ? "[" + std::to_string(scene.mesh.divisions[0]) + ", " +
                                           std::to_string(scene.mesh.divisions[1]) + "]"
                                     : "\"" + scene.mesh.file + "\"";
-  const std::string valid = "expected a mesh of at most " + std::to_string(fitting) + " " + kind +
+  const std::string valid = "expected a mesh of at most " + std::to_string(available_bytes / per_element) + " " + kind +
                             " elements (the most that could fit on this machine)";
   throw SceneError(scene.source_name.empty() ? "scene" : scene.source_name, generated ? "mesh.divisions" : "mesh.file",
                    problem, got, valid);

@@ -150,7 +150,7 @@ class ParseTimeChecks {
   }
 
  private:
-  // Scene files nest 5 levels deep at most (boundary[0].select.plane.normal[0]).
+  // Scene files nest 6 levels deep at most (the root, boundary, boundary[0], select, plane, normal).
   static constexpr std::size_t kMaxNesting = 32;
 
   struct Frame {
