@@ -22,6 +22,7 @@
 #include "dgtex/kernels/multigrid_transfer.h"
 #include "dgtex/kernels/multigrid_unknowns.h"
 #include "dgtex/stage_timer.h"
+#include "api_argument_checks.h"
 #include "banded_cholesky.h"
 #include "grid_nested_dissection.h"
 #include "multigrid_buffer.h"
@@ -875,9 +876,9 @@ LaplaceSolveStats LaplaceMultigrid::solve(kernels::TexelTile& tile, std::vector<
     }
     stats.relative_residual = relative;
     if (!(relative <= o.tolerance))
-      throw std::runtime_error("Laplace multigrid: relative residual " + std::to_string(relative) + " after " +
-                               std::to_string(stats.iterations) + " cycles, tolerance " + std::to_string(o.tolerance) +
-                               " not reached; raise max_cycles or use the cholmod solver");
+      throw std::runtime_error("Laplace multigrid: relative residual " + detail::short_number(relative) + " after " +
+                               std::to_string(stats.iterations) + " cycles, tolerance " +
+                               detail::short_number(o.tolerance) + " not reached; raise max_cycles or use the cholmod solver");
   } else {
     record(0.0);
     std::fill(fine.x.begin(), fine.x.end(), 0.0);

@@ -19,6 +19,7 @@
 #include "dgtex/accuracy_benchmark.h"
 #include "dgtex/benchmark_machine.h"
 #include "gnuplot_chart.h"
+#include "option_errors.h"
 #include "output_paths.h"
 
 namespace dgtex::cli {
@@ -115,7 +116,9 @@ int bench_accuracy_command(int argc, char** argv) {
   app.add_option("--charts", charts, "plate, quadrature, texture, tolerance, rotation, scene_quadrature")
       ->delimiter(',')
       ->capture_default_str();
-  app.add_option("--out", out_dir, "output folder (charts, accuracy.json, accuracy.md)")->capture_default_str();
+  app.add_option("--out", out_dir, "output folder (charts, accuracy.json, accuracy.md)")
+      ->capture_default_str()
+      ->check(creatable_folder());
   app.add_option("--format", format, "chart format: png or svg")->capture_default_str()->check(CLI::IsMember({"png", "svg"}));
   app.add_option("--clock", clock, "cpu (process CPU time; robust on a shared machine with 1 thread) or wall")
       ->capture_default_str()->check(CLI::IsMember({"cpu", "wall"}));
@@ -159,7 +162,7 @@ int bench_accuracy_command(int argc, char** argv) {
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
-    return app.exit(e) == 0 ? 0 : 2;
+    return exit_on_option_error(app, e);
   }
   const std::string command = bench_command_line(argc, argv);
   try {

@@ -16,6 +16,7 @@
 #include "dgtex/benchmark_machine.h"
 #include "dgtex/laplace_benchmark.h"
 #include "dgtex/laplace_domains.h"
+#include "option_errors.h"
 #include "output_paths.h"
 
 namespace dgtex::cli {
@@ -69,14 +70,15 @@ int bench_laplace_command(int argc, char** argv) {
   app.add_option("--repeat", repeat, "runs per case; the best time counts")
       ->capture_default_str()
       ->check(at_least_one());
-  app.add_option("--tolerance", tolerance, "relative residual to reach")->capture_default_str();
+  app.add_option("--tolerance", tolerance, "relative residual to reach")->capture_default_str()->check(relative_tolerance());
   app.add_option("--max-other-unknowns", max_other_unknowns,
                  "skip solvers other than multigrid above this many unknowns")->capture_default_str();
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
-    return app.exit(e) == 0 ? 0 : 2;
+    return exit_on_option_error(app, e);
   }
+  if (!outputs_are_distinct("dgtex bench laplace", {{"--json", &json_path}, {"--chart", &chart_path}})) return 2;
   try {
     std::vector<LaplaceDomain> domain_list;
     std::vector<LaplaceBenchSolver> solver_list;

@@ -16,6 +16,7 @@
 #include "gnuplot_chart.h"
 #include "dgtex/benchmark_machine.h"
 #include "dgtex/render_benchmark.h"
+#include "option_errors.h"
 #include "output_paths.h"
 
 namespace dgtex::cli {
@@ -83,8 +84,9 @@ int bench_render_command(int argc, char** argv) {
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
-    return app.exit(e) == 0 ? 0 : 2;
+    return exit_on_option_error(app, e);
   }
+  if (!outputs_are_distinct("dgtex bench render", {{"--json", &json_path}, {"--chart", &chart_path}})) return 2;
   options.partial_cut = !complete_only;
   try {
     const std::string machine = describe_machine_and_probe();

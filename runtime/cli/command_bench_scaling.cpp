@@ -23,6 +23,7 @@
 #include "dgtex/model_error.h"
 #include "dgtex/scaling_benchmark.h"
 #include "dgtex/scene_io.h"
+#include "option_errors.h"
 #include "output_paths.h"
 
 namespace dgtex::cli {
@@ -186,8 +187,11 @@ int bench_scaling_command(int argc, char** argv) {
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
-    return app.exit(e) == 0 ? 0 : 2;
+    return exit_on_option_error(app, e);
   }
+  if (!outputs_are_distinct("dgtex bench scaling",
+                            {{"--json", &json_path}, {"--markdown", &markdown_path}, {"--chart", &chart_path}}))
+    return 2;
   for (const std::string& f : families)
     if (std::find(kFamilies.begin(), kFamilies.end(), f) == kFamilies.end()) {
       std::fprintf(stderr, "dgtex bench scaling: --families: unknown family '%s'; valid: enrichment_solve, assembly, "

@@ -25,6 +25,7 @@
 #include "dgtex/model_error.h"
 #include "dgtex/scene_benchmark.h"
 #include "dgtex/scene_io.h"
+#include "option_errors.h"
 #include "output_paths.h"
 
 namespace dgtex::cli {
@@ -384,9 +385,18 @@ int bench_scenes_command(int argc, char** argv) {
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
-    return app.exit(e) == 0 ? 0 : 2;
+    return exit_on_option_error(app, e);
   }
+  if (!outputs_are_distinct("dgtex bench scenes", {{"--json", &json_path}, {"--markdown", &markdown_path}})) return 2;
   if (threads > 0) omp_set_num_threads(threads);
+  if (const int spare = omp_get_max_threads() - 1; cut_update_threads > spare) {
+    const std::string valid = spare == 0 ? "0 (the steps run on one thread: none to spare beside them)"
+                                         : "0 (balanced step by step) or 1 to " + std::to_string(spare) +
+                                               " (--threads less one)";
+    std::fprintf(stderr, "dgtex bench scenes: --cut-update-threads: %d is more than the steps' threads (%d) can spare; "
+                 "expected %s\n", cut_update_threads, spare + 1, valid.c_str());
+    return 2;
+  }
 
   std::vector<SceneEntry> entries;
   for (const std::string& s : scenes) {

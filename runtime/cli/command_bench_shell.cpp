@@ -20,6 +20,7 @@
 #include "dgtex/mesh_error.h"
 #include "dgtex/scene_io.h"
 #include "dgtex/shell_benchmark.h"
+#include "option_errors.h"
 #include "output_paths.h"
 
 namespace dgtex::cli {
@@ -84,7 +85,9 @@ int bench_shell_command(int argc, char** argv) {
   app.add_option("--gemm-size", gemm_size, "n of the n x n Eigen GEMM reference")
       ->capture_default_str()
       ->check(at_least_one());
-  app.add_option("--tolerance", solver.relative_tolerance, "PCG relative residual bound per step")->capture_default_str();
+  app.add_option("--tolerance", solver.relative_tolerance, "PCG relative residual bound per step")
+      ->capture_default_str()
+      ->check(relative_tolerance());
   app.add_option("--refactor-after", solver.refactor_after_iterations,
                  "refactorise when a step needed more PCG iterations than this")->capture_default_str();
   std::string preconditioner = "element_local";
@@ -106,8 +109,9 @@ int bench_shell_command(int argc, char** argv) {
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
-    return app.exit(e) == 0 ? 0 : 2;
+    return exit_on_option_error(app, e);
   }
+  if (!outputs_are_distinct("dgtex bench shell", {{"--json", &json_path}, {"--chart", &chart_path}})) return 2;
   solver.preconditioner_pattern =
       preconditioner == "full" ? PreconditionerPattern::full : PreconditionerPattern::element_local;
   solver.overlap_factorization = !synchronous_factorization;

@@ -13,9 +13,11 @@
 #include <vector>
 
 #include "commands.h"
+#include "count_option.h"
 #include "dgtex/png_io.h"
 #include "dgtex/shell_renderer.h"
 #include "dgtex/shell_state.h"
+#include "option_errors.h"
 #include "output_paths.h"
 
 namespace dgtex::cli {
@@ -37,12 +39,13 @@ std::filesystem::path image_path(const std::string& out) {
 CLI::Validator writable_image() {
   return CLI::Validator(
       [](std::string& value) -> std::string {
+        if (value.empty()) return "an empty path; give a folder or a .png file";
         const std::filesystem::path image = image_path(value);
-        std::string folder = image.has_parent_path() ? image.parent_path().string() : ".";
-        if (std::string why = creatable_folder()(folder); !why.empty()) return why;
         std::string file = image.string();
         std::error_code error;
-        return std::filesystem::exists(image, error) ? writable_file()(file) : "";
+        // A new image: its path as the folders to create (the nearest existing one writable,
+        // every name within the file systems' limit).
+        return std::filesystem::exists(image, error) ? writable_file()(file) : creatable_folder()(file);
       },
       "DIR|FILE.png");
 }
@@ -73,15 +76,14 @@ int render_command(int argc, char** argv) {
   app.add_option("--camera-target", target, "point looked at x y z")->expected(3);
   app.add_option("--camera-up", up, "up direction x y z")->expected(3);
   app.add_option("--fov", settings.fov_deg, "vertical field of view in degrees")->capture_default_str();
-  app.add_option("--background", background, "background colour r g b in [0, 1]")->expected(3);
+  app.add_option("--background", background, "background colour r g b in [0, 1]")->expected(3)->check(colour_component());
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp&) {
     std::printf("%s", app.help().c_str());
     return 0;
   } catch (const CLI::ParseError& e) {
-    std::fprintf(stderr, "dgtex render: %s (see dgtex render --help)\n", e.what());
-    return 2;
+    return exit_on_option_error(app, e);
   }
 
   ShellState state;

@@ -27,6 +27,7 @@
 #include "dgtex/texel_memory_estimate.h"
 #include "api_argument_checks.h"
 #include "interrupt_request.h"
+#include "option_errors.h"
 #include "output_paths.h"
 
 namespace dgtex::cli {
@@ -76,7 +77,7 @@ int run_command(int argc, char** argv) {
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
-    return app.exit(e) == 0 ? 0 : 2;
+    return exit_on_option_error(app, e);
   }
   if (threads > 0) omp_set_num_threads(threads);
   // Progress: on a terminal the set-up and one line rewritten every step; into a log (not a
@@ -277,6 +278,7 @@ int run_command(int argc, char** argv) {
   const fs::path report_path = out / scene.output.report;
   std::ofstream file(report_path);
   file << report.dump(2) << "\n";
+  file.close();  // a full disk shows only when the buffer is written out
   if (!file) {
     std::fprintf(stderr, "dgtex run: cannot write %s\n", report_path.string().c_str());
     return 1;

@@ -1,5 +1,5 @@
 #pragma once
-// Range checks for integer options. CLI11's PositiveNumber reports a refused 0 as "not in
+// Range checks for numeric options. CLI11's PositiveNumber reports a refused 0 as "not in
 // range 0.000000 to 1797...(309 digits)"; these name the integers an option takes.
 #include <CLI/CLI.hpp>
 #include <limits>
@@ -14,5 +14,21 @@ inline CLI::Range zero_or_more() { return CLI::Range(0, std::numeric_limits<int>
 
 // OpenMP thread counts, as `dgtex run --threads` takes them.
 inline CLI::Range thread_count() { return CLI::Range(1, 1024); }
+
+// A relative tolerance: 0 < t < 1 (0, a negative or NaN could never be met; 1 is met by any
+// guess).
+inline CLI::Validator relative_tolerance() {
+  return CLI::Validator(
+      [](std::string& value) -> std::string {
+        double t = 0;
+        if (!CLI::detail::lexical_cast(value, t) || !(t > 0 && t < 1))
+          return "Value " + value + " is not a relative tolerance; expected a number in (0, 1), e.g. 1e-8";
+        return "";
+      },
+      "(0, 1)");
+}
+
+// A colour component in [0, 1] (NaN refused).
+inline CLI::Range colour_component() { return CLI::Range(0.0, 1.0); }
 
 }  // namespace dgtex::cli

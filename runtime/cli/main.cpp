@@ -58,6 +58,11 @@ int main(int argc, char** argv) {
     if (what == "scenes") return dgtex::cli::bench_scenes_command(argc - 2, argv + 2);
     if (what == "scaling") return dgtex::cli::bench_scaling_command(argc - 2, argv + 2);
     if (what == "accuracy") return dgtex::cli::bench_accuracy_command(argc - 2, argv + 2);
+    if (what == "--help" || what == "-h") {
+      std::printf("Usage: dgtex bench BENCHMARK [OPTIONS]; benchmarks: laplace, shell, render, scenes, scaling, "
+                  "accuracy (dgtex bench BENCHMARK --help for each one's options)\n");
+      return 0;
+    }
     std::fprintf(stderr,
                  "dgtex bench: unknown benchmark '%s' (valid: laplace, shell, render, scenes, scaling, accuracy)\n",
                  what.c_str());

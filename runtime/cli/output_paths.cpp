@@ -3,6 +3,7 @@
 #include <unistd.h>
 
 #include <filesystem>
+#include <cstdio>
 #include <fstream>
 #include <stdexcept>
 #include <system_error>
@@ -21,6 +22,16 @@ constexpr const char* kRunOutputFolders[] = {"frames", "textures"};
 
 bool is_writable(const fs::path& path) { return ::access(path.c_str(), W_OK) == 0; }
 
+// "" when every name in PATH fits the file systems' limit (NAME_MAX, 255 bytes), else why
+// not: such a path fails only when the command writes it, after its work.
+std::string check_name_lengths(const fs::path& path) {
+  for (const fs::path& part : path)
+    if (part.native().size() > 255)
+      return "a name in '" + path.string() + "' has " + std::to_string(part.native().size()) +
+             " bytes; file systems take at most 255";
+  return "";
+}
+
 // "" when FOLDER is a folder this process may create files in, else why not.
 std::string check_writable_folder(const fs::path& folder) {
   std::error_code error;
@@ -34,8 +45,10 @@ std::string check_writable_folder(const fs::path& folder) {
 CLI::Validator writable_file() {
   return CLI::Validator(
       [](std::string& value) -> std::string {
-        if (value.empty()) return "";
+        // Called only for a given option: an empty value is a mistake, not "no file".
+        if (value.empty()) return "an empty path; give a file name";
         const fs::path path(value);
+        if (std::string why = check_name_lengths(path); !why.empty()) return why;
         std::error_code error;
         if (fs::is_directory(path, error)) return "'" + value + "' is a folder; give a file name";
         const fs::path folder = path.has_parent_path() ? path.parent_path() : fs::path(".");
@@ -50,13 +63,34 @@ CLI::Validator writable_file() {
 CLI::Validator creatable_folder() {
   return CLI::Validator(
       [](std::string& value) -> std::string {
-        if (value.empty()) return "";
+        // An empty --out would write into (and clear an earlier run's files from) the
+        // working folder.
+        if (value.empty()) return "an empty path; give a folder (\".\" for the working folder)";
+        if (std::string why = check_name_lengths(fs::path(value)); !why.empty()) return why;
         fs::path existing = fs::absolute(fs::path(value)).lexically_normal();
         std::error_code error;
         while (!fs::exists(existing, error) && existing.has_relative_path()) existing = existing.parent_path();
         return check_writable_folder(existing);
       },
       "DIR");
+}
+
+bool outputs_are_distinct(const std::string& command,
+                          std::initializer_list<std::pair<const char*, const std::string*>> outputs) {
+  std::vector<std::pair<const char*, fs::path>> given;
+  for (const auto& [option, value] : outputs) {
+    if (value->empty()) continue;
+    std::error_code error;
+    const fs::path file = fs::weakly_canonical(fs::absolute(*value), error);
+    for (const auto& [earlier, earlier_file] : given)
+      if (earlier_file == file) {
+        std::fprintf(stderr, "%s: %s and %s both name '%s'; give each its own file (the second would replace the first)\n",
+                     command.c_str(), earlier, option, value->c_str());
+        return false;
+      }
+    given.emplace_back(option, file);
+  }
+  return true;
 }
 
 void create_output_folder(const std::string& folder, const char* option) {
@@ -120,6 +154,7 @@ int remove_earlier_run_outputs(const std::string& folder, const std::string& rep
 void write_output_file(const std::string& path, const std::string& text, const char* option) {
   std::ofstream out(path);
   out << text;
+  out.close();  // a full disk (/dev/full) shows only when the buffer is written out
   if (!out) throw std::runtime_error(std::string("cannot write ") + option + " file '" + path + "'");
 }
 

@@ -3,20 +3,31 @@
 // write their results at the end, so a path they could not write is refused when the
 // options are read, before the work, and the write itself names the option it came from.
 #include <CLI/CLI.hpp>
+#include <initializer_list>
 #include <string>
+#include <utility>
 
 #include "dgtex/scene.h"
 
 namespace dgtex::cli {
 
 // Accepts a path whose folder exists and may be written to, and which is not itself a
-// folder or a read-only file. An empty value passes (the option was not given).
+// folder or a read-only file. Refuses an empty path (CLI11 checks only options that were
+// given) and names of more than 255 bytes.
 CLI::Validator writable_file();
 
 // Accepts an existing folder that may be written to, or a path whose nearest existing
 // part is such a folder (the command creates the rest when it writes). Nothing is created
-// here: a run that fails later leaves no empty output folder behind.
+// here: a run that fails later leaves no empty output folder behind. Refuses an empty path
+// and names of more than 255 bytes.
 CLI::Validator creatable_folder();
+
+// Whether the output files given to a command (options and their values; empty: not
+// given) are distinct files; if not, prints one line naming the two options and the file to
+// stderr, prefixed with the command's name ("dgtex bench scaling"). One file given twice
+// would keep only the output written last.
+bool outputs_are_distinct(const std::string& command,
+                          std::initializer_list<std::pair<const char*, const std::string*>> outputs);
 
 // Creates FOLDER and its parents (nothing when it exists); throws std::invalid_argument naming
 // OPTION ("--out"), the folder and why it cannot be created.

@@ -1,0 +1,105 @@
+// Command-line values of every command, as a fuzzing pass over the options found them
+// (session 67): each bad value ends the command at once with exit code 2 and one line naming
+// the command, the option and the value; a write that fails says so (exit code 1).
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <filesystem>
+#include <string>
+
+#include "cli_test_support.h"
+
+namespace fs = std::filesystem;
+
+namespace {
+
+using dgtex::test::CliResult;
+using dgtex::test::run_cli;
+
+const std::string kScenes = std::string(DGTEX_SOURCE_DIR) + "/examples/scenes";
+
+struct Refusal {
+  const char* args;
+  const char* message_start;  // the whole of stderr starts with it
+};
+
+TEST(CliOptions, BadValuesAreOneLineNamingTheCommandAndOption) {
+  const fs::path dir = dgtex::test::fresh_dir("dgtex_cli_options", "refusals");
+  const std::string plate = kScenes + "/clamped_plate.json";
+  const Refusal refusals[] = {
+      // CLI11's own errors, which it followed with "Run with --help for more information."
+      {"run PLATE --out DIR/o --bogus", "dgtex run: The following argument was not expected: --bogus (see dgtex run --help)"},
+      {"bench scenes --threads 0", "dgtex bench scenes: --threads: Value 0 not in range 1 to 1024"},
+      // An empty path is a given option, not a missing one: --out '' wrote into the
+      // working folder and removed an earlier run's files there.
+      {"run PLATE --out ''", "dgtex run: --out: an empty path; give a folder"},
+      {"bench scaling --json ''", "dgtex bench scaling: --json: an empty path; give a file name"},
+      {"bench accuracy --out ''", "dgtex bench accuracy: --out: an empty path"},
+      {"render x.state --out ''", "dgtex render: --out: an empty path"},
+      // Names over 255 bytes failed only when written, after the work.
+      {"bench scaling --json DIR/NAME300.json", "dgtex bench scaling: --json: a name in '"},
+      {"run PLATE --out DIR/NAME300", "dgtex run: --out: a name in '"},
+      // Tolerances no solve can meet, or that any guess meets.
+      {"bench shell --tolerance 0", "dgtex bench shell: --tolerance: Value 0 is not a relative tolerance"},
+      {"bench shell --tolerance -1", "dgtex bench shell: --tolerance: Value -1 is not a relative tolerance"},
+      {"bench laplace --tolerance 1", "dgtex bench laplace: --tolerance: Value 1 is not a relative tolerance"},
+      {"render x.state --background 2 0 0", "dgtex render: --background: Value 2 not in range"},
+      {"bench scenes --threads 1 --cut-update-threads 1",
+       "dgtex bench scenes: --cut-update-threads: 1 is more than the steps' threads (1) can spare"},
+      // One file for two outputs kept only the one written last.
+      {"bench scaling --json DIR/a.json --markdown DIR/a.json",
+       "dgtex bench scaling: --json and --markdown both name '"},
+      {"bench shell --json DIR/a.json --chart DIR/./a.json", "dgtex bench shell: --json and --chart both name '"},
+  };
+  for (const Refusal& refusal : refusals) {
+    std::string args = refusal.args;
+    auto replace = [&](const std::string& from, const std::string& to) {
+      for (std::size_t at = args.find(from); at != std::string::npos; at = args.find(from, at + to.size()))
+        args.replace(at, from.size(), to);
+    };
+    replace("NAME300", std::string(300, 'n'));
+    replace("PLATE", plate);
+    replace("DIR", dir.string());
+    const CliResult r = run_cli(args, dir);
+    EXPECT_EQ(r.exit_code, 2) << refusal.args << ": " << r.stderr_text;
+    EXPECT_EQ(r.stderr_text.rfind(refusal.message_start, 0), 0u) << refusal.args << ": " << r.stderr_text;
+    EXPECT_EQ(std::count(r.stderr_text.begin(), r.stderr_text.end(), '\n'), 1) << refusal.args << ": " << r.stderr_text;
+  }
+  EXPECT_FALSE(fs::exists(dir / "a.json"));
+}
+
+// An empty --out must not make the working folder the output folder: run there, nothing
+// appears in it.
+TEST(CliOptions, AnEmptyOutputFolderWritesNothingIntoTheWorkingFolder) {
+  const fs::path dir = dgtex::test::fresh_dir("dgtex_cli_options", "empty_out");
+  const fs::path work = dir / "work";
+  fs::create_directories(work);
+  const CliResult r =
+      run_cli("run " + kScenes + "/clamped_plate.json --out '' --quiet --no-render", dir, "cd " + work.string() + " &&");
+  EXPECT_EQ(r.exit_code, 2) << r.stderr_text;
+  EXPECT_TRUE(fs::is_empty(work));
+}
+
+// A failed write is a failure: the JSON and Markdown were buffered and never flushed, so a
+// full disk (/dev/full) ended the command with exit code 0.
+TEST(CliOptions, AWriteThatFailsEndsWithExitCodeOne) {
+  const fs::path dir = dgtex::test::fresh_dir("dgtex_cli_options", "full");
+  for (const char* option : {"--json", "--markdown"}) {
+    const CliResult r = run_cli(std::string("bench scaling --families polar_decomposition --polar-count 1000 --repeats 1 "
+                                            "--threads-list 1 ") +
+                                    option + " /dev/full",
+                                dir);
+    EXPECT_EQ(r.exit_code, 1) << option << ": " << r.stderr_text;
+    EXPECT_NE(r.stderr_text.find(std::string("cannot write ") + option + " file '/dev/full'"), std::string::npos)
+        << r.stderr_text;
+  }
+}
+
+TEST(CliOptions, BenchHelpListsTheBenchmarks) {
+  const fs::path dir = dgtex::test::fresh_dir("dgtex_cli_options", "help");
+  const CliResult r = run_cli("bench --help", dir);
+  EXPECT_EQ(r.exit_code, 0) << r.stderr_text;
+  EXPECT_EQ(r.stderr_text, "");
+}
+
+}  // namespace
