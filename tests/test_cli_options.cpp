@@ -46,6 +46,8 @@ TEST(CliOptions, BadValuesAreOneLineNamingTheCommandAndOption) {
       {"render x.state --background 2 0 0", "dgtex render: --background: Value 2 not in range"},
       {"bench scenes --threads 1 --cut-update-threads 1",
        "dgtex bench scenes: --cut-update-threads: 1 is more than the steps' threads (1) can spare"},
+      {"bench scaling --threads-list 2,1", "dgtex bench scaling: --threads-list: 2,1; expected increasing thread counts"},
+      {"bench accuracy --shell-scene DIR/missing.json", "dgtex bench accuracy: --shell-scene: File does not exist: "},
       // One file for two outputs kept only the one written last.
       {"bench scaling --json DIR/a.json --markdown DIR/a.json",
        "dgtex bench scaling: --json and --markdown both name '"},

@@ -6,6 +6,7 @@
 #include <omp.h>
 
 #include <algorithm>
+#include <functional>
 #include <cstdio>
 #include <filesystem>
 #include <nlohmann/json.hpp>
@@ -192,6 +193,16 @@ int bench_scaling_command(int argc, char** argv) {
   if (!outputs_are_distinct("dgtex bench scaling",
                             {{"--json", &json_path}, {"--markdown", &markdown_path}, {"--chart", &chart_path}}))
     return 2;
+  // The speed-ups are over the first count: a list such as 2,1 or 1,1 gave "speed-up 2->1".
+  if (std::adjacent_find(threads.begin(), threads.end(), std::greater_equal<int>()) != threads.end()) {
+    std::string list;
+    for (const int t : threads) list += (list.empty() ? "" : ",") + std::to_string(t);
+    std::fprintf(stderr,
+                 "dgtex bench scaling: --threads-list: %s; expected increasing thread counts (the first is the base "
+                 "of the speed-ups), e.g. 1,2,4\n",
+                 list.c_str());
+    return 2;
+  }
   for (const std::string& f : families)
     if (std::find(kFamilies.begin(), kFamilies.end(), f) == kFamilies.end()) {
       std::fprintf(stderr, "dgtex bench scaling: --families: unknown family '%s'; valid: enrichment_solve, assembly, "
