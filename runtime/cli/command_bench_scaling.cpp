@@ -6,9 +6,9 @@
 #include <omp.h>
 
 #include <algorithm>
-#include <functional>
 #include <cstdio>
 #include <filesystem>
+#include <functional>
 #include <nlohmann/json.hpp>
 #include <set>
 #include <sstream>
