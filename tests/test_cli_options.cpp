@@ -48,6 +48,13 @@ TEST(CliOptions, BadValuesAreOneLineNamingTheCommandAndOption) {
        "dgtex bench scenes: --cut-update-threads: 1 is more than the steps' threads (1) can spare"},
       {"bench scaling --threads-list 2,1", "dgtex bench scaling: --threads-list: 2,1; expected increasing thread counts"},
       {"bench accuracy --shell-scene DIR/missing.json", "dgtex bench accuracy: --shell-scene: File does not exist: "},
+      // A chart case not among the cases run was found missing only at the end.
+      {"bench laplace --sizes 16 --domains open --chart DIR/c.svg",
+       "dgtex bench laplace: --chart-domain: slit is not among --domains"},
+      {"bench laplace --sizes 16 --domains open --chart DIR/c.svg --chart-domain open",
+       "dgtex bench laplace: --chart-size: 512 is not among --sizes"},
+      {"bench laplace --max-other-unknowns -1", "dgtex bench laplace: --max-other-unknowns: Value -1 not in range"},
+      {"bench shell --refactor-after -1", "dgtex bench shell: --refactor-after: Value -1 not in range"},
       // One file for two outputs kept only the one written last.
       {"bench scaling --json DIR/a.json --markdown DIR/a.json",
        "dgtex bench scaling: --json and --markdown both name '"},

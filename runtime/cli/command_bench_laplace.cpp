@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <iostream>
+#include <limits>
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <string>
@@ -72,13 +73,25 @@ int bench_laplace_command(int argc, char** argv) {
       ->check(at_least_one());
   app.add_option("--tolerance", tolerance, "relative residual to reach")->capture_default_str()->check(relative_tolerance());
   app.add_option("--max-other-unknowns", max_other_unknowns,
-                 "skip solvers other than multigrid above this many unknowns")->capture_default_str();
+                 "skip solvers other than multigrid above this many unknowns")
+      ->capture_default_str()
+      ->check(CLI::Range(0L, std::numeric_limits<long>::max()));
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     return exit_on_option_error(app, e);
   }
   if (!outputs_are_distinct("dgtex bench laplace", {{"--json", &json_path}, {"--chart", &chart_path}})) return 2;
+  // The chart's case must be one of the cases run, else it would be found missing at the end.
+  if (!chart_path.empty() && std::find(domains.begin(), domains.end(), chart_domain) == domains.end()) {
+    std::fprintf(stderr, "dgtex bench laplace: --chart-domain: %s is not among --domains; expected one of them\n",
+                 chart_domain.c_str());
+    return 2;
+  }
+  if (!chart_path.empty() && std::find(sizes.begin(), sizes.end(), chart_size) == sizes.end()) {
+    std::fprintf(stderr, "dgtex bench laplace: --chart-size: %d is not among --sizes; expected one of them\n", chart_size);
+    return 2;
+  }
   try {
     std::vector<LaplaceDomain> domain_list;
     std::vector<LaplaceBenchSolver> solver_list;

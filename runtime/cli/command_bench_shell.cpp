@@ -89,7 +89,9 @@ int bench_shell_command(int argc, char** argv) {
       ->capture_default_str()
       ->check(relative_tolerance());
   app.add_option("--refactor-after", solver.refactor_after_iterations,
-                 "refactorise when a step needed more PCG iterations than this")->capture_default_str();
+                 "refactorise when a step needed more PCG iterations than this")
+      ->capture_default_str()
+      ->check(zero_or_more());
   std::string preconditioner = "element_local";
   app.add_option("--preconditioner", preconditioner,
                  "pattern of the PCG preconditioner's factor: element_local (the default) or full")
