@@ -76,7 +76,7 @@ PlateSolve solve_simply_supported_plate(ElementType type, int n, double penalty,
 
 }  // namespace
 
-AccuracyChart run_plate_accuracy(const PlateAccuracyOptions& options, const AccuracyProgress& progress) {
+void check_plate_accuracy_options(const PlateAccuracyOptions& options) {
   // Memory grows ~160 KB per element (system, factor; measured: n = 64 0.63 GB, 128 2.6 GB),
   // so n = 256 takes ~10 GB and 512 outgrew a 23 GB machine; larger n failed with a bare
   // std::bad_alloc.
@@ -85,6 +85,10 @@ AccuracyChart run_plate_accuracy(const PlateAccuracyOptions& options, const Accu
     if (n < 2 || n % 2 || n > max_divisions)
       throw std::invalid_argument("plate divisions: n = " + std::to_string(n) + "; need an even n in 2.." +
                                   std::to_string(max_divisions) + " (a node at the plate centre)");
+}
+
+AccuracyChart run_plate_accuracy(const PlateAccuracyOptions& options, const AccuracyProgress& progress) {
+  check_plate_accuracy_options(options);
   AccuracyChart chart;
   chart.name = "plate";
   chart.title = "simply supported square plate, uniform load";

@@ -19,6 +19,7 @@
 #include "dgtex/scene_run.h"
 #include "dgtex/shell_simulation.h"
 #include "dgtex/topology.h"
+#include "api_argument_checks.h"
 
 namespace dgtex {
 namespace {
@@ -81,14 +82,18 @@ QuadratureCase run_case(const Scene& scene, const ShellModel& base, const std::v
 
 }  // namespace
 
-AccuracyChart run_quadrature_accuracy(const QuadratureAccuracyOptions& options, const AccuracyProgress& progress) {
+void check_quadrature_accuracy_options(const QuadratureAccuracyOptions& options) {
   if (options.resolution < 8)
     throw std::invalid_argument("quadrature resolution T = " + std::to_string(options.resolution) + "; need T >= 8");
   for (double tol : options.tolerances)
-    if (!(tol > 0)) throw std::invalid_argument("quadrature tolerance " + std::to_string(tol) + "; need > 0");
+    if (!(tol > 0)) throw std::invalid_argument("quadrature tolerance " + detail::short_number(tol) + "; need > 0");
   for (const std::string& e : options.elements)
     if (e != "quad8" && e != "tri6")
       throw std::invalid_argument("quadrature element '" + e + "'; valid: quad8, tri6");
+}
+
+AccuracyChart run_quadrature_accuracy(const QuadratureAccuracyOptions& options, const AccuracyProgress& progress) {
+  check_quadrature_accuracy_options(options);
   AccuracyChart chart;
   chart.name = "quadrature";
   chart.title = "enriched quadrature: merge tolerance (plate with an arc cut, T = " +

@@ -37,7 +37,7 @@ RotationRun run_scene(const Scene& base, int block_texels, int steps, AccuracyCl
 
 }  // namespace
 
-AccuracyChart run_rotation_accuracy(const RotationAccuracyOptions& options, const AccuracyProgress& progress) {
+void check_rotation_accuracy_options(const RotationAccuracyOptions& options) {
   if (options.steps < 1)
     throw std::invalid_argument("rotation accuracy: steps = " + std::to_string(options.steps) + "; need >= 1");
   for (int b : options.block_texels)
@@ -51,6 +51,11 @@ AccuracyChart run_rotation_accuracy(const RotationAccuracyOptions& options, cons
   if (base.cuts.empty())
     throw std::invalid_argument("rotation accuracy: " + options.scene +
                                 " has no cuts; rotation clusters group the quadrature points of cut elements");
+}
+
+AccuracyChart run_rotation_accuracy(const RotationAccuracyOptions& options, const AccuracyProgress& progress) {
+  check_rotation_accuracy_options(options);
+  const Scene base = load_scene(options.scene);
   AccuracyChart chart;
   chart.name = "rotation";
   chart.title = "rotation clusters of enriched elements against time";

@@ -13,6 +13,7 @@
 #include "dgtex/scene_io.h"
 #include "dgtex/scene_run.h"
 #include "accuracy_scene_runs.h"
+#include "api_argument_checks.h"
 
 namespace dgtex {
 namespace {
@@ -97,17 +98,16 @@ std::string affordable_tolerance(const std::vector<std::pair<double, Difference>
 
 }  // namespace
 
-AccuracyChart run_scene_quadrature_accuracy(const SceneQuadratureAccuracyOptions& options,
-                                            const AccuracyProgress& progress) {
+void check_scene_quadrature_accuracy_options(const SceneQuadratureAccuracyOptions& options) {
   if (options.steps < 0)
     throw std::invalid_argument("scene quadrature accuracy: steps = " + std::to_string(options.steps) +
                                 "; need >= 0 (0: the scene's own analysis.steps)");
   for (double t : options.tolerances)
     if (!(t > 0))
-      throw std::invalid_argument("scene quadrature accuracy: tolerance " + std::to_string(t) + "; need > 0");
+      throw std::invalid_argument("scene quadrature accuracy: tolerance " + detail::short_number(t) + "; need > 0");
   if (!(options.reference_tolerance > 0))
     throw std::invalid_argument("scene quadrature accuracy: reference tolerance " +
-                                std::to_string(options.reference_tolerance) + "; need > 0");
+                                detail::short_number(options.reference_tolerance) + "; need > 0");
   const Scene scene = load_scene(options.scene);
   if (!scene.analysis.is_dynamic())
     throw std::invalid_argument("scene quadrature accuracy: " + options.scene + " is not a dynamic scene");
@@ -115,6 +115,12 @@ AccuracyChart run_scene_quadrature_accuracy(const SceneQuadratureAccuracyOptions
   if (scene.cuts.empty())
     throw std::invalid_argument("scene quadrature accuracy: " + options.scene +
                                 " has no cuts; the merge tolerance applies to the quadrature of cut elements");
+}
+
+AccuracyChart run_scene_quadrature_accuracy(const SceneQuadratureAccuracyOptions& options,
+                                            const AccuracyProgress& progress) {
+  check_scene_quadrature_accuracy_options(options);
+  const Scene scene = load_scene(options.scene);
   const int steps = options.steps > 0 ? options.steps : scene.analysis.steps;
   const std::string name = detail::scene_file_name(options.scene);
   AccuracyChart chart;

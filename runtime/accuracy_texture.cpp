@@ -86,10 +86,14 @@ double crack_tip_texture_error(int resolution, double r_min, double r_max) {
   return tip_error(h.tile, p.tip, r_min, r_max).max;
 }
 
-AccuracyChart run_texture_accuracy(const TextureAccuracyOptions& options, const AccuracyProgress& progress) {
+void check_texture_accuracy_options(const TextureAccuracyOptions& options) {
   for (int T : options.resolutions) check_resolution(T);
   if (!(options.r_min > 0 && options.r_min < options.r_max && options.r_max <= 0.5))
     throw std::invalid_argument("texture accuracy annulus: need 0 < r_min < r_max <= 0.5 (element lengths)");
+}
+
+AccuracyChart run_texture_accuracy(const TextureAccuracyOptions& options, const AccuracyProgress& progress) {
+  check_texture_accuracy_options(options);
   AccuracyChart chart;
   chart.name = "texture";
   chart.title = "texture resolution: +-sqrt(r) harmonic enrichment vs sqrt(r) sin(theta/2)";

@@ -13,6 +13,7 @@
 #include "dgtex/laplace_solver.h"
 #include "dgtex/shell_benchmark.h"
 #include "accuracy_scene_runs.h"
+#include "api_argument_checks.h"
 
 namespace dgtex {
 namespace {
@@ -110,14 +111,21 @@ void multigrid_points(const ToleranceAccuracyOptions& options, const AccuracyPro
 
 }  // namespace
 
-AccuracyChart run_tolerance_accuracy(const ToleranceAccuracyOptions& options, const AccuracyProgress& progress) {
+void check_tolerance_accuracy_options(const ToleranceAccuracyOptions& options) {
+  if (!options.shell && !options.multigrid)
+    throw std::invalid_argument("tolerance accuracy: neither the shell nor the multigrid series is on; the chart would be "
+                                "empty");
   if (options.shell && options.shell_steps < 1)
     throw std::invalid_argument("tolerance accuracy: shell steps = " + std::to_string(options.shell_steps) +
                                 "; need >= 1");
   for (const auto* list : {&options.shell_tolerances, &options.multigrid_tolerances})
     for (double tol : *list)
       if (!(tol > 0 && tol < 1))
-        throw std::invalid_argument("tolerance accuracy: tolerance " + std::to_string(tol) + "; need 0 < tol < 1");
+        throw std::invalid_argument("tolerance accuracy: tolerance " + detail::short_number(tol) + "; need 0 < tol < 1");
+}
+
+AccuracyChart run_tolerance_accuracy(const ToleranceAccuracyOptions& options, const AccuracyProgress& progress) {
+  check_tolerance_accuracy_options(options);
   AccuracyChart chart;
   chart.name = "tolerance";
   chart.title = "solver tolerance against time";

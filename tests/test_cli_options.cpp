@@ -55,6 +55,11 @@ TEST(CliOptions, BadValuesAreOneLineNamingTheCommandAndOption) {
        "dgtex bench laplace: --chart-size: 512 is not among --sizes"},
       {"bench laplace --max-other-unknowns -1", "dgtex bench laplace: --max-other-unknowns: Value -1 not in range"},
       {"bench shell --refactor-after -1", "dgtex bench shell: --refactor-after: Value -1 not in range"},
+      // A bad value of a later sweep ended the command after the earlier sweeps' minutes.
+      {"bench accuracy --charts texture,plate --texture-sizes 16 --plate-divisions 3 --out DIR/acc",
+       "dgtex bench accuracy: plate divisions: n = 3; need an even n"},
+      {"bench accuracy --charts tolerance --no-shell --no-multigrid --out DIR/acc",
+       "dgtex bench accuracy: tolerance accuracy: neither the shell nor the multigrid series is on"},
       // One file for two outputs kept only the one written last.
       {"bench scaling --json DIR/a.json --markdown DIR/a.json",
        "dgtex bench scaling: --json and --markdown both name '"},
@@ -75,6 +80,7 @@ TEST(CliOptions, BadValuesAreOneLineNamingTheCommandAndOption) {
     EXPECT_EQ(std::count(r.stderr_text.begin(), r.stderr_text.end(), '\n'), 1) << refusal.args << ": " << r.stderr_text;
   }
   EXPECT_FALSE(fs::exists(dir / "a.json"));
+  EXPECT_FALSE(fs::exists(dir / "acc"));  // refused before the output folder and the first sweep
 }
 
 // An empty --out must not make the working folder the output folder: run there, nothing

@@ -175,6 +175,16 @@ int bench_accuracy_command(int argc, char** argv) {
     const AccuracyClock which = clock == "cpu" ? AccuracyClock::cpu : AccuracyClock::wall;
     plate.clock = quadrature.clock = texture.clock = tolerance.clock = rotation.clock = scene_quadrature.clock = which;
     omp_set_num_threads(threads);
+    // Every chosen sweep's options before the first sweep runs: a bad value of the last
+    // sweep ended the command minutes in.
+    for (const std::string& name : charts) {
+      if (name == "plate") check_plate_accuracy_options(plate);
+      if (name == "quadrature") check_quadrature_accuracy_options(quadrature);
+      if (name == "texture") check_texture_accuracy_options(texture);
+      if (name == "tolerance") check_tolerance_accuracy_options(tolerance);
+      if (name == "rotation") check_rotation_accuracy_options(rotation);
+      if (name == "scene_quadrature") check_scene_quadrature_accuracy_options(scene_quadrature);
+    }
     create_output_folder(out_dir, "--out");
     const std::string machine = describe_machine_and_probe();
     const auto start = std::chrono::steady_clock::now();

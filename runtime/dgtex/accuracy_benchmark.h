@@ -22,6 +22,8 @@
 //                tolerance, beside the scene's time-step error (accuracy_scene_quadrature.cpp).
 // Times are milliseconds of the chosen clock (AccuracyClock), best of `repeat` runs where a
 // case is cheap enough to repeat. All sweeps run with the current OpenMP thread count.
+// Each sweep's check_*_options throws what its run_* would for bad options (and runs first
+// in it), so a caller can check every sweep before the first one runs.
 // Plain functions that return their results (nothing kept); each sweep uses all OpenMP
 // threads, so run one at a time. Units: times in ms, errors relative (dimensionless).
 #include <functional>
@@ -68,6 +70,7 @@ struct PlateAccuracyOptions {
   AccuracyClock clock = AccuracyClock::cpu;
 };
 // std::invalid_argument for odd or non-positive n.
+void check_plate_accuracy_options(const PlateAccuracyOptions& options);
 AccuracyChart run_plate_accuracy(const PlateAccuracyOptions& options, const AccuracyProgress& progress = {});
 
 // Navier double series for the centre deflection of a simply supported a x b plate under
@@ -85,6 +88,7 @@ struct QuadratureAccuracyOptions {
 // Points carry extra "quadrature_points" (enriched element points), "rule_ms" (building
 // the rule and the enriched model) and "compliance". std::invalid_argument for a bad
 // element name, T < 8 or a non-positive tolerance.
+void check_quadrature_accuracy_options(const QuadratureAccuracyOptions& options);
 AccuracyChart run_quadrature_accuracy(const QuadratureAccuracyOptions& options, const AccuracyProgress& progress = {});
 
 struct TextureAccuracyOptions {
@@ -98,6 +102,7 @@ struct TextureAccuracyOptions {
 };
 // Points carry extra "rms_error" (root mean square of the same ratio over the annulus),
 // "texels" (in the annulus) and "unknowns". std::invalid_argument for T < 16 or odd T.
+void check_texture_accuracy_options(const TextureAccuracyOptions& options);
 AccuracyChart run_texture_accuracy(const TextureAccuracyOptions& options, const AccuracyProgress& progress = {});
 
 // Largest relative error |H - f| / sqrt(r) of the +-sqrt(r) harmonic enrichment at one T
@@ -119,6 +124,7 @@ struct ToleranceAccuracyOptions {
 // "factorizations". Multigrid: error = max |H - H_ref| against CHOLMOD (H is O(1)), ms =
 // one solve from zero (setup included); extra "iterations". The references appear with
 // error 0. Throws what run_shell_benchmark throws for a bad scene.
+void check_tolerance_accuracy_options(const ToleranceAccuracyOptions& options);
 AccuracyChart run_tolerance_accuracy(const ToleranceAccuracyOptions& options, const AccuracyProgress& progress = {});
 
 struct RotationAccuracyOptions {
@@ -132,6 +138,7 @@ struct RotationAccuracyOptions {
 // whole run (set-up, cuts, steps); extra "clusters", "cluster_mb" (their rest sums) and
 // "assembly_wall_ms". std::invalid_argument for steps < 1, a block < 1 or a scene that is
 // not dynamic and corotated; what load_scene and SceneRun throw for a bad scene.
+void check_rotation_accuracy_options(const RotationAccuracyOptions& options);
 AccuracyChart run_rotation_accuracy(const RotationAccuracyOptions& options, const AccuracyProgress& progress = {});
 
 struct SceneQuadratureAccuracyOptions {
@@ -154,6 +161,7 @@ struct SceneQuadratureAccuracyOptions {
 // that none does): the coarsest quadrature the scene can afford.
 // std::invalid_argument for steps < 0, a tolerance <= 0, or a scene that is not dynamic or has
 // no cuts; what load_scene and SceneRun throw for a bad scene.
+void check_scene_quadrature_accuracy_options(const SceneQuadratureAccuracyOptions& options);
 AccuracyChart run_scene_quadrature_accuracy(const SceneQuadratureAccuracyOptions& options,
                                             const AccuracyProgress& progress = {});
 
