@@ -81,7 +81,7 @@ int bench_laplace_command(int argc, char** argv) {
   } catch (const CLI::ParseError& e) {
     return exit_on_option_error(app, e);
   }
-  if (!outputs_are_distinct("dgtex bench laplace", {{"--json", &json_path}, {"--chart", &chart_path}})) return 2;
+  if (!outputs_are_distinct(app, {{"--json", &json_path}, {"--chart", &chart_path}})) return 2;
   // The chart's case must be one of the cases run, else it would be found missing at the end.
   if (!chart_path.empty() && std::find(domains.begin(), domains.end(), chart_domain) == domains.end()) {
     std::fprintf(stderr, "dgtex bench laplace: --chart-domain: %s is not among --domains; expected one of them\n",

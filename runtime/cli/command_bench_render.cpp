@@ -86,7 +86,7 @@ int bench_render_command(int argc, char** argv) {
   } catch (const CLI::ParseError& e) {
     return exit_on_option_error(app, e);
   }
-  if (!outputs_are_distinct("dgtex bench render", {{"--json", &json_path}, {"--chart", &chart_path}})) return 2;
+  if (!outputs_are_distinct(app, {{"--json", &json_path}, {"--chart", &chart_path}})) return 2;
   options.partial_cut = !complete_only;
   try {
     const std::string machine = describe_machine_and_probe();

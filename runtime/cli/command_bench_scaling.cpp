@@ -190,8 +190,7 @@ int bench_scaling_command(int argc, char** argv) {
   } catch (const CLI::ParseError& e) {
     return exit_on_option_error(app, e);
   }
-  if (!outputs_are_distinct("dgtex bench scaling",
-                            {{"--json", &json_path}, {"--markdown", &markdown_path}, {"--chart", &chart_path}}))
+  if (!outputs_are_distinct(app, {{"--json", &json_path}, {"--markdown", &markdown_path}, {"--chart", &chart_path}}))
     return 2;
   // The speed-ups are over the first count: a list such as 2,1 or 1,1 gave "speed-up 2->1".
   if (std::adjacent_find(threads.begin(), threads.end(), std::greater_equal<int>()) != threads.end()) {

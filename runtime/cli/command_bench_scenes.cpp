@@ -387,7 +387,7 @@ int bench_scenes_command(int argc, char** argv) {
   } catch (const CLI::ParseError& e) {
     return exit_on_option_error(app, e);
   }
-  if (!outputs_are_distinct("dgtex bench scenes", {{"--json", &json_path}, {"--markdown", &markdown_path}})) return 2;
+  if (!outputs_are_distinct(app, {{"--json", &json_path}, {"--markdown", &markdown_path}})) return 2;
   if (threads > 0) omp_set_num_threads(threads);
   if (const int spare = omp_get_max_threads() - 1; cut_update_threads > spare) {
     const std::string valid = spare == 0 ? "0 (the steps run on one thread: none to spare beside them)"

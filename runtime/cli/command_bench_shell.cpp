@@ -113,7 +113,7 @@ int bench_shell_command(int argc, char** argv) {
   } catch (const CLI::ParseError& e) {
     return exit_on_option_error(app, e);
   }
-  if (!outputs_are_distinct("dgtex bench shell", {{"--json", &json_path}, {"--chart", &chart_path}})) return 2;
+  if (!outputs_are_distinct(app, {{"--json", &json_path}, {"--chart", &chart_path}})) return 2;
   solver.preconditioner_pattern =
       preconditioner == "full" ? PreconditionerPattern::full : PreconditionerPattern::element_local;
   solver.overlap_factorization = !synchronous_factorization;

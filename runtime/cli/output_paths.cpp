@@ -75,17 +75,18 @@ CLI::Validator creatable_folder() {
       "DIR");
 }
 
-bool outputs_are_distinct(const std::string& command,
+bool outputs_are_distinct(const CLI::App& app,
                           std::initializer_list<std::pair<const char*, const std::string*>> outputs) {
   std::vector<std::pair<const char*, fs::path>> given;
   for (const auto& [option, value] : outputs) {
     if (value->empty()) continue;
     std::error_code error;
-    const fs::path file = fs::weakly_canonical(fs::absolute(*value), error);
+    fs::path file = fs::weakly_canonical(fs::absolute(*value), error);
+    if (error) file = fs::absolute(*value).lexically_normal();  // weakly_canonical gives an empty path then
     for (const auto& [earlier, earlier_file] : given)
       if (earlier_file == file) {
         std::fprintf(stderr, "%s: %s and %s both name '%s'; give each its own file (the second would replace the first)\n",
-                     command.c_str(), earlier, option, value->c_str());
+                     app.get_name().c_str(), earlier, option, value->c_str());
         return false;
       }
     given.emplace_back(option, file);

@@ -24,9 +24,9 @@ CLI::Validator creatable_folder();
 
 // Whether the output files given to a command (options and their values; empty: not
 // given) are distinct files; if not, prints one line naming the two options and the file to
-// stderr, prefixed with the command's name ("dgtex bench scaling"). One file given twice
-// would keep only the output written last.
-bool outputs_are_distinct(const std::string& command,
+// stderr, prefixed with the command's name (app's, "dgtex bench scaling"). One file given
+// twice would keep only the output written last.
+bool outputs_are_distinct(const CLI::App& app,
                           std::initializer_list<std::pair<const char*, const std::string*>> outputs);
 
 // Creates FOLDER and its parents (nothing when it exists); throws std::invalid_argument naming
