@@ -5,6 +5,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <nlohmann/json.hpp>
@@ -114,6 +115,15 @@ int bench_shell_command(int argc, char** argv) {
     return exit_on_option_error(app, e);
   }
   if (!outputs_are_distinct(app, {{"--json", &json_path}, {"--chart", &chart_path}})) return 2;
+  // a, b and c = a b: three n x n matrices of doubles.
+  if (const std::int64_t most = most_that_fit(std::int64_t{gemm_size} * gemm_size, 3 * 8); most >= 0) {
+    std::fprintf(stderr,
+                 "dgtex bench shell: --gemm-size: %d: three n x n matrices would not fit the %s of memory available; "
+                 "expected at most %lld\n",
+                 gemm_size, memory_size_text(available_memory_bytes()).c_str(),
+                 static_cast<long long>(std::sqrt(static_cast<double>(most))));
+    return 2;
+  }
   solver.preconditioner_pattern =
       preconditioner == "full" ? PreconditionerPattern::full : PreconditionerPattern::element_local;
   solver.overlap_factorization = !synchronous_factorization;

@@ -2,7 +2,11 @@
 // Range checks for numeric options. CLI11's PositiveNumber reports a refused 0 as "not in
 // range 0.000000 to 1797...(309 digits)"; these name the integers an option takes.
 #include <CLI/CLI.hpp>
+#include <cstdint>
 #include <limits>
+#include <string>
+
+#include "dgtex/texel_memory_estimate.h"
 
 namespace dgtex::cli {
 
@@ -30,5 +34,13 @@ inline CLI::Validator relative_tolerance() {
 
 // A colour component in [0, 1] (NaN refused).
 inline CLI::Range colour_component() { return CLI::Range(0.0, 1.0); }
+
+// The most items of `bytes_each` bytes that fit the memory available
+// (available_memory_bytes, texel_memory_estimate.h), or -1 when `count` of them fit or there
+// is no figure: a size a benchmark allocates ended the command with a bare "std::bad_alloc".
+inline std::int64_t most_that_fit(std::int64_t count, std::int64_t bytes_each) {
+  const std::int64_t available = available_memory_bytes();
+  return available < 0 || count <= available / bytes_each ? -1 : available / bytes_each;
+}
 
 }  // namespace dgtex::cli
