@@ -88,21 +88,19 @@ TEST(CliOptions, BadValuesAreOneLineNamingTheCommandAndOption) {
 // three 2000 x 2000 matrices (96 MB) are refused when the options are read.
 TEST(CliOptions, SizesBeyondTheMemoryAreRefusedNamingTheMostThatFit) {
   const fs::path dir = dgtex::test::fresh_dir("dgtex_cli_options", "memory");
-  const CliResult polar = run_cli("bench scaling --families polar_decomposition --polar-count 1000000 --repeats 1", dir,
-                                  "DGTEX_MEMORY_LIMIT_MB=64");
-  EXPECT_EQ(polar.exit_code, 2) << polar.stderr_text;
-  EXPECT_EQ(polar.stderr_text.rfind("dgtex bench scaling: --polar-count: 1000000 matrices (216 bytes each) would not "
-                                    "fit the 64 MiB of memory available; expected at most ",
-                                    0),
-            0u)
-      << polar.stderr_text;
-  const CliResult gemm = run_cli("bench shell --gemm-size 2000", dir, "DGTEX_MEMORY_LIMIT_MB=64");
-  EXPECT_EQ(gemm.exit_code, 2) << gemm.stderr_text;
-  EXPECT_EQ(gemm.stderr_text.rfind("dgtex bench shell: --gemm-size: 2000: three n x n matrices would not fit the "
-                                   "64 MiB of memory available; expected at most ",
-                                   0),
-            0u)
-      << gemm.stderr_text;
+  const Refusal refusals[] = {
+      {"bench scaling --families polar_decomposition --polar-count 1000000 --repeats 1",
+       "dgtex bench scaling: --polar-count: 1000000 matrices (216 bytes each) would not fit the 64 MiB of memory "
+       "available; expected at most "},
+      {"bench shell --gemm-size 2000",
+       "dgtex bench shell: --gemm-size: 2000: three n x n matrices would not fit the 64 MiB of memory available; "
+       "expected at most "},
+  };
+  for (const Refusal& refusal : refusals) {
+    const CliResult r = run_cli(refusal.args, dir, "DGTEX_MEMORY_LIMIT_MB=64");
+    EXPECT_EQ(r.exit_code, 2) << refusal.args << ": " << r.stderr_text;
+    EXPECT_EQ(r.stderr_text.rfind(refusal.message_start, 0), 0u) << r.stderr_text;
+  }
 }
 
 // An empty --out must not make the working folder the output folder: run there, nothing
