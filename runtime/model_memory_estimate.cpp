@@ -11,12 +11,6 @@ std::int64_t model_memory_lower_bound(ElementType type, std::int64_t elements) {
   return elements * (type == ElementType::tri6 ? kTri6ModelBytesPerElement : kQuad8ModelBytesPerElement);
 }
 
-std::int64_t generated_element_count(const MeshSpec& mesh) {
-  if (mesh.source == MeshSource::file) return -1;
-  const std::int64_t cells = static_cast<std::int64_t>(mesh.divisions[0]) * mesh.divisions[1];
-  return mesh.element.value_or(ElementType::quad8) == ElementType::tri6 ? 2 * cells : cells;
-}
-
 void check_model_memory(const Scene& scene, ElementType type, std::int64_t elements, std::int64_t available_bytes) {
   if (available_bytes < 0) return;
   const std::int64_t needed = model_memory_lower_bound(type, elements);
@@ -38,7 +32,7 @@ void check_model_memory(const Scene& scene, ElementType type, std::int64_t eleme
 }
 
 std::string model_memory_caution(const Scene& scene, std::int64_t available_bytes) {
-  const std::int64_t elements = generated_element_count(scene.mesh);
+  const std::int64_t elements = scene.mesh.generated_elements();
   if (elements < 0 || available_bytes < 0) return "";
   const ElementType type = scene.mesh.element.value_or(ElementType::quad8);
   const std::int64_t needed = model_memory_lower_bound(type, elements);

@@ -602,9 +602,7 @@ class SceneReader {
     if (const json* elements = find(v, "elements")) {
       const std::string ep = child(path, "elements");
       if (!elements->is_array() || elements->empty()) fail(ep, "expected a non-empty array of element indices", *elements, "e.g. [0, 2]; leave the key out for all elements");
-      long long count = 1LL << 30;
-      if (mesh.source != MeshSource::file)
-        count = static_cast<long long>(mesh.divisions[0]) * mesh.divisions[1] * (mesh.element == ElementType::tri6 ? 2 : 1);
+      const long long count = mesh.source == MeshSource::file ? 1LL << 30 : mesh.generated_elements();
       for (size_t k = 0; k < elements->size(); ++k) {
         const int e = integer((*elements)[k], item(ep, k), 0, count - 1);
         if (std::find(t.elements.begin(), t.elements.end(), e) != t.elements.end())
@@ -825,8 +823,7 @@ class SceneReader {
         fail(child(p, "xi"), "outside the tri6 reference element", point["xi"], "expected xi1, xi2 >= 0 and xi1 + xi2 <= 1");
       }
       if (mesh.source != MeshSource::file) {
-        const long long count = static_cast<long long>(mesh.divisions[0]) * mesh.divisions[1] *
-                                (*mesh.element == ElementType::tri6 ? 2 : 1);
+        const long long count = mesh.generated_elements();
         if (sp.element >= count)
           fail(child(p, "element"), "no such element", point["element"],
                "the generated mesh has elements 0.." + std::to_string(count - 1));

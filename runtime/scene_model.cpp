@@ -20,7 +20,7 @@ Mesh build_scene_mesh(const Scene& scene) {
   const MeshSpec& m = scene.mesh;
   const ElementType type = m.element.value_or(ElementType::quad8);
   // A model that cannot fit is refused before its mesh is built (a file's once it is read).
-  if (const std::int64_t elements = generated_element_count(m); elements >= 0)
+  if (const std::int64_t elements = m.generated_elements(); elements >= 0)
     check_model_memory(scene, type, elements, available_memory_bytes());
   switch (m.source) {
     case MeshSource::rectangle:

@@ -28,11 +28,11 @@ Scene plate(int nx, int ny, ElementType type = ElementType::quad8) {
 }
 
 TEST(ModelMemoryEstimate, GeneratedMeshesAreCountedBeforeTheyAreBuilt) {
-  EXPECT_EQ(generated_element_count(plate(100000, 100).mesh), 10000000);
-  EXPECT_EQ(generated_element_count(plate(30, 20, ElementType::tri6).mesh), 1200);  // two triangles a cell
+  EXPECT_EQ(plate(100000, 100).mesh.generated_elements(), 10000000);
+  EXPECT_EQ(plate(30, 20, ElementType::tri6).mesh.generated_elements(), 1200);  // two triangles a cell
   Scene from_file = plate(4, 4);
   from_file.mesh.source = MeshSource::file;
-  EXPECT_EQ(generated_element_count(from_file.mesh), -1);
+  EXPECT_EQ(from_file.mesh.generated_elements(), -1);
   EXPECT_EQ(model_memory_lower_bound(ElementType::quad8, 1000), 1000 * kQuad8ModelBytesPerElement);
   EXPECT_EQ(model_memory_lower_bound(ElementType::tri6, 1000), 1000 * kTri6ModelBytesPerElement);
 }

@@ -29,10 +29,6 @@ inline constexpr std::int64_t kTri6ModelBytesPerElement = 40 * 1024;
 // Lower bound of the peak memory of a model of `elements` elements of `type`, in bytes.
 std::int64_t model_memory_lower_bound(ElementType type, std::int64_t elements);
 
-// The elements of the scene's generated mesh, known before it is built (divisions, two
-// triangles a cell for tri6); -1 for a mesh read from a file.
-std::int64_t generated_element_count(const MeshSpec& mesh);
-
 // Throws SceneError(scene.source_name, "mesh.divisions" (generators) or "mesh.file", ...)
 // when the lower bound for `elements` elements exceeds available_bytes, naming both and the
 // most elements whose bound fits. available_bytes < 0: no check.

@@ -7,6 +7,7 @@
 // Plain value types (copying copies everything; no references). Quantities per field in
 // the scene's consistent units; dgtex's examples use SI: m, kg, s, Pa, N, kg/m^3, m/s^2.
 #include <array>
+#include <cstdint>
 #include <optional>
 #include <string>
 #include <vector>
@@ -37,6 +38,14 @@ struct MeshSpec {
   std::array<double, 2> angle_deg{};  // cylinder: [t0, t1], either order, 0 < |t1 - t0| <= 360
   double hole_deg = 0;                // hemisphere: polar angle range [hole_deg, 90]
   std::string file;                   // file: path, already resolved against the scene's folder
+
+  // The elements of a generated mesh, known before it is built (two triangles a cell for
+  // tri6); -1 for a mesh read from a file.
+  std::int64_t generated_elements() const {
+    if (source == MeshSource::file) return -1;
+    const std::int64_t cells = static_cast<std::int64_t>(divisions[0]) * divisions[1];
+    return element.value_or(ElementType::quad8) == ElementType::tri6 ? 2 * cells : cells;
+  }
 
   // True for a cylinder whose angle range is a full 360 degrees (the seam is shared).
   bool closed_cylinder() const {
