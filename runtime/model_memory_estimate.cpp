@@ -33,11 +33,10 @@ void check_model_memory(const Scene& scene, ElementType type, std::int64_t eleme
 
 std::string model_memory_caution(const Scene& scene, std::int64_t available_bytes) {
   const std::int64_t elements = scene.mesh.generated_elements();
-  if (elements < 0 || available_bytes < 0) return "";
+  if (elements < 0) return "";
   const ElementType type = scene.mesh.element.value_or(ElementType::quad8);
   const std::int64_t needed = model_memory_lower_bound(type, elements);
-  // Beyond the memory available check_model_memory refuses the scene instead.
-  if (2 * needed <= available_bytes || needed > available_bytes) return "";
+  if (!near_memory_limit(needed, available_bytes)) return "";
   return "mesh.divisions [" + std::to_string(scene.mesh.divisions[0]) + ", " + std::to_string(scene.mesh.divisions[1]) +
          "]: the model of its " + std::to_string(elements) + " elements needs at least " + memory_size_text(needed) +
          " of the " + memory_size_text(available_bytes) +

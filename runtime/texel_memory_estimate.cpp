@@ -122,10 +122,14 @@ void check_texel_memory(const TexelFields& fields, std::int64_t available_bytes,
   throw SceneError(source_name, "enrichment.texture_resolution", problem, t, valid);
 }
 
+bool near_memory_limit(std::int64_t needed, std::int64_t available_bytes) {
+  // Beyond the memory available the checks refuse the scene instead.
+  return available_bytes >= 0 && 2 * needed > available_bytes && needed <= available_bytes;
+}
+
 std::string texel_memory_caution(const TexelFields& fields, std::int64_t available_bytes) {
   const std::int64_t needed = texel_memory_lower_bound(fields);
-  // Beyond the memory available check_texel_memory refuses the scene instead.
-  if (available_bytes < 0 || 2 * needed <= available_bytes || needed > available_bytes) return "";
+  if (!near_memory_limit(needed, available_bytes)) return "";
   return "enrichment.texture_resolution " + std::to_string(fields.resolution) + ": the texel fields need at least " +
          memory_size_text(needed) + " of the " + memory_size_text(available_bytes) +
          " of memory available, and runs measured 1.3-4x that bound; the run may be killed for memory (a lower "

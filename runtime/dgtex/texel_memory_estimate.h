@@ -69,6 +69,11 @@ std::string memory_size_text(std::int64_t bytes);
 // T >= 8 whose bound fits (or that none does). available_bytes < 0: no check.
 void check_texel_memory(const TexelFields& fields, std::int64_t available_bytes, const std::string& source_name);
 
+// Whether a lower bound of `needed` bytes calls for a caution rather than a refusal or
+// nothing: above half the memory available and within all of it (available_bytes < 0:
+// never). The texel fields' and the model's cautions share it.
+bool near_memory_limit(std::int64_t needed, std::int64_t available_bytes);
+
 // A caution for a scene that passes the check but comes near the limit: runs measured
 // 1.3-4x the bound, so above half the memory available it may still be killed. One
 // sentence naming the bound, the memory and the remedy, for `dgtex run` to print before its
