@@ -100,6 +100,11 @@ TEST(CliOptions, SizesBeyondTheMemoryAreRefusedNamingTheMostThatFit) {
     const CliResult r = run_cli(refusal.args, dir, "DGTEX_MEMORY_LIMIT_MB=64");
     EXPECT_EQ(r.exit_code, 2) << refusal.args << ": " << r.stderr_text;
     EXPECT_EQ(r.stderr_text.rfind(refusal.message_start, 0), 0u) << r.stderr_text;
+    // A limit that is no number is bad input too (the check's exception aborted the process).
+    const CliResult bad = run_cli(refusal.args, dir, "DGTEX_MEMORY_LIMIT_MB=abc");
+    EXPECT_EQ(bad.exit_code, 2) << refusal.args << ": " << bad.stderr_text;
+    EXPECT_NE(bad.stderr_text.find(": DGTEX_MEMORY_LIMIT_MB = 'abc': expected a whole number of MiB"), std::string::npos)
+        << bad.stderr_text;
   }
 }
 

@@ -210,12 +210,15 @@ int bench_scaling_command(int argc, char** argv) {
     }
   const std::set<std::string> chosen(families.begin(), families.end());
   // F, R and the first thread count's R: 27 doubles a matrix.
-  if (const std::int64_t most = chosen.count("polar_decomposition") ? most_that_fit(polar_count, 27 * 8) : -1;
+  const std::optional<std::int64_t> available = memory_for_options(app);
+  if (!available) return 2;
+  if (const std::int64_t most =
+          chosen.count("polar_decomposition") ? most_that_fit(polar_count, 27 * 8, *available) : -1;
       most >= 0) {
     std::fprintf(stderr,
                  "dgtex bench scaling: --polar-count: %lld matrices (216 bytes each) would not fit the %s of memory "
                  "available; expected at most %lld\n",
-                 static_cast<long long>(polar_count), memory_size_text(available_memory_bytes()).c_str(),
+                 static_cast<long long>(polar_count), memory_size_text(*available).c_str(),
                  static_cast<long long>(most));
     return 2;
   }

@@ -116,11 +116,13 @@ int bench_shell_command(int argc, char** argv) {
   }
   if (!outputs_are_distinct(app, {{"--json", &json_path}, {"--chart", &chart_path}})) return 2;
   // a, b and c = a b: three n x n matrices of doubles.
-  if (const std::int64_t most = most_that_fit(std::int64_t{gemm_size} * gemm_size, 3 * 8); most >= 0) {
+  const std::optional<std::int64_t> available = memory_for_options(app);
+  if (!available) return 2;
+  if (const std::int64_t most = most_that_fit(std::int64_t{gemm_size} * gemm_size, 3 * 8, *available); most >= 0) {
     std::fprintf(stderr,
                  "dgtex bench shell: --gemm-size: %d: three n x n matrices would not fit the %s of memory available; "
                  "expected at most %lld\n",
-                 gemm_size, memory_size_text(available_memory_bytes()).c_str(),
+                 gemm_size, memory_size_text(*available).c_str(),
                  static_cast<long long>(std::sqrt(static_cast<double>(most))));
     return 2;
   }

@@ -3,7 +3,10 @@
 // range 0.000000 to 1797...(309 digits)"; these name the integers an option takes.
 #include <CLI/CLI.hpp>
 #include <cstdint>
+#include <cstdio>
 #include <limits>
+#include <optional>
+#include <stdexcept>
 #include <string>
 
 #include "dgtex/texel_memory_estimate.h"
@@ -35,11 +38,22 @@ inline CLI::Validator relative_tolerance() {
 // A colour component in [0, 1] (NaN refused).
 inline CLI::Range colour_component() { return CLI::Range(0.0, 1.0); }
 
-// The most items of `bytes_each` bytes that fit the memory available
-// (available_memory_bytes, texel_memory_estimate.h), or -1 when `count` of them fit or there
-// is no figure: a size a benchmark allocates ended the command with a bare "std::bad_alloc".
-inline std::int64_t most_that_fit(std::int64_t count, std::int64_t bytes_each) {
-  const std::int64_t available = available_memory_bytes();
+// The memory a command's option checks compare sizes with (available_memory_bytes); a bad
+// DGTEX_MEMORY_LIMIT_MB is that command's bad input: one line on stderr and nullopt (exit
+// code 2), where the exception would have ended the process.
+inline std::optional<std::int64_t> memory_for_options(const CLI::App& app) {
+  try {
+    return available_memory_bytes();
+  } catch (const std::invalid_argument& e) {
+    std::fprintf(stderr, "%s: %s\n", app.get_name().c_str(), e.what());
+    return std::nullopt;
+  }
+}
+
+// The most items of `bytes_each` bytes that fit `available` bytes (available_memory_bytes,
+// texel_memory_estimate.h), or -1 when `count` of them fit or there is no figure (-1): a
+// size a benchmark allocates ended the command with a bare "std::bad_alloc".
+inline std::int64_t most_that_fit(std::int64_t count, std::int64_t bytes_each, std::int64_t available) {
   return available < 0 || count <= available / bytes_each ? -1 : available / bytes_each;
 }
 
