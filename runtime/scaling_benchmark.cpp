@@ -273,8 +273,7 @@ BatchThroughput measure_batch_throughput(const Scene& scene, int runs, int steps
   b.solo_threads = solo_threads;
 
   std::vector<std::vector<double>> results;
-  const detail::ThreadCountGuard restore;
-  omp_set_num_threads(solo_threads);
+  const detail::ThreadCountGuard solo(solo_threads);
   Clock::time_point start = Clock::now();
   for (int r = 0; r < runs; ++r) results.push_back(simulate());
   b.solo_ms = ms_since(start);

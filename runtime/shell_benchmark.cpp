@@ -71,8 +71,7 @@ ShellBenchRun run_shell_benchmark(const std::string& scene_path, int steps, int 
   const Mesh mesh = build_scene_mesh(scene);
   SceneModel setup = build_scene_model(scene, mesh);
   const ShellModel& model = *setup.model;
-  const detail::ThreadCountGuard restore;
-  omp_set_num_threads(threads);
+  const detail::ThreadCountGuard set_threads(threads);
   ShellSimulation sim(model, setup.fixed, setup.external_force);
   sim.set_solver_options(solver);
   DynamicsOptions options;
