@@ -23,6 +23,10 @@ namespace {
 // Beyond this magnitude a number is certainly a typo and products such as E h^3 would
 // approach overflow.
 constexpr double kMaxMagnitude = 1e30;
+// The same bound from below for the positive quantities (lengths, moduli, the density, the
+// time step, the penalty, tolerances): E h^3 / 12 of E = 1e6 and h = 1e-110 underflows to 0, a zero
+// pivot that read as "penalty too low?", and h = 1e-106 overflowed the displacement.
+constexpr double kMinPositive = 1e-30;
 constexpr int kMaxDivisions = 100000;
 constexpr long long kMaxGeneratedCells = 10000000;
 constexpr int kMaxSteps = 1000000000;
@@ -325,11 +329,15 @@ class SceneReader {
   double positive(const json& v, const std::string& path) const {
     const double x = number(v, path);
     if (!(x > 0)) fail(path, "must be positive", v, "expected a number > 0");
+    if (x < kMinPositive)
+      fail(path, "too small", v, "positive values from 1e-30 to 1e30 are accepted; choose units that bring it into range");
     return x;
   }
   double non_negative(const json& v, const std::string& path) const {
     const double x = number(v, path);
     if (!(x >= 0)) fail(path, "must not be negative", v, "expected a number >= 0");
+    if (x > 0 && x < kMinPositive)
+      fail(path, "too small", v, "0, or values from 1e-30 to 1e30, are accepted; choose units that bring it into range");
     return x;
   }
   int integer(const json& v, const std::string& path, long long lo, long long hi) const {
@@ -406,8 +414,7 @@ class SceneReader {
       case MeshSource::rectangle:
         check_keys(v, path, {"generator", "size", "divisions", "element", "triangles"});
         mesh.size = numbers<2>(require(v, path, "size", "[a, b]"), child(path, "size"));
-        for (int i = 0; i < 2; ++i)
-          if (!(mesh.size[i] > 0)) fail(item(child(path, "size"), i), "must be positive", v["size"][i], "expected a length > 0");
+        for (int i = 0; i < 2; ++i) positive(v["size"][i], item(child(path, "size"), i));
         break;
       case MeshSource::cylinder: {
         check_keys(v, path, {"generator", "radius", "length", "angle_deg", "divisions", "element", "triangles"});
@@ -597,8 +604,7 @@ class SceneReader {
       fail(child(path, "image"), problem, image,
            "a grayscale or RGB PNG; relative paths are resolved against the scene file's folder");
     t.range = numbers<2>(require(v, path, "range", "[min, max]"), child(path, "range"));
-    for (int k = 0; k < 2; ++k)
-      if (!(t.range[k] > 0)) fail(item(child(path, "range"), k), "must be positive", v["range"][k], "expected a number > 0");
+    for (int k = 0; k < 2; ++k) positive(v["range"][k], item(child(path, "range"), k));
     if (const json* elements = find(v, "elements")) {
       const std::string ep = child(path, "elements");
       if (!elements->is_array() || elements->empty()) fail(ep, "expected a non-empty array of element indices", *elements, "e.g. [0, 2]; leave the key out for all elements");

@@ -570,6 +570,9 @@ TEST_F(MaterialTextureScene, RejectsBadInputsWithTheJsonPath) {
             "material_textures[0].range[0]");
   EXPECT_EQ(error_path(R"([{"field": "thickness", "image": "step.png", "range": [1, -2]}])"),
             "material_textures[0].range[1]");
+  // 1e-300 was taken and then read as an element without stiffness ("unconstrained").
+  EXPECT_EQ(error_path(R"([{"field": "thickness", "image": "step.png", "range": [1e-300, 2]}])"),
+            "material_textures[0].range[0]");
   EXPECT_EQ(error_path(R"([{"field": "colour", "image": "step.png", "range": [1, 2]}])"),
             "material_textures[0].field");
   EXPECT_EQ(error_path(R"([{"field": "thickness", "image": "step.png", "range": [1, 2], "gain": 1}])"),

@@ -125,6 +125,20 @@ TEST(SceneErrors, NonPositiveMaterialValues) {
                "number out of range");
 }
 
+// Below 1e-30 a stiffness E h^3 / 12 underflows (h = 1e-110: a zero pivot that read as
+// "penalty too low?") or the displacement overflows (h = 1e-106: NaN in the mesh output).
+TEST(SceneErrors, PositiveValuesBelowTheRangeAreRefused) {
+  expect_error(with(valid_scene(), "/material/thickness"_json_pointer, 1e-110), "material.thickness", "1e-110",
+               "too small");
+  expect_error(with(valid_scene(), "/material/youngs_modulus"_json_pointer, 1e-300), "material.youngs_modulus",
+               "1e-300", "from 1e-30 to 1e30");
+  expect_error(with(valid_scene(), "/material/density"_json_pointer, 1e-31), "material.density", "1e-31",
+               "0, or values from 1e-30");
+  expect_error(with(valid_scene(), "/mesh/size/1"_json_pointer, 1e-40), "mesh.size[1]", "1e-40", "too small");
+  expect_error(with(valid_scene(), "/penalty"_json_pointer, 5e-324), "penalty", "", "too small");
+  EXPECT_EQ(error_of_text(with(valid_scene(), "/material/thickness"_json_pointer, 1e-30).dump()), "");
+}
+
 TEST(SceneErrors, ZeroDensityOnlyInStaticRuns) {
   EXPECT_EQ(error_of_text(with(valid_scene(), "/material/density"_json_pointer, 0).dump()), "");
   expect_error(with(dynamic_scene(), "/material/density"_json_pointer, 0), "material.density", "0",
