@@ -83,8 +83,12 @@ QuadratureCase run_case(const Scene& scene, const ShellModel& base, const std::v
 }  // namespace
 
 void check_quadrature_accuracy_options(const QuadratureAccuracyOptions& options) {
-  if (options.resolution < 8)
-    throw std::invalid_argument("quadrature resolution T = " + std::to_string(options.resolution) + "; need T >= 8");
+  // T becomes the arc-cut scene's enrichment.texture_resolution: a power of two in 8..4096
+  // (T = 100 was refused by that scene's reader only once the sweep ran, as exit code 1).
+  const int T = options.resolution;
+  if (T < 8 || T > 4096 || (T & (T - 1)) != 0)
+    throw std::invalid_argument("quadrature resolution T = " + std::to_string(T) +
+                                "; need a power of two in 8..4096 (8, 16, ..., 4096)");
   for (double tol : options.tolerances)
     if (!(tol > 0)) throw std::invalid_argument("quadrature tolerance " + detail::short_number(tol) + "; need > 0");
   for (const std::string& e : options.elements)

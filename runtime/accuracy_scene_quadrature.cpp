@@ -108,6 +108,14 @@ void check_scene_quadrature_accuracy_options(const SceneQuadratureAccuracyOption
   if (!(options.reference_tolerance > 0))
     throw std::invalid_argument("scene quadrature accuracy: reference tolerance " +
                                 detail::short_number(options.reference_tolerance) + "; need > 0");
+  // The errors are measured against the reference run: a looser reference (2 against 0.3)
+  // charted the swept runs' distance to a less accurate run as their error.
+  for (double t : options.tolerances)
+    if (options.reference_tolerance > t)
+      throw std::invalid_argument("scene quadrature accuracy: reference tolerance " +
+                                  detail::short_number(options.reference_tolerance) +
+                                  "; need one at or below every swept tolerance (" + detail::short_number(t) +
+                                  " is swept)");
   const Scene scene = load_scene(options.scene);
   if (!scene.analysis.is_dynamic())
     throw std::invalid_argument("scene quadrature accuracy: " + options.scene + " is not a dynamic scene");

@@ -6,6 +6,9 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <string>
+#include <utility>
+
 #include <omp.h>
 
 #include "dgtex/accuracy_benchmark.h"
@@ -118,10 +121,19 @@ void check_tolerance_accuracy_options(const ToleranceAccuracyOptions& options) {
   if (options.shell && options.shell_steps < 1)
     throw std::invalid_argument("tolerance accuracy: shell steps = " + std::to_string(options.shell_steps) +
                                 "; need >= 1");
-  for (const auto* list : {&options.shell_tolerances, &options.multigrid_tolerances})
+  for (const auto& [series, list] : {std::pair{"shell", &options.shell_tolerances},
+                                      std::pair{"multigrid", &options.multigrid_tolerances}})
     for (double tol : *list)
       if (!(tol > 0 && tol < 1))
-        throw std::invalid_argument("tolerance accuracy: tolerance " + detail::short_number(tol) + "; need 0 < tol < 1");
+        throw std::invalid_argument("tolerance accuracy: " + std::string(series) + " tolerance " +
+                                    detail::short_number(tol) + "; need 0 < tol < 1");
+  // The slit domain's size (T = 3 was refused only after the shell series had run; T =
+  // 100000 ended in a bare std::bad_alloc). Its reference is a CHOLMOD solve, which at T =
+  // 2048 took 63 s and 3.1 GB (dgtex bench laplace, 2-core EPYC); 4096 has 4x the texels.
+  const int T = options.multigrid_resolution;
+  if (options.multigrid && (T < 16 || T > 2048))
+    throw std::invalid_argument("tolerance accuracy: multigrid size T = " + std::to_string(T) +
+                                "; need 16..2048 (its reference is a CHOLMOD solve)");
 }
 
 AccuracyChart run_tolerance_accuracy(const ToleranceAccuracyOptions& options, const AccuracyProgress& progress) {

@@ -60,6 +60,18 @@ TEST(CliOptions, BadValuesAreOneLineNamingTheCommandAndOption) {
        "dgtex bench accuracy: plate divisions: n = 3; need an even n"},
       {"bench accuracy --charts tolerance --no-shell --no-multigrid --out DIR/acc",
        "dgtex bench accuracy: tolerance accuracy: neither the shell nor the multigrid series is on"},
+      // Sizes that failed only once their sweep ran (exit 1, or a bare std::bad_alloc), and a
+      // reference looser than the runs measured against it.
+      {"bench accuracy --charts quadrature --quadrature-resolution 100 --out DIR/acc",
+       "dgtex bench accuracy: quadrature resolution T = 100; need a power of two in 8..4096"},
+      {"bench accuracy --charts texture --texture-sizes 16,100000 --out DIR/acc",
+       "dgtex bench accuracy: texture size T = 100000; need an even T in 16..4096"},
+      {"bench accuracy --charts tolerance --no-shell --multigrid-size 3 --out DIR/acc",
+       "dgtex bench accuracy: tolerance accuracy: multigrid size T = 3; need 16..2048"},
+      {"bench accuracy --charts tolerance --multigrid-tolerances 2 --out DIR/acc",
+       "dgtex bench accuracy: tolerance accuracy: multigrid tolerance 2; need 0 < tol < 1"},
+      {"bench accuracy --charts scene_quadrature --scene-quadrature-reference 2 --out DIR/acc",
+       "dgtex bench accuracy: scene quadrature accuracy: reference tolerance 2; need one at or below every swept"},
       // One file for two outputs kept only the one written last.
       {"bench scaling --json DIR/a.json --markdown DIR/a.json",
        "dgtex bench scaling: --json and --markdown both name '"},

@@ -122,15 +122,16 @@ TEST(CliRun, AReportNamedLikeAnotherOutputIsRefusedBeforeTheRun) {
   }
 }
 
-// A segment length below the spacing of doubles never advanced the segmentation: the run
-// hung in its set-up. Shorter than a texel, a segment has no texels of its own.
+// A segment length below the spacing of doubles (1e-20 beside coordinates near 1) never
+// advanced the segmentation: the run hung in its set-up. Shorter than a texel, a segment has
+// no texels of its own.
 TEST(CliRun, ACutSegmentShorterThanATexelIsRefused) {
   nlohmann::json spiral;
   std::ifstream(std::string(DGTEX_SOURCE_DIR) + "/examples/scenes/spiral1.json") >> spiral;
-  spiral["enrichment"]["new_cut_length"] = 1e-300;
+  spiral["enrichment"]["new_cut_length"] = 1e-20;
   spiral.erase("render");
   expect_rejected("new_cut_length", spiral.dump(),
-                  "enrichment.new_cut_length: a cut segment cannot be shorter than a texel, got 1e-300; expected ");
+                  "enrichment.new_cut_length: a cut segment cannot be shorter than a texel, got 1e-20; expected ");
 }
 
 // The plate's 16 x 16 quad8 elements: a model bound of 24 MiB (dgtex/model_memory_estimate.h).

@@ -18,6 +18,7 @@
 #include "example_scenes.h"
 #include "dgtex/accuracy_benchmark.h"
 #include "dgtex/benchmark_machine.h"
+#include "dgtex/scene_io.h"
 #include "gnuplot_chart.h"
 #include "option_errors.h"
 #include "output_paths.h"
@@ -176,14 +177,23 @@ int bench_accuracy_command(int argc, char** argv) {
     plate.clock = quadrature.clock = texture.clock = tolerance.clock = rotation.clock = scene_quadrature.clock = which;
     omp_set_num_threads(threads);
     // Every chosen sweep's options before the first sweep runs: a bad value of the last
-    // sweep ended the command minutes in.
-    for (const std::string& name : charts) {
-      if (name == "plate") check_plate_accuracy_options(plate);
-      if (name == "quadrature") check_quadrature_accuracy_options(quadrature);
-      if (name == "texture") check_texture_accuracy_options(texture);
-      if (name == "tolerance") check_tolerance_accuracy_options(tolerance);
-      if (name == "rotation") check_rotation_accuracy_options(rotation);
-      if (name == "scene_quadrature") check_scene_quadrature_accuracy_options(scene_quadrature);
+    // sweep ended the command minutes in. The library names the sweep's field in words
+    // (plate divisions: --plate-divisions), so the line points to the options' help.
+    try {
+      for (const std::string& name : charts) {
+        if (name == "plate") check_plate_accuracy_options(plate);
+        if (name == "quadrature") check_quadrature_accuracy_options(quadrature);
+        if (name == "texture") check_texture_accuracy_options(texture);
+        if (name == "tolerance") check_tolerance_accuracy_options(tolerance);
+        if (name == "rotation") check_rotation_accuracy_options(rotation);
+        if (name == "scene_quadrature") check_scene_quadrature_accuracy_options(scene_quadrature);
+      }
+    } catch (const std::invalid_argument& e) {
+      std::fprintf(stderr, "dgtex bench accuracy: %s (see dgtex bench accuracy --help)\n", e.what());
+      return 2;
+    } catch (const SceneError& e) {  // a scene option's file (its path, field and value)
+      std::fprintf(stderr, "dgtex bench accuracy: %s\n", e.what());
+      return 2;
     }
     create_output_folder(out_dir, "--out");
     const std::string machine = describe_machine_and_probe();
