@@ -150,6 +150,28 @@ TEST(CliRun, AModelNearOrBeyondTheMemoryIsCautionedOrRefused) {
                   "mesh.divisions: 256 quad8 elements need at least 24 MiB", "DGTEX_MEMORY_LIMIT_MB=20");
 }
 
+// A penalty far above its threshold locks coarse meshes and fails nothing: the run says so
+// (dgtex/penalty_caution.h) and runs; the example plate at its own 0.8 runs without it.
+TEST(CliRun, APenaltyFarAboveItsThresholdIsCautioned) {
+  const std::string plate = std::string(DGTEX_SOURCE_DIR) + "/examples/scenes/clamped_plate.json";
+  const fs::path dir = fresh_dir("penalty_caution");
+  nlohmann::json scene;
+  std::ifstream(plate) >> scene;
+  scene["penalty"] = 30;
+  const fs::path high = dir / "high.json";
+  std::ofstream(high) << scene.dump();
+  const Result cautioned = dgtex::test::run_cli("run " + high.string() + " --out " + (dir / "high").string() +
+                                                " --quiet --no-render", dir);
+  EXPECT_EQ(cautioned.exit_code, 0) << cautioned.stderr_text;
+  EXPECT_NE(cautioned.stderr_text.find("dgtex run: warning: " + high.string() + ": penalty 30 is far above the "
+                                       "definiteness threshold"),
+            std::string::npos)
+      << cautioned.stderr_text;
+  const Result plain = dgtex::test::run_cli("run " + plate + " --out " + (dir / "plain").string() + " --quiet --no-render", dir);
+  EXPECT_EQ(plain.exit_code, 0) << plain.stderr_text;
+  EXPECT_EQ(plain.stderr_text, "");
+}
+
 // fracture.json at T = 4096: at least 346.3 GiB of texel fields (dgtex/texel_memory_estimate.h).
 // Without the check the system killed such a run minutes in; now one line, at once.
 TEST(CliRun, CutsWhoseTexelFieldsCannotFitAreRefusedNamingTheResolution) {

@@ -1,6 +1,7 @@
 // Where shell methods fail and what dgtex does about it (README "Stability where methods
 // fail"): time steps far beyond the explicit limit, large rotations (linear vs corotated),
-// nearly incompressible materials, and cuts that run exactly along element edges.
+// a penalty far above its threshold, nearly incompressible materials, and cuts that run
+// exactly along element edges.
 #include <gtest/gtest.h>
 
 #include <Eigen/Dense>
@@ -13,6 +14,7 @@
 #include "dense_matrix_support.h"
 #include "dgtex/cut_manager.h"
 #include "dgtex/kernels/shell_point.h"
+#include "dgtex/penalty_caution.h"
 #include "dgtex/shell_simulation.h"
 #include "shell_test_support.h"
 
@@ -219,6 +221,59 @@ TEST(LargeTimeSteps, CorotatedHugeStepsStayBoundedButDoNotSettle) {
   EXPECT_LT(largest, 5.0);
 }
 
+// Centre deflection of the unit square plate clamped on all sides under q = -1, n x n
+// elements, over Timoshenko's 0.00126532 q a^4 / D.
+double clamped_plate_deflection_ratio(ElementType type, int n, double penalty, const TestMaterial& m) {
+  const double a = 1.0, q = -1.0;
+  const Mesh mesh = make_rectangle(a, a, n, n, type);
+  auto edge = [a](const double* x) {
+    return std::abs(x[0]) < 1e-9 || std::abs(x[0] - a) < 1e-9 || std::abs(x[1]) < 1e-9 || std::abs(x[1] - a) < 1e-9;
+  };
+  auto model = make_model(mesh, m, penalty, edge);
+  std::vector<char> fixed;
+  fix_nodes(mesh, edge, true, true, true, fixed);
+  std::vector<double> f(model->num_dofs(), 0.0);
+  const double force[3] = {0, 0, q};
+  model->add_area_force(force, f);
+  ShellSimulation sim(*model, fixed, f);
+  sim.solve_static();
+  double w = 0;
+  for (int k = 0; k < mesh.num_nodes(); ++k)
+    if (std::abs(mesh.node(k)[0] - a / 2) < 1e-9 && std::abs(mesh.node(k)[1] - a / 2) < 1e-9)
+      w = sim.displacement()[3 * k + 2];
+  return w / (0.00126532 * q * a * a * a * a / kernels::bending_rigidity(m.E, m.nu, m.h));
+}
+
+// ---------------------------------------------------------------------------------------
+// Penalty too high. Nothing fails, but the C1 interior penalty locks coarse quadratic meshes
+// (tri6 far more than quad8), so `dgtex run` cautions above a line per element type
+// (dgtex/penalty_caution.h; the caution through the tool: test_cli_run).
+TEST(PenaltyTooHigh, CoarsePlatesLockAndTheLineCautions) {
+  const TestMaterial m;
+  for (ElementType type : {ElementType::quad8, ElementType::tri6}) {
+    const bool quad8 = type == ElementType::quad8;
+    const double line = quad8 ? kQuad8PenaltyCautionAbove : kTri6PenaltyCautionAbove;
+    const double high = quad8 ? 100 : 10;
+    const double at_one = clamped_plate_deflection_ratio(type, 8, 1, m);
+    const double at_line = clamped_plate_deflection_ratio(type, 8, line, m);
+    const double at_high = clamped_plate_deflection_ratio(type, 8, high, m);
+    std::printf("clamped plate %s 8x8, w / Timoshenko: penalty 1 %.4f, %g %.4f, %g %.4f\n", quad8 ? "quad8" : "tri6",
+                at_one, line, at_line, high, at_high);
+    // Stiffer as the penalty grows: 5-9 % at the line, 13 % (quad8 at 100) and 38 % (tri6 at 10).
+    EXPECT_LT(at_line, 0.96 * at_one);
+    EXPECT_GT(at_line, 0.9 * at_one);
+    EXPECT_LT(at_high, (quad8 ? 0.9 : 0.7) * at_one);
+    EXPECT_EQ(penalty_caution(line, type), "");
+    EXPECT_EQ(penalty_caution(1, type), "");
+    const std::string caution = penalty_caution(high, type);
+    EXPECT_NE(caution.find("penalty " + std::string(quad8 ? "100" : "10") + " is far above"), std::string::npos) << caution;
+    EXPECT_NE(caution.find(quad8 ? "8 x 8 quad8" : "8 x 8 tri6"), std::string::npos) << caution;
+  }
+  // Finer meshes lock less: quad8 32 x 32 at 1000 within 1 % of penalty 1.
+  EXPECT_NEAR(clamped_plate_deflection_ratio(ElementType::quad8, 32, 1000, m),
+              clamped_plate_deflection_ratio(ElementType::quad8, 32, 1, m), 0.01);
+}
+
 // ---------------------------------------------------------------------------------------
 // Nearly incompressible materials. A shell is in plane stress: E/(1 - nu^2) stays finite
 // as nu -> 0.5, so there is no volumetric locking, and the clamped plate's centre
@@ -226,30 +281,14 @@ TEST(LargeTimeSteps, CorotatedHugeStepsStayBoundedButDoNotSettle) {
 // involve nu). nu >= 0.5 is rejected by the scene validation (test_scene_errors,
 // test_cli_run).
 TEST(NearlyIncompressible, ClampedPlateFollowsDOfNu) {
-  const double a = 1.0, q = -1.0;
   double ratios[3];
   const double nus[3] = {0.3, 0.49, 0.499};
   for (int i = 0; i < 3; ++i) {
     TestMaterial m;
     m.nu = nus[i];
-    const Mesh mesh = make_rectangle(a, a, 16, 16, ElementType::quad8);
-    auto edge = [a](const double* x) {
-      return std::abs(x[0]) < 1e-9 || std::abs(x[0] - a) < 1e-9 || std::abs(x[1]) < 1e-9 || std::abs(x[1] - a) < 1e-9;
-    };
-    auto model = make_model(mesh, m, 0.8, edge);
-    std::vector<char> fixed;
-    fix_nodes(mesh, edge, true, true, true, fixed);
-    std::vector<double> f(model->num_dofs(), 0.0);
-    const double force[3] = {0, 0, q};
-    model->add_area_force(force, f);
-    ShellSimulation sim(*model, fixed, f);
-    sim.solve_static();
-    double w = 0;
-    for (int n = 0; n < mesh.num_nodes(); ++n)
-      if (std::abs(mesh.node(n)[0] - a / 2) < 1e-9 && std::abs(mesh.node(n)[1] - a / 2) < 1e-9) w = sim.displacement()[3 * n + 2];
-    const double D = kernels::bending_rigidity(m.E, m.nu, m.h);
-    ratios[i] = w / (0.00126532 * q * a * a * a * a / D);
-    std::printf("clamped plate quad8 16x16, nu = %.3f: D = %.5e, w / (0.00126532 q a^4 / D) = %.5f\n", nus[i], D, ratios[i]);
+    ratios[i] = clamped_plate_deflection_ratio(ElementType::quad8, 16, 0.8, m);
+    std::printf("clamped plate quad8 16x16, nu = %.3f: D = %.5e, w / (0.00126532 q a^4 / D) = %.5f\n", nus[i],
+                kernels::bending_rigidity(m.E, m.nu, m.h), ratios[i]);
     EXPECT_NEAR(ratios[i], 1.0, 0.01) << "nu " << nus[i];
   }
   // The discretisation error does not depend on nu (no locking as nu -> 0.5).

@@ -20,6 +20,7 @@
 #include "dgtex/mesh_output.h"
 #include "dgtex/model_error.h"
 #include "dgtex/model_memory_estimate.h"
+#include "dgtex/penalty_caution.h"
 #include "dgtex/scene_io.h"
 #include "dgtex/scene_run.h"
 #include "dgtex/shell_state.h"
@@ -123,6 +124,9 @@ int run_command(int argc, char** argv) {
     return 2;
   }
   const Mesh& mesh = run->mesh();
+  // Valid but likely locked (dgtex/penalty_caution.h): nothing fails, so say it.
+  if (const std::string caution = penalty_caution(scene.penalty, mesh.type); !caution.empty())
+    std::fprintf(stderr, "dgtex run: warning: %s: %s\n", scene_path.c_str(), caution.c_str());
   // PNG frames (dgtex/frame_writer.h). The EGL context opens before the run, so a machine
   // without one fails here with one line and writes nothing.
   std::unique_ptr<FrameWriter> png_frames;
