@@ -39,6 +39,9 @@ TEST(CliOptions, BadValuesAreOneLineNamingTheCommandAndOption) {
       // Names over 255 bytes failed only when written, after the work.
       {"bench scaling --json DIR/NAME300.json", "dgtex bench scaling: --json: a name in '"},
       {"run PLATE --out DIR/NAME300", "dgtex run: --out: a name in '"},
+      // The permission bits, which root passes, took /proc: the run failed after its work.
+      {"run PLATE --out /proc/dgtex_out", "dgtex run: --out: folder '/proc' is not writable"},
+      {"bench scenes --json /proc/dgtex.json", "dgtex bench scenes: --json: folder '/proc' is not writable"},
       // Tolerances no solve can meet, or that any guess meets.
       {"bench shell --tolerance 0", "dgtex bench shell: --tolerance: Value 0 is not a relative tolerance"},
       {"bench shell --tolerance -1", "dgtex bench shell: --tolerance: Value -1 is not a relative tolerance"},

@@ -1,9 +1,11 @@
 #include "output_paths.h"
 
+#include <fcntl.h>
 #include <unistd.h>
 
-#include <filesystem>
 #include <cstdio>
+#include <cstdlib>
+#include <filesystem>
 #include <fstream>
 #include <stdexcept>
 #include <system_error>
@@ -20,7 +22,24 @@ namespace {
 constexpr const char* kRunOutputFiles[] = {"deformed.vtu", "cut_surface.obj", "final.state", "textures/enrichment.vdb"};
 constexpr const char* kRunOutputFolders[] = {"frames", "textures"};
 
-bool is_writable(const fs::path& path) { return ::access(path.c_str(), W_OK) == 0; }
+// access() answers from the permission bits, which root passes everywhere: /proc took root's
+// --out and --json and failed only after the work. Creating (and removing) a file, and
+// opening an existing one for writing (without truncating it), are the real tests.
+bool can_create_files_in(const fs::path& folder) {
+  std::string probe = (folder / ".dgtex-write-probe-XXXXXX").string();
+  const int fd = ::mkstemp(probe.data());
+  if (fd < 0) return false;
+  ::close(fd);
+  ::unlink(probe.c_str());
+  return true;
+}
+
+bool can_write(const fs::path& file) {
+  const int fd = ::open(file.c_str(), O_WRONLY | O_NONBLOCK | O_CLOEXEC);  // a FIFO without reader: refused
+  if (fd < 0) return false;
+  ::close(fd);
+  return true;
+}
 
 // "" when every name in PATH fits the file systems' limit (NAME_MAX, 255 bytes), else why
 // not: such a path fails only when the command writes it, after its work.
@@ -36,7 +55,7 @@ std::string check_name_lengths(const fs::path& path) {
 std::string check_writable_folder(const fs::path& folder) {
   std::error_code error;
   if (!fs::is_directory(folder, error)) return "'" + folder.string() + "' is not a folder";
-  if (!is_writable(folder)) return "folder '" + folder.string() + "' is not writable";
+  if (!can_create_files_in(folder)) return "folder '" + folder.string() + "' is not writable";
   return "";
 }
 
@@ -51,11 +70,12 @@ CLI::Validator writable_file() {
         if (std::string why = check_name_lengths(path); !why.empty()) return why;
         std::error_code error;
         if (fs::is_directory(path, error)) return "'" + value + "' is a folder; give a file name";
+        // An existing file is written in place (write_output_file): its folder need not be
+        // writable (/dev/null for a user).
+        if (fs::exists(path, error)) return can_write(path) ? "" : "file '" + value + "' is not writable";
         const fs::path folder = path.has_parent_path() ? path.parent_path() : fs::path(".");
         if (!fs::exists(folder, error)) return "folder '" + folder.string() + "' does not exist";
-        if (std::string why = check_writable_folder(folder); !why.empty()) return why;
-        if (fs::exists(path, error) && !is_writable(path)) return "file '" + value + "' is not writable";
-        return "";
+        return check_writable_folder(folder);
       },
       "FILE");
 }
