@@ -7,6 +7,7 @@
 #include "dgtex/kernels/shell_point.h"
 #include "dgtex/shell_simulation.h"
 #include "shell_test_support.h"
+#include "square_plate_support.h"
 
 using namespace dgtex;
 using namespace dgtex::testing_support;
@@ -27,15 +28,6 @@ double navier_centre_deflection(double a, double b, double q, double D) {
   return 16 * q / (std::pow(kPi, 6) * D) * w;
 }
 
-double centre_deflection(const ShellModel& model, const std::vector<double>& u, double a) {
-  // The generator's centre node (even divisions) sits at (a/2, a/2).
-  const Mesh& mesh = model.mesh();
-  for (int n = 0; n < mesh.num_nodes(); ++n)
-    if (std::abs(mesh.node(n)[0] - a / 2) < 1e-9 && std::abs(mesh.node(n)[1] - a / 2) < 1e-9) return u[3 * n + 2];
-  ADD_FAILURE() << "no centre node";
-  return 0;
-}
-
 struct PlateCase {
   ElementType type;
   const char* name;
@@ -46,22 +38,9 @@ class Plates : public ::testing::TestWithParam<PlateCase> {};
 // Penalties about twice the definiteness threshold (0.35-0.4, see test_shell_definiteness):
 // larger ones over-stiffen the plate (the C1 penalty locks quadratic elements).
 double solve_plate(ElementType type, int n, bool clamped, double* D_out, double penalty) {
-  const double a = 1.0, q = -1.0;
-  Material m;
-  const Mesh mesh = make_rectangle(a, a, n, n, type);
-  auto on_boundary = [a](const double* x) {
-    return std::abs(x[0]) < 1e-9 || std::abs(x[0] - a) < 1e-9 || std::abs(x[1]) < 1e-9 || std::abs(x[1] - a) < 1e-9;
-  };
-  auto model = make_model(mesh, m, penalty, clamped ? NodePredicate(on_boundary) : nullptr);
-  std::vector<char> fixed;
-  fix_nodes(mesh, on_boundary, true, true, true, fixed);
-  std::vector<double> f(model->num_dofs(), 0.0);
-  const double force[3] = {0, 0, q};
-  model->add_area_force(force, f);
-  ShellSimulation sim(*model, fixed, f);
-  sim.solve_static();
+  const Material m;
   *D_out = kernels::bending_rigidity(m.E, m.nu, m.h);
-  return centre_deflection(*model, sim.displacement(), a);
+  return square_plate_centre_deflection(type, n, penalty, clamped, m);
 }
 
 TEST_P(Plates, ClampedSquarePlateMatchesTimoshenko) {

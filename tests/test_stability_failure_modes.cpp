@@ -17,6 +17,7 @@
 #include "dgtex/penalty_caution.h"
 #include "dgtex/shell_simulation.h"
 #include "shell_test_support.h"
+#include "square_plate_support.h"
 
 using namespace dgtex;
 using namespace dgtex::testing_support;
@@ -224,24 +225,8 @@ TEST(LargeTimeSteps, CorotatedHugeStepsStayBoundedButDoNotSettle) {
 // Centre deflection of the unit square plate clamped on all sides under q = -1, n x n
 // elements, over Timoshenko's 0.00126532 q a^4 / D.
 double clamped_plate_deflection_ratio(ElementType type, int n, double penalty, const TestMaterial& m) {
-  const double a = 1.0, q = -1.0;
-  const Mesh mesh = make_rectangle(a, a, n, n, type);
-  auto edge = [a](const double* x) {
-    return std::abs(x[0]) < 1e-9 || std::abs(x[0] - a) < 1e-9 || std::abs(x[1]) < 1e-9 || std::abs(x[1] - a) < 1e-9;
-  };
-  auto model = make_model(mesh, m, penalty, edge);
-  std::vector<char> fixed;
-  fix_nodes(mesh, edge, true, true, true, fixed);
-  std::vector<double> f(model->num_dofs(), 0.0);
-  const double force[3] = {0, 0, q};
-  model->add_area_force(force, f);
-  ShellSimulation sim(*model, fixed, f);
-  sim.solve_static();
-  double w = 0;
-  for (int k = 0; k < mesh.num_nodes(); ++k)
-    if (std::abs(mesh.node(k)[0] - a / 2) < 1e-9 && std::abs(mesh.node(k)[1] - a / 2) < 1e-9)
-      w = sim.displacement()[3 * k + 2];
-  return w / (0.00126532 * q * a * a * a * a / kernels::bending_rigidity(m.E, m.nu, m.h));
+  return square_plate_centre_deflection(type, n, penalty, true, m) /
+         (-0.00126532 / kernels::bending_rigidity(m.E, m.nu, m.h));
 }
 
 // ---------------------------------------------------------------------------------------
