@@ -1,9 +1,12 @@
 #include "dgtex/shell_state.h"
 
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
+#include <new>
 #include <stdexcept>
 #include <string>
 #include <type_traits>
@@ -14,10 +17,36 @@ namespace {
 static_assert(sizeof(float) == 4 && sizeof(double) == 8, "the state format needs IEEE float/double");
 
 constexpr char kMagic[8] = {'D', 'G', 'T', 'E', 'X', 'S', 'T', '\0'};
-constexpr std::uint32_t kVersion = 1;
+// Version 2 appends a CRC-32 of every byte before it: a damaged file is refused instead of
+// rendered (a changed element index or texel read as a valid, different state). Version 1
+// files (no checksum) are still read.
+constexpr std::uint32_t kVersion = 2;
+constexpr std::uint32_t kFirstVersionWithChecksum = 2;
 // Upper bounds that keep a corrupt header from asking for absurd allocations.
 constexpr std::uint64_t kMaxCount = std::uint64_t(1) << 34;
 constexpr int kMaxResolution = 1 << 14;
+
+// CRC-32 (IEEE 802.3, reflected polynomial 0xEDB88320), as zlib and PNG compute it.
+class Crc32 {
+ public:
+  void add(const void* data, size_t n) {
+    static const std::array<std::uint32_t, 256> table = [] {
+      std::array<std::uint32_t, 256> t{};
+      for (std::uint32_t i = 0; i < 256; ++i) {
+        std::uint32_t c = i;
+        for (int k = 0; k < 8; ++k) c = (c & 1) ? 0xEDB88320u ^ (c >> 1) : c >> 1;
+        t[i] = c;
+      }
+      return t;
+    }();
+    const auto* bytes = static_cast<const unsigned char*>(data);
+    for (size_t i = 0; i < n; ++i) state_ = table[(state_ ^ bytes[i]) & 0xFFu] ^ (state_ >> 8);
+  }
+  std::uint32_t value() const { return state_ ^ 0xFFFFFFFFu; }
+
+ private:
+  std::uint32_t state_ = 0xFFFFFFFFu;
+};
 
 bool host_is_little_endian() {
   const std::uint16_t probe = 1;
@@ -38,8 +67,12 @@ class Writer {
   void bytes(const void* data, size_t n) {
     out_.write(static_cast<const char*>(data), static_cast<std::streamsize>(n));
     if (!out_) throw std::runtime_error("writing state file '" + path_ + "' failed (disk full?)");
+    crc_.add(data, n);
   }
-  void close() {
+  // The checksum of everything written, then the file is closed.
+  void close_with_checksum() {
+    const std::uint32_t crc = crc_.value();
+    bytes(&crc, sizeof crc);
     out_.close();
     if (!out_) throw std::runtime_error("closing state file '" + path_ + "' failed");
   }
@@ -47,11 +80,18 @@ class Writer {
  private:
   std::string path_;
   std::ofstream out_;
+  Crc32 crc_;
 };
 
 class Reader {
  public:
-  explicit Reader(const std::string& path) : path_(path), in_(path, std::ios::binary | std::ios::ate) {
+  explicit Reader(const std::string& path) : path_(path) {
+    // The size comes from seeking to the end: a pipe (/dev/stdin) failed as "missing or
+    // unreadable", a fifo without writer blocked, a folder read as a truncated header.
+    std::error_code error;
+    if (std::filesystem::exists(path, error) && !std::filesystem::is_regular_file(path, error))
+      fail("not a regular file (a folder, pipe or device); give a file written by save_state or dgtex run --save-state");
+    in_.open(path, std::ios::binary | std::ios::ate);
     if (!in_) throw std::runtime_error("cannot open state file '" + path + "' (missing or unreadable)");
     file_bytes_ = static_cast<std::uint64_t>(in_.tellg());
     in_.seekg(0);
@@ -66,26 +106,29 @@ class Reader {
   void array(std::vector<T>& v, std::uint64_t n, const char* what) {
     if (n > kMaxCount) fail(std::string(what) + " has an implausible size " + std::to_string(n));
     // A damaged count must not allocate gigabytes that the file cannot hold.
-    const std::uint64_t remaining = file_bytes_ - static_cast<std::uint64_t>(in_.tellg());
-    if (n > remaining / sizeof(T))
+    if (n > remaining() / sizeof(T))
       fail(std::string("truncated or damaged: ") + what + " need " + std::to_string(n * sizeof(T)) + " bytes, " +
-           std::to_string(remaining) + " remain in the file");
+           std::to_string(remaining()) + " remain in the file");
     v.resize(n);
     bytes(v.data(), n * sizeof(T), what);
   }
   [[noreturn]] void fail(const std::string& message) const {
     throw std::runtime_error("state file '" + path_ + "': " + message);
   }
-  bool at_end() { return in_.peek() == std::ifstream::traits_type::eof(); }
+  std::uint64_t remaining() { return file_bytes_ - static_cast<std::uint64_t>(in_.tellg()); }
+  std::uint64_t file_bytes() const { return file_bytes_; }
+  std::uint32_t checksum_so_far() const { return crc_.value(); }
 
  private:
   void bytes(void* data, size_t n, const char* what) {
     in_.read(static_cast<char*>(data), static_cast<std::streamsize>(n));
     if (static_cast<size_t>(in_.gcount()) != n) fail(std::string("truncated while reading ") + what);
+    crc_.add(data, n);
   }
   std::string path_;
   std::ifstream in_;
   std::uint64_t file_bytes_ = 0;
+  Crc32 crc_;
 };
 
 }  // namespace
@@ -93,6 +136,7 @@ class Reader {
 void validate_state(const ShellState& s) {
   const Mesh& m = s.mesh;
   const int npe = m.nodes_per_element();
+  if (!std::isfinite(s.time)) throw std::invalid_argument("time is not finite");
   if (m.positions.size() % 3 != 0)
     throw std::invalid_argument("mesh.positions has " + std::to_string(m.positions.size()) +
                                 " entries, not a multiple of 3");
@@ -113,6 +157,9 @@ void validate_state(const ShellState& s) {
   for (size_t i = 0; i < s.displacement.size(); ++i)
     if (!std::isfinite(s.displacement[i]))
       throw std::invalid_argument("displacement[" + std::to_string(i) + "] is not finite");
+    else if (!std::isfinite(m.positions[i] + s.displacement[i]))  // each finite, the deformed position not
+      throw std::invalid_argument("mesh.positions[" + std::to_string(i) + "] + displacement[" + std::to_string(i) +
+                                  "] is not finite");
   for (size_t k = 0; k < s.enrichments.size(); ++k) {
     const ElementEnrichment& e = s.enrichments[k];
     const std::string name = "enrichments[" + std::to_string(k) + "]";
@@ -170,18 +217,18 @@ void save_state(const std::string& path, const ShellState& state) {
     w.array(e.node_values);
     w.array(e.dofs);
   }
-  w.close();
+  w.close_with_checksum();
 }
 
-ShellState load_state(const std::string& path) {
-  if (!host_is_little_endian()) throw std::runtime_error("load_state: only little-endian hosts are supported");
-  Reader r(path);
+namespace {
+
+ShellState read_state(Reader& r) {
   char magic[8];
   for (char& c : magic) c = r.value<char>("the header");
   if (std::memcmp(magic, kMagic, sizeof(kMagic)) != 0) r.fail("not a dgtex state file (bad magic)");
   const auto version = r.value<std::uint32_t>("the version");
-  if (version != kVersion)
-    r.fail("format version " + std::to_string(version) + " is not supported (this build reads version " +
+  if (version < 1 || version > kVersion)
+    r.fail("format version " + std::to_string(version) + " is not supported (this build reads versions 1.." +
            std::to_string(kVersion) + ")");
   ShellState s;
   const auto type = r.value<std::int32_t>("the element type");
@@ -198,7 +245,13 @@ ShellState load_state(const std::string& path) {
   if (has_displacement > 1) r.fail("displacement flag " + std::to_string(has_displacement) + " (valid: 0, 1)");
   if (has_displacement) r.array(s.displacement, 3 * nodes, "displacement");
   const auto count = r.value<std::uint64_t>("the enrichment count");
-  if (count > kMaxCount) r.fail("implausible enrichment count " + std::to_string(count));
+  // A damaged count must not allocate gigabytes of empty enrichments (2^26 of them asked
+  // for 5.3 GB from a 4.8 KB file): each takes at least its two indices, one texel, its
+  // node values and DOFs.
+  const std::uint64_t smallest = 2 * 4 + 4 + npe * 4 + 3 * npe * 8;
+  if (count > r.remaining() / smallest)
+    r.fail("truncated or damaged: " + std::to_string(count) + " enrichments need at least " +
+           std::to_string(count * smallest) + " bytes, " + std::to_string(r.remaining()) + " remain in the file");
   s.enrichments.resize(count);
   for (ElementEnrichment& e : s.enrichments) {
     e.element = r.value<std::int32_t>("an enrichment's element");
@@ -209,13 +262,32 @@ ShellState load_state(const std::string& path) {
     r.array(e.node_values, npe, "enrichment node values");
     r.array(e.dofs, 3 * npe, "enrichment DOFs");
   }
-  if (!r.at_end()) r.fail("unexpected data after the last enrichment");
+  if (version >= kFirstVersionWithChecksum) {
+    const std::uint32_t computed = r.checksum_so_far();
+    const auto stored = r.value<std::uint32_t>("the checksum");
+    if (stored != computed || r.remaining() != 0)
+      r.fail("damaged: its checksum does not match its contents (or the counts in its header do not)");
+  } else if (r.remaining() != 0) {
+    r.fail("damaged: " + std::to_string(r.remaining()) + " bytes after the last enrichment");
+  }
   try {
     validate_state(s);
   } catch (const std::invalid_argument& e) {
     r.fail(e.what());
   }
   return s;
+}
+
+}  // namespace
+
+ShellState load_state(const std::string& path) {
+  if (!host_is_little_endian()) throw std::runtime_error("load_state: only little-endian hosts are supported");
+  Reader r(path);
+  try {
+    return read_state(r);
+  } catch (const std::bad_alloc&) {  // a file of gigabytes, each count within it
+    r.fail("out of memory reading its " + std::to_string(r.file_bytes()) + " bytes");
+  }
 }
 
 }  // namespace dgtex

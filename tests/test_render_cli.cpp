@@ -105,6 +105,14 @@ TEST(RenderCli, BadInputExitsWithTwo) {
   r = run_cli("", "'" + state + "' --out '" + state + "/out'");  // the state file is no folder
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_NE(r.err.find("--out: '" + state + "' is not a folder"), std::string::npos) << r.err;
+  // A state without elements: the library draws the background, the command refuses it
+  // (it wrote a blank image and reported success).
+  const std::string empty = (work_dir() / "empty.state").string();
+  save_state(empty, ShellState{});
+  r = run_cli("", "'" + empty + "' --out '" + out + "'");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("state file '" + empty + "': no elements to draw"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(fs::path(out) / "frame.png"));
 }
 
 // With glvnd pointed at a vendor file that does not exist no EGL implementation loads:

@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <string>
 
 #include "dgtex/png_io.h"
@@ -92,6 +93,72 @@ TEST(RenderStateIo, ErrorsNameTheFileAndTheProblem) {
   bad = test::straight_cut_plate().state;
   bad.mesh.elements[3] = 1000;
   EXPECT_NE(test::message_of([&] { save_state(path, bad); }).find("mesh.elements[3] = 1000"), std::string::npos);
+  std::remove(path.c_str());
+}
+
+// Where the enrichment count lies: header (40 bytes), positions, elements, the displacement
+// flag and the displacement.
+std::uint64_t enrichment_count_offset(const ShellState& s) {
+  return 40 + 8 * s.mesh.positions.size() + 4 * s.mesh.elements.size() + 1 + 8 * s.displacement.size();
+}
+
+template <class T>
+void overwrite(const std::string& path, std::uint64_t offset, T value) {
+  std::fstream file(path, std::ios::binary | std::ios::in | std::ios::out);
+  file.seekp(static_cast<std::streamoff>(offset));
+  file.write(reinterpret_cast<const char*>(&value), sizeof value);
+}
+
+// Found by mutating saved states (933 files, session 68): a changed index or texel was
+// rendered as a valid, different state; a damaged enrichment count allocated gigabytes; a
+// folder read as a truncated header.
+TEST(RenderStateIo, DamageIsFoundByTheChecksumAndTheCounts) {
+  const ShellState state = test::straight_cut_plate().state;
+  const std::string path = temp_path("damaged.state");
+  save_state(path, state);
+  const auto size = std::filesystem::file_size(path);
+  // One element index changed: still a valid state, but not the one saved.
+  overwrite<std::int32_t>(path, 40 + 8 * state.mesh.positions.size() + 4 * 3, 0);
+  std::string message = test::message_of([&] { load_state(path); });
+  EXPECT_NE(message.find(path + "': damaged: its checksum does not match"), std::string::npos) << message;
+
+  save_state(path, state);
+  overwrite<std::uint64_t>(path, enrichment_count_offset(state), std::uint64_t(1) << 26);
+  message = test::message_of([&] { load_state(path); });
+  EXPECT_NE(message.find("truncated or damaged: 67108864 enrichments need at least"), std::string::npos) << message;
+
+  // Version 1 (no checksum) is still read.
+  save_state(path, state);
+  overwrite<std::uint32_t>(path, 8, 1);
+  std::filesystem::resize_file(path, size - 4);
+  const ShellState version1 = load_state(path);
+  EXPECT_EQ(version1.mesh.positions, state.mesh.positions);
+  EXPECT_EQ(version1.enrichments.size(), state.enrichments.size());
+  overwrite<std::uint32_t>(path, 8, 3);
+  message = test::message_of([&] { load_state(path); });
+  EXPECT_NE(message.find("format version 3 is not supported (this build reads versions 1..2)"), std::string::npos)
+      << message;
+  std::remove(path.c_str());
+
+  const std::string folder = temp_path("folder.state");
+  std::filesystem::create_directories(folder);
+  message = test::message_of([&] { load_state(folder); });
+  EXPECT_NE(message.find(folder + "': not a regular file"), std::string::npos) << message;
+  std::filesystem::remove(folder);
+}
+
+TEST(RenderStateIo, NonFiniteTimesAndDeformedPositionsAreRefused) {
+  const std::string path = temp_path("nonfinite.state");
+  ShellState bad = test::straight_cut_plate().state;
+  bad.time = std::numeric_limits<double>::quiet_NaN();
+  std::string message = test::message_of([&] { save_state(path, bad); });
+  EXPECT_NE(message.find("time is not finite"), std::string::npos) << message;
+  // Each finite, their sum not: the renderer framed an infinite box and drew nothing.
+  bad = test::straight_cut_plate().state;
+  bad.mesh.positions[0] = 1.7e308;
+  bad.displacement[0] = 1.7e308;
+  message = test::message_of([&] { save_state(path, bad); });
+  EXPECT_NE(message.find("mesh.positions[0] + displacement[0] is not finite"), std::string::npos) << message;
   std::remove(path.c_str());
 }
 

@@ -99,6 +99,10 @@ int render_command(int argc, char** argv) {
       if (!background.empty()) settings.background[d] = static_cast<float>(background[d]);
     }
     state = load_state(state_path);
+    // The library draws an empty state as the background alone; from a file that is a
+    // damaged count, not an image to write with success.
+    if (state.mesh.num_elements() == 0)
+      throw std::invalid_argument("state file '" + state_path + "': no elements to draw (dgtex run never writes such a file)");
   } catch (const std::exception& e) {
     std::fprintf(stderr, "dgtex render: %s\n", e.what());
     return 2;

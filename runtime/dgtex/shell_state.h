@@ -36,17 +36,22 @@ struct ShellState {
   double time = 0;
 };
 
-// Checks sizes and indices; throws std::invalid_argument naming the offending field.
+// Checks sizes and indices, and that time, positions,
+// displacements (and their sums) and enrichments are finite; throws std::invalid_argument
+// naming the offending field.
 void validate_state(const ShellState& state);
 
-// Binary format, little-endian, version 1 ("dgtex state"):
-//   char[8]  magic "DGTEXST\0"      u32 version = 1
+// Binary format, little-endian, version 2 ("dgtex state"):
+//   char[8]  magic "DGTEXST\0"      u32 version = 2
 //   i32 element type (0 quad8, 1 tri6)  u64 #nodes  u64 #elements  f64 time
 //   f64 positions[#nodes*3]   i32 elements[#elements*npe]
 //   u8  has_displacement      f64 displacement[#nodes*3] if has_displacement
 //   u64 #enrichments, then per enrichment:
 //     i32 element  i32 T  f32 values[T*T]  f32 node_values[npe]  f64 dofs[npe*3]
-// Errors (cannot open, truncated, bad magic/version, inconsistent sizes) throw
+//   u32 CRC-32 (IEEE, as zlib's crc32) of every byte before it
+// Version 1 is the same without the checksum; load_state reads both, save_state writes 2.
+// Errors (cannot open, not a regular file, truncated, bad magic/version, a checksum that
+// does not match, inconsistent sizes, a state validate_state refuses) throw
 // std::runtime_error naming the file.
 void save_state(const std::string& path, const ShellState& state);
 ShellState load_state(const std::string& path);
