@@ -2,10 +2,13 @@
 // Argument checks of the public runtime classes: a wrong size or index from a program
 // linking dgtex throws std::invalid_argument naming the function, the argument, its value
 // and what is valid, instead of reading or writing out of bounds. O(1); not for kernels.
+#include <cmath>
 #include <cstddef>
 #include <cstdio>
 #include <stdexcept>
 #include <string>
+
+#include "dgtex/kernels/shape_functions.h"
 
 namespace dgtex::detail {
 
@@ -31,6 +34,22 @@ inline void check_index(const char* function, const char* argument, long long in
   throw std::invalid_argument(std::string(function) + ": " + argument + " " + std::to_string(index) +
                               " is out of range; expected 0.." + std::to_string(count - 1) + " (" + count_name +
                               " = " + std::to_string(count) + ")");
+}
+
+// "ShellModel::interpolate: xi (1.5, 0) is outside the reference element; quad8 needs ..."
+// (extrapolated through the shape functions; NaN reached a cast to int in the texel lookup)
+inline void check_parametric_point(const char* function, kernels::ElementType type, const double xi[2]) {
+  if (kernels::inside_reference_element(type, xi[0], xi[1])) return;
+  throw std::invalid_argument(std::string(function) + ": xi (" + short_number(xi[0]) + ", " + short_number(xi[1]) +
+                              ") is outside the reference element; " + kernels::reference_element_rule(type));
+}
+
+// "ShellSimulation: external_force[17] is nan; expected a finite number"
+inline void check_finite(const char* function, const char* argument, const double* values, std::size_t count) {
+  for (std::size_t i = 0; i < count; ++i)
+    if (!std::isfinite(values[i]))
+      throw std::invalid_argument(std::string(function) + ": " + argument + "[" + std::to_string(i) + "] is " +
+                                  short_number(values[i]) + "; expected a finite number");
 }
 
 }  // namespace dgtex::detail

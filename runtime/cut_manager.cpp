@@ -18,6 +18,7 @@
 #include "dgtex/stage_timer.h"
 #include "dgtex/surface_point.h"
 #include "dgtex/texel_storage.h"
+#include "shell_model_inputs.h"
 
 namespace dgtex {
 namespace {
@@ -208,7 +209,9 @@ void CutManager::trim_shared_end_spurs(std::vector<std::vector<std::pair<int, Cu
 
 CutManager::CutManager(const Mesh& mesh, const Topology& topology, const std::vector<Cut>& cuts,
                        const EnrichmentOptions& options, CutManagerOptions manager_options)
-    : mesh_(mesh),
+    // Checked before the adjacency reads them: a topology of another (finer) mesh wrote
+    // out of bounds there, and a bad node index read out of bounds in the point search.
+    : mesh_((detail::check_mesh_and_topology("CutManager", mesh, topology), mesh)),
       adjacency_(mesh, topology),
       cuts_(cuts),
       options_(options),

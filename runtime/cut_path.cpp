@@ -364,7 +364,6 @@ MeshCutPath trace_cut_path(const Mesh& mesh, const ElementAdjacency& adjacency, 
 
 MeshCutPath trace_cut_path(const Mesh& mesh, const SurfacePointSearch& search, const ElementAdjacency& adjacency,
                            const Cut& cut, int resolution, const std::string& name) {
-  constexpr double kSlack = 1e-12;
   if (mesh.num_elements() == 0) throw std::invalid_argument(name + ": the mesh has no elements to cut");
   if (resolution <= 0) throw std::invalid_argument(name + ": texture resolution must be positive, got " + std::to_string(resolution));
   const bool given_on_surface = cut.kind == Cut::Kind::surface_points;
@@ -383,13 +382,9 @@ MeshCutPath trace_cut_path(const Mesh& mesh, const SurfacePointSearch& search, c
         throw std::invalid_argument(where + ".element: no such element, got " + std::to_string(sp.element) +
                                     "; the mesh has elements 0.." + std::to_string(mesh.num_elements() - 1));
       const double a = sp.xi[0], b = sp.xi[1];
-      const bool inside = mesh.type == ElementType::quad8
-                              ? std::abs(a) <= 1 + kSlack && std::abs(b) <= 1 + kSlack
-                              : a >= -kSlack && b >= -kSlack && a + b <= 1 + kSlack;
-      if (!(inside && std::isfinite(a) && std::isfinite(b)))
+      if (!kernels::inside_reference_element(mesh.type, a, b))
         throw std::invalid_argument(where + ".xi: outside the reference element, got [" + num(a) + ", " + num(b) + "]; " +
-                                    (mesh.type == ElementType::quad8 ? "quad8 needs xi1, xi2 in [-1, 1]"
-                                                                     : "tri6 needs xi1, xi2 >= 0 and xi1 + xi2 <= 1"));
+                                    kernels::reference_element_rule(mesh.type));
       anchors.push_back(vertex_at(mesh, sp.element, a, b));
     } else {
       const Vec3& p = cut.points[k];

@@ -6,6 +6,7 @@
 #include <limits>
 #include <stdexcept>
 #include <string>
+#include <utility>
 
 #include "dgtex/kernels/forall.h"
 #include "dgtex/shell_model.h"
@@ -132,6 +133,22 @@ FactorReusingSolver::FactorReusingSolver(const BlockAssembly& pattern, const Fre
 }
 
 void FactorReusingSolver::set_options(const FactorReuseOptions& options) {
+  // A tolerance of 1 or more took the extrapolated guess as the solution (0 iterations);
+  // 0, NaN or no iterations made every step refactorise and end "ill-conditioned".
+  if (!(options.relative_tolerance > 0 && options.relative_tolerance < 1))
+    throw std::invalid_argument("FactorReuseOptions: relative_tolerance " +
+                                detail::short_number(options.relative_tolerance) + "; expected a number in (0, 1), e.g. 1e-8");
+  if (options.max_iterations < 1)
+    throw std::invalid_argument("FactorReuseOptions: max_iterations " + std::to_string(options.max_iterations) +
+                                "; expected an integer >= 1");
+  for (const auto& [name, value] : {std::pair{"refactor_after_iterations", options.refactor_after_iterations},
+                                    {"large_dense_refactor_after_iterations", options.large_dense_refactor_after_iterations}})
+    if (value < 0)  // 0: every solve that iterates at all factorises the next system
+      throw std::invalid_argument(std::string("FactorReuseOptions: ") + name + " " + std::to_string(value) +
+                                  "; expected an integer >= 0");
+  if (!(options.element_local_max_dropped_radius >= 0))
+    throw std::invalid_argument("FactorReuseOptions: element_local_max_dropped_radius " +
+                                detail::short_number(options.element_local_max_dropped_radius) + "; expected a number >= 0");
   const bool ruled_out = element_local_dropped_radius_ > options.element_local_max_dropped_radius;
   const bool element_local = options.preconditioner_pattern == PreconditionerPattern::element_local &&
                              element_local_differs_ && !whole_pattern_dense_ && stats_.element_local_fallbacks == 0 &&

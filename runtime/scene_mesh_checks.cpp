@@ -77,7 +77,6 @@ void check_selections(const Scene& scene, const Mesh& mesh) {
 }
 
 void check_surface_points(const Scene& scene, const Mesh& mesh) {
-  constexpr double kSlack = 1e-12;
   for (size_t c = 0; c < scene.cuts.size(); ++c) {
     const Cut& cut = scene.cuts[c];
     if (cut.kind != Cut::Kind::surface_points) continue;
@@ -91,12 +90,9 @@ void check_surface_points(const Scene& scene, const Mesh& mesh) {
         throw SceneError(scene.source_name, p + ".element", "no such element", std::to_string(sp.element),
                          "the mesh has elements 0.." + std::to_string(mesh.num_elements() - 1));
       const double a = sp.xi[0], b = sp.xi[1];
-      const bool inside = mesh.type == ElementType::quad8 ? std::abs(a) <= 1 + kSlack && std::abs(b) <= 1 + kSlack
-                                                          : a >= -kSlack && b >= -kSlack && a + b <= 1 + kSlack;
-      if (!inside)
+      if (!kernels::inside_reference_element(mesh.type, a, b))
         throw SceneError(scene.source_name, p + ".xi", "outside the reference element", "[" + fmt(a) + ", " + fmt(b) + "]",
-                         mesh.type == ElementType::quad8 ? "quad8 needs xi1, xi2 in [-1, 1]"
-                                                         : "tri6 needs xi1, xi2 >= 0 and xi1 + xi2 <= 1");
+                         kernels::reference_element_rule(mesh.type));
       Eigen::Vector3d x, normal;
       surface_point(mesh, sp.element, sp.xi.data(), x, normal);
       if (k > 0) total += (x - previous).norm();

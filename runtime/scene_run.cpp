@@ -121,6 +121,10 @@ void SceneRun::step() {
   if (!scene_.analysis.is_dynamic())
     throw std::logic_error("SceneRun::step: the scene's analysis is static; call solve_static, or give the scene a "
                            "dynamic analysis");
+  if (!failed_step_.empty())
+    throw std::logic_error("SceneRun::step: step " + std::to_string(steps_ + 1) + " failed (" + failed_step_ +
+                           "); its cuts may have moved on without their basis, so the run cannot go on: start a new "
+                           "SceneRun");
   const double next = time_ + dynamics_.time_step;
   const kernels::ScopedThreadsBusyBeside beside(&cut_update_threads_);
   last_cut_update_threads_ = 0;
@@ -143,8 +147,13 @@ void SceneRun::step() {
       beside_update_ms_ = ms_since(next_cut_update_started_);  // the step's own work beside it
       next_cut_update_.wait();  // both done: the step is over
     }
+  } catch (const std::exception& e) {
+    discard_next_cut_update();
+    failed_step_ = e.what();
+    throw;
   } catch (...) {
-    discard_next_cut_update();  // the cut manager may be ahead: the next step updates again
+    discard_next_cut_update();
+    failed_step_ = "an exception of unknown type";
     throw;
   }
   time_ = next;

@@ -53,6 +53,7 @@ ShellModel::ShellModel(Mesh mesh, const Topology& topology, std::vector<kernels:
 // quadrature of the enriched ones, the mass and the load weights. Without enrichments
 // the plain arrays are the whole mesh and every result is that of the plain DG shell.
 void ShellModel::rebuild(std::vector<double>* integrated_mass) {
+  ++revision_;
   const int ne = mesh_.num_elements();
   const int npe = mesh_.nodes_per_element();
   const bool enriched = !enriched_elements_.empty();
@@ -288,7 +289,43 @@ void ShellModel::install_enrichments(std::vector<EnrichmentFunction> functions, 
   std::vector<std::vector<std::pair<int, int>>> incident(nn);
   for (int e = 0; e < ne; ++e)
     for (int a = 0; a < npe; ++a) incident[mesh_.element_nodes(e)[a]].push_back({e, a});
+  // The checks that take the functions together, also before any member changes: a throw
+  // leaves the model as it was (these came after the old functions were freed, and a caller
+  // that caught them kept a model whose textures pointed into them).
+  std::vector<int> functions_on(ne, 0);  // per element: functions with an enriched node of it
+  for (int i = 0; i < static_cast<int>(functions.size()); ++i) {
+    const EnrichmentFunction& f = functions[i];
+    auto has_texture = [&](int element) {
+      auto it = std::lower_bound(f.elements.begin(), f.elements.end(), element,
+                                 [](const ElementTexture& et, int e) { return et.element < e; });
+      return it != f.elements.end() && it->element == element;
+    };
+    for (int a : f.enriched_nodes)
+      for (const auto& [e, local] : incident[a])
+        if (!has_texture(e))
+          fail(i, "element " + std::to_string(e) + " is incident to enriched node " + std::to_string(a) +
+                      " but has no texture (Omega_i must hold every element incident to N_i)");
+    for (const ElementTexture& et : f.elements) {
+      const int* nodes = mesh_.element_nodes(et.element);
+      if (std::any_of(nodes, nodes + npe, [&](int a) {
+            return std::binary_search(f.enriched_nodes.begin(), f.enriched_nodes.end(), a);
+          }))
+        ++functions_on[et.element];
+    }
+  }
+  for (int e = 0; e < ne; ++e) {
+    if (functions_on[e] == 0) continue;
+    if (!textured_index_.empty() && textured_index_[e] >= 0)
+      throw std::invalid_argument("enrichment: element " + std::to_string(e) +
+                                  " has a material texture; cuts through material-textured elements are not supported");
+    if (functions_on[e] > kernels::max_enrichments_per_element)
+      throw std::invalid_argument("enrichment: element " + std::to_string(e) + " carries " +
+                                  std::to_string(functions_on[e]) + " enrichment functions; at most " +
+                                  std::to_string(kernels::max_enrichments_per_element) +
+                                  " are supported (fewer cuts through and around the element, or a finer mesh)");
+  }
 
+  ++revision_;
   enrichments_ = std::make_shared<std::vector<EnrichmentFunction>>(std::move(functions));
   resolution_ = resolution;
   function_slot_start_.assign(1, 0);
@@ -305,10 +342,7 @@ void ShellModel::install_enrichments(std::vector<EnrichmentFunction> functions, 
     for (int a : (*enrichments_)[i].enriched_nodes) {
       double sum = 0;
       for (const auto& [e, local] : incident[a]) {
-        const kernels::TexelTile* tile = texture_of(i, e);
-        if (!tile)
-          fail(i, "element " + std::to_string(e) + " is incident to enriched node " + std::to_string(a) +
-                      " but has no texture (Omega_i must hold every element incident to N_i)");
+        const kernels::TexelTile* tile = texture_of(i, e);  // there is one (checked above)
         double xi[2];
         kernels::node_parametric_position(type, local, xi);
         kernels::TextureSample sample;
@@ -348,15 +382,7 @@ void ShellModel::install_enrichments(std::vector<EnrichmentFunction> functions, 
   enriched_node_.clear();
   enriched_shift_.clear();
   for (int e = 0; e < ne; ++e) {
-    if (per_element[e].empty()) continue;
-    if (!textured_index_.empty() && textured_index_[e] >= 0)
-      throw std::invalid_argument("enrichment: element " + std::to_string(e) +
-                                  " has a material texture; cuts through material-textured elements are not supported");
-    if (static_cast<int>(per_element[e].size()) > kernels::max_enrichments_per_element)
-      throw std::invalid_argument("enrichment: element " + std::to_string(e) + " carries " +
-                                  std::to_string(per_element[e].size()) + " enrichment functions; at most " +
-                                  std::to_string(kernels::max_enrichments_per_element) +
-                                  " are supported (fewer cuts through and around the element, or a finer mesh)");
+    if (per_element[e].empty()) continue;  // not more than max_enrichments_per_element (checked above)
     enriched_index_[e] = static_cast<int>(enriched_elements_.size());
     enriched_elements_.push_back(e);
     for (const ElementEnrichment& ee : per_element[e]) {
@@ -994,6 +1020,15 @@ void ShellModel::add_area_force(const double q[3], std::vector<double>& f) const
     for (int c = 0; c < 3; ++c) f[3 * textured_connectivity_[i] + c] += textured_area_weights_[i] * q[c];
 }
 
+int ShellModel::virtual_slot(int virtual_node) const {
+  if (virtual_node < num_nodes() || virtual_node >= num_nodes() + num_enriched_nodes())
+    throw std::invalid_argument("ShellModel: virtual node " + std::to_string(virtual_node) + " is out of range; expected " +
+                                std::to_string(num_nodes()) + ".." + std::to_string(num_nodes() + num_enriched_nodes() - 1) +
+                                " (num_nodes() = " + std::to_string(num_nodes()) + ", num_enriched_nodes() = " +
+                                std::to_string(num_enriched_nodes()) + ")");
+  return virtual_node - num_nodes();
+}
+
 void ShellModel::set_enrichments(std::vector<EnrichmentFunction> functions) {
   pruned_enriched_nodes_ = 0;
   kept_ = KeptBasisValues{};  // of the basis being replaced (a basis without enriched elements integrates nothing)
@@ -1129,6 +1164,7 @@ int ShellModel::basis_at(int element, const double xi[2], int* global, double* v
 void ShellModel::add_point_force(int element, const double xi[2], const double force[3], std::vector<double>& f) const {
   detail::check_size("ShellModel::add_point_force", "f", f.size(), "num_dofs()", num_dofs());
   detail::check_index("ShellModel::add_point_force", "element", element, "mesh().num_elements()", mesh_.num_elements());
+  detail::check_parametric_point("ShellModel::add_point_force", mesh_.type, xi);
   int global[kernels::max_enriched_basis];
   double values[kernels::max_enriched_basis];
   const int n = basis_at(element, xi, global, values);
@@ -1139,6 +1175,7 @@ void ShellModel::add_point_force(int element, const double xi[2], const double f
 void ShellModel::interpolate(const std::vector<double>& u, int element, const double xi[2], double out[3]) const {
   detail::check_size("ShellModel::interpolate", "u", u.size(), "num_dofs()", num_dofs());
   detail::check_index("ShellModel::interpolate", "element", element, "mesh().num_elements()", mesh_.num_elements());
+  detail::check_parametric_point("ShellModel::interpolate", mesh_.type, xi);
   int global[kernels::max_enriched_basis];
   double values[kernels::max_enriched_basis];
   const int n = basis_at(element, xi, global, values);

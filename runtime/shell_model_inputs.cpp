@@ -16,7 +16,7 @@ namespace {
 }
 
 // Each edge must name elements of this mesh and the nodes of their local edge.
-void check_edge(const Mesh& mesh, const MeshEdge& edge, bool interior, const std::string& name) {
+void check_edge(const char* who, const Mesh& mesh, const MeshEdge& edge, bool interior, const std::string& name) {
   const int corners = kernels::corners_per_element(mesh.type);
   for (int side = 0; side < (interior ? 2 : 1); ++side) {
     const int element = side == 0 ? edge.plus_element : edge.minus_element;
@@ -31,7 +31,7 @@ void check_edge(const Mesh& mesh, const MeshEdge& edge, bool interior, const std
                        : nodes[local[0]] == edge.nodes[2] && nodes[local[2]] == edge.nodes[0];
     }
     if (!fits)
-      throw std::invalid_argument("ShellModel: the topology was not built from this mesh: " + name + " (element " +
+      throw std::invalid_argument(std::string(who) + ": the topology was not built from this mesh: " + name + " (element " +
                                   std::to_string(element) + ", local edge " + std::to_string(local_edge) +
                                   ") does not match it; pass build_topology(mesh)");
   }
@@ -39,21 +39,24 @@ void check_edge(const Mesh& mesh, const MeshEdge& edge, bool interior, const std
 
 }  // namespace
 
-void check_shell_model_inputs(const Mesh& mesh, const Topology& topology,
-                              const std::vector<kernels::ShellSection>& sections, const std::vector<int>& clamped_edges,
-                              const ShellModelOptions& options) {
+void check_mesh_and_topology(const char* who, const Mesh& mesh, const Topology& topology) {
   validate_mesh(mesh);
-
   const long long half_edges = 2LL * topology.interior_edges.size() + topology.boundary_edges.size();
   const long long expected = static_cast<long long>(mesh.num_elements()) * kernels::corners_per_element(mesh.type);
   if (half_edges != expected)
-    throw std::invalid_argument("ShellModel: the topology was not built from this mesh: its edges have " +
+    throw std::invalid_argument(std::string(who) + ": the topology was not built from this mesh: its edges have " +
                                 std::to_string(half_edges) + " sides, the mesh's elements " + std::to_string(expected) +
                                 "; pass build_topology(mesh)");
   for (size_t k = 0; k < topology.interior_edges.size(); ++k)
-    check_edge(mesh, topology.interior_edges[k], true, "interior_edges[" + std::to_string(k) + "]");
+    check_edge(who, mesh, topology.interior_edges[k], true, "interior_edges[" + std::to_string(k) + "]");
   for (size_t k = 0; k < topology.boundary_edges.size(); ++k)
-    check_edge(mesh, topology.boundary_edges[k], false, "boundary_edges[" + std::to_string(k) + "]");
+    check_edge(who, mesh, topology.boundary_edges[k], false, "boundary_edges[" + std::to_string(k) + "]");
+}
+
+void check_shell_model_inputs(const Mesh& mesh, const Topology& topology,
+                              const std::vector<kernels::ShellSection>& sections, const std::vector<int>& clamped_edges,
+                              const ShellModelOptions& options) {
+  check_mesh_and_topology("ShellModel", mesh, topology);
 
   check_size("ShellModel", "sections", sections.size(), "mesh.num_elements()", mesh.num_elements());
   for (size_t e = 0; e < sections.size(); ++e) {
@@ -65,9 +68,15 @@ void check_shell_model_inputs(const Mesh& mesh, const Topology& topology,
     if (!(s.thickness > 0 && std::isfinite(s.thickness))) refuse(name + "thickness", s.thickness, "a positive finite number");
     if (!(s.density >= 0 && std::isfinite(s.density))) refuse(name + "density", s.density, "a finite number >= 0");
   }
-  for (size_t k = 0; k < clamped_edges.size(); ++k)
+  std::vector<char> listed(topology.boundary_edges.size(), 0);
+  for (size_t k = 0; k < clamped_edges.size(); ++k) {
     check_index("ShellModel", ("clamped_edges[" + std::to_string(k) + "]").c_str(), clamped_edges[k],
                 "topology.boundary_edges.size()", static_cast<long long>(topology.boundary_edges.size()));
+    // Listed twice, its clamp terms were assembled twice: a silently stiffer clamp.
+    if (listed[clamped_edges[k]]++)
+      throw std::invalid_argument("ShellModel: clamped_edges[" + std::to_string(k) + "] " +
+                                  std::to_string(clamped_edges[k]) + " is listed twice; list each edge once");
+  }
 
   if (!(options.penalty > 0 && std::isfinite(options.penalty)))
     refuse("options.penalty", options.penalty, "a positive finite number");

@@ -11,9 +11,14 @@
 
 namespace dgtex::detail {
 
+// Throws MeshError for a mesh validate_mesh refuses, and std::invalid_argument
+// "<who>: the topology was not built from this mesh: ..." for a topology that is not
+// build_topology(mesh)'s (ShellModel, CutManager).
+void check_mesh_and_topology(const char* who, const Mesh& mesh, const Topology& topology);
+
 // Throws MeshError for a mesh validate_mesh refuses, and std::invalid_argument for a
 // topology not built from this mesh, a section that is not a material (E, h > 0,
-// -1 < nu < 0.5, density >= 0, all finite), a clamped edge out of range, or options out
+// -1 < nu < 0.5, density >= 0, all finite), a clamped edge out of range or listed twice, or options out
 // of their ranges (penalty > 0, 1..5 edge points, mass ratio in [0, 1), cluster texels
 // >= 0, merge tolerance > 0).
 void check_shell_model_inputs(const Mesh& mesh, const Topology& topology,

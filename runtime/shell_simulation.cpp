@@ -4,6 +4,8 @@
 #include <cmath>
 #include <stdexcept>
 #include <string>
+#include <type_traits>
+#include <utility>
 
 #include "dgtex/kernels/forall.h"
 #include "dgtex/model_error.h"
@@ -18,6 +20,7 @@ namespace {
 template <class T>
 std::vector<T> checked_size(const char* argument, std::vector<T> values, int dofs) {
   detail::check_size("ShellSimulation", argument, values.size(), "model.num_dofs()", dofs);
+  if constexpr (std::is_same_v<T, double>) detail::check_finite("ShellSimulation", argument, values.data(), values.size());
   return values;
 }
 
@@ -25,6 +28,7 @@ std::vector<T> checked_size(const char* argument, std::vector<T> values, int dof
 
 ShellSimulation::ShellSimulation(const ShellModel& model, std::vector<char> fixed, std::vector<double> external_force)
     : model_(model),
+      model_revision_(model.revision()),
       fixed_(checked_size("fixed", std::move(fixed), model.num_dofs())),
       f_ext_(checked_size("external_force", std::move(external_force), model.num_dofs())),
       system_(model.pattern(), fixed_),
@@ -43,9 +47,20 @@ const std::vector<double>& ShellSimulation::linear_stiffness() {
   return linear_k_;
 }
 
+void ShellSimulation::check_model_unchanged(const char* function) const {
+  if (model_.revision() != model_revision_)
+    throw std::logic_error(std::string(function) +
+                           ": the model's basis or material textures changed after this simulation was built "
+                           "(set_enrichments, set_material_textures); build a new ShellSimulation (and carry the "
+                           "state over, as SceneRun does by projection)");
+}
+
 void ShellSimulation::set_state(std::vector<double> u, std::vector<double> v) {
+  check_model_unchanged("ShellSimulation::set_state");
   detail::check_size("ShellSimulation::set_state", "u", u.size(), "model.num_dofs()", model_.num_dofs());
   detail::check_size("ShellSimulation::set_state", "v", v.size(), "model.num_dofs()", model_.num_dofs());
+  detail::check_finite("ShellSimulation::set_state", "u", u.data(), u.size());
+  detail::check_finite("ShellSimulation::set_state", "v", v.data(), v.size());
   u_ = std::move(u);
   v_ = std::move(v);
   previous_v_.clear();
@@ -61,6 +76,7 @@ std::string ShellSimulation::enrichment_hint() const {
 }
 
 void ShellSimulation::check_statically_constrained() {
+  check_model_unchanged("ShellSimulation::check_statically_constrained");
   const Mesh& mesh = model_.mesh();
   const int n = mesh.num_nodes();
   Eigen::Vector3d centre = Eigen::Vector3d::Zero();
@@ -114,6 +130,7 @@ void ShellSimulation::check_statically_constrained() {
 }
 
 void ShellSimulation::solve_static() {
+  check_model_unchanged("ShellSimulation::solve_static");
   check_statically_constrained();
   const std::vector<double>& K = linear_stiffness();
   std::vector<double> values, rhs, x;
@@ -153,10 +170,16 @@ void ShellSimulation::extrapolate_initial_guess() {
 void ShellSimulation::set_solver_options(const FactorReuseOptions& options) { solver_.set_options(options); }
 
 void ShellSimulation::step(const DynamicsOptions& o) {
+  check_model_unchanged("ShellSimulation::step");
   const double dt = o.time_step;
   if (!(dt > 0 && std::isfinite(dt)))
     throw std::invalid_argument("ShellSimulation::step: time_step " + detail::short_number(dt) +
                                 " is not a positive finite time");
+  // Negative damping read as "not positive definite (penalty too low?)" once 1 + dt a <= 0.
+  for (const auto& [name, value] : {std::pair{"mass_damping", o.mass_damping}, {"stiffness_damping", o.stiffness_damping}})
+    if (!(value >= 0 && std::isfinite(value)))
+      throw std::invalid_argument(std::string("ShellSimulation::step: ") + name + " " + detail::short_number(value) +
+                                  "; expected a finite number >= 0");
   const int ndofs = model_.num_dofs();
   corrective_.clear();
   const std::vector<double>* K = nullptr;
@@ -257,6 +280,7 @@ void ShellSimulation::step(const DynamicsOptions& o) {
 }
 
 double ShellSimulation::kinetic_energy() const {
+  check_model_unchanged("ShellSimulation::kinetic_energy");
   std::vector<double> Mv(model_.num_dofs());
   block_multiply(model_.pattern(), model_.mass_blocks().data(), v_.data(), Mv.data());
   double e = 0;
@@ -265,6 +289,7 @@ double ShellSimulation::kinetic_energy() const {
 }
 
 double ShellSimulation::linear_elastic_energy() const {
+  check_model_unchanged("ShellSimulation::linear_elastic_energy");
   std::vector<double> K, Ku(model_.num_dofs());
   model_.assemble_stiffness(nullptr, K, nullptr);
   block_multiply(model_.pattern(), K.data(), u_.data(), Ku.data());

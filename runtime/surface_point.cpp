@@ -4,9 +4,11 @@
 #include <array>
 #include <cmath>
 #include <limits>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
+#include "api_argument_checks.h"
 #include "box_hierarchy.h"
 
 namespace dgtex {
@@ -521,6 +523,14 @@ SurfacePoint SurfacePointSearch::closest(const double p[3]) const {
 
 SurfacePoint SurfacePointSearch::closest_among(const std::vector<int>& elements, const double p[3]) const {
   if (elements.empty()) throw MeshError("closest_surface_point: no elements to search");
+  for (size_t k = 0; k < elements.size(); ++k) {  // they index the per-element boxes
+    detail::check_index("SurfacePointSearch::closest_among", ("elements[" + std::to_string(k) + "]").c_str(),
+                        elements[k], "mesh.num_elements()", mesh_.num_elements());
+    if (k > 0 && elements[k] <= elements[k - 1])
+      throw std::invalid_argument("SurfacePointSearch::closest_among: elements[" + std::to_string(k) + "] " +
+                                  std::to_string(elements[k]) + " follows " + std::to_string(elements[k - 1]) +
+                                  "; expected distinct elements in ascending order");
+  }
   check_query(p);
   return search(elements.data(), static_cast<int>(elements.size()), p, tie_tolerance_of(elements), false);
 }

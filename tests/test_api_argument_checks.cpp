@@ -15,10 +15,12 @@
 #include "dgtex/cut_manager.h"
 #include "dgtex/mesh_error.h"
 #include "dgtex/mesh_generators.h"
+#include "dgtex/model_error.h"
 #include "dgtex/scene.h"
 #include "dgtex/scene_model.h"
 #include "dgtex/scene_run.h"
 #include "dgtex/shell_simulation.h"
+#include "dgtex/surface_point.h"
 #include "dgtex/topology.h"
 #include "exception_message_support.h"
 #include "scene_in_code_support.h"
@@ -108,6 +110,9 @@ TEST(ApiArgumentChecks, ShellModelChecksItsMeshTopologySectionsAndOptions) {
   EXPECT_NE(with_section([](kernels::ShellSection& s) { s.density = std::nan(""); }), "");
   EXPECT_EQ(model_error(mesh, topology, sections, {8}, {}),
             "ShellModel: clamped_edges[0] 8 is out of range; expected 0..7 (topology.boundary_edges.size() = 8)");
+  // Listed twice, its clamp terms were assembled twice (a silently stiffer clamp).
+  EXPECT_EQ(model_error(mesh, topology, sections, {0, 3, 0}, {}),
+            "ShellModel: clamped_edges[2] 0 is listed twice; list each edge once");
 
   // A topology of another mesh: more edges, or as many but of other elements.
   EXPECT_NE(model_error(mesh, build_topology(make_rectangle(1, 1, 4, 4, ElementType::quad8)), sections, {}, {})
@@ -151,6 +156,134 @@ TEST(ApiArgumentChecks, CutManagerUpdatesToFiniteTimesOnly) {
   EXPECT_NE(message_of<std::invalid_argument>([&] { cuts.update(std::nan("")); }).find("is not finite"), std::string::npos);
   EXPECT_TRUE(cuts.update(0.0));
   EXPECT_EQ(cuts.functions().size(), 1u);
+}
+
+// Found by reading the public headers (session 68): each read or wrote out of bounds, or
+// was taken silently.
+TEST(ApiArgumentChecks, ShellSimulationRefusesNonFiniteInputsNegativeDampingAndBadSolverOptions) {
+  const Scene scene = strip_built_in_code(true, false);
+  const Mesh mesh = build_scene_mesh(scene);
+  const SceneModel built = build_scene_model(scene, mesh);
+  const int dofs = built.model->num_dofs();
+  std::vector<double> force = built.external_force;
+  force[17] = std::nan("");
+  EXPECT_EQ(message_of<std::invalid_argument>([&] { ShellSimulation(*built.model, built.fixed, force); }),
+            "ShellSimulation: external_force[17] is nan; expected a finite number");
+  ShellSimulation simulation(*built.model, built.fixed, built.external_force);
+  std::vector<double> u(dofs, 0.0);
+  u[4] = INFINITY;
+  EXPECT_EQ(message_of<std::invalid_argument>([&] { simulation.set_state(u, std::vector<double>(dofs, 0.0)); }),
+            "ShellSimulation::set_state: u[4] is inf; expected a finite number");
+  DynamicsOptions options;
+  options.time_step = 0.005;
+  options.mass_damping = -3;  // 1 + dt a <= 0 read as "not positive definite (penalty too low?)"
+  EXPECT_EQ(message_of<std::invalid_argument>([&] { simulation.step(options); }),
+            "ShellSimulation::step: mass_damping -3; expected a finite number >= 0");
+  options.mass_damping = 0;
+  FactorReuseOptions solver;
+  solver.relative_tolerance = 1;  // took the extrapolated guess as the solution
+  EXPECT_EQ(message_of<std::invalid_argument>([&] { simulation.set_solver_options(solver); }),
+            "FactorReuseOptions: relative_tolerance 1; expected a number in (0, 1), e.g. 1e-8");
+  solver.relative_tolerance = 1e-8;
+  solver.max_iterations = 0;
+  EXPECT_NE(message_of<std::invalid_argument>([&] { simulation.set_solver_options(solver); }).find("max_iterations 0"),
+            std::string::npos);
+  solver.max_iterations = 40;
+  solver.refactor_after_iterations = 0;  // every solve that iterates refactorises: valid
+  EXPECT_EQ(message_of<std::invalid_argument>([&] { simulation.set_solver_options(solver); }), "");
+  simulation.step(options);
+}
+
+// A simulation keeps the DOFs of the model it was built on: a model changed under it was
+// stepped with the old state, constraints and factor (writes past the end of the state).
+TEST(ApiArgumentChecks, ASimulationRefusesToGoOnOnceItsModelChanged) {
+  const Scene scene = strip_built_in_code(true, false);
+  const Mesh mesh = build_scene_mesh(scene);
+  SceneModel built = build_scene_model(scene, mesh);
+  ShellModel& model = *built.model;
+  ShellSimulation simulation(model, built.fixed, built.external_force);
+  DynamicsOptions options;
+  options.time_step = 0.005;
+  simulation.step(options);
+  const std::uint64_t revision = model.revision();
+
+  // set_enrichments that throws leaves the model (and so the simulation) as they were: a
+  // function enriching a node of two elements with a texture on one of them only.
+  int node = -1;
+  for (int a = 0; a < mesh.nodes_per_element() && node < 0; ++a)
+    for (int e = 1; e < mesh.num_elements(); ++e)
+      if (std::count(mesh.element_nodes(e), mesh.element_nodes(e) + mesh.nodes_per_element(), mesh.element_nodes(0)[a]))
+        node = mesh.element_nodes(0)[a];
+  ASSERT_GE(node, 0);
+  EnrichmentFunction half;
+  half.enriched_nodes = {node};
+  half.elements.push_back({0, kernels::TexelTile(4, 4)});
+  EXPECT_NE(message_of<std::invalid_argument>([&] { model.set_enrichments({half}); }).find("but has no texture"),
+            std::string::npos);
+  EXPECT_EQ(model.revision(), revision);
+  EXPECT_EQ(model.num_enriched_nodes(), 0);
+  simulation.step(options);
+
+  model.set_material_textures({{1, 1, 1, {2e6}, {0.02}}});
+  EXPECT_GT(model.revision(), revision);
+  EXPECT_NE(message_of<std::logic_error>([&] { simulation.step(options); })
+                .find("ShellSimulation::step: the model's basis or material textures changed after this simulation "
+                      "was built"),
+            std::string::npos);
+  EXPECT_THROW(simulation.kinetic_energy(), std::logic_error);
+  ShellSimulation rebuilt(model, built.fixed, built.external_force);
+  rebuilt.step(options);
+}
+
+TEST(ApiArgumentChecks, IndicesAndParametricPointsOfModelCutsAndSearchAreChecked) {
+  const Mesh mesh = make_rectangle(1, 1, 2, 2, ElementType::quad8);
+  const Topology topology = build_topology(mesh);
+  const std::vector<kernels::ShellSection> sections(4, kernels::ShellSection{1e6, 0.3, 0.01, 1000});
+  const ShellModel model(mesh, topology, sections, {}, {});
+  const std::vector<double> u(model.num_dofs(), 0.0);
+  double out[3];
+  const double outside[2] = {1.5, 0}, not_a_number[2] = {std::nan(""), 0}, corner[2] = {1, -1};
+  EXPECT_EQ(message_of<std::invalid_argument>([&] { model.interpolate(u, 0, outside, out); }),
+            "ShellModel::interpolate: xi (1.5, 0) is outside the reference element; quad8 needs xi1, xi2 in [-1, 1]");
+  EXPECT_NE(message_of<std::invalid_argument>([&] { model.interpolate(u, 0, not_a_number, out); }), "");
+  EXPECT_EQ(message_of<std::invalid_argument>([&] { model.interpolate(u, 0, corner, out); }), "");
+  std::vector<double> f(model.num_dofs(), 0.0);
+  const double up[3] = {0, 0, 1};
+  EXPECT_NE(message_of<std::invalid_argument>([&] { model.add_point_force(0, outside, up, f); }), "");
+  // Virtual nodes start at num_nodes(): 0 read before the arrays.
+  EXPECT_NE(message_of<std::invalid_argument>([&] { model.node_shift(0); }).find("virtual node 0 is out of range"),
+            std::string::npos);
+
+  // A topology of another (finer) mesh wrote out of bounds in the cut manager's adjacency.
+  Cut cut;
+  cut.points = {{0, 0.5, 0}, {1, 0.5, 0}};
+  EnrichmentOptions options;
+  options.texture_resolution = 32;
+  const Mesh finer = make_rectangle(1, 1, 4, 4, ElementType::quad8);
+  EXPECT_NE(message_of<std::invalid_argument>([&] { CutManager(mesh, build_topology(finer), {cut}, options); })
+                .find("CutManager: the topology was not built from this mesh"),
+            std::string::npos);
+
+  const SurfacePointSearch search(mesh);
+  const double p[3] = {0.2, 0.2, 0.1};
+  EXPECT_EQ(message_of<std::invalid_argument>([&] { search.closest_among({0, 99}, p); }),
+            "SurfacePointSearch::closest_among: elements[1] 99 is out of range; expected 0..3 (mesh.num_elements() = 4)");
+  EXPECT_NE(message_of<std::invalid_argument>([&] { search.closest_among({2, 1}, p); }).find("ascending"),
+            std::string::npos);
+  EXPECT_EQ(search.closest_among({0, 1}, p).element, 0);
+}
+
+// A step that threw (here: a penalty below the definiteness threshold) ends the run: a
+// retry after a failed basis change went on with the old basis, its cuts already moved on.
+TEST(ApiArgumentChecks, AStepAfterAFailedStepIsALogicError) {
+  Scene scene = strip_built_in_code(true, false);
+  scene.penalty = 0.01;
+  SceneRun run(scene);
+  EXPECT_NE(message_of<ModelError>([&] { run.step(); }).find("penalty too low?"), std::string::npos);
+  EXPECT_NE(message_of<std::logic_error>([&] { run.step(); })
+                .find("SceneRun::step: step 1 failed (dynamic system matrix not positive definite"),
+            std::string::npos);
+  EXPECT_EQ(run.steps_taken(), 0);
 }
 
 TEST(ApiArgumentChecks, SteppingAStaticSceneIsALogicError) {

@@ -11,6 +11,7 @@
 #include "dgtex/factor_reusing_solver.h"
 #include "dgtex/scene_run.h"
 #include "dgtex/shell_simulation.h"
+#include "dgtex/surface_point.h"
 #include "scene_in_code_support.h"
 
 namespace {
@@ -31,6 +32,9 @@ TEST(KeptReferences, ATemporaryIsRefusedWhereAReferenceIsKept) {
   static_assert(!std::is_constructible_v<CutManager, Mesh, const Topology&, const Cuts&, const EnrichmentOptions&>);
   // The topology is read by the constructor only (build_topology(mesh) as an argument is fine).
   static_assert(std::is_constructible_v<CutManager, const Mesh&, Topology, const Cuts&, const EnrichmentOptions&>);
+
+  static_assert(std::is_constructible_v<SurfacePointSearch, const Mesh&>);
+  static_assert(!std::is_constructible_v<SurfacePointSearch, Mesh>, "SurfacePointSearch(make_rectangle(...)) would dangle");
 
   using Mass = std::vector<double>;
   static_assert(std::is_constructible_v<FactorReusingSolver, const BlockAssembly&, const FreeDofSystem&, const Mass&>);

@@ -77,8 +77,9 @@ struct CutUpdateStats {
 
 class CutManager {
  public:
-  // The mesh must outlive the manager. Throws std::invalid_argument for a cut the
-  // mesh cannot take (messages name cuts[i].points[j]; see trace_cut_path).
+  // The mesh must outlive the manager. Throws MeshError for a mesh validate_mesh refuses,
+  // std::invalid_argument for a topology that is not build_topology(mesh)'s and for a cut
+  // the mesh cannot take (messages name cuts[i].points[j]; see trace_cut_path).
   CutManager(const Mesh& mesh, const Topology& topology, const std::vector<Cut>& cuts,
              const EnrichmentOptions& options, CutManagerOptions manager_options = {});
   // The mesh is kept by reference: a temporary one would dangle.

@@ -194,6 +194,8 @@ class FactorReusingSolver {
   const FactorReuseStatistics& statistics() const { return stats_; }
   const FactorReuseOptions& options() const { return options_; }
   // A change of the preconditioner pattern takes effect with a factorisation at the next solve.
+  // std::invalid_argument naming the field for a relative_tolerance outside (0, 1),
+  // max_iterations < 1, negative refactor_after counts or a negative radius.
   void set_options(const FactorReuseOptions& options);
 
  private:

@@ -41,6 +41,7 @@
 #include <functional>
 #include <future>
 #include <memory>
+#include <string>
 #include <vector>
 
 #include "dgtex/cut_manager.h"
@@ -96,9 +97,13 @@ class SceneRun {
 
   // Static analysis: solve K u = f with the cuts present at time 0.
   void solve_static();
-  // One dynamic step of the scene's time step; std::logic_error for a static scene.
+  // One dynamic step of the scene's time step; std::logic_error for a static scene, and
+  // after a step that threw (its cut manager may have moved on without the new basis: a
+  // retry went on with the old one).
   void step();
 
+  // The model and simulation of the current basis, and the displacement below: valid until
+  // the next step(), since a step that changes the basis replaces them (hold none across it).
   const Mesh& mesh() const { return mesh_; }
   const ShellModel& model() const { return *model_; }
   const ShellSimulation& simulation() const { return *simulation_; }
@@ -154,6 +159,7 @@ class SceneRun {
   double time_ = 0;
   int steps_ = 0;
   int basis_changes_ = 0;
+  std::string failed_step_;  // what a step that threw said; the run cannot go on after it
   std::int64_t reserved_step_memory_bytes_ = 0;
   SceneRunOptions options_;
   // The next step's cut update while it runs beside a step (after cuts_: it refers to it,

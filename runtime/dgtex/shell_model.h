@@ -100,7 +100,8 @@ class ShellModel {
   // Throws std::invalid_argument naming the function, element or node for: textures not
   // all T x T (T >= 1) or with non-finite values, unsorted/duplicate/out-of-range nodes or
   // elements, an element incident to an enriched node that has no texture of that
-  // function, or more than kernels::max_enrichments_per_element functions on one element.
+  // function, or more than kernels::max_enrichments_per_element functions on one element;
+  // each before anything changes, so the model keeps its basis when it throws.
   // Enriched nodes below options().min_enrichment_mass_ratio are dropped (and functions
   // left without nodes), so enrichments() may hold less than was given.
   // Cost: an enriched element whose textures (and enriched nodes and shifts) are bitwise
@@ -145,15 +146,20 @@ class ShellModel {
     return element >= 0 && element < static_cast<int>(kept_.start.size()) && kept_.start[element] >= 0;
   }
   const std::vector<EnrichmentFunction>& enrichments() const { return *enrichments_; }
+  // Grows with every change of the basis or the material textures (set_enrichments,
+  // set_material_textures): a ShellSimulation built on the model refuses to go on once it
+  // changed, since its state, constraints and factor have the old DOFs.
+  std::uint64_t revision() const { return revision_; }
   int num_enriched_nodes() const { return static_cast<int>(virtual_node_function_.size()); }  // virtual nodes
   int num_enriched_dofs() const { return 3 * num_enriched_nodes(); }
   // Virtual node of (function i, mesh node a), or -1 if a is not in N_i.
   int virtual_node(int function, int node) const;
-  // Mesh node a and function i of virtual node v (v >= num_nodes()).
-  int virtual_node_mesh_node(int virtual_node) const { return virtual_node_mesh_node_[virtual_node - num_nodes()]; }
-  int virtual_node_function(int virtual_node) const { return virtual_node_function_[virtual_node - num_nodes()]; }
-  // H_i(xi^a) of virtual node v (offset by num_nodes(): v = num_nodes() + slot).
-  double node_shift(int virtual_node) const { return virtual_node_shift_[virtual_node - num_nodes()]; }
+  // Mesh node a and function i of virtual node v, and H_i(xi^a) (num_nodes() <= v <
+  // num_nodes() + num_enriched_nodes(), else std::invalid_argument: a loop from 0 read
+  // before the arrays).
+  int virtual_node_mesh_node(int virtual_node) const { return virtual_node_mesh_node_[virtual_slot(virtual_node)]; }
+  int virtual_node_function(int virtual_node) const { return virtual_node_function_[virtual_slot(virtual_node)]; }
+  double node_shift(int virtual_node) const { return virtual_node_shift_[virtual_slot(virtual_node)]; }
   int num_enriched_elements() const { return static_cast<int>(enriched_elements_.size()); }
   int num_enriched_edges() const { return static_cast<int>(enriched_edges_.size() / 4); }
   // Rotation clusters of the enriched elements (options().rotation_cluster_texels > 0) as of
@@ -225,6 +231,9 @@ class ShellModel {
   void interpolate(const std::vector<double>& u, int element, const double xi[2], double out[3]) const;
 
  private:
+  // v - num_nodes() for a virtual node v, checked.
+  int virtual_slot(int virtual_node) const;
+
   Mesh mesh_;
   std::vector<kernels::ShellSection> sections_;
   ShellModelOptions options_;
@@ -258,6 +267,7 @@ class ShellModel {
   std::vector<int> enriched_node_;          // per element enrichment x npe
   std::vector<double> enriched_shift_;      // per element enrichment x npe
   int width_ = 0;                           // padded local basis size of enriched elements
+  std::uint64_t revision_ = 0;              // see revision()
   std::vector<int> enriched_global_nodes_;  // #enriched elements x width
   std::vector<std::int64_t> element_qp_start_;
   std::vector<double> element_qp_;

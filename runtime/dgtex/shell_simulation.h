@@ -13,6 +13,7 @@
 // ShellSimulation owns its state (u, v), free-DOF system and Cholesky factor and keeps a
 // reference to the ShellModel (which must outlive it). Not thread-safe; each call uses all
 // OpenMP threads. Units: those of the model (SI: m, m/s, s, N, kg).
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -34,7 +35,9 @@ struct DynamicsOptions {
 
 class ShellSimulation {
  public:
-  // fixed: #dofs flags; external_force: #dofs (std::invalid_argument for other sizes).
+  // fixed: #dofs flags; external_force: #dofs, finite (std::invalid_argument otherwise).
+  // Every method below throws std::logic_error once the model's basis or material
+  // textures changed (ShellModel::revision): build a new simulation for the new DOFs.
   ShellSimulation(const ShellModel& model, std::vector<char> fixed, std::vector<double> external_force);
   // The model is kept by reference: a temporary one would dangle.
   ShellSimulation(ShellModel&&, std::vector<char>, std::vector<double>) = delete;
@@ -45,12 +48,13 @@ class ShellSimulation {
   void check_statically_constrained();
   // Throws ModelError "stiffness not positive definite (penalty too low?)" when K is not.
   void solve_static();
-  // std::invalid_argument unless options.time_step is positive and finite.
+  // std::invalid_argument unless options.time_step is positive and finite and the damping
+  // coefficients finite and >= 0.
   void step(const DynamicsOptions& options);
 
   const std::vector<double>& displacement() const { return u_; }
   const std::vector<double>& velocity() const { return v_; }
-  void set_state(std::vector<double> u, std::vector<double> v);  // #dofs each, else std::invalid_argument
+  void set_state(std::vector<double> u, std::vector<double> v);  // #dofs each, finite, else std::invalid_argument
   double time() const { return time_; }
   const StageTimings& timings() const { return timings_; }
   const FreeDofSystem& system() const { return system_; }
@@ -73,7 +77,10 @@ class ShellSimulation {
   // guess_ (and k_guess_ sized): the PCG's initial guess for the next velocity.
   void extrapolate_initial_guess();
 
+  void check_model_unchanged(const char* function) const;
+
   const ShellModel& model_;
+  std::uint64_t model_revision_;  // the model's revision() when this simulation was built
   std::vector<char> fixed_;
   std::vector<double> f_ext_;
   FreeDofSystem system_;

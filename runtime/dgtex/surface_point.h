@@ -51,10 +51,13 @@ class BoxHierarchy;
 class SurfacePointSearch {
  public:
   explicit SurfacePointSearch(const Mesh& mesh);
+  // The mesh is kept by reference: a temporary one would dangle.
+  explicit SurfacePointSearch(Mesh&&) = delete;
   // == closest_surface_point(mesh, p).
   SurfacePoint closest(const double p[3]) const;
   // == closest_surface_point of the sub-mesh made of these elements (distinct, ascending),
-  // with the element given as a mesh element index. Throws MeshError for an empty list.
+  // with the element given as a mesh element index. Throws MeshError for an empty list and
+  // std::invalid_argument for an index out of range or a list not strictly ascending.
   SurfacePoint closest_among(const std::vector<int>& elements, const double p[3]) const;
 
  private:

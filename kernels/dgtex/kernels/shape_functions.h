@@ -32,6 +32,16 @@ void evaluate_shape(ElementType type, double xi1, double xi2, ShapeValues& out);
 // Parametric coordinates of local node a.
 void node_parametric_position(ElementType type, int a, double xi[2]);
 
+// Whether (xi1, xi2) lies in the reference element (quad8 [-1, 1]^2; tri6 xi1, xi2 >= 0,
+// xi1 + xi2 <= 1) to within `slack` (1e-12 for points given by a user); false for NaN.
+inline bool inside_reference_element(ElementType type, double xi1, double xi2, double slack = 1e-12) {
+  return type == ElementType::quad8 ? xi1 >= -1 - slack && xi1 <= 1 + slack && xi2 >= -1 - slack && xi2 <= 1 + slack
+                                    : xi1 >= -slack && xi2 >= -slack && xi1 + xi2 <= 1 + slack;
+}
+constexpr const char* reference_element_rule(ElementType type) {
+  return type == ElementType::quad8 ? "quad8 needs xi1, xi2 in [-1, 1]" : "tri6 needs xi1, xi2 >= 0 and xi1 + xi2 <= 1";
+}
+
 // Local edge k: its three local nodes (start corner, midside, end corner) and the map
 // t in [-1,1] -> xi with its derivative dxi/dt (constant along an edge).
 void local_edge_nodes(ElementType type, int k, int nodes[3]);
