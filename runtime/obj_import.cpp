@@ -23,7 +23,8 @@ std::string where(const std::string& path, int line) { return path + ":" + std::
 double parse_coordinate(const std::string& token, const std::string& path, int line) {
   char* end = nullptr;
   const double value = std::strtod(token.c_str(), &end);
-  if (token.empty() || *end != '\0' || !std::isfinite(value))
+  // The whole token (a NUL inside it ended the number silently).
+  if (token.empty() || end != token.c_str() + token.size() || !std::isfinite(value))
     throw MeshError(where(path, line) + ": vertex coordinate '" + token + "' is not a finite number");
   // As for the scene's numbers: beyond this, element areas (squares of lengths) overflow.
   if (std::abs(value) > 1e30)
@@ -37,7 +38,7 @@ int parse_face_corner(const std::string& token, int vertices_so_far, const std::
   const std::string index_text = token.substr(0, token.find('/'));
   char* end = nullptr;
   const long index = std::strtol(index_text.c_str(), &end, 10);
-  if (index_text.empty() || *end != '\0')
+  if (index_text.empty() || end != index_text.c_str() + index_text.size())
     throw MeshError(where(path, line) + ": face corner '" + token + "' does not start with a vertex index");
   const long resolved = index > 0 ? index - 1 : vertices_so_far + index;
   if (index == 0 || resolved < 0 || resolved >= vertices_so_far)
@@ -46,6 +47,16 @@ int parse_face_corner(const std::string& token, int vertices_so_far, const std::
                     "(valid: 1.." + std::to_string(vertices_so_far) + " or -1..-" + std::to_string(vertices_so_far) +
                     ")");
   return static_cast<int>(resolved);
+}
+
+// Statements of the OBJ format that carry nothing a shell mesh needs (texture coordinates,
+// normals, lines, points, groups, materials): skipped. Any other keyword is refused: an
+// 'F' or 'V' (upper case) dropped a face or a vertex silently, shifting every later index.
+bool is_skipped_obj_statement(const std::string& keyword) {
+  static const char* const skipped[] = {"vt", "vn", "vp", "l", "p", "g", "o", "s", "mtllib", "usemtl"};
+  for (const char* k : skipped)
+    if (keyword == k) return true;
+  return false;
 }
 
 }  // namespace
@@ -59,9 +70,11 @@ Mesh load_obj(const std::string& path) {
   std::string text;
   for (int line = 1; std::getline(in, text); ++line) {
     if (!text.empty() && text.back() == '\r') text.pop_back();
+    if (line == 1 && text.compare(0, 3, "\xEF\xBB\xBF") == 0) text.erase(0, 3);  // a UTF-8 byte order mark
+    text = text.substr(0, text.find('#'));  // a comment, also after a statement
     std::istringstream tokens(text);
     std::string keyword;
-    if (!(tokens >> keyword) || keyword[0] == '#') continue;
+    if (!(tokens >> keyword)) continue;
     if (keyword == "v") {
       std::string c[3];
       if (!(tokens >> c[0] >> c[1] >> c[2]))
@@ -85,6 +98,10 @@ Mesh load_obj(const std::string& path) {
                         where(path, faces.front().line) + " has " + std::to_string(faces.front().vertices.size()) +
                         "; a mesh must be all triangles or all quads");
       faces.push_back(std::move(face));
+    } else if (!is_skipped_obj_statement(keyword)) {
+      throw MeshError(where(path, line) + ": unknown OBJ statement '" + keyword +
+                      "'; a mesh takes 'v x y z' and 'f a b c [d]' (skipped: vt, vn, vp, l, p, g, o, s, mtllib, "
+                      "usemtl, and comments after #)");
     }
   }
   if (in.bad()) throw MeshError(path + ": read error");

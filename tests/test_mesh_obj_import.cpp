@@ -134,3 +134,23 @@ TEST(ObjImport, CrLfLineEndingsAreAccepted) {
   EXPECT_EQ(mesh.num_elements(), 1);
   EXPECT_EQ(mesh.num_nodes(), 6);
 }
+
+// Found by mutating OBJ files (568 runs, session 68): an unknown statement ('F' for 'f')
+// dropped a face silently, a byte order mark dropped the first vertex (shifting every later
+// index), a comment after a face was refused, and a NUL inside a number cut it short.
+TEST(ObjImport, UnknownStatementsAreRefusedByteOrderMarksAndTrailingCommentsAccepted) {
+  EXPECT_CONTAINS(load_error_of_text("v 0 0 0\nv 1 0 0\nv 0 1 0\nF 1 2 3\n"), ".obj:4: unknown OBJ statement 'F'");
+  EXPECT_CONTAINS(load_error_of_text("v 0 0 0\nV 1 0 0\nv 0 1 0\nf 1 2 3\n"), ".obj:2: unknown OBJ statement 'V'");
+  EXPECT_EQ(load_error_of_text("mtllib a.mtl\no plate\nv 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvn 0 0 1\ns off\nusemtl m\n"
+                               "f 1/1/1 2/1/1 3/1/1  # the only face\nl 1 2\n"),
+            "");
+  const std::string path = ::testing::TempDir() + "dgtex_obj_import_bom.obj";
+  std::ofstream(path) << "\xEF\xBB\xBFv 0 0 0\nv 1 0 0 # x\nv 0 1 0\nf 1 2 3\n";
+  const Mesh mesh = load_obj(path);
+  std::remove(path.c_str());
+  EXPECT_EQ(mesh.num_elements(), 1);
+  EXPECT_EQ(mesh.node(0)[0], 0.0);  // the first vertex kept
+  EXPECT_EQ(mesh.node(1)[0], 1.0);
+  EXPECT_CONTAINS(load_error_of_text(std::string("v 0 0 0\nv 1", 11) + std::string(1, '\0') + "5 0 0\n"),
+                  ".obj:2: vertex coordinate");
+}

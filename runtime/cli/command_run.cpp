@@ -9,6 +9,7 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <omp.h>
+#include <new>
 #include <string>
 #include <vector>
 
@@ -122,6 +123,10 @@ int run_command(int argc, char** argv) {
   } catch (const std::invalid_argument& e) {  // a cut the mesh cannot take (names cuts[i])
     std::fprintf(stderr, "dgtex run: %s: %s\n", scene_path.c_str(), e.what());
     return 2;
+  } catch (const std::bad_alloc&) {  // past the memory guards' lower bounds (it aborted, SIGABRT)
+    std::fprintf(stderr, "dgtex run: %s: out of memory in the set-up; a smaller mesh or texture_resolution, or more "
+                 "memory\n", scene_path.c_str());
+    return 1;
   }
   const Mesh& mesh = run->mesh();
   // Valid but likely locked (dgtex/penalty_caution.h): nothing fails, so say it.
