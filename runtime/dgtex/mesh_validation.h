@@ -15,7 +15,10 @@ namespace dgtex {
 //  - no element is degenerate: at each of its quadrature points the area Jacobian
 //    |dx/dxi1 x dx/dxi2| must exceed 1e-10 x (element diameter)^2, where the diameter is the
 //    largest distance between two of its nodes;
+//  - no element is a sliver: diameter^2 / area at most kMaxElementAspect (a square has 2,
+//    a right isosceles triangle 4; above it the stiffness is round-off, mesh_validation.cpp);
 //  - build_topology succeeds (manifold, consistently oriented, shared midside nodes).
+inline constexpr double kMaxElementAspect = 1e4;
 void validate_mesh(const Mesh& mesh);
 
 // Area of element e by its quadrature rule (exact for the flat undistorted elements,
