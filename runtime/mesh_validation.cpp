@@ -38,6 +38,19 @@ double area_jacobian(const Mesh& mesh, int e, double xi1, double xi2) {
   return norm(cross(t1, t2));
 }
 
+constexpr double kDegreesPerRadian = 180 / 3.14159265358979323846;
+
+// Unit normal of element e at the midpoint of its local edge k.
+Vec3 edge_midpoint_normal(const Mesh& mesh, int e, int k) {
+  double xi[2], dxi[2];
+  kernels::local_edge_point(mesh.type, k, 0.0, xi, dxi);
+  Vec3 t1, t2;
+  tangents(mesh, e, xi[0], xi[1], t1, t2);
+  const Vec3 n = cross(t1, t2);
+  const double length = norm(n);
+  return {n.x / length, n.y / length, n.z / length};
+}
+
 double element_diameter(const Mesh& mesh, int e) {
   const int* en = mesh.element_nodes(e);
   const int n = mesh.nodes_per_element();
@@ -127,7 +140,24 @@ void validate_mesh(const Mesh& mesh) {
                       {e});
   }
 
-  build_topology(mesh);
+  // A face turned back onto its neighbour (a 180-degree fold, a face and its reverse
+  // copy) is manifold and consistently oriented, but the DG edge terms then tie opposite
+  // normals: the corotated step matrix lost definiteness ("penalty too low?") and static
+  // runs gave results without meaning (OBJ fuzzing, session 68).
+  const Topology topology = build_topology(mesh);
+  for (const MeshEdge& edge : topology.interior_edges) {
+    const Vec3 plus = edge_midpoint_normal(mesh, edge.plus_element, edge.plus_local_edge);
+    const Vec3 minus = edge_midpoint_normal(mesh, edge.minus_element, edge.minus_local_edge);
+    const double cosine = plus.x * minus.x + plus.y * minus.y + plus.z * minus.z;
+    if (cosine < kMinNeighbourNormalCosine)
+      throw MeshError("elements " + std::to_string(edge.plus_element) + " and " + std::to_string(edge.minus_element) +
+                          " fold back onto each other along their shared edge (nodes " + std::to_string(edge.nodes[0]) +
+                          "-" + std::to_string(edge.nodes[2]) + "): their normals there are " +
+                          std::to_string(std::lround(std::acos(std::max(-1.0, cosine)) * kDegreesPerRadian)) +
+                          " degrees apart, more than a shell can turn between neighbours (at most " +
+                          std::to_string(std::lround(std::acos(kMinNeighbourNormalCosine) * kDegreesPerRadian)) + ")",
+                      {edge.plus_element, edge.minus_element});
+  }
 }
 
 double element_area(const Mesh& mesh, int e) {

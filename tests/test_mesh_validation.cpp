@@ -2,6 +2,7 @@
 // element_area / element_perimeter against closed forms.
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 #include <string>
 
@@ -66,6 +67,32 @@ TEST(Validation, SliversAboveTheAspectLimitAreRefused) {
     EXPECT_MESSAGE_CONTAINS(validation_message(make_rectangle(1, 5e-5, 1, 1, type)), "is above 10000");
     EXPECT_EQ(validation_message(make_rectangle(1, 1e-3, 1, 1, type)), "");  // 1e3 (2e3): thin but sound
   }
+}
+
+// Triangle A (0,0,0), (1,0,0), (0.5,1,0) and triangle B across their edge 0-1, apex given.
+Mesh two_triangles(const std::array<double, 3>& apex) {
+  Mesh mesh;
+  mesh.type = ElementType::tri6;
+  const std::array<std::array<double, 3>, 4> corners = {{{0, 0, 0}, {1, 0, 0}, {0.5, 1, 0}, apex}};
+  for (const auto& c : corners) mesh.positions.insert(mesh.positions.end(), c.begin(), c.end());
+  auto midside = [&](int a, int b) {
+    for (int d = 0; d < 3; ++d) mesh.positions.push_back(0.5 * (corners[a][d] + corners[b][d]));
+    return mesh.num_nodes() - 1;
+  };
+  const int m01 = midside(0, 1), m12 = midside(1, 2), m20 = midside(2, 0), m03 = midside(0, 3), m31 = midside(3, 1);
+  mesh.elements = {0, 1, 2, m01, m12, m20, 1, 0, 3, m01, m03, m31};
+  return mesh;
+}
+
+// B's apex beside A's: manifold and consistently oriented, but folded back 180 degrees (the
+// corotated step read it as "penalty too low?"). A 90-degree fold is a crease and passes.
+TEST(Validation, NeighboursFoldedBackOntoEachOtherAreRefused) {
+  EXPECT_EQ(validation_message(two_triangles({0.5, -1, 0})), "");  // flat
+  EXPECT_EQ(validation_message(two_triangles({0.5, 0, -1})), "");  // creased 90 degrees
+  EXPECT_EQ(validation_message(two_triangles({0.5, 0.9, -0.2})), "");  // 167 degrees: below the 172
+  const std::string folded = validation_message(two_triangles({0.5, 0.9, 0}));
+  EXPECT_MESSAGE_CONTAINS(folded, "elements 0 and 1 fold back onto each other along their shared edge (nodes 0-1)");
+  EXPECT_MESSAGE_CONTAINS(folded, "180 degrees apart");
 }
 
 TEST(Validation, RepeatedAndOutOfRangeNodes) {

@@ -17,8 +17,11 @@ namespace dgtex {
 //    largest distance between two of its nodes;
 //  - no element is a sliver: diameter^2 / area at most kMaxElementAspect (a square has 2,
 //    a right isosceles triangle 4; above it the stiffness is round-off, mesh_validation.cpp);
-//  - build_topology succeeds (manifold, consistently oriented, shared midside nodes).
+//  - build_topology succeeds (manifold, consistently oriented, shared midside nodes);
+//  - no two neighbours fold back onto each other: their normals at the midpoint of their
+//    shared edge at most acos(kMinNeighbourNormalCosine) = 172 degrees apart.
 inline constexpr double kMaxElementAspect = 1e4;
+inline constexpr double kMinNeighbourNormalCosine = -0.99;
 void validate_mesh(const Mesh& mesh);
 
 // Area of element e by its quadrature rule (exact for the flat undistorted elements,
