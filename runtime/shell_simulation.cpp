@@ -83,11 +83,16 @@ void ShellSimulation::check_statically_constrained() {
   for (int i = 0; i < n; ++i) centre += Eigen::Map<const Eigen::Vector3d>(mesh.node(i));
   centre /= n;
   // Rigid modes: 3 translations, 3 rotations about the centroid (standard DOFs; the
-  // enriched DOFs of a rigid motion are zero).
+  // enriched DOFs of a rigid motion are zero). The rotations are divided by the nodes' RMS
+  // distance from the centroid, so that all six are of size 1 whatever the length unit:
+  // a clamped plate of size 1e-9 or 1e10 read as unconstrained against the fixed threshold.
+  double squared_radius = 0;
+  for (int i = 0; i < n; ++i) squared_radius += (Eigen::Map<const Eigen::Vector3d>(mesh.node(i)) - centre).squaredNorm();
+  const double radius = std::sqrt(squared_radius / n);
   const int ndofs = model_.num_dofs();
   Eigen::MatrixXd modes = Eigen::MatrixXd::Zero(ndofs, 6);
   for (int i = 0; i < n; ++i) {
-    const Eigen::Vector3d x = Eigen::Map<const Eigen::Vector3d>(mesh.node(i)) - centre;
+    const Eigen::Vector3d x = (Eigen::Map<const Eigen::Vector3d>(mesh.node(i)) - centre) / radius;
     for (int c = 0; c < 3; ++c) {
       modes(3 * i + c, c) = 1;
       const Eigen::Vector3d axis = Eigen::Vector3d::Unit(c);

@@ -5,6 +5,7 @@
 #include <cstdio>
 
 #include "dgtex/kernels/shell_point.h"
+#include "dgtex/model_error.h"
 #include "dgtex/shell_simulation.h"
 #include "shell_test_support.h"
 #include "square_plate_support.h"
@@ -117,6 +118,28 @@ TEST(Cantilever, TipLoadMatchesBeamTheory) {
     std::printf("cantilever %s: tip %.6e, PL^3/3EI %.6e, error %.3f%%\n", type == ElementType::quad8 ? "quad8" : "tri6",
                 tip, reference, 100 * std::abs(tip / reference - 1));
     EXPECT_NEAR(tip / reference, 1.0, 0.01);
+  }
+}
+
+// The rigid modes are sized by the mesh: a plate held on all four sides read as free at
+// sizes 1e-9 and 1e10 (the rotations' columns scaled with the length, against a fixed
+// threshold); one held side still leaves the rotation about it.
+TEST(PlateConstraints, TheRigidModeCheckDoesNotDependOnTheLengthUnit) {
+  for (double a : {1e-9, 1.0, 1e10}) {
+    const Mesh mesh = make_rectangle(a, a, 4, 4, ElementType::quad8);
+    const auto model = make_model(mesh, Material{}, 0.8);
+    auto on_side = [a](const double* x) {
+      return std::abs(x[0]) < 1e-9 * a || std::abs(x[0] - a) < 1e-9 * a || std::abs(x[1]) < 1e-9 * a ||
+             std::abs(x[1] - a) < 1e-9 * a;
+    };
+    std::vector<char> fixed;
+    fix_nodes(mesh, on_side, true, true, true, fixed);
+    ShellSimulation held(*model, fixed, std::vector<double>(model->num_dofs(), 0.0));
+    EXPECT_NO_THROW(held.check_statically_constrained()) << a;
+    std::vector<char> one_side;
+    fix_nodes(mesh, [a](const double* x) { return std::abs(x[0]) < 1e-9 * a; }, true, true, true, one_side);
+    ShellSimulation hinged(*model, one_side, std::vector<double>(model->num_dofs(), 0.0));
+    EXPECT_THROW(hinged.check_statically_constrained(), ModelError) << a;
   }
 }
 
