@@ -69,6 +69,27 @@ TEST(Validation, SliversAboveTheAspectLimitAreRefused) {
   }
 }
 
+// A reflex corner, or two corners at one point, kept every quadrature point's Jacobian
+// positive (the factorisation then failed as "penalty too low?"): checked at the corners.
+TEST(Validation, ReflexAndCollapsedCornersAreRefused) {
+  Mesh mesh = make_rectangle(1, 1, 2, 2, ElementType::quad8);
+  auto move_corner = [&](Mesh& m, int element, int corner, double x, double y) {
+    const int* n = m.element_nodes(element);
+    m.positions[3 * n[corner]] = x, m.positions[3 * n[corner] + 1] = y;
+    // the midside nodes next to it stay at the middle of their edges
+    const int before = (corner + 3) % 4, after = (corner + 1) % 4;
+    for (const auto& [mid, other] : {std::pair{4 + before, before}, std::pair{4 + corner, after}})
+      for (int d = 0; d < 2; ++d) m.positions[3 * n[mid] + d] = 0.5 * (m.positions[3 * n[corner] + d] + m.positions[3 * n[other] + d]);
+  };
+  EXPECT_EQ(validation_message(mesh), "");
+  Mesh reflex = mesh;  // element 0's corner at the plate's centre pulled back past its diagonal
+  move_corner(reflex, 0, 2, 0.1, 0.1);
+  EXPECT_MESSAGE_CONTAINS(validation_message(reflex), "element 0 is degenerate at its corner 2");
+  Mesh collapsed = mesh;  // element 0's corner 1 onto its corner 0: a zero-length edge
+  move_corner(collapsed, 0, 1, 0, 0);
+  EXPECT_MESSAGE_CONTAINS(validation_message(collapsed), "is degenerate");
+}
+
 // Triangle A (0,0,0), (1,0,0), (0.5,1,0) and triangle B across their edge 0-1, apex given.
 Mesh two_triangles(const std::array<double, 3>& apex) {
   Mesh mesh;

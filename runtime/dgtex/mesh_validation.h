@@ -14,7 +14,9 @@ namespace dgtex {
 //  - every node is used by some element (a free node has no stiffness: singular system);
 //  - no element is degenerate: at each of its quadrature points the area Jacobian
 //    |dx/dxi1 x dx/dxi2| must exceed 1e-10 x (element diameter)^2, where the diameter is the
-//    largest distance between two of its nodes;
+//    largest distance between two of its nodes, and at each corner the signed Jacobian
+//    (against the normal at the element's centre) must too (a reflex corner, two corners
+//    at one point);
 //  - no element is a sliver: diameter^2 / area at most kMaxElementAspect (a square has 2,
 //    a right isosceles triangle 4; above it the stiffness is round-off, mesh_validation.cpp);
 //  - build_topology succeeds (manifold, consistently oriented, shared midside nodes);
