@@ -24,8 +24,9 @@ namespace {
 // approach overflow.
 constexpr double kMaxMagnitude = 1e30;
 // The same bound from below for the positive quantities (lengths, moduli, the density, the
-// time step, the penalty, tolerances): E h^3 / 12 of E = 1e6 and h = 1e-110 underflows to 0, a zero
-// pivot that read as "penalty too low?", and h = 1e-106 overflowed the displacement.
+// time step, the penalty, tolerances): E h^3 / 12 of E = 1e6 and h = 1e-110 underflows to
+// 0, a zero pivot that read as "penalty too low?", and h = 1e-106 overflowed the
+// displacement.
 constexpr double kMinPositive = 1e-30;
 constexpr int kMaxDivisions = 100000;
 constexpr long long kMaxGeneratedCells = 10000000;

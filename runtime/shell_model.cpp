@@ -1064,14 +1064,15 @@ void ShellModel::set_enrichments(std::vector<EnrichmentFunction> functions) {
   std::vector<std::vector<int>> functions_at(nn);  // per mesh node: N^a, then its virtual nodes
   std::vector<int> position(nn + num_enriched_nodes(), -1);  // of a basis node in its list
   for (int v = nn; v < nn + num_enriched_nodes(); ++v) {
-    auto& list = functions_at[virtual_node_mesh_node(v)];
-    if (list.empty()) list.push_back(virtual_node_mesh_node(v)), position[virtual_node_mesh_node(v)] = 0;
+    const int node = virtual_node_mesh_node_[v - nn];  // the arrays, unchecked: v is in range here
+    auto& list = functions_at[node];
+    if (list.empty()) list.push_back(node), position[node] = 0;
     position[v] = static_cast<int>(list.size());
     list.push_back(v);
   }
   std::vector<std::vector<double>> node_mass(nn);  // per mesh node: Gram of its list, row-major
   for (int a = 0; a < nn; ++a) node_mass[a].assign(functions_at[a].size() * functions_at[a].size(), 0.0);
-  auto mesh_node_of = [&](int g) { return g < nn ? g : virtual_node_mesh_node(g); };
+  auto mesh_node_of = [&](int g) { return g < nn ? g : virtual_node_mesh_node_[g - nn]; };
   for (int x = 0; x < num_enriched_elements(); ++x) {
     const int* global = enriched_global_nodes_.data() + static_cast<size_t>(x) * W;
     const double* mass = element_mass.data() + static_cast<size_t>(x) * W * W;
@@ -1093,7 +1094,7 @@ void ShellModel::set_enrichments(std::vector<EnrichmentFunction> functions) {
   int pruned = 0;
   std::vector<std::vector<int>> kept_at(num_nodes());  // per mesh node: its kept virtual nodes so far
   for (int v = nn; v < nn + num_enriched_nodes(); ++v) {  // virtual nodes go function by function
-    const int node = virtual_node_mesh_node(v);
+    const int node = virtual_node_mesh_node_[v - nn];
     std::vector<int> earlier = {node};  // N^a, then its kept enrichments
     earlier.insert(earlier.end(), kept_at[node].begin(), kept_at[node].end());
     const int k = static_cast<int>(earlier.size());
@@ -1107,7 +1108,7 @@ void ShellModel::set_enrichments(std::vector<EnrichmentFunction> functions) {
     if (independent < options_.min_enrichment_mass_ratio * gram(0, 0)) {  // gram(0, 0) = M_aa
       ++pruned;
     } else {
-      kept_nodes[virtual_node_function(v)].push_back(node);
+      kept_nodes[virtual_node_function_[v - nn]].push_back(node);
       kept_at[node].push_back(v);
     }
   }

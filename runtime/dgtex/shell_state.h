@@ -36,9 +36,8 @@ struct ShellState {
   double time = 0;
 };
 
-// Checks sizes and indices, and that time, positions,
-// displacements (and their sums) and enrichments are finite; throws std::invalid_argument
-// naming the offending field.
+// Checks sizes and indices, and that time, positions, displacements (and their sums) and
+// enrichments are finite; throws std::invalid_argument naming the offending field.
 void validate_state(const ShellState& state);
 
 // Binary format, little-endian, version 2 ("dgtex state"):
