@@ -119,29 +119,36 @@ std::vector<int> part_of_node(const Mesh& mesh) {
 
 // Static runs need every connected part held against all six rigid motions
 // u(x) = t + w x (x - c). Each constraint is a linear condition on (t, w); the part is
-// held when those conditions have rank 6. Rotations are scaled by the part's size so the
-// rank test does not depend on the length unit.
+// held when those conditions have rank 6. Rotations are scaled by the spread of the part's
+// held nodes so the rank test depends neither on the length unit nor on nodes far from the
+// supports (the part's bounding box took one node lifted to z = 1e5 on a unit plate as its
+// size, and the held nodes' rotation rows fell below the test's tolerance).
 void check_rigid_motions(const Scene& scene, const Mesh& mesh) {
   if (scene.analysis.is_dynamic() || mesh.num_elements() == 0) return;
   const std::vector<int> part = part_of_node(mesh);
   std::vector<char> used(mesh.num_nodes(), 0);
   for (int n : mesh.elements) used[n] = 1;
+  std::vector<std::vector<int>> selections;
+  for (const BoundaryCondition& bc : scene.boundary) selections.push_back(select_nodes(mesh, bc.select));
 
-  // Per part: centre, size, and the accumulated normal matrix A^T A of the constraints.
-  std::map<int, Eigen::Vector3d> lo, hi;
-  for (int n = 0; n < mesh.num_nodes(); ++n) {
-    if (!used[n]) continue;
-    const int p = part[n];
-    const Eigen::Vector3d x = node_position(mesh, n);
-    if (!lo.count(p)) lo[p] = hi[p] = x;
-    lo[p] = lo[p].cwiseMin(x);
-    hi[p] = hi[p].cwiseMax(x);
-  }
+  // Per part: centroid and RMS radius of its held nodes, and the accumulated normal matrix
+  // A^T A of the constraints.
+  std::map<int, Eigen::Vector3d> held_sum;
+  std::map<int, double> held_count, held_squares;
+  for (const std::vector<int>& selected : selections)
+    for (int n : selected) {  // zero first: a default Eigen vector is left unset
+      held_sum.try_emplace(part[n], Eigen::Vector3d::Zero()).first->second += node_position(mesh, n);
+      held_count[part[n]] += 1;
+    }
+  auto centre = [&](int p) { return Eigen::Vector3d(held_sum[p] / held_count[p]); };
+  for (const std::vector<int>& selected : selections)
+    for (int n : selected) held_squares[part[n]] += (node_position(mesh, n) - centre(part[n])).squaredNorm();
   std::map<int, Eigen::Matrix<double, 6, 6>> normal_matrix;
-  for (const auto& entry : lo) normal_matrix[entry.first].setZero();
+  for (int n = 0; n < mesh.num_nodes(); ++n)
+    if (used[n]) normal_matrix[part[n]].setZero();
   auto add_row = [&](int p, const Eigen::Matrix<double, 6, 1>& row) { normal_matrix[p] += row * row.transpose(); };
-  auto scale = [&](int p) { return std::max((hi[p] - lo[p]).norm(), 1e-300); };
-  auto centre = [&](int p) { return Eigen::Vector3d(0.5 * (lo[p] + hi[p])); };
+  // A single held point has no spread: its rotation rows are 0 whatever the scale.
+  auto scale = [&](int p) { return std::max(std::sqrt(held_squares[p] / held_count[p]), 1e-300); };
 
   // Boundary edges (used by one element) keyed by their sorted corner pair.
   std::map<std::pair<int, int>, std::pair<int, int>> edge_owner;  // -> (element, local edge)
@@ -158,8 +165,9 @@ void check_rigid_motions(const Scene& scene, const Mesh& mesh) {
     }
   }
 
-  for (const BoundaryCondition& bc : scene.boundary) {
-    const std::vector<int> selected = select_nodes(mesh, bc.select);
+  for (size_t b = 0; b < scene.boundary.size(); ++b) {
+    const BoundaryCondition& bc = scene.boundary[b];
+    const std::vector<int>& selected = selections[b];
     std::vector<char> is_selected(mesh.num_nodes(), 0);
     for (int n : selected) {
       is_selected[n] = 1;

@@ -80,6 +80,23 @@ TEST(SceneMeshChecks, SimplySupportedPlateIsHeld) {
   EXPECT_EQ(error_of(s, mesh), "");
 }
 
+// One node far from the supports (the centre of a plate held on its four sides lifted to
+// z = 1e5) sized the part by its bounding box, and the held nodes' rotation rows fell below
+// the rank test's tolerance: "unconstrained". The held nodes' spread sizes it now.
+TEST(SceneMeshChecks, AFarNodeDoesNotHideTheSupports) {
+  Mesh mesh = make_rectangle(1, 1, 4, 4, ElementType::quad8);
+  for (int n = 0; n < mesh.num_nodes(); ++n)
+    if (mesh.node(n)[0] == 0.5 && mesh.node(n)[1] == 0.5) mesh.positions[3 * n + 2] = 1e5;
+  Scene s = static_scene();
+  s.boundary.push_back(on_plane({1, 0, 0}, 0, kAll, false));
+  s.boundary.push_back(on_plane({1, 0, 0}, 1, kAll, false));
+  s.boundary.push_back(on_plane({0, 1, 0}, 0, kAll, false));
+  s.boundary.push_back(on_plane({0, 1, 0}, 1, kAll, false));
+  EXPECT_EQ(error_of(s, mesh), "");
+  s.boundary.resize(1);  // one side, no clamp: the rotation about it is free
+  EXPECT_NE(error_of(s, mesh).find("rotation about [0, 1, 0]"), std::string::npos) << error_of(s, mesh);
+}
+
 TEST(SceneMeshChecks, InPlaneMotionsLeftFree) {
   const Mesh mesh = make_rectangle(1, 1, 2, 2, ElementType::quad8);
   Scene s = static_scene();
