@@ -59,6 +59,44 @@ bool is_skipped_obj_statement(const std::string& keyword) {
   return false;
 }
 
+// One statement (a line without its end), read into vertices or faces.
+void read_statement(std::string text, int line, const std::string& path, std::vector<double>& vertices,
+                    std::vector<ObjFace>& faces) {
+  if (line == 1 && text.compare(0, 3, "\xEF\xBB\xBF") == 0) text.erase(0, 3);  // a UTF-8 byte order mark
+  text = text.substr(0, text.find('#'));  // a comment, also after a statement
+  std::istringstream tokens(text);
+  std::string keyword;
+  if (!(tokens >> keyword)) return;
+  if (keyword == "v") {
+    std::string c[3];
+    if (!(tokens >> c[0] >> c[1] >> c[2]))
+      throw MeshError(where(path, line) + ": vertex needs three coordinates 'v x y z', got '" + text + "'");
+    for (int d = 0; d < 3; ++d) vertices.push_back(parse_coordinate(c[d], path, line));
+  } else if (keyword == "f") {
+    ObjFace face;
+    face.line = line;
+    const int defined = static_cast<int>(vertices.size() / 3);
+    for (std::string corner; tokens >> corner;) face.vertices.push_back(parse_face_corner(corner, defined, path, line));
+    const int n = static_cast<int>(face.vertices.size());
+    if (n != 3 && n != 4)
+      throw MeshError(where(path, line) + ": face has " + std::to_string(n) +
+                      " corners; only triangles (-> tri6) and quads (-> quad8) are supported");
+    for (int a = 0; a < n; ++a)
+      for (int b = 0; b < a; ++b)
+        if (face.vertices[a] == face.vertices[b])
+          throw MeshError(where(path, line) + ": face repeats vertex " + std::to_string(face.vertices[a] + 1));
+    if (!faces.empty() && faces.front().vertices.size() != face.vertices.size())
+      throw MeshError(where(path, line) + ": face has " + std::to_string(n) + " corners but the face at " +
+                      where(path, faces.front().line) + " has " + std::to_string(faces.front().vertices.size()) +
+                      "; a mesh must be all triangles or all quads");
+    faces.push_back(std::move(face));
+  } else if (!is_skipped_obj_statement(keyword)) {
+    throw MeshError(where(path, line) + ": unknown OBJ statement '" + keyword +
+                    "'; a mesh takes 'v x y z' and 'f a b c [d]' (skipped: vt, vn, vp, l, p, g, o, s, mtllib, "
+                    "usemtl, and comments after #)");
+  }
+}
+
 }  // namespace
 
 Mesh load_obj(const std::string& path) {
@@ -67,41 +105,18 @@ Mesh load_obj(const std::string& path) {
 
   std::vector<double> vertices;
   std::vector<ObjFace> faces;
-  std::string text;
-  for (int line = 1; std::getline(in, text); ++line) {
-    if (!text.empty() && text.back() == '\r') text.pop_back();
-    if (line == 1 && text.compare(0, 3, "\xEF\xBB\xBF") == 0) text.erase(0, 3);  // a UTF-8 byte order mark
-    text = text.substr(0, text.find('#'));  // a comment, also after a statement
-    std::istringstream tokens(text);
-    std::string keyword;
-    if (!(tokens >> keyword)) continue;
-    if (keyword == "v") {
-      std::string c[3];
-      if (!(tokens >> c[0] >> c[1] >> c[2]))
-        throw MeshError(where(path, line) + ": vertex needs three coordinates 'v x y z', got '" + text + "'");
-      for (int d = 0; d < 3; ++d) vertices.push_back(parse_coordinate(c[d], path, line));
-    } else if (keyword == "f") {
-      ObjFace face;
-      face.line = line;
-      const int defined = static_cast<int>(vertices.size() / 3);
-      for (std::string corner; tokens >> corner;) face.vertices.push_back(parse_face_corner(corner, defined, path, line));
-      const int n = static_cast<int>(face.vertices.size());
-      if (n != 3 && n != 4)
-        throw MeshError(where(path, line) + ": face has " + std::to_string(n) +
-                        " corners; only triangles (-> tri6) and quads (-> quad8) are supported");
-      for (int a = 0; a < n; ++a)
-        for (int b = 0; b < a; ++b)
-          if (face.vertices[a] == face.vertices[b])
-            throw MeshError(where(path, line) + ": face repeats vertex " + std::to_string(face.vertices[a] + 1));
-      if (!faces.empty() && faces.front().vertices.size() != face.vertices.size())
-        throw MeshError(where(path, line) + ": face has " + std::to_string(n) + " corners but the face at " +
-                        where(path, faces.front().line) + " has " + std::to_string(faces.front().vertices.size()) +
-                        "; a mesh must be all triangles or all quads");
-      faces.push_back(std::move(face));
-    } else if (!is_skipped_obj_statement(keyword)) {
-      throw MeshError(where(path, line) + ": unknown OBJ statement '" + keyword +
-                      "'; a mesh takes 'v x y z' and 'f a b c [d]' (skipped: vt, vn, vp, l, p, g, o, s, mtllib, "
-                      "usemtl, and comments after #)");
+  // Lines end in LF, CR LF or (old Mac files) CR alone: a chunk up to LF may hold several.
+  int line = 0;
+  for (std::string chunk; std::getline(in, chunk);) {
+    if (!chunk.empty() && chunk.back() == '\r') chunk.pop_back();
+    if (chunk.empty()) {
+      ++line;
+      continue;
+    }
+    std::istringstream pieces(chunk);
+    for (std::string text; std::getline(pieces, text, '\r');) {
+      ++line;
+      read_statement(std::move(text), line, path, vertices, faces);
     }
   }
   if (in.bad()) throw MeshError(path + ": read error");

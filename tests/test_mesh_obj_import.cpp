@@ -126,6 +126,16 @@ TEST(ObjImport, MalformedLinesNameTheLine) {
   EXPECT_CONTAINS(load_error("/nonexistent/dir/mesh.obj"), "/nonexistent/dir/mesh.obj: cannot open");
 }
 
+// Old Mac files end lines with CR alone: they read as one line ("no faces").
+TEST(ObjImport, CrOnlyLineEndingsAreLinesToo) {
+  const std::string path = ::testing::TempDir() + "dgtex_obj_import_cr.obj";
+  std::ofstream(path) << "v 0 0 0\rv 1 0 0\r\rv 0 1 0\rf 1 2 3\r";
+  EXPECT_EQ(load_obj(path).num_elements(), 1);
+  std::ofstream(path) << "v 0 0 0\rv 1 0 0\r\rv 0 1 0\rf 1 2 x\r";
+  EXPECT_CONTAINS(load_error(path), ".obj:5: face corner 'x'");  // counted as lines, the empty one too
+  std::remove(path.c_str());
+}
+
 TEST(ObjImport, CrLfLineEndingsAreAccepted) {
   const std::string path = ::testing::TempDir() + "dgtex_obj_import_crlf.obj";
   std::ofstream(path) << "v 0 0 0\r\nv 1 0 0\r\nv 0 1 0\r\nf 1 2 3\r\n";
