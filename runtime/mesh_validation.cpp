@@ -1,8 +1,11 @@
 #include "dgtex/mesh_validation.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <map>
 #include <string>
+#include <vector>
 
 #include "dgtex/topology.h"
 
@@ -179,6 +182,40 @@ void validate_mesh(const Mesh& mesh) {
                           std::to_string(std::lround(std::acos(kMinNeighbourNormalCosine) * kDegreesPerRadian)) + ")",
                       {edge.plus_element, edge.minus_element});
   }
+}
+
+std::string unwelded_seam_caution(const Mesh& mesh) {
+  const Topology topology = build_topology(mesh);
+  std::vector<int> boundary;
+  for (const MeshEdge& edge : topology.boundary_edges) boundary.insert(boundary.end(), edge.nodes, edge.nodes + 3);
+  std::sort(boundary.begin(), boundary.end());
+  boundary.erase(std::unique(boundary.begin(), boundary.end()), boundary.end());
+  Vec3 lo{1e300, 1e300, 1e300}, hi{-1e300, -1e300, -1e300};
+  for (int n = 0; n < mesh.num_nodes(); ++n) {
+    const double* p = mesh.node(n);
+    lo = {std::min(lo.x, p[0]), std::min(lo.y, p[1]), std::min(lo.z, p[2])};
+    hi = {std::max(hi.x, p[0]), std::max(hi.y, p[1]), std::max(hi.z, p[2])};
+  }
+  const double tolerance = 1e-9 * std::max(norm(Vec3{hi.x - lo.x, hi.y - lo.y, hi.z - lo.z}), 1e-300);
+  // Repeated vertices carry the same coordinates: the same cell of a grid at the tolerance.
+  std::map<std::array<long long, 3>, int> first_at;
+  int coincident = 0, example = -1, example_other = -1;
+  for (int n : boundary) {
+    const double* p = mesh.node(n);
+    const std::array<long long, 3> cell = {std::llround((p[0] - lo.x) / tolerance), std::llround((p[1] - lo.y) / tolerance),
+                                           std::llround((p[2] - lo.z) / tolerance)};  // at most 1e9 each
+    const auto [it, inserted] = first_at.emplace(cell, n);
+    if (inserted) continue;
+    ++coincident;
+    if (example < 0) example = it->second, example_other = n;
+  }
+  if (coincident == 0) return "";
+  const double* p = mesh.node(example);
+  return std::to_string(coincident) + " boundary node" + (coincident == 1 ? "" : "s") +
+         " lie on other boundary nodes without being joined to them (node " + std::to_string(example) + " and node " +
+         std::to_string(example_other) + " at [" + mesh_number(p[0]) + ", " + mesh_number(p[1]) + ", " +
+         mesh_number(p[2]) + "]): the pieces run apart, as if cut there; if they are one sheet, give their faces "
+         "shared vertices (an OBJ seam that repeats its vertices)";
 }
 
 double element_area(const Mesh& mesh, int e) {

@@ -172,6 +172,29 @@ TEST(CliRun, APenaltyFarAboveItsThresholdIsCautioned) {
   EXPECT_EQ(plain.stderr_text, "");
 }
 
+// An OBJ whose two quads repeat the vertices of their shared side runs as two pieces: the
+// run says so (mesh_validation.h, unwelded_seam_caution) and runs.
+TEST(CliRun, AnUnweldedSeamIsCautioned) {
+  const fs::path dir = fresh_dir("unwelded_seam");
+  std::ofstream(dir / "m.obj") << "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3 4\n"
+                                  "v 1 0 0\nv 2 0 0\nv 2 1 0\nv 1 1 0\nf 5 6 7 8\n";
+  std::ofstream(dir / "seam.json") << R"({
+    "mesh": {"file": "m.obj"},
+    "material": {"youngs_modulus": 1e6, "poisson_ratio": 0.3, "thickness": 0.01},
+    "penalty": 1,
+    "boundary": [{"select": {"plane": {"normal": [1, 0, 0], "offset": 0}}, "fix": ["x", "y", "z"], "clamp": true},
+                 {"select": {"plane": {"normal": [1, 0, 0], "offset": 2}}, "fix": ["x", "y", "z"], "clamp": true}],
+    "loads": [{"type": "area_force", "force_per_area": [0, 0, -1]}],
+    "analysis": {"type": "static"}})";
+  const std::string scene = (dir / "seam.json").string();
+  const Result r = dgtex::test::run_cli("run " + scene + " --out " + (dir / "out").string() + " --quiet --no-render", dir);
+  EXPECT_EQ(r.exit_code, 0) << r.stderr_text;
+  EXPECT_NE(r.stderr_text.find("dgtex run: warning: " + scene + ": mesh: 3 boundary nodes lie on other boundary nodes "
+                               "without being joined to them"),
+            std::string::npos)
+      << r.stderr_text;
+}
+
 // fracture.json at T = 4096: at least 346.3 GiB of texel fields (dgtex/texel_memory_estimate.h).
 // Without the check the system killed such a run minutes in; now one line, at once.
 TEST(CliRun, CutsWhoseTexelFieldsCannotFitAreRefusedNamingTheResolution) {

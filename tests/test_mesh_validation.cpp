@@ -188,3 +188,19 @@ TEST(Validation, AreaAndPerimeterOfCurvedElements) {
   EXPECT_NEAR(element_perimeter(tri, 0), 1 + std::sqrt(2.0) + parabola, 2e-4);
   EXPECT_THROW(element_area(tri, 1), MeshError);
 }
+
+// Two unit squares side by side whose shared side repeats its nodes instead of sharing
+// them (an OBJ seam written twice): valid, separate pieces, so only a caution.
+TEST(Validation, UnweldedSeamsAreCautioned) {
+  for (ElementType type : {ElementType::quad8, ElementType::tri6}) {
+    const Mesh left = make_rectangle(1, 1, 1, 1, type);
+    Mesh both = left;
+    for (int n = 0; n < left.num_nodes(); ++n)
+      both.positions.insert(both.positions.end(), {left.node(n)[0] + 1, left.node(n)[1], left.node(n)[2]});
+    for (int index : left.elements) both.elements.push_back(index + left.num_nodes());
+    EXPECT_EQ(validation_message(both), "");  // valid
+    const std::string caution = unwelded_seam_caution(both);
+    EXPECT_MESSAGE_CONTAINS(caution, "3 boundary nodes lie on other boundary nodes without being joined to them");
+    EXPECT_EQ(unwelded_seam_caution(make_rectangle(2, 1, 2, 1, type)), "");  // the same squares, welded
+  }
+}

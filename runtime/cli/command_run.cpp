@@ -19,6 +19,7 @@
 #include "dgtex/frame_writer.h"
 #include "dgtex/mesh_error.h"
 #include "dgtex/mesh_output.h"
+#include "dgtex/mesh_validation.h"
 #include "dgtex/model_error.h"
 #include "dgtex/model_memory_estimate.h"
 #include "dgtex/penalty_caution.h"
@@ -129,9 +130,11 @@ int run_command(int argc, char** argv) {
     return 1;
   }
   const Mesh& mesh = run->mesh();
-  // Valid but likely locked (dgtex/penalty_caution.h): nothing fails, so say it.
+  // Valid but likely not what was meant (dgtex/penalty_caution.h, mesh_validation.h): say so.
   if (const std::string caution = penalty_caution(scene.penalty, mesh.type); !caution.empty())
     std::fprintf(stderr, "dgtex run: warning: %s: %s\n", scene_path.c_str(), caution.c_str());
+  if (const std::string caution = unwelded_seam_caution(mesh); !caution.empty())
+    std::fprintf(stderr, "dgtex run: warning: %s: mesh: %s\n", scene_path.c_str(), caution.c_str());
   // PNG frames (dgtex/frame_writer.h). The EGL context opens before the run, so a machine
   // without one fails here with one line and writes nothing.
   std::unique_ptr<FrameWriter> png_frames;

@@ -1,6 +1,8 @@
 #pragma once
 // Checks that a mesh is usable by the shell solver, and per-element measures.
 // Pure functions (thread-safe). Lengths in the mesh's unit (SI: m), areas in its square (m^2).
+#include <string>
+
 #include "dgtex/mesh.h"
 #include "dgtex/mesh_error.h"
 
@@ -25,6 +27,13 @@ namespace dgtex {
 inline constexpr double kMaxElementAspect = 1e4;
 inline constexpr double kMinNeighbourNormalCosine = -0.99;
 void validate_mesh(const Mesh& mesh);
+
+// A caution for boundary nodes that lie on other boundary nodes (within 1e-9 of the mesh's
+// extent) without being joined to them: an OBJ whose seam repeats its vertices instead of
+// sharing them, which runs as separate pieces (a plate split so deflected 1.54x as far;
+// every face of a triangle soup fell on its own). Valid, so `dgtex run` only says so: one
+// sentence naming how many nodes and one pair, or "" (a validated mesh).
+std::string unwelded_seam_caution(const Mesh& mesh);
 
 // Area of element e by its quadrature rule (exact for the flat undistorted elements,
 // degree-5 accurate otherwise). Units: length^2.
