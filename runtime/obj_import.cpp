@@ -99,6 +99,27 @@ void read_statement(std::string text, int line, const std::string& path, std::ve
 
 }  // namespace
 
+ObjFaceCount count_obj_faces(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw MeshError(path + ": cannot open OBJ file for reading");
+  ObjFaceCount count;
+  // Line ends as load_obj takes them: CR alone ends a line too.
+  for (std::string chunk; std::getline(in, chunk);) {
+    std::istringstream pieces(chunk);
+    for (std::string text; std::getline(pieces, text, '\r');) {
+      const std::size_t start = text.find_first_not_of(" \t");
+      if (start == std::string::npos || text[start] != 'f' || start + 1 >= text.size() ||
+          (text[start + 1] != ' ' && text[start + 1] != '\t'))
+        continue;
+      if (count.faces++ == 0) {
+        std::istringstream tokens(text.substr(start + 1));
+        for (std::string corner; tokens >> corner && corner[0] != '#';) ++count.first_face_corners;
+      }
+    }
+  }
+  return count;
+}
+
 Mesh load_obj(const std::string& path) {
   std::ifstream in(path);
   if (!in) throw MeshError(path + ": cannot open OBJ file for reading");

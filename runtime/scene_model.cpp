@@ -19,9 +19,16 @@ Mesh build_scene_mesh(const Scene& scene) {
   validate_scene(scene);
   const MeshSpec& m = scene.mesh;
   const ElementType type = m.element.value_or(ElementType::quad8);
-  // A model that cannot fit is refused before its mesh is built (a file's once it is read).
+  // A model that cannot fit is refused before its mesh is built (a file's from its faces
+  // counted before it is parsed, and again once it is read).
   if (const std::int64_t elements = m.generated_elements(); elements >= 0)
     check_model_memory(scene, type, elements, available_memory_bytes());
+  if (m.source == MeshSource::file) {
+    const ObjFaceCount count = count_obj_faces(m.file);
+    if (count.first_face_corners == 3 || count.first_face_corners == 4)
+      check_model_memory(scene, count.first_face_corners == 3 ? ElementType::tri6 : ElementType::quad8, count.faces,
+                         available_memory_bytes());
+  }
   switch (m.source) {
     case MeshSource::rectangle:
       return make_rectangle(m.size[0], m.size[1], m.divisions[0], m.divisions[1], type, m.triangles);

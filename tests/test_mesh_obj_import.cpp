@@ -164,3 +164,13 @@ TEST(ObjImport, UnknownStatementsAreRefusedByteOrderMarksAndTrailingCommentsAcce
   EXPECT_CONTAINS(load_error_of_text(std::string("v 0 0 0\nv 1", 11) + std::string(1, '\0') + "5 0 0\n"),
                   ".obj:2: vertex coordinate");
 }
+
+TEST(ObjImport, FacesAreCountedWithoutReadingTheFile) {
+  const std::string path = ::testing::TempDir() + "dgtex_obj_import_count.obj";
+  std::ofstream(path) << "# f 1 2 3\nv 0 0 0\rv 1 0 0\nfoo 1\n  f 1 2 3 4 # quad\r\tf\t1 2 3\nf 1 2 3\n";
+  const ObjFaceCount count = count_obj_faces(path);
+  std::remove(path.c_str());
+  EXPECT_EQ(count.faces, 3);
+  EXPECT_EQ(count.first_face_corners, 4);
+  EXPECT_THROW(count_obj_faces("/nonexistent/dir/mesh.obj"), MeshError);
+}

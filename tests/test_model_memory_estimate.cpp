@@ -59,7 +59,7 @@ TEST(ModelMemoryEstimate, AModelBeyondTheMemoryAvailableIsRefusedNamingTheDivisi
 
 // The whole path, with the memory capped (one process per test: the environment is this
 // test's own): build_scene_mesh refuses the divisions at once, before 10 million elements
-// exist, and a file's mesh once it is read, naming mesh.file.
+// exist, and a file's mesh from its faces before it is read, naming mesh.file.
 TEST(ModelMemoryEstimate, BuildSceneMeshRefusesBeforeBuildingAndFilesOnceRead) {
   ::setenv("DGTEX_MEMORY_LIMIT_MB", "1", 1);
   const auto start = std::chrono::steady_clock::now();
@@ -90,6 +90,14 @@ TEST(ModelMemoryEstimate, BuildSceneMeshRefusesBeforeBuildingAndFilesOnceRead) {
   const std::string file = message_of<SceneError>([&] { build_scene_mesh(from_file); });
   EXPECT_NE(file.find(": mesh.file: 16 quad8 elements need at least 1 MiB"), std::string::npos) << file;
   EXPECT_NE(file.find("got \"" + obj + "\""), std::string::npos) << file;
+  // Counted from its 'f' lines before it is parsed: these faces name vertices that do not
+  // exist, which reading it would refuse.
+  {
+    std::ofstream out(obj);
+    for (int k = 0; k < 16; ++k) out << "f 1 2 3 4  # no vertices\n";
+  }
+  EXPECT_NE(message_of<SceneError>([&] { build_scene_mesh(from_file); }).find(": mesh.file: 16 quad8 elements need"),
+            std::string::npos);
   ::unsetenv("DGTEX_MEMORY_LIMIT_MB");
 }
 
