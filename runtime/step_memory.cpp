@@ -6,6 +6,8 @@
 #include <limits>
 #include <mutex>
 #include <new>
+#include <stdexcept>
+#include <string>
 #include <vector>
 
 #if defined(__GLIBC__)
@@ -73,6 +75,12 @@ void prepare_step_memory() {
 
 void reserve_step_memory(std::int64_t bytes) {
   if (bytes <= 0) return;
+  // Faulted in page by page, more than the memory available is not a std::bad_alloc under
+  // the kernel's overcommit but a process killed part way.
+  if (const std::int64_t available = available_memory_bytes(); available >= 0 && bytes > available)
+    throw std::invalid_argument("reserve_step_memory: " + std::to_string(bytes) + " bytes is more than the " +
+                                std::to_string(available) +
+                                " bytes of memory available; reserve less (step_memory_bytes takes at most a quarter)");
   prepare_step_memory();
 #if defined(__GLIBC__)
   fault_in_heap(bytes - bytes / 3);

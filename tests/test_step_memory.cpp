@@ -8,6 +8,7 @@
 
 #include <cstdint>
 #include <cstdlib>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -63,6 +64,21 @@ TEST(StepMemory, SixTimesTheFieldsBoundWithinTheCaps) {
   const long before = minor_faults();
   for (int step = 0; step < steps; ++step) run.step();
   return minor_faults() - before;
+}
+
+// More than the memory available, faulted in page by page, got the process killed under
+// the kernel's overcommit instead of a std::bad_alloc: refused before anything is touched.
+TEST(StepMemory, AReservationBeyondTheMemoryAvailableIsRefused) {
+  ::setenv("DGTEX_MEMORY_LIMIT_MB", "64", 1);  // this test's own process (one per test)
+  try {
+    reserve_step_memory(65 * mib);
+    ADD_FAILURE() << "65 MiB of 64 reserved";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("reserve_step_memory: 68157440 bytes is more than the 67108864 bytes"),
+              std::string::npos)
+        << e.what();
+  }
+  ::unsetenv("DGTEX_MEMORY_LIMIT_MB");
 }
 
 TEST(StepMemory, ALargerReservationTopsTheHeapUpToAllOfIt) {

@@ -19,7 +19,9 @@
 // call it (or prepare_step_memory) before the threads that run the steps allocate, for
 // them to share the reserved heap (SceneRunOptions::reserve_step_memory does so in the
 // set-up of a SceneRun: the `dgtex` tool's `run` and `bench scenes`). Throws
-// std::bad_alloc where the memory is not to be had.
+// std::invalid_argument for more bytes than available_memory_bytes() (faulting them in
+// would get the process killed rather than a std::bad_alloc), std::bad_alloc where the
+// memory is not to be had.
 #include <cstdint>
 
 #include "dgtex/texel_memory_estimate.h"
