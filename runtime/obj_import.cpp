@@ -59,6 +59,22 @@ bool is_skipped_obj_statement(const std::string& keyword) {
   return false;
 }
 
+// Calls read(text, line) for every line of `in` (1-based, without its end). Lines end in LF,
+// CR LF or (old Mac files) CR alone: a chunk up to LF may hold several.
+template <class Read>
+void for_each_line(std::istream& in, Read&& read) {
+  int line = 0;
+  for (std::string chunk; std::getline(in, chunk);) {
+    if (!chunk.empty() && chunk.back() == '\r') chunk.pop_back();
+    if (chunk.empty()) {
+      ++line;
+      continue;
+    }
+    std::istringstream pieces(chunk);
+    for (std::string text; std::getline(pieces, text, '\r');) read(std::move(text), ++line);
+  }
+}
+
 // One statement (a line without its end), read into vertices or faces.
 void read_statement(std::string text, int line, const std::string& path, std::vector<double>& vertices,
                     std::vector<ObjFace>& faces) {
@@ -103,20 +119,16 @@ ObjFaceCount count_obj_faces(const std::string& path) {
   std::ifstream in(path);
   if (!in) throw MeshError(path + ": cannot open OBJ file for reading");
   ObjFaceCount count;
-  // Line ends as load_obj takes them: CR alone ends a line too.
-  for (std::string chunk; std::getline(in, chunk);) {
-    std::istringstream pieces(chunk);
-    for (std::string text; std::getline(pieces, text, '\r');) {
-      const std::size_t start = text.find_first_not_of(" \t");
-      if (start == std::string::npos || text[start] != 'f' || start + 1 >= text.size() ||
-          (text[start + 1] != ' ' && text[start + 1] != '\t'))
-        continue;
-      if (count.faces++ == 0) {
-        std::istringstream tokens(text.substr(start + 1));
-        for (std::string corner; tokens >> corner && corner[0] != '#';) ++count.first_face_corners;
-      }
+  for_each_line(in, [&](std::string text, int) {
+    const std::size_t start = text.find_first_not_of(" \t");
+    if (start == std::string::npos || text[start] != 'f' || start + 1 >= text.size() ||
+        (text[start + 1] != ' ' && text[start + 1] != '\t'))
+      return;
+    if (count.faces++ == 0) {
+      std::istringstream tokens(text.substr(start + 1));
+      for (std::string corner; tokens >> corner && corner[0] != '#';) ++count.first_face_corners;
     }
-  }
+  });
   return count;
 }
 
@@ -126,20 +138,7 @@ Mesh load_obj(const std::string& path) {
 
   std::vector<double> vertices;
   std::vector<ObjFace> faces;
-  // Lines end in LF, CR LF or (old Mac files) CR alone: a chunk up to LF may hold several.
-  int line = 0;
-  for (std::string chunk; std::getline(in, chunk);) {
-    if (!chunk.empty() && chunk.back() == '\r') chunk.pop_back();
-    if (chunk.empty()) {
-      ++line;
-      continue;
-    }
-    std::istringstream pieces(chunk);
-    for (std::string text; std::getline(pieces, text, '\r');) {
-      ++line;
-      read_statement(std::move(text), line, path, vertices, faces);
-    }
-  }
+  for_each_line(in, [&](std::string text, int line) { read_statement(std::move(text), line, path, vertices, faces); });
   if (in.bad()) throw MeshError(path + ": read error");
   if (faces.empty()) throw MeshError(path + ": no faces ('f' lines) found");
 
