@@ -86,7 +86,7 @@ void check_quadrature_accuracy_options(const QuadratureAccuracyOptions& options)
   // T becomes the arc-cut scene's enrichment.texture_resolution: a power of two in 8..4096
   // (T = 100 was refused by that scene's reader only once the sweep ran, as exit code 1).
   const int T = options.resolution;
-  if (T < 8 || T > 4096 || (T & (T - 1)) != 0)
+  if (!is_texture_resolution(T))
     throw std::invalid_argument("quadrature resolution T = " + std::to_string(T) +
                                 "; need a power of two in 8..4096 (8, 16, ..., 4096)");
   for (double tol : options.tolerances)

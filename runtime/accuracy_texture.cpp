@@ -14,6 +14,7 @@
 #include "dgtex/harmonic_enrichment.h"
 #include "dgtex/kernels/cut_rasterization.h"
 #include "dgtex/laplace_solver.h"
+#include "dgtex/scene.h"
 
 namespace dgtex {
 namespace {
@@ -75,7 +76,7 @@ TipError tip_error(const kernels::TexelTile& solution, double tip, double r_min,
 // At most the largest texture a scene takes (enrichment.texture_resolution), as in dgtex
 // bench laplace: T = 100000 ended the sweep in a bare std::bad_alloc.
 void check_resolution(int T) {
-  if (T < 16 || T > 4096 || T % 2)
+  if (T < 16 || T > kMaxTextureResolution || T % 2)
     throw std::invalid_argument("texture size T = " + std::to_string(T) + "; need an even T in 16..4096");
 }
 

@@ -706,8 +706,8 @@ class SceneReader {
     EnrichmentOptions e;
     if (const json* r = find(v, "texture_resolution")) {
       const std::string p = child(path, "texture_resolution");
-      e.texture_resolution = integer(*r, p, 8, 4096);
-      if ((e.texture_resolution & (e.texture_resolution - 1)) != 0)
+      e.texture_resolution = integer(*r, p, kMinTextureResolution, kMaxTextureResolution);
+      if (!is_texture_resolution(e.texture_resolution))
         fail(p, "not a power of two", *r, "expected one of 8, 16, 32, 64, 128, 256, 512, 1024, 2048, 4096");
     }
     if (const json* s = find(v, "solver"))

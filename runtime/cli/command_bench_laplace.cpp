@@ -17,6 +17,7 @@
 #include "dgtex/benchmark_machine.h"
 #include "dgtex/laplace_benchmark.h"
 #include "dgtex/laplace_domains.h"
+#include "dgtex/scene.h"
 #include "option_errors.h"
 #include "output_paths.h"
 
@@ -101,7 +102,9 @@ int bench_laplace_command(int argc, char** argv) {
       if (T < 16) throw std::invalid_argument("--sizes: T = " + std::to_string(T) + " is too small, need >= 16");
       // The largest texture a scene takes (enrichment.texture_resolution); beyond it the
       // texel arrays of one domain pass tens of gigabytes.
-      if (T > 4096) throw std::invalid_argument("--sizes: T = " + std::to_string(T) + " is too large, need <= 4096");
+      if (T > kMaxTextureResolution)
+        throw std::invalid_argument("--sizes: T = " + std::to_string(T) + " is too large, need <= " +
+                                    std::to_string(kMaxTextureResolution));
     }
 
     const std::string machine = describe_machine_and_probe();

@@ -140,6 +140,14 @@ struct Cut {
                                 // cut appears at start_time
 };
 
+// The texture resolutions a scene takes (enrichment.texture_resolution), and so the
+// benchmarks that build textures: powers of two in 8..4096.
+inline constexpr int kMinTextureResolution = 8;
+inline constexpr int kMaxTextureResolution = 4096;
+constexpr bool is_texture_resolution(int T) {
+  return T >= kMinTextureResolution && T <= kMaxTextureResolution && (T & (T - 1)) == 0;
+}
+
 // "enrichment" (optional block).
 struct EnrichmentOptions {
   enum class Solver { multigrid, cholmod };
