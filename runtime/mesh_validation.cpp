@@ -135,9 +135,9 @@ void validate_mesh(const Mesh& mesh) {
     // The corners too, signed against the normal at the centre: a reflex (concave) corner
     // or two corners at one point (a zero-length edge) kept every quadrature point's
     // Jacobian positive, and the factorisation failed as "penalty too low?".
-    const double centre[2] = {mesh.type == ElementType::quad8 ? 0.0 : 1.0 / 3, mesh.type == ElementType::quad8 ? 0.0 : 1.0 / 3};
+    const double centre = mesh.type == ElementType::quad8 ? 0.0 : 1.0 / 3;  // both coordinates
     Vec3 t1, t2;
-    tangents(mesh, e, centre[0], centre[1], t1, t2);
+    tangents(mesh, e, centre, centre, t1, t2);
     const Vec3 normal = cross(t1, t2);
     const double normal_length = norm(normal);
     for (int a = 0; a < kernels::corners_per_element(mesh.type); ++a) {

@@ -24,6 +24,13 @@ std::vector<T> checked_size(const char* argument, std::vector<T> values, int dof
   return values;
 }
 
+// After the penalty in "not positive definite" errors. OBJ fuzzing (session 68): one quad8
+// of a 4 x 4 plate narrowed at one end to 1/5 of its opposite edge failed at penalty 0.8 and
+// ran at 2, to 1/25 needed 20, to 1/250 failed at 20; every one passed validate_mesh.
+constexpr const char* kDistortionHint =
+    ", whose threshold (0.35-0.40 on regular elements) grows with their distortion: an edge much shorter than the "
+    "opposite one needs a larger penalty or a better mesh";
+
 }  // namespace
 
 ShellSimulation::ShellSimulation(const ShellModel& model, std::vector<char> fixed, std::vector<double> external_force)
@@ -65,14 +72,6 @@ void ShellSimulation::set_state(std::vector<double> u, std::vector<double> v) {
   v_ = std::move(v);
   previous_v_.clear();
   previous_previous_v_.clear();
-}
-
-std::string ShellSimulation::distortion_hint() {
-  // OBJ fuzzing (session 68): one quad8 of a 4 x 4 plate narrowed at one end to 1/5 of its
-  // opposite edge failed at penalty 0.8 and ran at 2, to 1/25 needed 20, to 1/250 failed at
-  // 20; every one passed validate_mesh.
-  return ", whose threshold (0.35-0.40 on regular elements) grows with their distortion: an edge much shorter "
-         "than the opposite one needs a larger penalty or a better mesh";
 }
 
 std::string ShellSimulation::enrichment_hint() const {
@@ -156,7 +155,7 @@ void ShellSimulation::solve_static() {
       cholesky_.factorize(values);
     } catch (const NotPositiveDefinite& e) {
       throw ModelError("stiffness not positive definite (penalty too low?): penalty = " +
-                       detail::short_number(model_.options().penalty) + distortion_hint() + "; " + e.what() +
+                       detail::short_number(model_.options().penalty) + kDistortionHint + "; " + e.what() +
                        enrichment_hint());
     }
     system_.restrict_vector(f_ext_, rhs);
@@ -287,7 +286,7 @@ void ShellSimulation::step(const DynamicsOptions& o) {
     }
   } catch (const NotPositiveDefinite& e) {
     throw ModelError("dynamic system matrix not positive definite (penalty too low?): penalty = " +
-                     detail::short_number(model_.options().penalty) + distortion_hint() + "; " + e.what() +
+                     detail::short_number(model_.options().penalty) + kDistortionHint + "; " + e.what() +
                      enrichment_hint());
   }
   for (int d = 0; d < ndofs; ++d) u_[d] += dt * v_[d];

@@ -99,7 +99,6 @@ class ShellSimulation {
 
   const std::vector<double>& linear_stiffness();
   std::string enrichment_hint() const;  // appended to "not positive definite" errors
-  static std::string distortion_hint();  // likewise, after the penalty
 };
 
 }  // namespace dgtex
