@@ -1,5 +1,7 @@
 #include "dgtex/obj_import.h"
 
+#include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstdlib>
 #include <fstream>
@@ -59,12 +61,14 @@ bool is_skipped_obj_statement(const std::string& keyword) {
   return false;
 }
 
-// Calls read(text, line) for every line of `in` (1-based, without its end). Lines end in LF,
-// CR LF or (old Mac files) CR alone: a chunk up to LF may hold several.
+// Calls read(text, line) for every line of `in` (1-based, without its end and the first
+// without a UTF-8 byte order mark). Lines end in LF, CR LF or (old Mac files) CR alone: a
+// chunk up to LF may hold several.
 template <class Read>
 void for_each_line(std::istream& in, Read&& read) {
   int line = 0;
   for (std::string chunk; std::getline(in, chunk);) {
+    if (line == 0 && chunk.compare(0, 3, "\xEF\xBB\xBF") == 0) chunk.erase(0, 3);
     if (!chunk.empty() && chunk.back() == '\r') chunk.pop_back();
     if (chunk.empty()) {
       ++line;
@@ -78,7 +82,6 @@ void for_each_line(std::istream& in, Read&& read) {
 // One statement (a line without its end), read into vertices or faces.
 void read_statement(std::string text, int line, const std::string& path, std::vector<double>& vertices,
                     std::vector<ObjFace>& faces) {
-  if (line == 1 && text.compare(0, 3, "\xEF\xBB\xBF") == 0) text.erase(0, 3);  // a UTF-8 byte order mark
   text = text.substr(0, text.find('#'));  // a comment, also after a statement
   std::istringstream tokens(text);
   std::string keyword;
@@ -119,13 +122,13 @@ ObjFaceCount count_obj_faces(const std::string& path) {
   std::ifstream in(path);
   if (!in) throw MeshError(path + ": cannot open OBJ file for reading");
   ObjFaceCount count;
+  auto space = [](char c) { return std::isspace(static_cast<unsigned char>(c)) != 0; };
   for_each_line(in, [&](std::string text, int) {
-    const std::size_t start = text.find_first_not_of(" \t");
-    if (start == std::string::npos || text[start] != 'f' || start + 1 >= text.size() ||
-        (text[start + 1] != ' ' && text[start + 1] != '\t'))
-      return;
+    // As load_obj's statements: "f" first, then white space (as a stream reads it).
+    const auto start = std::find_if_not(text.begin(), text.end(), space);
+    if (start == text.end() || *start != 'f' || start + 1 == text.end() || !space(start[1])) return;
     if (count.faces++ == 0) {
-      std::istringstream tokens(text.substr(start + 1));
+      std::istringstream tokens(std::string(start + 1, text.end()));
       for (std::string corner; tokens >> corner && corner[0] != '#';) ++count.first_face_corners;
     }
   });

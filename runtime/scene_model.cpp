@@ -19,8 +19,8 @@ Mesh build_scene_mesh(const Scene& scene) {
   validate_scene(scene);
   const MeshSpec& m = scene.mesh;
   const ElementType type = m.element.value_or(ElementType::quad8);
-  // A model that cannot fit is refused before its mesh is built (a file's from its faces
-  // counted before it is parsed, and again once it is read).
+  // A model that cannot fit is refused before its mesh is built (a file's from its faces,
+  // counted as load_obj will read them, before it is parsed).
   if (const std::int64_t elements = m.generated_elements(); elements >= 0)
     check_model_memory(scene, type, elements, available_memory_bytes());
   if (m.source == MeshSource::file) {
@@ -37,11 +37,8 @@ Mesh build_scene_mesh(const Scene& scene) {
                            m.triangles);
     case MeshSource::hemisphere:
       return make_hemisphere(m.radius, m.hole_deg, m.divisions[0], m.divisions[1], type, m.triangles);
-    case MeshSource::file: {
-      Mesh mesh = load_obj(m.file);
-      check_model_memory(scene, mesh.type, mesh.num_elements(), available_memory_bytes());
-      return mesh;
-    }
+    case MeshSource::file:
+      return load_obj(m.file);
   }
   return {};
 }

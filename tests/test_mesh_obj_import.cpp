@@ -172,5 +172,12 @@ TEST(ObjImport, FacesAreCountedWithoutReadingTheFile) {
   std::remove(path.c_str());
   EXPECT_EQ(count.faces, 3);
   EXPECT_EQ(count.first_face_corners, 4);
+  // A byte order mark before the first face counts it, as load_obj reads it; one alone on
+  // the first line keeps the line numbers.
+  std::ofstream(path) << "\xEF\xBB\xBF" "f 1 2 3 4\n";
+  EXPECT_EQ(count_obj_faces(path).faces, 1);
+  std::ofstream(path) << "\xEF\xBB\xBF\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 x\n";
+  EXPECT_CONTAINS(load_error(path), ".obj:5: face corner 'x'");
+  std::remove(path.c_str());
   EXPECT_THROW(count_obj_faces("/nonexistent/dir/mesh.obj"), MeshError);
 }
