@@ -5,6 +5,7 @@
 #include <cmath>
 #include <map>
 #include <numeric>
+#include <set>
 #include <sstream>
 #include <string>
 #include <utility>
@@ -15,8 +16,9 @@
 #include "dgtex/boundary_selection.h"
 #include "dgtex/cut_path.h"
 #include "dgtex/kernels/flood_fill.h"
-#include "dgtex/surface_point.h"
 #include "dgtex/scene_io.h"
+#include "dgtex/surface_point.h"
+#include "dgtex/topology.h"
 
 namespace dgtex {
 namespace {
@@ -104,124 +106,186 @@ void check_surface_points(const Scene& scene, const Mesh& mesh) {
   }
 }
 
-// Connected parts: nodes linked through shared elements (union-find over element nodes).
-std::vector<int> part_of_node(const Mesh& mesh) {
-  std::vector<int> parent(mesh.num_nodes());
-  std::iota(parent.begin(), parent.end(), 0);
-  auto root = [&](int n) { return kernels::find_root_halving(parent, n); };
+// Rigid bodies of a static check: elements joined across shared edges move as one (the DG
+// edge terms tie their rotations); bodies that meet only at nodes share those nodes'
+// translations and can turn about them (two squares meeting at a corner: the solver's
+// factorisation failed and read as "penalty too low?"). A piece of the mesh (nodes linked
+// through elements) with more than kMaxJointedBodies bodies is tested as one rigid body,
+// as if its node joints were stiff: its dense 6B x 6B test would grow as B^3.
+constexpr int kMaxJointedBodies = 32;
+
+struct RigidBodies {
+  std::vector<int> of_element;              // body of each element
+  std::vector<std::vector<int>> of_node;    // distinct bodies using each node, ascending
+  std::vector<int> piece, index_in_piece;   // per body: its piece and its place there
+  std::vector<int> piece_size;              // bodies per piece
+  int count() const { return static_cast<int>(piece.size()); }
+};
+
+RigidBodies rigid_bodies(const Mesh& mesh, const Topology& topology) {
+  std::vector<int> edge_joined(mesh.num_elements()), node_joined(mesh.num_nodes());
+  std::iota(edge_joined.begin(), edge_joined.end(), 0);
+  std::iota(node_joined.begin(), node_joined.end(), 0);
+  for (const MeshEdge& edge : topology.interior_edges)
+    kernels::unite_smaller_root(edge_joined, edge.plus_element, edge.minus_element);
+  for (int e = 0; e < mesh.num_elements(); ++e)
+    for (int a = 1; a < mesh.nodes_per_element(); ++a)
+      kernels::unite_smaller_root(node_joined, mesh.element_nodes(e)[0], mesh.element_nodes(e)[a]);
+  auto piece_of = [&](int e) { return kernels::find_root_halving(node_joined, mesh.element_nodes(e)[0]); };
+  std::map<int, std::set<int>> edge_parts_of_piece;
+  for (int e = 0; e < mesh.num_elements(); ++e)
+    edge_parts_of_piece[piece_of(e)].insert(kernels::find_root_halving(edge_joined, e));
+
+  RigidBodies bodies;
+  bodies.of_element.resize(mesh.num_elements());
+  std::map<int, int> body_of_root, piece_index;  // roots of edge parts (or of big pieces)
   for (int e = 0; e < mesh.num_elements(); ++e) {
-    const int* nodes = mesh.element_nodes(e);
-    for (int a = 1; a < mesh.nodes_per_element(); ++a) parent[root(nodes[a])] = root(nodes[0]);
+    const int piece = piece_of(e);
+    const bool jointed = static_cast<int>(edge_parts_of_piece[piece].size()) <= kMaxJointedBodies;
+    const int root = jointed ? kernels::find_root_halving(edge_joined, e) : -1 - piece;
+    const auto [it, inserted] = body_of_root.emplace(root, bodies.count());
+    if (inserted) {
+      const auto [p, new_piece] = piece_index.emplace(piece, static_cast<int>(bodies.piece_size.size()));
+      if (new_piece) bodies.piece_size.push_back(0);
+      bodies.piece.push_back(p->second);
+      bodies.index_in_piece.push_back(bodies.piece_size[p->second]++);
+    }
+    bodies.of_element[e] = it->second;
   }
-  for (int n = 0; n < mesh.num_nodes(); ++n) parent[n] = root(n);
-  return parent;
+  bodies.of_node.resize(mesh.num_nodes());
+  for (int e = 0; e < mesh.num_elements(); ++e)
+    for (int a = 0; a < mesh.nodes_per_element(); ++a) bodies.of_node[mesh.element_nodes(e)[a]].push_back(bodies.of_element[e]);
+  for (std::vector<int>& list : bodies.of_node) {
+    std::sort(list.begin(), list.end());
+    list.erase(std::unique(list.begin(), list.end()), list.end());
+  }
+  return bodies;
 }
 
-// Static runs need every connected part held against all six rigid motions
-// u(x) = t + w x (x - c). Each constraint is a linear condition on (t, w); the part is
-// held when those conditions have rank 6. Rotations are scaled by the spread of the part's
-// held nodes so the rank test depends neither on the length unit nor on nodes far from the
-// supports (the part's bounding box took one node lifted to z = 1e5 on a unit plate as its
+// Static runs need every body held against all six rigid motions u(x) = t + w x (x - c),
+// jointly: each constraint is a linear condition on the (t, w) of one body, each node
+// shared by two bodies three conditions on both, and a piece is held when its conditions
+// have full rank 6B. Rotations are scaled by the spread of each body's held and shared
+// nodes so the rank test depends neither on the length unit nor on nodes far from the
+// supports (a plate's bounding box took one node lifted to z = 1e5 on a unit plate as its
 // size, and the held nodes' rotation rows fell below the test's tolerance).
 void check_rigid_motions(const Scene& scene, const Mesh& mesh) {
   if (scene.analysis.is_dynamic() || mesh.num_elements() == 0) return;
-  const std::vector<int> part = part_of_node(mesh);
-  std::vector<char> used(mesh.num_nodes(), 0);
-  for (int n : mesh.elements) used[n] = 1;
+  const Topology topology = build_topology(mesh);
+  const RigidBodies bodies = rigid_bodies(mesh, topology);
   std::vector<std::vector<int>> selections;
   for (const BoundaryCondition& bc : scene.boundary) selections.push_back(select_nodes(mesh, bc.select));
 
-  // Per part: centroid and RMS radius of its held nodes, and the accumulated normal matrix
-  // A^T A of the constraints.
-  std::map<int, Eigen::Vector3d> held_sum;
-  std::map<int, double> held_count, held_squares;
-  for (const std::vector<int>& selected : selections)
-    for (int n : selected) {  // zero first: a default Eigen vector is left unset
-      held_sum.try_emplace(part[n], Eigen::Vector3d::Zero()).first->second += node_position(mesh, n);
-      held_count[part[n]] += 1;
-    }
-  auto centre = [&](int p) { return Eigen::Vector3d(held_sum[p] / held_count[p]); };
-  for (const std::vector<int>& selected : selections)
-    for (int n : selected) held_squares[part[n]] += (node_position(mesh, n) - centre(part[n])).squaredNorm();
-  std::map<int, Eigen::Matrix<double, 6, 6>> normal_matrix;
-  for (int n = 0; n < mesh.num_nodes(); ++n)
-    if (used[n]) normal_matrix[part[n]].setZero();
-  auto add_row = [&](int p, const Eigen::Matrix<double, 6, 1>& row) { normal_matrix[p] += row * row.transpose(); };
-  // A single held point has no spread: its rotation rows are 0 whatever the scale.
-  auto scale = [&](int p) { return std::max(std::sqrt(held_squares[p] / held_count[p]), 1e-300); };
+  // Per body: centroid and RMS radius of the nodes that hold it (selected or shared).
+  std::vector<Eigen::Vector3d> centre(bodies.count(), Eigen::Vector3d::Zero());
+  std::vector<double> count(bodies.count(), 0), squares(bodies.count(), 0);
+  auto for_each_holding_node = [&](auto&& visit) {
+    for (const std::vector<int>& selected : selections)
+      for (int n : selected)
+        for (int b : bodies.of_node[n]) visit(b, n);
+    for (int n = 0; n < mesh.num_nodes(); ++n)
+      if (bodies.of_node[n].size() > 1)
+        for (int b : bodies.of_node[n]) visit(b, n);
+  };
+  for_each_holding_node([&](int b, int n) { centre[b] += node_position(mesh, n), count[b] += 1; });
+  for (int b = 0; b < bodies.count(); ++b)
+    if (count[b] > 0) centre[b] /= count[b];
+  for_each_holding_node([&](int b, int n) { squares[b] += (node_position(mesh, n) - centre[b]).squaredNorm(); });
+  // A single holding point has no spread: its rotation rows are 0 whatever the scale.
+  auto offset = [&](int b, int n) {
+    const double scale = count[b] > 0 ? std::sqrt(squares[b] / count[b]) : 0;
+    return Eigen::Vector3d((node_position(mesh, n) - centre[b]) / std::max(scale, 1e-300));
+  };
 
-  // Boundary edges (used by one element) keyed by their sorted corner pair.
-  std::map<std::pair<int, int>, std::pair<int, int>> edge_owner;  // -> (element, local edge)
-  std::map<std::pair<int, int>, int> edge_count;
-  const int corners = kernels::corners_per_element(mesh.type);
-  for (int e = 0; e < mesh.num_elements(); ++e) {
-    for (int k = 0; k < corners; ++k) {
-      int local[3];
-      kernels::local_edge_nodes(mesh.type, k, local);
-      const int* nodes = mesh.element_nodes(e);
-      const std::pair<int, int> key = std::minmax(nodes[local[0]], nodes[local[2]]);
-      ++edge_count[key];
-      edge_owner[key] = {e, k};
-    }
-  }
+  // Normal matrices A^T A per piece, block (i, j) for the bodies at places i and j in it.
+  std::vector<Eigen::MatrixXd> normal_matrix;
+  for (int size : bodies.piece_size) normal_matrix.push_back(Eigen::MatrixXd::Zero(6 * size, 6 * size));
+  using Row = Eigen::Matrix<double, 6, 1>;
+  auto block = [&](int b, int c) {
+    return normal_matrix[bodies.piece[b]].block<6, 6>(6 * bodies.index_in_piece[b], 6 * bodies.index_in_piece[c]);
+  };
+  auto add_row = [&](int b, const Row& row) { block(b, b) += row * row.transpose(); };
+  auto translation_row = [&](int b, int n, int c) {  // component c of body b's motion at node n
+    const Eigen::Vector3d axis = Eigen::Vector3d::Unit(c);
+    Row row;
+    row << axis, offset(b, n).cross(axis);
+    return row;
+  };
 
-  for (size_t b = 0; b < scene.boundary.size(); ++b) {
-    const BoundaryCondition& bc = scene.boundary[b];
-    const std::vector<int>& selected = selections[b];
+  for (size_t k = 0; k < scene.boundary.size(); ++k) {
+    const BoundaryCondition& bc = scene.boundary[k];
     std::vector<char> is_selected(mesh.num_nodes(), 0);
-    for (int n : selected) {
+    for (int n : selections[k]) {
       is_selected[n] = 1;
-      const int p = part[n];
-      const Eigen::Vector3d r = (node_position(mesh, n) - centre(p)) / scale(p);
-      for (int c = 0; c < 3; ++c) {
-        if (!bc.fixed[c]) continue;
-        const Eigen::Vector3d axis = Eigen::Vector3d::Unit(c);
-        Eigen::Matrix<double, 6, 1> row;
-        row << axis, r.cross(axis);
-        add_row(p, row);
-      }
+      for (int b : bodies.of_node[n])
+        for (int c = 0; c < 3; ++c)
+          if (bc.fixed[c]) add_row(b, translation_row(b, n, c));
     }
     if (!bc.clamp) continue;
     // A held normal n forbids rotations w with w x n != 0: rows (0, n x e_c).
-    for (const auto& entry : edge_count) {
-      if (entry.second != 1) continue;
-      const auto [e, k] = edge_owner[entry.first];
-      int local[3];
-      kernels::local_edge_nodes(mesh.type, k, local);
-      const int* nodes = mesh.element_nodes(e);
-      if (!(is_selected[nodes[local[0]]] && is_selected[nodes[local[1]]] && is_selected[nodes[local[2]]])) continue;
+    for (const MeshEdge& edge : topology.boundary_edges) {
+      if (!(is_selected[edge.nodes[0]] && is_selected[edge.nodes[1]] && is_selected[edge.nodes[2]])) continue;
       double xi[2], dxi[2];
-      kernels::local_edge_point(mesh.type, k, 0.0, xi, dxi);
+      kernels::local_edge_point(mesh.type, edge.plus_local_edge, 0.0, xi, dxi);
       Eigen::Vector3d x, normal;
-      surface_point(mesh, e, xi, x, normal);
+      surface_point(mesh, edge.plus_element, xi, x, normal);
       if (!(normal.norm() > 0)) continue;
       normal.normalize();
       for (int c = 0; c < 3; ++c) {
-        Eigen::Matrix<double, 6, 1> row;
+        Row row;
         row << Eigen::Vector3d::Zero(), normal.cross(Eigen::Vector3d::Unit(c));
-        add_row(part[nodes[local[1]]], row);
+        add_row(bodies.of_element[edge.plus_element], row);
       }
     }
   }
+  // A node shared by bodies a < b: their motions agree there, rows (a's) - (b's).
+  for (int n = 0; n < mesh.num_nodes(); ++n) {
+    const std::vector<int>& shared = bodies.of_node[n];
+    for (size_t i = 1; i < shared.size(); ++i)
+      for (int c = 0; c < 3; ++c) {
+        const int a = shared[0], b = shared[i];
+        const Row row_a = translation_row(a, n, c), row_b = translation_row(b, n, c);
+        block(a, a) += row_a * row_a.transpose();
+        block(b, b) += row_b * row_b.transpose();
+        block(a, b) -= row_a * row_b.transpose();
+        block(b, a) -= row_b * row_a.transpose();
+      }
+  }
 
-  for (const auto& entry : normal_matrix) {
-    const int p = entry.first;
-    Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, 6, 6>> solver(entry.second);
-    const Eigen::Matrix<double, 6, 1> eigenvalues = solver.eigenvalues();  // ascending
-    const double largest = std::max(eigenvalues[5], 0.0);
+  std::vector<std::vector<int>> body_at(bodies.piece_size.size());
+  for (int b = 0; b < bodies.count(); ++b) body_at[bodies.piece[b]].push_back(b);
+  for (size_t p = 0; p < normal_matrix.size(); ++p) {
+    Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> solver(normal_matrix[p]);
+    const Eigen::VectorXd& eigenvalues = solver.eigenvalues();  // ascending
+    const double largest = std::max(eigenvalues[eigenvalues.size() - 1], 0.0);
     if (eigenvalues[0] > 1e-10 * largest && largest > 0) continue;
-    Eigen::Matrix<double, 6, 1> mode = solver.eigenvectors().col(0);
+    // The free motion: shown for the body that moves most in it.
+    const Eigen::VectorXd mode_of_piece = solver.eigenvectors().col(0);
+    int place = 0;
+    for (int i = 1; i < bodies.piece_size[p]; ++i)
+      if (mode_of_piece.segment<6>(6 * i).norm() > mode_of_piece.segment<6>(6 * place).norm() + 1e-9) place = i;
+    Row mode = mode_of_piece.segment<6>(6 * place);
     Eigen::Index largest_entry = 0;
     mode.cwiseAbs().maxCoeff(&largest_entry);
     if (mode[largest_entry] < 0) mode = -mode;  // eigenvector sign is arbitrary; print a stable one
     const Eigen::Vector3d t = mode.head<3>(), w = mode.tail<3>();
     const std::string motion = t.norm() >= w.norm() ? "translation along " + direction_text(t)
                                                     : "rotation about " + direction_text(w);
-    int example_node = 0;
-    while (part[example_node] != p || !used[example_node]) ++example_node;
+    const int body = body_at[p][place];
+    int example_node = -1, joint = -1;  // a node of the body alone (else any), and a shared one
+    for (int n = 0; n < mesh.num_nodes(); ++n) {
+      const std::vector<int>& of = bodies.of_node[n];
+      if (std::find(of.begin(), of.end(), body) == of.end()) continue;
+      if (of.size() > 1 && joint < 0) joint = n;
+      if (of.size() == 1 && example_node < 0) example_node = n;
+    }
+    if (example_node < 0) example_node = joint;
+    const std::string joint_text = joint < 0 ? "" : "; it meets the rest of the mesh only at single nodes (node " +
+                                                        std::to_string(joint) +
+                                                        "), not along an edge, and can turn about them";
     throw SceneError(scene.source_name, "boundary", "the model is statically unconstrained (the part containing node " +
                          std::to_string(example_node) + " at " + fmt(node_position(mesh, example_node)) +
-                         " can still move rigidly, e.g. " + motion + ")",
+                         " can still move rigidly, e.g. " + motion + joint_text + ")",
                      std::to_string(scene.boundary.size()) + " boundary condition(s)",
                      "hold every part against all rigid motions (e.g. fix x, y, z on a line of nodes and clamp it) or "
                      "use a dynamic analysis");

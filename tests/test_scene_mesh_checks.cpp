@@ -2,6 +2,7 @@
 // free in static runs.
 #include <gtest/gtest.h>
 
+#include <functional>
 #include <string>
 
 #include "dgtex/mesh_generators.h"
@@ -124,6 +125,77 @@ TEST(SceneMeshChecks, EveryDisconnectedPartNeedsSupport) {
       << message;
   s.boundary.push_back(on_plane({1, 0, 0}, 4, kAll, true));
   EXPECT_EQ(error_of(s, mesh), "");
+}
+
+// Appends b to a, sharing the nodes of b that lie exactly on nodes of a.
+Mesh joined_where_nodes_meet(Mesh a, const Mesh& b) {
+  std::vector<int> index(b.num_nodes());
+  for (int n = 0; n < b.num_nodes(); ++n) {
+    index[n] = -1;
+    for (int m = 0; m < a.num_nodes() && index[n] < 0; ++m)
+      if (a.node(m)[0] == b.node(n)[0] && a.node(m)[1] == b.node(n)[1] && a.node(m)[2] == b.node(n)[2]) index[n] = m;
+    if (index[n] >= 0) continue;
+    index[n] = a.num_nodes();
+    a.positions.insert(a.positions.end(), b.node(n), b.node(n) + 3);
+  }
+  for (int node : b.elements) a.elements.push_back(index[node]);
+  return a;
+}
+
+Mesh moved(Mesh mesh, const std::function<Vec3(const double*)>& map) {
+  for (int n = 0; n < mesh.num_nodes(); ++n) {
+    const Vec3 x = map(mesh.node(n));
+    for (int c = 0; c < 3; ++c) mesh.positions[3 * n + c] = x[c];
+  }
+  return mesh;
+}
+
+BoundaryCondition at_point(Vec3 p, std::array<bool, 3> fixed) {
+  BoundaryCondition bc;
+  bc.select.kind = BoundarySelect::Kind::box;
+  bc.select.min = bc.select.max = p;
+  bc.fixed = fixed;
+  return bc;
+}
+
+// Two squares that meet at one corner: a shared node ties their translations there but
+// not their rotations, so clamping one leaves the other free to turn about the corner.
+// It used to pass this check and fail in the factorisation as "penalty too low?".
+TEST(SceneMeshChecks, PartsMeetingAtANodeTurnAboutIt) {
+  for (ElementType type : {ElementType::quad8, ElementType::tri6}) {
+    const Mesh square = make_rectangle(1, 1, 1, 1, type);
+    const Mesh bowtie =
+        joined_where_nodes_meet(square, moved(square, [](const double* x) { return Vec3{x[0] + 1, x[1] + 1, x[2]}; }));
+    ASSERT_EQ(bowtie.num_nodes(), 2 * square.num_nodes() - 1);
+    Scene s = static_scene();
+    s.boundary.push_back(on_plane({1, 0, 0}, 0, kAll, true));
+    const std::string message = error_of(s, bowtie);
+    EXPECT_NE(message.find("statically unconstrained (the part containing node " + std::to_string(square.num_nodes())),
+              std::string::npos)
+        << message;
+    EXPECT_NE(message.find("it meets the rest of the mesh only at single nodes (node "), std::string::npos) << message;
+    s.boundary.push_back(on_plane({1, 0, 0}, 2, kAll, true));  // the second square clamped too
+    EXPECT_EQ(error_of(s, bowtie), "");
+  }
+}
+
+// Parts that each keep one free rotation can hold each other through the node they share:
+// a square in the xy-plane pinned at two corners (free: the rotation about x = 0, which
+// lifts the shared corner along z) and one in the xz-plane pinned at two corners (free:
+// the rotation about its far edge, which moves the shared corner along y). Tested one part
+// at a time, each would read as unconstrained; together they are held.
+TEST(SceneMeshChecks, PartsMeetingAtANodeCanHoldEachOther) {
+  for (ElementType type : {ElementType::quad8, ElementType::tri6}) {
+    const Mesh square = make_rectangle(1, 1, 1, 1, type);
+    const Mesh upright = moved(square, [](const double* x) { return Vec3{1 + x[0], 1, x[1]}; });
+    const Mesh corner = joined_where_nodes_meet(square, upright);
+    ASSERT_EQ(corner.num_nodes(), 2 * square.num_nodes() - 1);
+    Scene s = static_scene();
+    for (Vec3 p : {Vec3{0, 0, 0}, Vec3{0, 1, 0}, Vec3{2, 1, 0}, Vec3{2, 1, 1}}) s.boundary.push_back(at_point(p, kAll));
+    EXPECT_EQ(error_of(s, corner), "");
+    s.boundary.pop_back();  // the upright square now also turns about its pinned corner
+    EXPECT_NE(error_of(s, corner).find("statically unconstrained"), std::string::npos);
+  }
 }
 
 TEST(SceneMeshChecks, ClampedCylinderEdgeIsHeld) {
