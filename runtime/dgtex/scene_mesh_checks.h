@@ -14,7 +14,9 @@ namespace dgtex {
 //    element of the mesh's type, or span zero length on the surface;
 //  - the analysis is static and some connected part of the mesh can still move rigidly
 //    under the boundary conditions (fixed components on selected nodes, clamped normals on
-//    boundary edges whose three nodes are all selected).
+//    boundary edges whose three nodes are all selected). Parts are elements joined across
+//    shared edges; parts that meet only at nodes share those nodes' translations, not
+//    their rotations.
 void check_scene_against_mesh(const Scene& scene, const Mesh& mesh);
 
 }  // namespace dgtex
