@@ -9,6 +9,9 @@
 #include <stdexcept>
 #include <utility>
 
+#include <sys/resource.h>
+#include <unistd.h>
+
 #include "dgtex/scene_io.h"
 
 namespace dgtex {
@@ -43,6 +46,19 @@ std::int64_t cut_bytes_per_texel(const TexelFields& fields) {
 
 std::string count_of(int n, const std::string& noun) { return std::to_string(n) + " " + noun + (n == 1 ? "" : "s"); }
 
+// The address space left under `ulimit -v` (RLIMIT_AS): its limit less the process's
+// virtual size (/proc/self/statm), where allocations fail long before the machine's memory
+// runs out; -1 without a limit.
+std::int64_t address_space_left() {
+  rlimit limit{};
+  if (getrlimit(RLIMIT_AS, &limit) != 0 || limit.rlim_cur == RLIM_INFINITY) return -1;
+  std::ifstream statm("/proc/self/statm");
+  long long pages = 0;
+  if (!(statm >> pages)) pages = 0;
+  const std::int64_t used = static_cast<std::int64_t>(pages) * sysconf(_SC_PAGESIZE);
+  return std::max<std::int64_t>(0, static_cast<std::int64_t>(limit.rlim_cur) - used);
+}
+
 // DGTEX_MEMORY_LIMIT_MB as bytes; -1 when unset or empty. Throws std::invalid_argument for
 // anything but a whole number of MiB >= 1.
 std::int64_t memory_limit_from_environment() {
@@ -74,14 +90,19 @@ std::string memory_size_text(std::int64_t bytes) {
 }
 
 std::int64_t available_memory_bytes() {
-  const std::int64_t user_limit = memory_limit_from_environment();
+  std::int64_t bytes = -1;  // the least of the figures that are known
+  auto cap = [&](std::int64_t figure) {
+    if (figure >= 0) bytes = bytes < 0 ? figure : std::min(bytes, figure);
+  };
+  cap(memory_limit_from_environment());
+  cap(address_space_left());
   std::ifstream meminfo("/proc/meminfo");
-  if (!meminfo) return user_limit;
+  if (!meminfo) return bytes;
   std::stringstream text;
   text << "\n" << meminfo.rdbuf();
   const std::int64_t available = meminfo_bytes(text.str(), "MemAvailable");
-  if (available < 0) return user_limit;
-  std::int64_t bytes = available + std::max<std::int64_t>(0, meminfo_bytes(text.str(), "SwapFree"));
+  if (available < 0) return bytes;
+  cap(available + std::max<std::int64_t>(0, meminfo_bytes(text.str(), "SwapFree")));
   // A container's limit (the cgroup's) can be far below the host's memory. v1 reports "no
   // limit" as a number near 2^63.
   const std::int64_t no_limit = std::int64_t{1} << 60;
@@ -89,9 +110,9 @@ std::int64_t available_memory_bytes() {
                                                  std::pair{"/sys/fs/cgroup/memory/memory.limit_in_bytes",
                                                            "/sys/fs/cgroup/memory/memory.usage_in_bytes"}}) {
     const std::int64_t limit = file_number(limit_file), usage = file_number(usage_file);
-    if (limit > 0 && limit < no_limit && usage >= 0) bytes = std::min(bytes, std::max<std::int64_t>(0, limit - usage));
+    if (limit > 0 && limit < no_limit && usage >= 0) cap(std::max<std::int64_t>(0, limit - usage));
   }
-  return user_limit < 0 ? bytes : std::min(bytes, user_limit);
+  return bytes;
 }
 
 void check_texel_memory(const TexelFields& fields, std::int64_t available_bytes, const std::string& source_name) {

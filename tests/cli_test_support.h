@@ -29,6 +29,12 @@ inline CliResult run_cli(const std::string& args, const std::filesystem::path& w
   return {WEXITSTATUS(status), std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>())};
 }
 
+// The whole of a file as text ("" when it cannot be read).
+inline std::string file_text(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+}
+
 // An empty folder under the system's temporary folder, named after PREFIX, NAME and the pid.
 inline std::filesystem::path fresh_dir(const std::string& prefix, const std::string& name) {
   const std::filesystem::path dir =

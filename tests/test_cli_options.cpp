@@ -47,6 +47,13 @@ TEST(CliOptions, BadValuesAreOneLineNamingTheCommandAndOption) {
       {"bench shell --tolerance -1", "dgtex bench shell: --tolerance: Value -1 is not a relative tolerance"},
       {"bench laplace --tolerance 1", "dgtex bench laplace: --tolerance: Value 1 is not a relative tolerance"},
       {"render x.state --background 2 0 0", "dgtex render: --background: Value 2 not in range"},
+      // Passed CLI11's range (NaN), or were refused by the library naming its own fields.
+      {"render x.state --out DIR/r.png --background nan 0 0", "dgtex render: --background: nan 0 0: expected three numbers in [0, 1]"},
+      {"render x.state --out DIR/r.png --camera-up 0 0 0", "dgtex render: --camera-up: 0 0 0: expected a non-zero direction"},
+      {"render x.state --out DIR/r.png --fov 180", "dgtex render: --fov: 180: expected more than 0 and less than 180 degrees"},
+      {"render x.state --out DIR/r.png --camera-position 1 1 1 --camera-target 1 1 1",
+       "dgtex render: --camera-target: 1 1 1: the camera's own position"},
+      {"render x.state --out DIR/r.png --shading bogus", "dgtex render: --shading: shading 'bogus' (valid: flat, smooth)"},
       {"bench scenes --threads 1 --cut-update-threads 1",
        "dgtex bench scenes: --cut-update-threads: 1 is more than the steps' threads (1) can spare"},
       {"bench scaling --threads-list 2,1", "dgtex bench scaling: --threads-list: 2,1; expected increasing thread counts"},
@@ -148,6 +155,57 @@ TEST(CliOptions, AWriteThatFailsEndsWithExitCodeOne) {
     EXPECT_NE(r.stderr_text.find(std::string("cannot write ") + option + " file '/dev/full'"), std::string::npos)
         << r.stderr_text;
   }
+}
+
+// An output given the path of an input replaced it: `bench shell --scene s.json --json
+// s.json` left results where the scene was, `render s.png --out s.png` the image where
+// the state was, and `run r/final.state --out r` (a scene saved under an output's name)
+// deleted its own scene when it cleared the earlier run's files. Each is refused before
+// anything is written, the input unchanged.
+TEST(CliOptions, OutputsNeverReplaceInputs) {
+  const fs::path dir = dgtex::test::fresh_dir("dgtex_cli_options", "inputs");
+  const std::string scene = (dir / "scene.json").string(), saved = (dir / "final.state").string();
+  const std::string cylinder = kScenes + "/cylinder_buckling.json";
+  for (const std::string& copy : {scene, saved, (dir / "s.png").string()})
+    fs::copy_file(cylinder, copy, fs::copy_options::overwrite_existing);
+  const Refusal refusals[] = {
+      {"bench shell --scene DIR/scene.json --json DIR/scene.json",
+       "dgtex bench shell: --json 'DIR/scene.json' is the scene of --scene 'DIR/scene.json'; give the output another "
+       "file"},
+      {"bench scaling --families batch --batch-scenes DIR/scene.json --markdown DIR/./scene.json",
+       "dgtex bench scaling: --markdown 'DIR/./scene.json' is a scene of --batch-scenes"},
+      {"bench scenes --scenes DIR/scene.json --json DIR/scene.json", "dgtex bench scenes: --json 'DIR/scene.json' is a "
+                                                                     "scene of --scenes"},
+      {"render DIR/s.png --out DIR/s.png", "dgtex render: --out 'DIR/s.png' is the state file"},
+      {"run DIR/final.state --out DIR", "dgtex run: DIR/final.state: --out DIR: the run writes or clears "
+                                        "'DIR/final.state', the scene file; choose another output folder"},
+  };
+  for (const Refusal& refusal : refusals) {
+    std::string args = refusal.args, expected = refusal.message_start;
+    for (std::string* text : {&args, &expected})
+      for (std::size_t at = text->find("DIR"); at != std::string::npos; at = text->find("DIR", at))
+        text->replace(at, 3, dir.string());
+    const CliResult r = run_cli(args, dir);
+    EXPECT_EQ(r.exit_code, 2) << args << ": " << r.stderr_text;
+    EXPECT_EQ(r.stderr_text.rfind(expected, 0), 0u) << args << ": " << r.stderr_text;
+  }
+  const std::string original = dgtex::test::file_text(cylinder);
+  for (const std::string& copy : {scene, saved, (dir / "s.png").string()})
+    EXPECT_EQ(dgtex::test::file_text(copy), original) << copy;
+}
+
+// `bench scenes` read each scene when it came to it: a static scene after a dynamic one
+// ended the command after the first one's runs, with a partial table. All are read first.
+TEST(CliOptions, BenchScenesReadsEverySceneBeforeTheFirstRuns) {
+  const fs::path dir = dgtex::test::fresh_dir("dgtex_cli_options", "scenes_first");
+  const CliResult r = run_cli("bench scenes --quiet --steps 1 --scenes " + kScenes + "/cylinder_buckling.json," + kScenes +
+                                  "/clamped_plate.json --json " + (dir / "t.json").string(),
+                              dir);
+  EXPECT_EQ(r.exit_code, 2) << r.stderr_text;
+  EXPECT_EQ(r.stderr_text.rfind("dgtex bench scenes: --scenes: '" + kScenes + "/clamped_plate.json' is a static analysis", 0),
+            0u)
+      << r.stderr_text;
+  EXPECT_FALSE(fs::exists(dir / "t.json"));  // nothing ran
 }
 
 TEST(CliOptions, BenchHelpListsTheBenchmarks) {

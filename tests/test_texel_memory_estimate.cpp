@@ -3,6 +3,8 @@
 // of GB, and the system killed such a run minutes in. The footprints the bound counts come
 // from the traced cuts and creases alone and are checked against the fields they build.
 #include <gtest/gtest.h>
+#include <sys/resource.h>
+#include <unistd.h>
 
 #include <cstdint>
 #include <cstdlib>
@@ -223,6 +225,33 @@ TEST(TexelMemoryEstimate, TheEnvironmentsLimitCapsTheMemoryAvailable) {
   ::setenv("DGTEX_MEMORY_LIMIT_MB", "", 1);  // empty: as unset
   EXPECT_GT(available_memory_bytes(), capped);
   ::unsetenv("DGTEX_MEMORY_LIMIT_MB");
+}
+
+// Under `ulimit -v` allocations fail once the address space is used, whatever the machine
+// has free: the memory available is at most what the limit leaves (the checks read the
+// machine's memory alone, and a scene past the limit ended in std::bad_alloc).
+TEST(TexelMemoryEstimate, TheAddressSpaceLimitCapsTheMemoryAvailable) {
+#if defined(__SANITIZE_ADDRESS__)
+  GTEST_SKIP() << "ASan reserves terabytes of address space for its shadow memory";
+#else
+  std::ifstream statm("/proc/self/statm");
+  long long pages = 0;
+  if (!(statm >> pages)) GTEST_SKIP() << "no /proc/self/statm";
+  rlimit original{};
+  ASSERT_EQ(getrlimit(RLIMIT_AS, &original), 0);
+  const std::int64_t used = static_cast<std::int64_t>(pages) * sysconf(_SC_PAGESIZE);
+  const std::int64_t room = std::int64_t{256} << 20;
+  if (original.rlim_max != RLIM_INFINITY && static_cast<std::int64_t>(original.rlim_max) < used + room)
+    GTEST_SKIP() << "the hard limit leaves less than 256 MiB";
+  rlimit limited = original;
+  limited.rlim_cur = static_cast<rlim_t>(used + room);
+  ASSERT_EQ(setrlimit(RLIMIT_AS, &limited), 0);
+  const std::int64_t available = available_memory_bytes();
+  ASSERT_EQ(setrlimit(RLIMIT_AS, &original), 0);  // back before any assertion can fail
+  EXPECT_LE(available, room);
+  EXPECT_GT(available, room / 2);  // the process grew by less than 128 MiB between the two reads
+  EXPECT_GT(available_memory_bytes(), room) << "the machine should have more than 256 MiB free";
+#endif
 }
 
 // The whole path: fracture.json at T = 4096 through SceneRun, refused in the set-up before

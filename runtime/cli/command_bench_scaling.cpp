@@ -190,7 +190,10 @@ int bench_scaling_command(int argc, char** argv) {
   } catch (const CLI::ParseError& e) {
     return exit_on_option_error(app, e);
   }
-  if (!outputs_are_distinct(app, {{"--json", &json_path}, {"--markdown", &markdown_path}, {"--chart", &chart_path}}))
+  std::vector<InputFile> inputs = {{"the scene of --scene", scene_path}, {"the scene of --cut-scene", cut_scene_path}};
+  for (const std::string& path : batch_scenes) inputs.push_back({"a scene of --batch-scenes", path});
+  if (!outputs_are_distinct(app, {{"--json", &json_path}, {"--markdown", &markdown_path}, {"--chart", &chart_path}},
+                            inputs))
     return 2;
   // The speed-ups are over the first count: a list such as 2,1 or 1,1 gave "speed-up 2->1".
   if (std::adjacent_find(threads.begin(), threads.end(), std::greater_equal<int>()) != threads.end()) {

@@ -387,7 +387,6 @@ int bench_scenes_command(int argc, char** argv) {
   } catch (const CLI::ParseError& e) {
     return exit_on_option_error(app, e);
   }
-  if (!outputs_are_distinct(app, {{"--json", &json_path}, {"--markdown", &markdown_path}})) return 2;
   if (threads > 0) omp_set_num_threads(threads);
   if (const int spare = omp_get_max_threads() - 1; cut_update_threads > spare) {
     const std::string valid = spare == 0 ? "0 (the steps run on one thread: none to spare beside them)"
@@ -409,6 +408,25 @@ int bench_scenes_command(int argc, char** argv) {
       return 2;
     }
   }
+  std::vector<InputFile> inputs;
+  for (const SceneEntry& entry : entries) inputs.push_back({"a scene of --scenes", entry.path});
+  if (!outputs_are_distinct(app, {{"--json", &json_path}, {"--markdown", &markdown_path}}, inputs)) return 2;
+  // Every scene is read, and must be dynamic, before the first one runs: a bad one met
+  // after minutes of benchmarking ended the command with a partial table.
+  std::vector<Scene> loaded;
+  for (const SceneEntry& entry : entries) {
+    try {
+      loaded.push_back(load_scene(entry.path));
+    } catch (const SceneError& e) {
+      std::fprintf(stderr, "dgtex bench scenes: %s\n", e.what());
+      return 2;
+    }
+    if (!loaded.back().analysis.is_dynamic()) {
+      std::fprintf(stderr, "dgtex bench scenes: --scenes: '%s' is a static analysis; the scene benchmark steps "
+                   "\"analysis\": {\"type\": \"dynamic\", ...}\n", entry.path.c_str());
+      return 2;
+    }
+  }
 
   std::vector<SceneBenchResult> results;
   std::vector<EveryRun> every_runs;  // per scene, for the table of every run
@@ -426,9 +444,10 @@ int bench_scenes_command(int argc, char** argv) {
                         {"targets", {{"steps_per_second", kTargetStepsPerSecond}, {"stage_ratio", kTargetStageRatio}}},
                         {"scenes", nlohmann::json::array()}};
   const bool tty = isatty(fileno(stderr));
-  for (const SceneEntry& entry : entries) {
+  for (std::size_t k = 0; k < entries.size(); ++k) {
+    const SceneEntry& entry = entries[k];
     try {
-      const Scene scene = load_scene(entry.path);
+      const Scene& scene = loaded[k];
       if (!quiet) std::fprintf(stderr, "bench scenes: %s (%s) ...%s", entry.name.c_str(), entry.path.c_str(), tty ? "" : "\n");
       SceneRunOptions run_options;
       run_options.overlap_cut_updates = !inline_cut_updates;

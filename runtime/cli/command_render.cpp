@@ -7,13 +7,16 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <string>
 #include <vector>
 
+#include "api_argument_checks.h"
 #include "commands.h"
 #include "count_option.h"
+#include "dgtex/kernels/vec3.h"
 #include "dgtex/png_io.h"
 #include "dgtex/shell_renderer.h"
 #include "dgtex/shell_state.h"
@@ -86,10 +89,53 @@ int render_command(int argc, char** argv) {
     return exit_on_option_error(app, e);
   }
 
-  ShellState state;
+  // Refused by option name before the state is read: the library's own checks name its
+  // settings' fields (fov_deg, auto_camera), and a NaN colour or a zero up passed them.
+  auto refuse = [](const std::string& why) {
+    std::fprintf(stderr, "dgtex render: %s (see dgtex render --help)\n", why.c_str());
+    return 2;
+  };
+  auto text = [](const std::vector<double>& v) {
+    std::string t;
+    for (double x : v) t += (t.empty() ? "" : " ") + detail::short_number(x);
+    return t;
+  };
+  auto norm3 = [](const std::vector<double>& v) { return std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]); };
   try {
     settings.shading = parse_shading(shading);
+  } catch (const std::invalid_argument& e) {
+    return refuse(std::string("--shading: ") + e.what());
+  }
+  try {
     settings.cut_method = parse_cut_method(cut_method);
+  } catch (const std::invalid_argument& e) {
+    return refuse(std::string("--cut-method: ") + e.what());
+  }
+  if (!(settings.fov_deg > 0 && settings.fov_deg < 180))
+    return refuse("--fov: " + detail::short_number(settings.fov_deg) + ": expected more than 0 and less than 180 degrees");
+  for (double c : background)
+    if (!(c >= 0 && c <= 1)) return refuse("--background: " + text(background) + ": expected three numbers in [0, 1]");
+  for (const auto& [option, v] : {std::pair{"--camera-position", &position}, {"--camera-target", &target}, {"--camera-up", &up}})
+    if (!v->empty() && !std::isfinite(norm3(*v))) return refuse(std::string(option) + ": " + text(*v) + ": expected finite numbers");
+  if (!up.empty() && !(norm3(up) > 0)) return refuse("--camera-up: " + text(up) + ": expected a non-zero direction");
+  if (!position.empty()) {
+    const double* look = target.empty() ? settings.camera_target : target.data();
+    const std::vector<double> view = {look[0] - position[0], look[1] - position[1], look[2] - position[2]};
+    if (!(norm3(view) > 0))
+      return refuse("--camera-target: " + text({look[0], look[1], look[2]}) +
+                    ": the camera's own position; expected a point away from it");
+    const std::vector<double> u = up.empty() ? std::vector<double>(settings.camera_up, settings.camera_up + 3) : up;
+    std::vector<double> side(3);
+    kernels::cross3(view.data(), u.data(), side.data());
+    if (!(norm3(side) > 1e-9 * norm3(view) * norm3(u)))
+      return refuse("--camera-up: " + text(u) + ": parallel to the viewing direction; expected another up");
+  }
+  if (const std::string image = image_path(out_dir).string();
+      !outputs_are_distinct(app, {{"--out", &image}}, {{"the state file", state_path}}))
+    return 2;
+
+  ShellState state;
+  try {
     // Without an explicit camera, look from the default direction and frame the shell.
     settings.auto_camera = position.empty();
     for (int d = 0; d < 3; ++d) {

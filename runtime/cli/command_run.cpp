@@ -94,6 +94,11 @@ int run_command(int argc, char** argv) {
   try {
     scene = load_scene(scene_path);
     check_report_name(scene);
+    std::vector<InputFile> inputs = {{"the scene file", scene_path}};
+    if (scene.mesh.source == MeshSource::file) inputs.push_back({"the scene's mesh.file", scene.mesh.file});
+    for (size_t i = 0; i < scene.material_textures.size(); ++i)
+      inputs.push_back({"the scene's material_textures[" + std::to_string(i) + "].image", scene.material_textures[i].image});
+    check_run_outputs_spare_inputs(out_dir, scene.output.report, inputs);
     // The set-up (cut tracing, the first enrichment solves, the model) can take minutes
     // at a high texture_resolution: say so, then how long it took.
     const auto setup_start = std::chrono::steady_clock::now();
@@ -222,6 +227,11 @@ int run_command(int argc, char** argv) {
   } catch (const ModelError& e) {
     std::fprintf(stderr, "%sdgtex run: %s: %s\n", progress_line_open ? "\n" : "", scene_path.c_str(), e.what());
     return 2;
+  } catch (const std::bad_alloc&) {  // past the set-up's memory checks, which are lower bounds
+    std::fprintf(stderr, "%sdgtex run: %s: out of memory after %d of %d steps; a smaller texture_resolution, fewer "
+                 "enriched elements, or more memory (ulimit -v, the container's limit)\n", progress_line_open ? "\n" : "",
+                 scene_path.c_str(), steps_completed, scene.analysis.is_dynamic() ? scene.analysis.steps : 1);
+    return 1;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "%sdgtex run: %s: %s\n", progress_line_open ? "\n" : "", scene_path.c_str(), e.what());
     return 1;

@@ -95,18 +95,43 @@ CLI::Validator creatable_folder() {
       "DIR");
 }
 
+namespace {
+
+// A path as outputs are compared: absolute, symbolic links resolved where they exist.
+fs::path comparable_path(const std::string& path) {
+  std::error_code error;
+  fs::path file = fs::weakly_canonical(fs::absolute(path), error);
+  if (error) file = fs::absolute(path).lexically_normal();  // weakly_canonical gives an empty path then
+  return file;
+}
+
+// Whether A and B name one file: the same path, or (both existing) the same inode, as
+// through a hard link.
+bool same_file(const fs::path& a, const fs::path& b) {
+  if (comparable_path(a.string()) == comparable_path(b.string())) return true;
+  std::error_code error;
+  return fs::exists(a, error) && fs::exists(b, error) && fs::equivalent(a, b, error) && !error;
+}
+
+}  // namespace
+
 bool outputs_are_distinct(const CLI::App& app,
-                          std::initializer_list<std::pair<const char*, const std::string*>> outputs) {
+                          std::initializer_list<std::pair<const char*, const std::string*>> outputs,
+                          const std::vector<InputFile>& inputs) {
   std::vector<std::pair<const char*, fs::path>> given;
   for (const auto& [option, value] : outputs) {
     if (value->empty()) continue;
-    std::error_code error;
-    fs::path file = fs::weakly_canonical(fs::absolute(*value), error);
-    if (error) file = fs::absolute(*value).lexically_normal();  // weakly_canonical gives an empty path then
+    const fs::path file = comparable_path(*value);
     for (const auto& [earlier, earlier_file] : given)
       if (earlier_file == file) {
         std::fprintf(stderr, "%s: %s and %s both name '%s'; give each its own file (the second would replace the first)\n",
                      app.get_name().c_str(), earlier, option, value->c_str());
+        return false;
+      }
+    for (const InputFile& input : inputs)
+      if (!input.path.empty() && same_file(input.path, *value)) {
+        std::fprintf(stderr, "%s: %s '%s' is %s '%s'; give the output another file (it would replace the input)\n",
+                     app.get_name().c_str(), option, value->c_str(), input.what.c_str(), input.path.c_str());
         return false;
       }
     given.emplace_back(option, file);
@@ -170,6 +195,23 @@ int remove_earlier_run_outputs(const std::string& folder, const std::string& rep
       if (is_frame_file_name(entry.path().filename().string())) frames.push_back(entry.path());
   for (const fs::path& frame : frames) removed += remove_file(frame);
   return removed;
+}
+
+void check_run_outputs_spare_inputs(const std::string& folder, const std::string& report_name,
+                                    const std::vector<InputFile>& inputs) {
+  const fs::path out(folder);
+  std::vector<fs::path> outputs = {out / report_name};
+  for (const char* name : kRunOutputFiles) outputs.push_back(out / name);
+  for (const InputFile& input : inputs) {
+    if (input.path.empty()) continue;
+    const fs::path path(input.path);
+    bool taken = false;
+    for (const fs::path& output : outputs) taken = taken || same_file(path, output);
+    taken = taken || (is_frame_file_name(path.filename().string()) && same_file(path.parent_path(), out / "frames"));
+    if (taken)
+      throw std::invalid_argument("--out " + folder + ": the run writes or clears '" + input.path + "', " + input.what +
+                                  "; choose another output folder, or move the input out of it");
+  }
 }
 
 void write_output_file(const std::string& path, const std::string& text, const char* option) {

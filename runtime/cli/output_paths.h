@@ -6,6 +6,7 @@
 #include <initializer_list>
 #include <string>
 #include <utility>
+#include <vector>
 
 #include "dgtex/scene.h"
 
@@ -22,12 +23,20 @@ CLI::Validator writable_file();
 // and names of more than 255 bytes.
 CLI::Validator creatable_folder();
 
+// A file a command reads: what names it ("--scene", "the scene file") and its path.
+struct InputFile {
+  std::string what;
+  std::string path;
+};
+
 // Whether the output files given to a command (options and their values; empty: not
-// given) are distinct files; if not, prints one line naming the two options and the file to
-// stderr, prefixed with the command's name (app's, "dgtex bench scaling"). One file given
-// twice would keep only the output written last.
+// given) are distinct files and none of them is one of INPUTS; if not, prints one line
+// naming the two options (or the option and the input) and the file to stderr, prefixed
+// with the command's name (app's, "dgtex bench scaling"). One file given twice would keep
+// only the output written last; an output on an input replaced the user's scene.
 bool outputs_are_distinct(const CLI::App& app,
-                          std::initializer_list<std::pair<const char*, const std::string*>> outputs);
+                          std::initializer_list<std::pair<const char*, const std::string*>> outputs,
+                          const std::vector<InputFile>& inputs = {});
 
 // Creates FOLDER and its parents (nothing when it exists); throws std::invalid_argument naming
 // OPTION ("--out"), the folder and why it cannot be created.
@@ -45,6 +54,12 @@ void check_report_name(const Scene& scene);
 // touched. Returns how many files were removed; throws std::runtime_error naming a file
 // that could not be.
 int remove_earlier_run_outputs(const std::string& folder, const std::string& report_name);
+
+// Throws std::invalid_argument naming --out FOLDER and the input where a file that
+// `dgtex run` writes or removes in FOLDER (remove_earlier_run_outputs) is one of INPUTS (a
+// scene saved as FOLDER/final.state was deleted by the run it started).
+void check_run_outputs_spare_inputs(const std::string& folder, const std::string& report_name,
+                                    const std::vector<InputFile>& inputs);
 
 // Writes TEXT to PATH; throws std::runtime_error naming OPTION ("--json") and the path.
 void write_output_file(const std::string& path, const std::string& text, const char* option);

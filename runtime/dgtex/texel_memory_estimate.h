@@ -23,7 +23,7 @@
 // A scene that passes may still need several times the bound (chad's cut on tri6
 // elements, one 8-element region: 4x). Material textures have their own check
 // (check_material_texture_memory, material_texture.h). Pure functions
-// but available_memory_bytes (reads /proc and the cgroup's limit).
+// but available_memory_bytes (reads /proc, the cgroup's limit and RLIMIT_AS).
 #include <cstdint>
 #include <string>
 
@@ -53,7 +53,9 @@ std::int64_t texel_memory_lower_bound(const TexelFields& fields);
 
 // Memory this process may still take, in bytes: MemAvailable + SwapFree of /proc/meminfo,
 // capped by the cgroup's limit less its usage (cgroup v2 memory.max, v1
-// memory.limit_in_bytes) where one is set, and by the environment's DGTEX_MEMORY_LIMIT_MB
+// memory.limit_in_bytes) where one is set, by the address space left under `ulimit -v`
+// (RLIMIT_AS less the process's virtual size) where that is set, and by the environment's
+// DGTEX_MEMORY_LIMIT_MB
 // (MiB; to share a machine, or to try a scene's limits) where that is set; -1 when neither
 // /proc/meminfo nor DGTEX_MEMORY_LIMIT_MB gives a figure. Throws std::invalid_argument
 // naming DGTEX_MEMORY_LIMIT_MB when it is set but not a whole number >= 1.
