@@ -40,9 +40,10 @@ RotationRun run_scene(const Scene& base, int block_texels, int steps, AccuracyCl
 void check_rotation_accuracy_options(const RotationAccuracyOptions& options) {
   if (options.steps < 1)
     throw std::invalid_argument("rotation accuracy: rotation steps = " + std::to_string(options.steps) + "; need >= 1");
-  for (int b : options.block_texels)
-    if (b < 1)
-      throw std::invalid_argument("rotation accuracy: rotation block B = " + std::to_string(b) + " texels; need >= 1");
+  for (int b : options.block_texels)  // the scene's enrichment.rotation_cluster_texels, 0 (per point) excluded
+    if (b < 1 || b > 4096)
+      throw std::invalid_argument("rotation accuracy: rotation block B = " + std::to_string(b) +
+                                  " texels; need 1..4096");
   const Scene base = load_scene(options.scene);
   if (!base.analysis.is_dynamic() || !base.analysis.corotational)
     throw std::invalid_argument("rotation accuracy: " + options.scene + " is not a dynamic corotated scene");

@@ -102,12 +102,16 @@ void check_scene_quadrature_accuracy_options(const SceneQuadratureAccuracyOption
   if (options.steps < 0)
     throw std::invalid_argument("scene quadrature accuracy: steps = " + std::to_string(options.steps) +
                                 "; need >= 0 (0: the scene's own analysis.steps)");
+  // The range of the scene's enrichment.quadrature_tolerance, which they become (inf was
+  // refused by the scene's reader only once the sweep ran).
+  auto in_scene_range = [](double t) { return t >= 1e-30 && t <= 1e30; };
   for (double t : options.tolerances)
-    if (!(t > 0))
-      throw std::invalid_argument("scene quadrature accuracy: tolerance " + detail::short_number(t) + "; need > 0");
-  if (!(options.reference_tolerance > 0))
+    if (!in_scene_range(t))
+      throw std::invalid_argument("scene quadrature accuracy: tolerance " + detail::short_number(t) +
+                                  "; need 1e-30 <= tol <= 1e30");
+  if (!in_scene_range(options.reference_tolerance))
     throw std::invalid_argument("scene quadrature accuracy: reference tolerance " +
-                                detail::short_number(options.reference_tolerance) + "; need > 0");
+                                detail::short_number(options.reference_tolerance) + "; need 1e-30 <= tol <= 1e30");
   // The errors are measured against the reference run: a looser reference (2 against 0.3)
   // charted the swept runs' distance to a less accurate run as their error.
   for (double t : options.tolerances)

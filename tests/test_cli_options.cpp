@@ -79,9 +79,26 @@ TEST(CliOptions, BadValuesAreOneLineNamingTheCommandAndOption) {
       {"bench accuracy --charts tolerance --no-shell --multigrid-size 3 --out DIR/acc",
        "dgtex bench accuracy: tolerance accuracy: multigrid size T = 3; need 16..2048"},
       {"bench accuracy --charts tolerance --multigrid-tolerances 2 --out DIR/acc",
-       "dgtex bench accuracy: tolerance accuracy: multigrid tolerance 2; need 0 < tol < 1"},
+       "dgtex bench accuracy: tolerance accuracy: multigrid tolerance 2; need 1e-12 <= tol < 1"},
       {"bench accuracy --charts scene_quadrature --scene-quadrature-reference 2 --out DIR/acc",
        "dgtex bench accuracy: scene quadrature accuracy: reference tolerance 2; need one at or below every swept"},
+      // CLI11 dropped empty list items and kept repeats (a case run and reported twice).
+      {"bench laplace --sizes 16,,32", "dgtex bench laplace: --sizes: '16,,32' has an empty item"},
+      {"bench laplace --sizes=16,32,", "dgtex bench laplace: --sizes: '16,32,' has an empty item"},
+      {"bench render --tessellations 1,1", "dgtex bench render: --tessellations: '1,1' names 1 twice"},
+      {"bench shell --threads-list 2,1", "dgtex bench shell: --threads-list: 2,1; expected increasing thread counts"},
+      // Tolerances round-off keeps a solve from reaching: they failed after the work began.
+      {"bench laplace --tolerance 1e-300",
+       "dgtex bench laplace: --tolerance: Value 1e-300 is not a relative tolerance a double-precision solve can reach"},
+      {"bench accuracy --charts tolerance --shell-tolerances 1e-300 --out DIR/acc",
+       "dgtex bench accuracy: tolerance accuracy: shell tolerance 1e-300; need 1e-12 <= tol < 1"},
+      // Values the sweep's scene would refuse only once the sweep ran, and the options of a
+      // chart not chosen (ignored without a word).
+      {"bench accuracy --charts quadrature --quadrature-tolerances inf --out DIR/acc",
+       "dgtex bench accuracy: quadrature tolerance inf; need 0 < tol <= 1e30"},
+      {"bench accuracy --charts rotation --rotation-blocks 100000 --out DIR/acc",
+       "dgtex bench accuracy: rotation accuracy: rotation block B = 100000 texels; need 1..4096"},
+      {"bench accuracy --charts plate --texture-sizes -5 --out DIR/acc", "dgtex bench accuracy: texture size T = -5"},
       // One file for two outputs kept only the one written last.
       {"bench scaling --json DIR/a.json --markdown DIR/a.json",
        "dgtex bench scaling: --json and --markdown both name '"},

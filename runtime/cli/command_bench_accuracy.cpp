@@ -166,6 +166,7 @@ int bench_accuracy_command(int argc, char** argv) {
   app.add_flag("!--no-multigrid", tolerance.multigrid, "tolerance chart without the multigrid series");
   try {
     app.parse(argc, argv);
+    check_list_items(app, argc, argv);
   } catch (const CLI::ParseError& e) {
     return exit_on_option_error(app, e);
   }
@@ -176,18 +177,17 @@ int bench_accuracy_command(int argc, char** argv) {
     const AccuracyClock which = clock == "cpu" ? AccuracyClock::cpu : AccuracyClock::wall;
     plate.clock = quadrature.clock = texture.clock = tolerance.clock = rotation.clock = scene_quadrature.clock = which;
     omp_set_num_threads(threads);
-    // Every chosen sweep's options before the first sweep runs: a bad value of the last
-    // sweep ended the command minutes in. The library names the sweep's field in words
-    // (plate divisions: --plate-divisions), so the line points to the options' help.
+    // Every sweep's options before the first sweep runs: a bad value of the last sweep
+    // ended the command minutes in, and those of a sweep not chosen were ignored without a
+    // word (their defaults are valid). The library names the sweep's field in words (plate
+    // divisions: --plate-divisions), so the line points to the options' help.
     try {
-      for (const std::string& name : charts) {
-        if (name == "plate") check_plate_accuracy_options(plate);
-        if (name == "quadrature") check_quadrature_accuracy_options(quadrature);
-        if (name == "texture") check_texture_accuracy_options(texture);
-        if (name == "tolerance") check_tolerance_accuracy_options(tolerance);
-        if (name == "rotation") check_rotation_accuracy_options(rotation);
-        if (name == "scene_quadrature") check_scene_quadrature_accuracy_options(scene_quadrature);
-      }
+      check_plate_accuracy_options(plate);
+      check_quadrature_accuracy_options(quadrature);
+      check_texture_accuracy_options(texture);
+      check_tolerance_accuracy_options(tolerance);
+      check_rotation_accuracy_options(rotation);
+      check_scene_quadrature_accuracy_options(scene_quadrature);
     } catch (const std::invalid_argument& e) {
       std::fprintf(stderr, "dgtex bench accuracy: %s (see dgtex bench accuracy --help)\n", e.what());
       return 2;

@@ -79,6 +79,7 @@ int bench_laplace_command(int argc, char** argv) {
       ->check(CLI::Range(0L, std::numeric_limits<long>::max()));
   try {
     app.parse(argc, argv);
+    check_list_items(app, argc, argv);
   } catch (const CLI::ParseError& e) {
     return exit_on_option_error(app, e);
   }

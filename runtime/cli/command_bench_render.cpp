@@ -83,6 +83,7 @@ int bench_render_command(int argc, char** argv) {
       ->check(writable_file());
   try {
     app.parse(argc, argv);
+    check_list_items(app, argc, argv);
   } catch (const CLI::ParseError& e) {
     return exit_on_option_error(app, e);
   }

@@ -187,6 +187,7 @@ int bench_scaling_command(int argc, char** argv) {
       ->check(writable_file());
   try {
     app.parse(argc, argv);
+    check_list_items(app, argc, argv);
   } catch (const CLI::ParseError& e) {
     return exit_on_option_error(app, e);
   }
@@ -195,16 +196,7 @@ int bench_scaling_command(int argc, char** argv) {
   if (!outputs_are_distinct(app, {{"--json", &json_path}, {"--markdown", &markdown_path}, {"--chart", &chart_path}},
                             inputs))
     return 2;
-  // The speed-ups are over the first count: a list such as 2,1 or 1,1 gave "speed-up 2->1".
-  if (std::adjacent_find(threads.begin(), threads.end(), std::greater_equal<int>()) != threads.end()) {
-    std::string list;
-    for (const int t : threads) list += (list.empty() ? "" : ",") + std::to_string(t);
-    std::fprintf(stderr,
-                 "dgtex bench scaling: --threads-list: %s; expected increasing thread counts (the first is the base "
-                 "of the speed-ups), e.g. 1,2,4\n",
-                 list.c_str());
-    return 2;
-  }
+  if (!thread_counts_increase(app, threads)) return 2;
   for (const std::string& f : families)
     if (std::find(kFamilies.begin(), kFamilies.end(), f) == kFamilies.end()) {
       std::fprintf(stderr, "dgtex bench scaling: --families: unknown family '%s'; valid: enrichment_solve, assembly, "
@@ -278,6 +270,7 @@ int bench_scaling_command(int argc, char** argv) {
     }
     if (chosen.count("polar_decomposition")) {
       note("polar decomposition");
+      current = "polar decomposition of " + std::to_string(polar_count) + " matrices";  // no scene
       kernels.push_back(scale_polar_decomposition(polar_count, threads, repeats));
     }
     if (chosen.count("factorization")) {

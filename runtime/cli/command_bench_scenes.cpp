@@ -384,6 +384,7 @@ int bench_scenes_command(int argc, char** argv) {
   app.add_flag("--quiet", quiet, "no progress on stderr");
   try {
     app.parse(argc, argv);
+    check_list_items(app, argc, argv);
   } catch (const CLI::ParseError& e) {
     return exit_on_option_error(app, e);
   }

@@ -111,11 +111,13 @@ int bench_shell_command(int argc, char** argv) {
       ->check(CLI::IsMember({"passive", "active", "inherit"}));
   try {
     app.parse(argc, argv);
+    check_list_items(app, argc, argv);
   } catch (const CLI::ParseError& e) {
     return exit_on_option_error(app, e);
   }
   if (!outputs_are_distinct(app, {{"--json", &json_path}, {"--chart", &chart_path}}, {{"the scene of --scene", scene_path}}))
     return 2;
+  if (!thread_counts_increase(app, threads_list)) return 2;
   // a, b and c = a b: three n x n matrices of doubles.
   const std::optional<std::int64_t> available = memory_for_options(app);
   if (!available) return 2;

@@ -82,6 +82,7 @@ int render_command(int argc, char** argv) {
   app.add_option("--background", background, "background colour r g b in [0, 1]")->expected(3)->check(colour_component());
   try {
     app.parse(argc, argv);
+    check_list_items(app, argc, argv);
   } catch (const CLI::CallForHelp&) {
     std::printf("%s", app.help().c_str());
     return 0;

@@ -79,6 +79,7 @@ int run_command(int argc, char** argv) {
                "do not fault in the memory of the first steps in the set-up (SceneRunOptions::reserve_step_memory)");
   try {
     app.parse(argc, argv);
+    check_list_items(app, argc, argv);
   } catch (const CLI::ParseError& e) {
     return exit_on_option_error(app, e);
   }

@@ -2,12 +2,14 @@
 // Range checks for numeric options. CLI11's PositiveNumber reports a refused 0 as "not in
 // range 0.000000 to 1797...(309 digits)"; these name the integers an option takes.
 #include <CLI/CLI.hpp>
+#include <algorithm>
 #include <cstdint>
 #include <cstdio>
 #include <limits>
 #include <optional>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include "dgtex/texel_memory_estimate.h"
 
@@ -22,17 +24,34 @@ inline CLI::Range zero_or_more() { return CLI::Range(0, std::numeric_limits<int>
 // OpenMP thread counts, as `dgtex run --threads` takes them.
 inline CLI::Range thread_count() { return CLI::Range(1, 1024); }
 
-// A relative tolerance: 0 < t < 1 (0, a negative or NaN could never be met; 1 is met by any
-// guess).
+// Whether a --threads-list increases; if not, prints one line naming it (the speed-ups are
+// over the first count: a list such as 2,1 gave "speed-up 2 -> 1 threads").
+inline bool thread_counts_increase(const CLI::App& app, const std::vector<int>& threads) {
+  if (std::adjacent_find(threads.begin(), threads.end(), std::greater_equal<int>()) == threads.end()) return true;
+  std::string list;
+  for (const int t : threads) list += (list.empty() ? "" : ",") + std::to_string(t);
+  std::fprintf(stderr,
+               "%s: --threads-list: %s; expected increasing thread counts (the first is the base of the speed-ups), "
+               "e.g. 1,2,4\n",
+               app.get_name().c_str(), list.c_str());
+  return false;
+}
+
+// A relative tolerance a double-precision solve can reach: kMinRelativeTolerance <= t < 1
+// (0, a negative or NaN could never be met, and 1e-300 failed after the work began: the
+// multigrid's residual stalls near 1e-14; 1 is met by any guess).
+inline constexpr double kMinRelativeTolerance = 1e-12;
 inline CLI::Validator relative_tolerance() {
   return CLI::Validator(
       [](std::string& value) -> std::string {
         double t = 0;
-        if (!CLI::detail::lexical_cast(value, t) || !(t > 0 && t < 1))
-          return "Value " + value + " is not a relative tolerance; expected a number in (0, 1), e.g. 1e-8";
+        if (!CLI::detail::lexical_cast(value, t) || !(t >= kMinRelativeTolerance && t < 1))
+          return "Value " + value +
+                 " is not a relative tolerance a double-precision solve can reach; expected a number in [1e-12, 1), "
+                 "e.g. 1e-8";
         return "";
       },
-      "(0, 1)");
+      "[1e-12, 1)");
 }
 
 // A colour component in [0, 1] (NaN refused).

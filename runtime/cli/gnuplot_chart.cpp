@@ -4,6 +4,7 @@
 #include <unistd.h>
 
 #include <atomic>
+#include <cctype>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -25,7 +26,9 @@ std::string draw_gnuplot_chart(const std::string& path, int width, int height, c
   const std::string data_path = stem.string() + ".dat", script_path = stem.string() + ".gp";
   const std::string image_path = stem.string() + ".image", errors_path = stem.string() + ".err";
   std::ofstream(data_path) << data;
-  const bool png = path.size() > 4 && path.substr(path.size() - 4) == ".png";
+  std::string extension = fs::path(path).extension().string();  // x.PNG is a PNG too, as for dgtex render
+  for (char& c : extension) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  const bool png = extension == ".png";
   const std::string size = " size " + std::to_string(width) + "," + std::to_string(height);
   const std::string body = "set output '" + image_path + "'\n" + commands(data_path) + "\n";
   int status = 0;

@@ -6,7 +6,7 @@
 
 namespace dgtex::cli {
 
-// Draws into `path`: PNG if it ends in .png (pngcairo, or the plain png terminal where the
+// Draws into `path`: PNG if it ends in .png, in any case (pngcairo, or the plain png terminal where the
 // gnuplot build lacks cairo), else SVG, width x height pixels. `data` goes to a temporary
 // file; `commands(data_file)` returns the settings and plot commands, referring to the data
 // by that file name (plain characters, safe inside '...'). gnuplot draws into a temporary

@@ -87,7 +87,7 @@ struct QuadratureAccuracyOptions {
 };
 // Points carry extra "quadrature_points" (enriched element points), "rule_ms" (building
 // the rule and the enriched model) and "compliance". std::invalid_argument for a bad
-// element name, T < 8 or a non-positive tolerance.
+// element name, T not a power of two in 8..4096, or a tolerance outside (0, 1e30].
 void check_quadrature_accuracy_options(const QuadratureAccuracyOptions& options);
 AccuracyChart run_quadrature_accuracy(const QuadratureAccuracyOptions& options, const AccuracyProgress& progress = {});
 
@@ -123,7 +123,9 @@ struct ToleranceAccuracyOptions {
 // step (direct solves), ms = assembly + solve time of all steps; extra "pcg_iterations",
 // "factorizations". Multigrid: error = max |H - H_ref| against CHOLMOD (H is O(1)), ms =
 // one solve from zero (setup included); extra "iterations". The references appear with
-// error 0. Throws what run_shell_benchmark throws for a bad scene.
+// error 0. std::invalid_argument for a tolerance outside [1e-12, 1) (round-off stalls the
+// solves below it), no series, or a multigrid T outside 16..2048; what run_shell_benchmark
+// throws for a bad scene.
 void check_tolerance_accuracy_options(const ToleranceAccuracyOptions& options);
 AccuracyChart run_tolerance_accuracy(const ToleranceAccuracyOptions& options, const AccuracyProgress& progress = {});
 
@@ -136,7 +138,7 @@ struct RotationAccuracyOptions {
 // error = |u - u_ref| / |u_ref| of the final displacement (all DOFs) against per-point
 // rotations (the reference, error 0; the scene's own setting is overridden), ms = the
 // whole run (set-up, cuts, steps); extra "clusters", "cluster_mb" (their rest sums) and
-// "assembly_wall_ms". std::invalid_argument for steps < 1, a block < 1 or a scene that is
+// "assembly_wall_ms". std::invalid_argument for steps < 1, a block outside 1..4096 or a scene that is
 // not dynamic and corotated; what load_scene and SceneRun throw for a bad scene.
 void check_rotation_accuracy_options(const RotationAccuracyOptions& options);
 AccuracyChart run_rotation_accuracy(const RotationAccuracyOptions& options, const AccuracyProgress& progress = {});
@@ -159,7 +161,7 @@ struct SceneQuadratureAccuracyOptions {
 // and "assembly_wall_ms". With the time-step point, the conclusion names the largest swept
 // tolerance whose error stays below the time-step error, at the end and over the run (or
 // that none does): the coarsest quadrature the scene can afford.
-// std::invalid_argument for steps < 0, a tolerance <= 0, or a scene that is not dynamic or has
+// std::invalid_argument for steps < 0, a tolerance outside [1e-30, 1e30], or a scene that is not dynamic or has
 // no cuts; what load_scene and SceneRun throw for a bad scene.
 void check_scene_quadrature_accuracy_options(const SceneQuadratureAccuracyOptions& options);
 AccuracyChart run_scene_quadrature_accuracy(const SceneQuadratureAccuracyOptions& options,
