@@ -860,6 +860,7 @@ Scene parse_scene(const std::string& json_text, const std::string& source_name) 
 }
 
 Scene load_scene(const std::string& path) {
+  if (path.empty()) throw SceneError("''", "an empty scene file path; give a scene file (JSON)");
   std::error_code error;
   if (!std::filesystem::exists(path, error)) throw SceneError(path, "cannot read the scene file: no such file");
   if (!std::filesystem::is_regular_file(path, error)) throw SceneError(path, "cannot read the scene file: not a regular file");

@@ -225,6 +225,25 @@ TEST(CliOptions, BenchScenesReadsEverySceneBeforeTheFirstRuns) {
   EXPECT_FALSE(fs::exists(dir / "t.json"));  // nothing ran
 }
 
+// The top level's own mistakes: "--version extra" read as an unknown command named
+// "--version", "dgtex bench" alone as a benchmark named '', an empty scene path as ": cannot
+// read the scene file".
+TEST(CliOptions, TopLevelMistakesNameWhatWasWrong) {
+  const fs::path dir = dgtex::test::fresh_dir("dgtex_cli_options", "top_level");
+  const Refusal refusals[] = {
+      {"--version extra", "dgtex: --version takes no arguments, got 'extra'"},
+      {"bench", "dgtex bench: which benchmark? (valid: laplace, shell, render, scenes, scaling, accuracy)"},
+      {"run '' --out DIR/o", "dgtex run: '': an empty scene file path; give a scene file (JSON)"},
+  };
+  for (const Refusal& refusal : refusals) {
+    std::string args = refusal.args;
+    if (const std::size_t at = args.find("DIR"); at != std::string::npos) args.replace(at, 3, dir.string());
+    const CliResult r = run_cli(args, dir);
+    EXPECT_EQ(r.exit_code, 2) << args << ": " << r.stderr_text;
+    EXPECT_EQ(r.stderr_text, std::string(refusal.message_start) + "\n") << args;
+  }
+}
+
 TEST(CliOptions, BenchHelpListsTheBenchmarks) {
   const fs::path dir = dgtex::test::fresh_dir("dgtex_cli_options", "help");
   const CliResult r = run_cli("bench --help", dir);

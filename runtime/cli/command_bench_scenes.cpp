@@ -445,6 +445,7 @@ int bench_scenes_command(int argc, char** argv) {
                         {"targets", {{"steps_per_second", kTargetStepsPerSecond}, {"stage_ratio", kTargetStageRatio}}},
                         {"scenes", nlohmann::json::array()}};
   const bool tty = isatty(fileno(stderr));
+  const char* open_line = tty && !quiet ? "\n" : "";  // ends a progress line a failure interrupts
   for (std::size_t k = 0; k < entries.size(); ++k) {
     const SceneEntry& entry = entries[k];
     try {
@@ -493,19 +494,19 @@ int bench_scenes_command(int argc, char** argv) {
       results.push_back(std::move(r));
       if (!json_path.empty()) write_output_file(json_path, all.dump(2) + "\n", "--json");
     } catch (const SceneError& e) {
-      std::fprintf(stderr, "\ndgtex bench scenes: %s\n", e.what());
+      std::fprintf(stderr, "%sdgtex bench scenes: %s\n", open_line, e.what());
       return 2;
     } catch (const MeshError& e) {
-      std::fprintf(stderr, "\ndgtex bench scenes: %s: mesh: %s\n", entry.path.c_str(), e.what());
+      std::fprintf(stderr, "%sdgtex bench scenes: %s: mesh: %s\n", open_line, entry.path.c_str(), e.what());
       return 2;
     } catch (const ModelError& e) {
-      std::fprintf(stderr, "\ndgtex bench scenes: %s: %s\n", entry.path.c_str(), e.what());
+      std::fprintf(stderr, "%sdgtex bench scenes: %s: %s\n", open_line, entry.path.c_str(), e.what());
       return 1;
     } catch (const std::invalid_argument& e) {
-      std::fprintf(stderr, "\ndgtex bench scenes: %s: %s\n", entry.path.c_str(), e.what());
+      std::fprintf(stderr, "%sdgtex bench scenes: %s: %s\n", open_line, entry.path.c_str(), e.what());
       return 2;
     } catch (const std::exception& e) {
-      std::fprintf(stderr, "\ndgtex bench scenes: %s: %s\n", entry.path.c_str(), e.what());
+      std::fprintf(stderr, "%sdgtex bench scenes: %s: %s\n", open_line, entry.path.c_str(), e.what());
       return 1;
     }
   }

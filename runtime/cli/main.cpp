@@ -39,7 +39,11 @@ int main(int argc, char** argv) {
     setenv("OMP_WAIT_POLICY", "passive", 1);
     execv("/proc/self/exe", argv);  // returns only on failure: then go on as we are
   }
-  if (argc == 2 && !std::strcmp(argv[1], "--version")) {
+  if (argc >= 2 && !std::strcmp(argv[1], "--version")) {
+    if (argc > 2) {
+      std::fprintf(stderr, "dgtex: --version takes no arguments, got '%s'\n", argv[2]);
+      return 2;
+    }
     std::printf("dgtex %s\n", dgtex::version());
     return 0;
   }
@@ -63,9 +67,12 @@ int main(int argc, char** argv) {
                   "accuracy (dgtex bench BENCHMARK --help for each one's options)\n");
       return 0;
     }
-    std::fprintf(stderr,
-                 "dgtex bench: unknown benchmark '%s' (valid: laplace, shell, render, scenes, scaling, accuracy)\n",
-                 what.c_str());
+    if (what.empty())
+      std::fprintf(stderr, "dgtex bench: which benchmark? (valid: laplace, shell, render, scenes, scaling, accuracy)\n");
+    else
+      std::fprintf(stderr,
+                   "dgtex bench: unknown benchmark '%s' (valid: laplace, shell, render, scenes, scaling, accuracy)\n",
+                   what.c_str());
     return 2;
   }
   std::fprintf(stderr, "dgtex: unknown command '%s'\n", command.c_str());
