@@ -65,10 +65,12 @@ int bench_laplace_command(int argc, char** argv) {
   app.add_option("--domains", domains, "open, slit, spiral, accordion, chad, one_ring")->delimiter(',');
   app.add_option("--solvers", solvers, "multigrid, multigrid_robust, cholmod, cholmod_solve, eigen_ichol_cg, boomeramg")->delimiter(',');
   app.add_option("--json", json_path, "write the results as JSON")->check(writable_file());
-  app.add_option("--chart", chart_path, "write residual against time (SVG, or PNG if FILE ends in .png)")
-      ->check(writable_file());
-  app.add_option("--chart-domain", chart_domain, "domain of the chart")->capture_default_str();
-  app.add_option("--chart-size", chart_size, "size T of the chart")->capture_default_str();
+  CLI::Option* chart_option =
+      app.add_option("--chart", chart_path, "write residual against time (SVG, or PNG if FILE ends in .png)")
+          ->check(writable_file());
+  // Without a chart they were ignored, a bad value too.
+  app.add_option("--chart-domain", chart_domain, "domain of the chart")->capture_default_str()->needs(chart_option);
+  app.add_option("--chart-size", chart_size, "size T of the chart")->capture_default_str()->needs(chart_option);
   app.add_option("--repeat", repeat, "runs per case; the best time counts")
       ->capture_default_str()
       ->check(at_least_one());

@@ -380,7 +380,8 @@ int bench_scenes_command(int argc, char** argv) {
                  "step's own work (one on two threads), N fixes N (at most --threads less one; "
                  "SceneRunOptions::cut_update_threads)")
       ->capture_default_str()
-      ->check(zero_or_more());
+      ->check(zero_or_more())
+      ->excludes("--inline-cut-updates");  // no update runs beside a step then
   app.add_flag("--quiet", quiet, "no progress on stderr");
   try {
     app.parse(argc, argv);

@@ -74,7 +74,7 @@ int bench_shell_command(int argc, char** argv) {
   std::vector<int> threads_list = {1, 2};
   bool refactor_every_step = false;
   FactorReuseOptions solver;
-  app.add_option("--scene", scene_path, "dynamic scene (JSON)")->capture_default_str();
+  app.add_option("--scene", scene_path, "dynamic scene (JSON)")->capture_default_str()->check(CLI::ExistingFile);
   app.add_option("--steps", steps, "time steps per case (from rest)")->capture_default_str()->check(at_least_one());
   app.add_option("--threads-list", threads_list, "OpenMP thread counts, one case each")
       ->delimiter(',')
@@ -86,23 +86,32 @@ int bench_shell_command(int argc, char** argv) {
   app.add_option("--gemm-size", gemm_size, "n of the n x n Eigen GEMM reference")
       ->capture_default_str()
       ->check(at_least_one());
-  app.add_option("--tolerance", solver.relative_tolerance, "PCG relative residual bound per step")
-      ->capture_default_str()
-      ->check(relative_tolerance());
-  app.add_option("--refactor-after", solver.refactor_after_iterations,
-                 "refactorise when a step needed more PCG iterations than this")
-      ->capture_default_str()
-      ->check(zero_or_more());
+  CLI::Option* tolerance_option =
+      app.add_option("--tolerance", solver.relative_tolerance, "PCG relative residual bound per step")
+          ->capture_default_str()
+          ->check(relative_tolerance());
+  CLI::Option* refactor_after_option =
+      app.add_option("--refactor-after", solver.refactor_after_iterations,
+                     "refactorise when a step needed more PCG iterations than this")
+          ->capture_default_str()
+          ->check(zero_or_more());
   std::string preconditioner = "element_local";
-  app.add_option("--preconditioner", preconditioner,
-                 "pattern of the PCG preconditioner's factor: element_local (the default) or full")
-      ->capture_default_str()
-      ->check(CLI::IsMember({"element_local", "full"}));
+  CLI::Option* preconditioner_option =
+      app.add_option("--preconditioner", preconditioner,
+                     "pattern of the PCG preconditioner's factor: element_local (the default) or full")
+          ->capture_default_str()
+          ->check(CLI::IsMember({"element_local", "full"}));
   bool synchronous_factorization = false;
-  app.add_flag("--synchronous-factorization", synchronous_factorization,
-               "factorise a stale preconditioner at the start of the next solve instead of beside the next assembly");
+  CLI::Option* synchronous_option = app.add_flag(
+      "--synchronous-factorization", synchronous_factorization,
+      "factorise a stale preconditioner at the start of the next solve instead of beside the next assembly");
+  // The PCG options mean nothing to the direct path: given with it, they were ignored.
   app.add_flag("--refactor-every-step", refactor_every_step,
-               "reference solver path: factorise the corotated matrix every step (no PCG)");
+               "reference solver path: factorise the corotated matrix every step (no PCG)")
+      ->excludes(tolerance_option)
+      ->excludes(refactor_after_option)
+      ->excludes(preconditioner_option)
+      ->excludes(synchronous_option);
   std::string wait_policy = "passive";
   app.add_option("--omp-wait-policy", wait_policy,
                  "OMP_WAIT_POLICY to run under (passive, active, or inherit): with libgomp's spinning default, "
