@@ -15,6 +15,7 @@ packages=(
   nlohmann-json3-dev libcli11-dev libgtest-dev libgmock-dev libbenchmark-dev libhypre-dev
   libegl-dev libegl-mesa0 libgl1-mesa-dri libgles-dev libepoxy-dev libpng-dev
   gnuplot-nox
+  python3-meshio  # the tests read the VTU output back with an independent reader
 )
 missing=()
 for p in "${packages[@]}"; do

@@ -223,8 +223,8 @@ TEST(BenchScenes, CountsMatchTheReportOfDgtexRun) {
   EXPECT_EQ(b["scenes"][0]["steps"], 3);
   EXPECT_EQ(b["scenes"][0]["counts"], report["counts"]);
   EXPECT_TRUE(b["scenes"][0]["targets_met"].is_boolean());  // a whole run is judged
-  // Each target it missed is named, exactly where its figure falls short (spiral1's assembly
-  // ratio, 1.8 ms / ours, always does), and met means none missed.
+  // Each target it missed is named, exactly where its figure falls short, and met means
+  // none missed.
   const nlohmann::json& s = b["scenes"][0];
   ASSERT_TRUE(s["targets_missed"].is_array());
   std::set<std::string> missed;
@@ -242,13 +242,15 @@ TEST(BenchScenes, CountsMatchTheReportOfDgtexRun) {
   falls_short("solve_ratio", s["ratio_to_table_5_1"]["solve"], 20);
   EXPECT_TRUE(missed.empty()) << "unknown target " << *missed.begin();
   EXPECT_EQ(s["targets_met"].get<bool>(), s["targets_missed"].empty());
-  ASSERT_LT(s["ratio_to_table_5_1"]["assembly"].get<double>(), 20);
-  // The Markdown table names them too.
+  // The Markdown table names them too ("no: " and their labels), or says "yes". (Whichever
+  // it is: a test that needed a target missed would fail once the code got fast enough.)
   std::ifstream markdown(dir / "bench.md");
   const std::string text((std::istreambuf_iterator<char>(markdown)), std::istreambuf_iterator<char>());
-  const std::size_t verdict = text.find(" | no: ");
+  const std::size_t verdict = text.find(s["targets_missed"].empty() ? " | yes |" : " | no: ");
   ASSERT_NE(verdict, std::string::npos) << text;
-  EXPECT_NE(text.find("assembly", verdict), std::string::npos) << text;
+  const std::string verdict_line = text.substr(verdict, text.find('\n', verdict) - verdict);
+  const bool assembly_missed = s["ratio_to_table_5_1"]["assembly"].get<double>() < 20;
+  EXPECT_EQ(verdict_line.find("assembly") != std::string::npos, assembly_missed) << text;
   // A missed peak step says how many steps were slower than the target; met, none was.
   const int slower = s["steps_slower_than_target"].get<int>();
   EXPECT_EQ(peak_missed, slower > 0);

@@ -43,7 +43,7 @@ TEST(CliRun, ClampedPlateSceneWritesReportWithinOnePercent) {
   const double w = report["probes"]["center"]["displacement"][2];
   const double D = 1e6 * 1e-6 / (12 * (1 - 0.09));
   EXPECT_NEAR(w / (-0.00126532 / D), 1.0, 0.01);
-  EXPECT_GE(report["timings_ms"]["solve"]["mean"].get<double>(), 0.0);
+  EXPECT_GT(report["timings_ms"]["solve"]["mean"].get<double>(), 0.0);  // measured, not left 0
   EXPECT_TRUE(fs::exists(dir / "out" / "deformed.vtu"));
 }
 

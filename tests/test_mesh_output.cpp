@@ -181,6 +181,41 @@ TEST(MeshOutputObj, Quad8CentreIsEvaluated) {
   EXPECT_NEAR(std::hypot(centre[0], centre[2]), 1.0, 1e-15);
 }
 
+// meshio (python3-meshio, which bootstrap.sh installs; an independent reader of VTK's XML
+// formats) reads the file back: the cell type and count, the points, and the displacement
+// and extra field bit for bit (the writer's ASCII keeps 17 digits).
+TEST_P(MeshOutput, MeshioReadsTheFileBack) {
+  if (std::system("/usr/bin/python3 -c 'import meshio' > /dev/null 2>&1") != 0)
+    GTEST_SKIP() << "python3-meshio not installed (bootstrap.sh installs it): meshio reader check skipped";
+  const ElementType type = GetParam();
+  const Mesh mesh = make_hemisphere(1.0, 20, 3, 8, type);
+  std::vector<double> displacement(3 * mesh.num_nodes()), field(mesh.num_nodes());
+  for (int n = 0; n < mesh.num_nodes(); ++n) {
+    for (int c = 0; c < 3; ++c) displacement[3 * n + c] = (3.0 * n + c) / 7;  // correctly rounded, as in numpy
+    field[n] = 1.0 / (n + 3);
+  }
+  const std::string path = temp_path("dgtex_mesh_output_meshio.vtu");
+  write_vtu(path, mesh, displacement.data(), {{"field", field}});
+  const std::string check =
+      "import sys, meshio, numpy as np\n"
+      "m = meshio.read(sys.argv[1])\n"
+      "n = len(m.points); u = np.array([(3.0 * i + c) / 7 for i in range(n) for c in range(3)])\n"
+      "f = np.array([1.0 / (i + 3) for i in range(n)])\n"
+      "ok = [b.type for b in m.cells] == [sys.argv[2]] and len(m.cells[0].data) == int(sys.argv[3]) and \\\n"
+      "     n == int(sys.argv[4]) and np.array_equal(m.point_data['displacement'].ravel(), u) and \\\n"
+      "     np.array_equal(m.point_data['field'].ravel(), f)\n"
+      "sys.exit(0 if ok else 1)\n";
+  const std::string script = temp_path("dgtex_mesh_output_meshio.py");
+  std::ofstream(script) << check;
+  const std::string command = "/usr/bin/python3 " + script + " " + path + " " +
+                              (type == ElementType::quad8 ? "quad8" : "triangle6") + " " +
+                              std::to_string(mesh.num_elements()) + " " + std::to_string(mesh.num_nodes());
+  const int status = std::system(command.c_str());
+  std::remove(path.c_str());
+  std::remove(script.c_str());
+  EXPECT_EQ(status, 0) << command;
+}
+
 // VTK's own reader (python3-vtk9, when installed) opens the file with the expected cells.
 TEST_P(MeshOutput, VtkReaderOpensTheFile) {
   if (std::system("/usr/bin/python3 -c 'import vtk' > /dev/null 2>&1") != 0)

@@ -58,7 +58,9 @@ void compare_with_reference(const std::string& name, const Image& image) {
   if (const char* update = std::getenv("DGTEX_UPDATE_REFERENCE"); update && std::string(update) == "1") {
     std::filesystem::create_directories(std::filesystem::path(path).parent_path());
     write_png(path, image);
-    std::printf("updated reference %s\n", path.c_str());
+    // A run that compares nothing must not pass as one that did (a CI job that kept the
+    // variable would have turned every image test into a no-op).
+    ADD_FAILURE() << "updated reference " << path << "; rerun without DGTEX_UPDATE_REFERENCE to compare";
     return;
   }
   ASSERT_TRUE(std::filesystem::exists(path)) << path << " is missing; generate it with DGTEX_UPDATE_REFERENCE=1";
