@@ -360,8 +360,18 @@ TEST(BasisChange, CorotatedEdgeStiffnessIsTheRotationsThenTheStiffnessBitwise) {
                                               setup.sections.data(),       &setup.batch, enriched_index.data()};
   std::vector<std::int64_t> qs;
   std::vector<double> qp;
-  kernels::enriched_edge_quadrature(edge_batch, kernels::EnrichedQuadratureOptions{}, qs, qp);
+  kernels::enriched_edge_quadrature(edge_batch, kernels::EnrichedQuadratureOptions{}, qs, qp, kernels::Execution::serial);
   ASSERT_GT(qs.back(), 3 * count);  // the cuts refine some edges
+  for (int threads : {1, 2, 3, 4}) {  // the parallel form is the serial one at every thread count
+    std::vector<std::int64_t> parallel_qs;
+    std::vector<double> parallel_qp;
+    test::with_threads(threads, [&] {
+      kernels::enriched_edge_quadrature(edge_batch, kernels::EnrichedQuadratureOptions{}, parallel_qs, parallel_qp,
+                                        kernels::Execution::parallel);
+    });
+    EXPECT_EQ(parallel_qs, qs) << threads;
+    EXPECT_TRUE(bitwise_equal(parallel_qp, qp)) << threads;
+  }
   const kernels::EdgeQuadrature quad{qs.data(), qp.data()};
   // A deformed state: rest positions turned and bent, enriched DOFs random.
   const int dofs = 3 * (100 + 3 * TwoEnrichedElements::npe);
@@ -380,6 +390,19 @@ TEST(BasisChange, CorotatedEdgeStiffnessIsTheRotationsThenTheStiffnessBitwise) {
   // The compact layout (no padding): every entry written.
   for (double v : blocks) ASSERT_FALSE(std::isnan(v));
   for (double v : forces) ASSERT_FALSE(std::isnan(v));
+  for (int threads : {1, 2, 3, 4}) {  // the parallel rotations and rotated stiffness are the serial ones
+    std::vector<double> parallel_rotations(rotations.size()), parallel_blocks(blocks.size()),
+        parallel_forces(forces.size());
+    test::with_threads(threads, [&] {
+      kernels::enriched_edge_rotations(edge_batch, quad, current.data(), parallel_rotations.data(),
+                                       kernels::Execution::parallel);
+      kernels::enriched_edge_stiffness(edge_batch, quad, rotations.data(), parallel_blocks.data(),
+                                       parallel_forces.data(), kernels::Execution::parallel);
+    });
+    EXPECT_TRUE(bitwise_equal(parallel_rotations, rotations)) << threads;
+    EXPECT_TRUE(bitwise_equal(parallel_blocks, blocks)) << threads;
+    EXPECT_TRUE(bitwise_equal(parallel_forces, forces)) << threads;
+  }
   double turned = 0;  // the state turns the edge frames: largest |R - I|
   for (size_t k = 0; k < rotations.size(); ++k)
     turned = std::max(turned, std::abs(rotations[k] - (k % 9 % 4 == 0 ? 1.0 : 0.0)));

@@ -11,6 +11,7 @@
 
 #include "dgtex/kernels/multigrid_unknowns.h"
 #include "seamed_patch_laplace.h"
+#include "thread_count_support.h"
 
 namespace dgtex {
 namespace {
@@ -105,6 +106,24 @@ TEST(SeamedPatchLaplace, RingMatchesTheDirectSolve) {
   options.tolerance = 1e-9;
   const LaplaceSolveStats again = detail::solve_seamed_patch_laplace(strip.tile, strip.seams, options);
   EXPECT_LE(again.iterations, 1);
+}
+
+// The solve's parallel passes (products, row sums) add in a fixed order: the same bits as
+// its serial form at every thread count (cut_manager.cpp runs it serially when it solves
+// several regions at once, in parallel when it solves one).
+TEST(SeamedPatchLaplace, ParallelSolveIsTheSerialOneAtEveryThreadCount) {
+  auto solve = [](kernels::Execution execution) {
+    Strip strip(256, 64);
+    LaplaceMultigridOptions options;
+    options.tolerance = 1e-9;
+    options.execution = execution;
+    const LaplaceSolveStats stats = detail::solve_seamed_patch_laplace(strip.tile, strip.seams, options);
+    EXPECT_GT(stats.iterations, 1);
+    return strip.tile.values;
+  };
+  const std::vector<double> serial = solve(kernels::Execution::serial);
+  for (int threads : {1, 2, 3, 4})
+    EXPECT_EQ(test::with_threads(threads, [&] { return solve(kernels::Execution::parallel); }), serial) << threads;
 }
 
 // A ring pinned only by a short cut (+1 above, -1 below, as a new cut segment's data):

@@ -25,6 +25,7 @@
 #include "shell_point_rows.h"        // internal (kernels/)
 #include "shell_point_rows_batch.h"  // internal (kernels/)
 #include "shell_test_support.h"
+#include "thread_count_support.h"
 
 namespace {
 
@@ -196,6 +197,7 @@ TEST(MaterialTextureModel, QuadratureLargerThanTheMemoryAvailableIsRefusedNaming
 }
 
 TEST(MaterialTextureKernel, ParallelEqualsSerialBitwise) {
+  const test::ThreadCountGuard set_threads(3);  // the parallel forms on several threads, even on a 1-core runner
   const Mesh mesh = make_rectangle(1.0, 0.7, 3, 2, ElementType::quad8);
   std::mt19937 rng(7);
   std::uniform_real_distribution<double> u(0.5, 1.5);
@@ -359,8 +361,20 @@ TEST(MaterialTextureKernel, GramFormMatchesThePointByPointReference) {
   for (const double* rotations : {static_cast<const double*>(nullptr), static_cast<const double*>(R.data())}) {
     std::vector<double> K(static_cast<size_t>(ne) * npe * npe * 9), K_ref(K.size());
     std::vector<double> f(static_cast<size_t>(ne) * npe * 3), f_ref(f.size());
-    kernels::point_section_stiffness(batch, rotations, K.data(), f.data());
+    kernels::point_section_stiffness(batch, rotations, K.data(), f.data(), kernels::Execution::serial);
     kernels::point_section_stiffness_reference(batch, rotations, K_ref.data(), f_ref.data());
+    // Its parallel form sums the chunks of an element in the same order at any thread count.
+    for (int threads : {1, 2, 3, 4}) {
+      std::vector<double> K_parallel(K.size()), f_parallel(f.size());
+      test::with_threads(threads, [&] {
+        kernels::point_section_stiffness(batch, rotations, K_parallel.data(), f_parallel.data(),
+                                         kernels::Execution::parallel);
+      });
+      EXPECT_EQ(K_parallel, K) << threads << " threads";
+      if (rotations) {
+        EXPECT_EQ(f_parallel, f) << threads << " threads";
+      }
+    }
     std::printf("Gram form against the reference (%s): K %.2e, f %.2e of the largest entry\n",
                 rotations ? "corotated" : "linear", max_difference(K, K_ref) / max_abs(K_ref),
                 rotations ? max_difference(f, f_ref) / max_abs(f_ref) : 0.0);

@@ -106,6 +106,14 @@ TEST_P(MultigridKernels, ParallelFormsEqualReferenceBitwise) {
     prolong_correction(L.fine, L.coarse, L.P().view(), L.xc.data(), active.data(), x2.data());
     EXPECT_EQ(x1, x2);
   }
+  // The level-0 product of conjugate gradients (the seamed patch solves use it).
+  {
+    std::vector<double> y1(L.x.size(), 0.0), y2 = y1, d1(L.fine.ny), d2(L.fine.ny);
+    apply_texels(L.fine, L.bits.data(), L.x.data(), y1.data(), d1.data(), Execution::serial);
+    apply_texels(L.fine, L.bits.data(), L.x.data(), y2.data(), d2.data(), Execution::parallel);
+    EXPECT_EQ(y1, y2);
+    EXPECT_EQ(d1, d2);
+  }
   // Setup kernels: serial and parallel forms.
   {
     TwoLevels M(make_laplace_domain(GetParam(), 96));

@@ -30,6 +30,7 @@ namespace {
 class EdgeFactors : public ::testing::TestWithParam<ElementType> {};
 
 TEST_P(EdgeFactors, ProductsAreTheMergedKernelsBlocksAndParallelIsTheReference) {
+  const test::ThreadCountGuard set_threads(3);  // the parallel forms on several threads, even on a 1-core runner
   const Mesh mesh = make_cylinder(0.5, 1.0, 0, 360, 8, 4, GetParam());
   const std::vector<kernels::ShellSection> sections(mesh.num_elements(), {1e6, 0.3, 0.01, 1000});
   const Topology topology = build_topology(mesh);
@@ -102,6 +103,7 @@ INSTANTIATE_TEST_SUITE_P(Shell, EdgeFactors, ::testing::Values(ElementType::quad
 // The element kernel over cached rest rows is shell_element_stiffness bitwise, serial and
 // parallel, with and without rotations.
 TEST_P(EdgeFactors, CachedElementKernelIsTheElementKernel) {
+  const test::ThreadCountGuard set_threads(3);  // the parallel forms on several threads, even on a 1-core runner
   const Mesh mesh = make_cylinder(0.5, 1.0, 0, 360, 8, 4, GetParam());
   const std::vector<kernels::ShellSection> sections(mesh.num_elements(), {1e6, 0.3, 0.01, 1000});
   const kernels::ElementBatch batch{mesh.type, mesh.num_elements(), mesh.elements.data(), mesh.positions.data(),

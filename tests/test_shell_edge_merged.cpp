@@ -12,6 +12,7 @@
 #include "dgtex/mesh_generators.h"
 #include "dgtex/topology.h"
 #include "shell_test_support.h"
+#include "thread_count_support.h"
 
 using namespace dgtex;
 using testing_support::random_rotations;
@@ -23,6 +24,7 @@ namespace {
 class MergedEdges : public ::testing::TestWithParam<ElementType> {};
 
 TEST_P(MergedEdges, MatchReferenceSummedOverSharedNodes) {
+  const test::ThreadCountGuard set_threads(3);  // the parallel forms on several threads, even on a 1-core runner
   const Mesh mesh = make_cylinder(0.5, 1.0, 0, 360, 8, 4, GetParam());
   const std::vector<kernels::ShellSection> sections(mesh.num_elements(), {1e6, 0.3, 0.01, 1000});
   std::vector<int> edges;

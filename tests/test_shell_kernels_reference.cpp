@@ -12,6 +12,7 @@
 #include "dgtex/kernels/shell_edge_kernel.h"
 #include "dgtex/kernels/shell_element_kernel.h"
 #include "dgtex/mesh_generators.h"
+#include "dgtex/mesh_validation.h"
 #include "dgtex/topology.h"
 #include "shell_test_support.h"
 #include "thread_count_support.h"
@@ -112,6 +113,54 @@ TEST_P(Kernels, EdgeStiffnessMatchesReference) {
       EXPECT_LE(max_difference(f, fref), 1e-12 * max_abs(Kref));
       EXPECT_EQ(f, fpar);
     }
+  }
+}
+
+// The geometry, mass and load kernels and the batched polar decomposition: their parallel
+// forms are the serial ones bitwise at 1-4 threads, and the mass and load weights sum to
+// rho h times the area and to the area (the partition of unity) on the curved elements.
+TEST_P(Kernels, GeometryMassAndLoadKernelsAreTheSerialOnesAtEveryThreadCount) {
+  const DeformedCylinder c(GetParam());
+  const kernels::ElementBatch elements = c.element_batch();
+  const kernels::EdgeBatch edges = c.edge_batch();
+  const int npe = c.mesh.nodes_per_element(), nq = kernels::element_quadrature(c.mesh.type).count;
+  struct Results {
+    std::vector<double> F, R, mass, area_weights, mass_weights, edge_rotations;
+  };
+  auto run = [&](Execution execution) {
+    Results r;
+    r.F.resize(elements.count * nq * 9);
+    r.R.resize(r.F.size());
+    r.mass.resize(elements.count * npe * npe);
+    r.area_weights.resize(elements.count * npe);
+    r.mass_weights.resize(r.area_weights.size());
+    r.edge_rotations.resize(edges.count * 3 * 9);
+    kernels::shell_element_deformation_gradients(elements, c.current.data(), r.F.data(), execution);
+    kernels::polar_decomposition_batch(elements.count * nq, r.F.data(), r.R.data(), execution);
+    kernels::shell_element_mass(elements, r.mass.data(), execution);
+    kernels::shell_element_load_weights(elements, r.area_weights.data(), r.mass_weights.data(), execution);
+    kernels::shell_edge_rotations(edges, c.current.data(), r.edge_rotations.data(), execution);
+    return r;
+  };
+  const Results serial = run(Execution::serial);
+  for (int threads : {1, 2, 3, 4}) {
+    const Results parallel = test::with_threads(threads, [&] { return run(Execution::parallel); });
+    EXPECT_EQ(parallel.F, serial.F) << threads;
+    EXPECT_EQ(parallel.R, serial.R) << threads;
+    EXPECT_EQ(parallel.mass, serial.mass) << threads;
+    EXPECT_EQ(parallel.area_weights, serial.area_weights) << threads;
+    EXPECT_EQ(parallel.mass_weights, serial.mass_weights) << threads;
+    EXPECT_EQ(parallel.edge_rotations, serial.edge_rotations) << threads;
+  }
+  const kernels::ShellSection& section = c.sections[0];
+  for (int e = 0; e < elements.count; ++e) {
+    const double area = element_area(c.mesh, e);
+    double mass = 0, weights = 0, mass_weights = 0;
+    for (int k = 0; k < npe * npe; ++k) mass += serial.mass[e * npe * npe + k];
+    for (int a = 0; a < npe; ++a) weights += serial.area_weights[e * npe + a], mass_weights += serial.mass_weights[e * npe + a];
+    EXPECT_NEAR(weights, area, 1e-14 * area) << e;
+    EXPECT_NEAR(mass_weights, section.density * section.thickness * area, 1e-12 * mass_weights) << e;
+    EXPECT_NEAR(mass, section.density * section.thickness * area, 1e-12 * mass) << e;
   }
 }
 
