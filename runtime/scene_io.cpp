@@ -4,6 +4,7 @@
 #include "dgtex/scene_io.h"
 
 #include <algorithm>
+#include <climits>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -31,7 +32,6 @@ constexpr double kMinPositive = 1e-30;
 constexpr int kMaxDivisions = 100000;
 constexpr long long kMaxGeneratedCells = 10000000;
 constexpr int kMaxSteps = 1000000000;
-constexpr size_t kMaxFileNameBytes = 255;  // NAME_MAX of ext4, XFS, Btrfs, tmpfs
 
 std::string one_line(std::string text) {
   std::replace(text.begin(), text.end(), '\n', ' ');
@@ -773,9 +773,9 @@ class SceneReader {
       o.report = string(*r, child(path, "report"));
       if (o.report.empty() || o.report == "." || o.report == ".." || o.report.find_first_of("/\\") != std::string::npos)
         fail(child(path, "report"), "not a plain file name", *r, "expected a file name such as \"report.json\" (it is written inside the output folder)");
-      if (o.report.size() > kMaxFileNameBytes)
+      if (o.report.size() > NAME_MAX)  // 255: ext4, XFS, Btrfs, tmpfs
         fail(child(path, "report"), "a file name of " + std::to_string(o.report.size()) + " bytes", *r,
-             "expected at most " + std::to_string(kMaxFileNameBytes) + " bytes (the file-name limit of Linux file systems)");
+             "expected at most " + std::to_string(NAME_MAX) + " bytes (the file-name limit of Linux file systems)");
     }
     return o;
   }

@@ -82,6 +82,10 @@ TEST(CliOptions, BadValuesAreOneLineNamingTheCommandAndOption) {
        "dgtex bench accuracy: tolerance accuracy: multigrid tolerance 2; need 1e-12 <= tol < 1"},
       {"bench accuracy --charts scene_quadrature --scene-quadrature-reference 2 --out DIR/acc",
        "dgtex bench accuracy: scene quadrature accuracy: reference tolerance 2; need one at or below every swept"},
+      // Numbers CLI11 read its own way: "1e3" and "2.5" called out of range, "0x10" taken as 16.
+      {"run PLATE --out DIR/o --threads 0x10", "dgtex run: --threads: Value 0x10 is not a whole number in decimal digits"},
+      {"render x.state --out DIR/r.png --width 2.5", "dgtex render: --width: Value 2.5 is not a whole number"},
+      {"bench laplace --sizes 16,1e3", "dgtex bench laplace: --sizes: Value 1e3 is not a whole number"},
       // CLI11 dropped empty list items and kept repeats (a case run and reported twice).
       {"bench laplace --sizes 16,,32", "dgtex bench laplace: --sizes: '16,,32' has an empty item"},
       {"bench laplace --sizes=16,32,", "dgtex bench laplace: --sizes: '16,32,' has an empty item"},

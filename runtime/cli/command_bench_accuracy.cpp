@@ -127,35 +127,47 @@ int bench_accuracy_command(int argc, char** argv) {
   app.add_option("--repeat", repeat, "runs per cheap case; the best time counts")
       ->capture_default_str()
       ->check(at_least_one());
-  app.add_option("--plate-divisions", plate.divisions, "plate meshes n x n (even n)")->delimiter(',')->capture_default_str();
+  app.add_option("--plate-divisions", plate.divisions, "plate meshes n x n (even n)")
+      ->delimiter(',')
+      ->capture_default_str()
+      ->check(whole_int());
   app.add_option("--quadrature-resolution", quadrature.resolution, "texels per element side T of the quadrature sweep")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check(whole_int());
   app.add_option("--quadrature-tolerances", quadrature.tolerances, "merge tolerances (the per-texel rule always runs)")
       ->delimiter(',')->capture_default_str();
   app.add_option("--quadrature-elements", quadrature.elements, "quad8, tri6")->delimiter(',')->capture_default_str();
-  app.add_option("--texture-sizes", texture.resolutions, "texture resolutions T")->delimiter(',')->capture_default_str();
+  app.add_option("--texture-sizes", texture.resolutions, "texture resolutions T")
+      ->delimiter(',')
+      ->capture_default_str()
+      ->check(whole_int());
   app.add_option("--shell-scene", tolerance.shell_scene, "dynamic corotated scene of the shell PCG tolerance sweep")
       ->capture_default_str()
       ->check(CLI::ExistingFile);
-  app.add_option("--shell-steps", tolerance.shell_steps, "steps per shell run")->capture_default_str();
+  app.add_option("--shell-steps", tolerance.shell_steps, "steps per shell run")->capture_default_str()->check(whole_int());
   app.add_option("--shell-tolerances", tolerance.shell_tolerances, "PCG relative tolerances")->delimiter(',')
       ->capture_default_str();
   app.add_option("--multigrid-size", tolerance.multigrid_resolution, "T of the multigrid tolerance sweep (slit domain)")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check(whole_int());
   app.add_option("--multigrid-tolerances", tolerance.multigrid_tolerances, "multigrid relative tolerances")
       ->delimiter(',')->capture_default_str();
   app.add_option("--rotation-scene", rotation.scene, "dynamic corotated scene with cuts of the rotation sweep")
       ->capture_default_str()
       ->check(CLI::ExistingFile);
-  app.add_option("--rotation-steps", rotation.steps, "steps per rotation run")->capture_default_str();
+  app.add_option("--rotation-steps", rotation.steps, "steps per rotation run")->capture_default_str()->check(whole_int());
   app.add_option("--rotation-blocks", rotation.block_texels, "rotation cluster blocks B (texels; per point is the reference)")
-      ->delimiter(',')->capture_default_str();
+      ->delimiter(',')
+      ->capture_default_str()
+      ->check(whole_int());
   app.add_option("--scene-quadrature-scene", scene_quadrature.scene,
                  "dynamic scene with cuts of the scene quadrature sweep")
       ->capture_default_str()
       ->check(CLI::ExistingFile);
   app.add_option("--scene-quadrature-steps", scene_quadrature.steps,
-                 "steps per run of that sweep (0: the scene's own analysis.steps)")->capture_default_str();
+                 "steps per run of that sweep (0: the scene's own analysis.steps)")
+      ->capture_default_str()
+      ->check(whole_int());
   app.add_option("--scene-quadrature-tolerances", scene_quadrature.tolerances, "merge tolerances of that sweep")
       ->delimiter(',')->capture_default_str();
   app.add_option("--scene-quadrature-reference", scene_quadrature.reference_tolerance,

@@ -61,7 +61,7 @@ int bench_laplace_command(int argc, char** argv) {
   int chart_size = 512, repeat = 3;
   double tolerance = 1e-6;
   long max_other_unknowns = 2'000'000;
-  app.add_option("--sizes", sizes, "texels per element side T")->delimiter(',');
+  app.add_option("--sizes", sizes, "texels per element side T")->delimiter(',')->check(whole_int());
   app.add_option("--domains", domains, "open, slit, spiral, accordion, chad, one_ring")->delimiter(',');
   app.add_option("--solvers", solvers, "multigrid, multigrid_robust, cholmod, cholmod_solve, eigen_ichol_cg, boomeramg")->delimiter(',');
   app.add_option("--json", json_path, "write the results as JSON")->check(writable_file());
@@ -70,7 +70,10 @@ int bench_laplace_command(int argc, char** argv) {
           ->check(writable_file());
   // Without a chart they were ignored, a bad value too.
   app.add_option("--chart-domain", chart_domain, "domain of the chart")->capture_default_str()->needs(chart_option);
-  app.add_option("--chart-size", chart_size, "size T of the chart")->capture_default_str()->needs(chart_option);
+  app.add_option("--chart-size", chart_size, "size T of the chart")
+      ->capture_default_str()
+      ->check(whole_int())
+      ->needs(chart_option);
   app.add_option("--repeat", repeat, "runs per case; the best time counts")
       ->capture_default_str()
       ->check(at_least_one());
@@ -78,7 +81,7 @@ int bench_laplace_command(int argc, char** argv) {
   app.add_option("--max-other-unknowns", max_other_unknowns,
                  "skip solvers other than multigrid above this many unknowns")
       ->capture_default_str()
-      ->check(CLI::Range(0L, std::numeric_limits<long>::max()));
+      ->check(whole_number(0, std::numeric_limits<long>::max()));
   try {
     app.parse(argc, argv);
     check_list_items(app, argc, argv);

@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "commands.h"
+#include "count_option.h"
 #include "gnuplot_chart.h"
 #include "dgtex/benchmark_machine.h"
 #include "dgtex/render_benchmark.h"
@@ -69,13 +70,13 @@ int bench_render_command(int argc, char** argv) {
   RenderBenchOptions options;
   std::string json_path, chart_path;
   app.add_option("--resolution", options.resolution, "texels per element side T (per-texel = tessellation T)")
-      ->capture_default_str()->check(CLI::Range(8, 256));
+      ->capture_default_str()->check(whole_number(8, 256));
   app.add_option("--tessellations", options.tessellations, "tessellation levels of the three methods")
-      ->delimiter(',')->check(CLI::Range(1, 256));
-  app.add_option("--width", options.width, "image width")->capture_default_str()->check(CLI::Range(16, 8192));
-  app.add_option("--height", options.height, "image height")->capture_default_str()->check(CLI::Range(16, 8192));
+      ->delimiter(',')->check(whole_number(1, 256));
+  app.add_option("--width", options.width, "image width")->capture_default_str()->check(whole_number(16, 8192));
+  app.add_option("--height", options.height, "image height")->capture_default_str()->check(whole_number(16, 8192));
   app.add_option("--repeat", options.repeat, "timed renders per case (medians)")->capture_default_str()
-      ->check(CLI::Range(1, 1000));
+      ->check(whole_number(1, 1000));
   bool complete_only = false;
   app.add_flag("--complete-cut-only", complete_only, "leave out the partial cut (and its tip)");
   app.add_option("--json", json_path, "write the results as JSON")->check(writable_file());

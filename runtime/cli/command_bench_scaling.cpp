@@ -219,7 +219,7 @@ int bench_scaling_command(int argc, char** argv) {
       most >= 0) {
     std::fprintf(stderr,
                  "dgtex bench scaling: --polar-count: %lld matrices (216 bytes each) would not fit the %s of memory "
-                 "available; expected at most %lld\n",
+                 "available; expected at most %lld (see dgtex bench scaling --help)\n",
                  static_cast<long long>(polar_count), memory_size_text(*available).c_str(),
                  static_cast<long long>(most));
     return 2;

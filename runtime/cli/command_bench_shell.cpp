@@ -133,7 +133,7 @@ int bench_shell_command(int argc, char** argv) {
   if (const std::int64_t most = most_that_fit(std::int64_t{gemm_size} * gemm_size, 3 * 8, *available); most >= 0) {
     std::fprintf(stderr,
                  "dgtex bench shell: --gemm-size: %d: three n x n matrices would not fit the %s of memory available; "
-                 "expected at most %lld\n",
+                 "expected at most %lld (see dgtex bench shell --help)\n",
                  gemm_size, memory_size_text(*available).c_str(),
                  static_cast<long long>(std::sqrt(static_cast<double>(most))));
     return 2;

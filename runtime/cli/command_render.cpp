@@ -67,14 +67,14 @@ int render_command(int argc, char** argv) {
   app.add_option("--out", out_dir, "output folder (created if missing) for frame.png, or the image's own name, FILE.png")
       ->required()
       ->check(writable_image());
-  app.add_option("--width", settings.width, "image width in pixels")->capture_default_str()->check(CLI::Range(1, 16384));
-  app.add_option("--height", settings.height, "image height in pixels")->capture_default_str()->check(CLI::Range(1, 16384));
+  app.add_option("--width", settings.width, "image width in pixels")->capture_default_str()->check(whole_number(1, 16384));
+  app.add_option("--height", settings.height, "image height in pixels")->capture_default_str()->check(whole_number(1, 16384));
   app.add_option("--shading", shading, "flat (one colour per element) or smooth (normals averaged at nodes)")
       ->capture_default_str();
   app.add_flag("--wireframe", settings.wireframe, "overlay the tessellation");
   app.add_option("--cut-method", cut_method, "geometry-shader, drop-triangles or kill-pixels")->capture_default_str();
   app.add_option("--tessellation", settings.tessellation, "subdivisions per element edge")
-      ->capture_default_str()->check(CLI::Range(1, 256));
+      ->capture_default_str()->check(whole_number(1, 256));
   app.add_option("--camera-position", position, "camera position x y z (default: frame the shell)")->expected(3);
   app.add_option("--camera-target", target, "point looked at x y z")->expected(3);
   app.add_option("--camera-up", up, "up direction x y z")->expected(3);

@@ -3,6 +3,9 @@
 // range 0.000000 to 1797...(309 digits)"; these name the integers an option takes.
 #include <CLI/CLI.hpp>
 #include <algorithm>
+#include <cctype>
+#include <cerrno>
+#include <cstdlib>
 #include <cstdint>
 #include <cstdio>
 #include <limits>
@@ -15,14 +18,39 @@
 
 namespace dgtex::cli {
 
+// A whole number in [low, high] as written: decimal digits, an optional sign. CLI11's Range
+// called "1e3" and "2.5" out of range (1000 is not) and CLI11 read "0x10" as 16, which a
+// report then showed as a thread count nobody typed.
+inline CLI::Validator whole_number(long long low, long long high) {
+  const std::string range = std::to_string(low) + " to " + std::to_string(high);
+  return CLI::Validator(
+      [low, high, range](std::string& value) -> std::string {
+        const std::size_t first = !value.empty() && (value[0] == '-' || value[0] == '+') ? 1 : 0;
+        const bool digits = value.size() > first && std::all_of(value.begin() + static_cast<std::ptrdiff_t>(first),
+                                                                value.end(), [](unsigned char c) { return std::isdigit(c); });
+        if (!digits) return "Value " + value + " is not a whole number in decimal digits";
+        errno = 0;
+        const long long number = std::strtoll(value.c_str(), nullptr, 10);
+        if (errno == ERANGE || number < low || number > high) return "Value " + value + " not in range " + range;
+        return "";
+      },
+      "INT in [" + range + "]");
+}
+
+// Any int as written (digits, a sign), for options whose range the library checks with
+// its own message (sizes, divisions, steps of bench accuracy and laplace).
+inline CLI::Validator whole_int() {
+  return whole_number(std::numeric_limits<int>::min(), std::numeric_limits<int>::max());
+}
+
 // A count of one or more (runs, steps, repeats): "Value 0 not in range 1 to 2147483647".
-inline CLI::Range at_least_one() { return CLI::Range(1, std::numeric_limits<int>::max()); }
+inline CLI::Validator at_least_one() { return whole_number(1, std::numeric_limits<int>::max()); }
 
 // A count that may be zero where zero means "the default" (bench scenes' --steps).
-inline CLI::Range zero_or_more() { return CLI::Range(0, std::numeric_limits<int>::max()); }
+inline CLI::Validator zero_or_more() { return whole_number(0, std::numeric_limits<int>::max()); }
 
 // OpenMP thread counts, as `dgtex run --threads` takes them.
-inline CLI::Range thread_count() { return CLI::Range(1, 1024); }
+inline CLI::Validator thread_count() { return whole_number(1, 1024); }
 
 // Whether a --threads-list increases; if not, prints one line naming it (the speed-ups are
 // over the first count: a list such as 2,1 gave "speed-up 2 -> 1 threads").

@@ -3,6 +3,7 @@
 #include <fcntl.h>
 #include <unistd.h>
 
+#include <climits>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -45,9 +46,9 @@ bool can_write(const fs::path& file) {
 // not: such a path fails only when the command writes it, after its work.
 std::string check_name_lengths(const fs::path& path) {
   for (const fs::path& part : path)
-    if (part.native().size() > 255)
+    if (part.native().size() > NAME_MAX)
       return "a name in '" + path.string() + "' has " + std::to_string(part.native().size()) +
-             " bytes; file systems take at most 255";
+             " bytes; file systems take at most " + std::to_string(NAME_MAX);
   return "";
 }
 
