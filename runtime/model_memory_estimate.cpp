@@ -2,6 +2,7 @@
 
 #include <string>
 
+#include "dgtex/obj_import.h"
 #include "dgtex/scene_io.h"
 #include "dgtex/texel_memory_estimate.h"
 
@@ -32,6 +33,19 @@ void check_model_memory(const Scene& scene, ElementType type, std::int64_t eleme
 }
 
 std::string model_memory_caution(const Scene& scene, std::int64_t available_bytes) {
+  if (available_bytes < 0) return "";
+  if (scene.mesh.source == MeshSource::file) {
+    // Its faces counted as the reader will read them (a line scan, cheap next to parsing).
+    const ObjFaceCount count = count_obj_faces(scene.mesh.file);
+    if (count.first_face_corners != 3 && count.first_face_corners != 4) return "";  // refused when read
+    const ElementType type = count.first_face_corners == 3 ? ElementType::tri6 : ElementType::quad8;
+    const std::int64_t needed = model_memory_lower_bound(type, count.faces);
+    if (!near_memory_limit(needed, available_bytes)) return "";
+    return "mesh.file \"" + scene.mesh.file + "\": the model of its " + std::to_string(count.faces) +
+           " elements needs at least " + memory_size_text(needed) + " of the " + memory_size_text(available_bytes) +
+           " of memory available, and runs measured 1.2-1.9x that bound; the run may be killed for memory (a coarser "
+           "mesh is safer)";
+  }
   const std::int64_t elements = scene.mesh.generated_elements();
   if (elements < 0) return "";
   const ElementType type = scene.mesh.element.value_or(ElementType::quad8);

@@ -122,9 +122,23 @@ TEST(ModelMemoryEstimate, ACautionBetweenHalfTheMemoryAndAllOfIt) {
                           0),
             0u)
       << caution;
+  // A mesh file's faces, counted as the reader will read them (it had no caution at all).
+  const std::string obj = ::testing::TempDir() + "model_memory_caution.obj";
+  {
+    std::ofstream out(obj);
+    for (int k = 0; k < 16; ++k) out << "f 1 2 3\n";  // 16 tri6 elements
+  }
   Scene from_file = scene;
   from_file.mesh.source = MeshSource::file;
-  EXPECT_EQ(model_memory_caution(from_file, needed), "");
+  from_file.mesh.file = obj;
+  const std::int64_t file_needed = model_memory_lower_bound(ElementType::tri6, 16);
+  EXPECT_EQ(model_memory_caution(from_file, 2 * file_needed), "");
+  EXPECT_EQ(model_memory_caution(from_file, file_needed - 1), "");  // refused instead
+  EXPECT_EQ(model_memory_caution(from_file, 2 * file_needed - 1)
+                .rfind("mesh.file \"" + obj + "\": the model of its 16 elements needs at least ", 0),
+            0u)
+      << model_memory_caution(from_file, 2 * file_needed - 1);
+  std::remove(obj.c_str());
 }
 
 }  // namespace

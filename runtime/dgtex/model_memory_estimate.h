@@ -34,11 +34,11 @@ std::int64_t model_memory_lower_bound(ElementType type, std::int64_t elements);
 // most elements whose bound fits. available_bytes < 0: no check.
 void check_model_memory(const Scene& scene, ElementType type, std::int64_t elements, std::int64_t available_bytes);
 
-// A caution for a generated mesh that passes the check but comes near the limit: runs
-// measured 1.2-1.9x the bound, and 400 x 400 quad8 elements (a 14.6 GiB bound) outgrew 23 GB.
-// One sentence naming the bound, the memory and the remedy, for `dgtex run` to print before
-// its set-up, when the bound lies between half the memory available and all of it; else ""
-// (also for a mesh read from a file, and with available_bytes < 0).
+// A caution for a mesh that passes the check but comes near the limit: runs measured
+// 1.2-1.9x the bound, and 400 x 400 quad8 elements (a 14.6 GiB bound) outgrew 23 GB. One
+// sentence naming the bound, the memory and the remedy, for `dgtex run` to print before its
+// set-up, when the bound lies between half the memory available and all of it; else "" (also
+// with available_bytes < 0). A mesh file's faces are counted (count_obj_faces) for it.
 std::string model_memory_caution(const Scene& scene, std::int64_t available_bytes);
 
 }  // namespace dgtex
