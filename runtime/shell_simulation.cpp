@@ -1,6 +1,7 @@
 #include "dgtex/shell_simulation.h"
 
 #include <Eigen/Dense>
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 #include <string>
@@ -82,6 +83,31 @@ std::string ShellSimulation::enrichment_hint() const {
   return "; with cuts, also check for cuts that almost touch each other or a node (slivers narrower than a texel)";
 }
 
+std::string ShellSimulation::pivot_location(const NotPositiveDefinite& failure) const {
+  if (failure.column() < 0 || failure.column() >= system_.size()) return "";
+  const Mesh& mesh = model_.mesh();
+  const int dof = system_.dof_of_unknown(failure.column());
+  int node = dof / 3;
+  std::string what = std::string("the failing column is the ") + "xyz"[dof % 3] + " unknown of node ";
+  if (node >= mesh.num_nodes()) {  // an enriched node: its function and mesh node
+    what = std::string("the failing column is the ") + "xyz"[dof % 3] + " unknown of enrichment function " +
+           std::to_string(model_.virtual_node_function(node)) + " at node ";
+    node = model_.virtual_node_mesh_node(node);
+  }
+  const double* x = mesh.node(node);
+  what += std::to_string(node) + " at [" + detail::short_number(x[0]) + ", " + detail::short_number(x[1]) + ", " +
+          detail::short_number(x[2]) + "], in element";
+  std::vector<int> elements;
+  for (int e = 0; e < mesh.num_elements(); ++e) {
+    const int* nodes = mesh.element_nodes(e);
+    if (std::find(nodes, nodes + mesh.nodes_per_element(), node) != nodes + mesh.nodes_per_element()) elements.push_back(e);
+  }
+  what += elements.size() == 1 ? " " : "s ";
+  for (std::size_t k = 0; k < elements.size() && k < 8; ++k) what += (k ? ", " : "") + std::to_string(elements[k]);
+  if (elements.size() > 8) what += ", ...";
+  return "; " + what;
+}
+
 void ShellSimulation::check_statically_constrained() {
   check_model_unchanged("ShellSimulation::check_statically_constrained");
   const Mesh& mesh = model_.mesh();
@@ -156,7 +182,7 @@ void ShellSimulation::solve_static() {
     } catch (const NotPositiveDefinite& e) {
       throw ModelError("stiffness not positive definite (penalty too low?): penalty = " +
                        detail::short_number(model_.options().penalty) + kDistortionHint + "; " + e.what() +
-                       enrichment_hint());
+                       pivot_location(e) + enrichment_hint());
     }
     system_.restrict_vector(f_ext_, rhs);
     cholesky_.solve(rhs, x);
@@ -287,7 +313,7 @@ void ShellSimulation::step(const DynamicsOptions& o) {
   } catch (const NotPositiveDefinite& e) {
     throw ModelError("dynamic system matrix not positive definite (penalty too low?): penalty = " +
                      detail::short_number(model_.options().penalty) + kDistortionHint + "; " + e.what() +
-                     enrichment_hint());
+                     pivot_location(e) + enrichment_hint());
   }
   for (int d = 0; d < ndofs; ++d) u_[d] += dt * v_[d];
   time_ += dt;

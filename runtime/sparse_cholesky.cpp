@@ -204,10 +204,15 @@ void SparseCholesky::factorize(const std::vector<double>& values) {
     const auto lock = detail::lock_cholmod();
     cholmod_factorize(m.matrix, m.factor, &m.common);
   }
-  if (m.common.status == CHOLMOD_NOT_POSDEF || m.factor->minor < static_cast<size_t>(n_))
-    throw NotPositiveDefinite("matrix not positive definite (non-positive pivot at column " +
-                                  std::to_string(m.factor->minor) + " of " + std::to_string(n_) + ")",
-                              static_cast<int>(m.factor->minor));
+  if (m.common.status == CHOLMOD_NOT_POSDEF || m.factor->minor < static_cast<size_t>(n_)) {
+    // minor counts the factor's columns, in the fill-reducing order: the matrix's own is Perm's.
+    const int minor = static_cast<int>(std::min(m.factor->minor, static_cast<size_t>(n_ - 1)));
+    const int* perm = static_cast<const int*>(m.factor->Perm);
+    const int column = perm ? perm[minor] : minor;
+    throw NotPositiveDefinite("matrix not positive definite (non-positive pivot at column " + std::to_string(column) +
+                                  " of " + std::to_string(n_) + ")",
+                              column);
+  }
   if (m.common.status < CHOLMOD_OK)
     throw std::runtime_error("CHOLMOD: numeric factorisation failed (status " + std::to_string(m.common.status) + ")");
 }

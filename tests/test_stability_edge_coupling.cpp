@@ -5,6 +5,9 @@
 // larger eta, which raises the highest frequency (explicit step limit) and the condition
 // number of K. ShellModelOptions::penalty_only_edges switches the terms off.
 #include <gtest/gtest.h>
+#include <cctype>
+#include <algorithm>
+#include <sstream>
 
 #include <Eigen/Dense>
 #include <cmath>
@@ -164,7 +167,37 @@ TEST(EdgeCoupling, PenaltyOnlyStaysDefiniteBelowTheThresholdButIsWrong) {
     consistent.solve_static();
     ADD_FAILURE() << "expected a ModelError at eta 0.1";
   } catch (const ModelError& e) {
-    EXPECT_NE(std::string(e.what()).find("stiffness not positive definite (penalty too low?)"), std::string::npos) << e.what();
+    const std::string what = e.what();
+    EXPECT_NE(what.find("stiffness not positive definite (penalty too low?)"), std::string::npos) << what;
+    // It says where: the failing column's node, at its position, among the elements named.
+    const std::string node_text = " unknown of node ";
+    const std::size_t at = what.find(node_text);
+    ASSERT_NE(at, std::string::npos) << what;
+    std::istringstream where(what.substr(at + node_text.size()));
+    int node = -1;
+    std::string at_word, elements_word;
+    char bracket = 0;
+    double x = 0, y = 0;
+    where >> node >> at_word >> bracket >> x;
+    where.ignore(2);
+    where >> y;
+    const Mesh& mesh = s.model->mesh();
+    ASSERT_TRUE(node >= 0 && node < mesh.num_nodes()) << what;
+    EXPECT_EQ(at_word, "at");
+    EXPECT_NEAR(x, mesh.node(node)[0], 1e-5 * (1 + std::abs(x))) << what;
+    EXPECT_NEAR(y, mesh.node(node)[1], 1e-5 * (1 + std::abs(y))) << what;
+    const std::size_t in = what.find("], in element", at);
+    ASSERT_NE(in, std::string::npos) << what;
+    std::istringstream listed(what.substr(what.find(' ', in + 12) + 1));
+    int named = 0;
+    for (std::string item; listed >> item && std::isdigit(static_cast<unsigned char>(item[0]));) {
+      const int e = std::stoi(item);
+      ASSERT_TRUE(e >= 0 && e < mesh.num_elements()) << what;
+      const int* nodes = mesh.element_nodes(e);
+      EXPECT_NE(std::find(nodes, nodes + mesh.nodes_per_element(), node), nodes + mesh.nodes_per_element()) << what;
+      ++named;
+    }
+    EXPECT_GE(named, 1) << what;
   }
   const double ratio = tip_ratio(10, 0.1, true);
   std::printf("eta 0.1: consistent indefinite (solve stopped); penalty-only tip / (PL^3/3EI) %.3f\n", ratio);

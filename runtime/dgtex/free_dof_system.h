@@ -23,6 +23,7 @@ class FreeDofSystem {
 
   int size() const { return static_cast<int>(dof_of_unknown_.size()); }
   int num_dofs() const { return static_cast<int>(unknown_of_dof_.size()); }  // free and fixed
+  int dof_of_unknown(int unknown) const { return dof_of_unknown_.at(static_cast<std::size_t>(unknown)); }
   std::int64_t nonzeros() const { return static_cast<std::int64_t>(row_index_.size()); }
   const std::vector<int>& column_start() const { return column_start_; }
   const std::vector<int>& row_index() const { return row_index_; }

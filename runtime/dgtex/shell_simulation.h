@@ -99,6 +99,8 @@ class ShellSimulation {
 
   const std::vector<double>& linear_stiffness();
   std::string enrichment_hint() const;  // appended to "not positive definite" errors
+  // Where a failed factorisation's column lies: its node, component and elements.
+  std::string pivot_location(const NotPositiveDefinite& failure) const;
 };
 
 }  // namespace dgtex

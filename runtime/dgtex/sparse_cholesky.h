@@ -20,6 +20,8 @@ namespace dgtex {
 class NotPositiveDefinite : public std::runtime_error {
  public:
   NotPositiveDefinite(const std::string& what, int column) : std::runtime_error(what), column_(column) {}
+  // The matrix's column (its own order, not the factor's) where the factorisation failed:
+  // one of the unknowns of the mode that lost definiteness, where to look for its cause.
   int column() const { return column_; }
 
  private:
