@@ -271,6 +271,38 @@ TEST(BenchAccuracyCharts, EveryErrorZeroStillDrawsTheChart) {
   fs::remove_all(out);
 }
 
+// A second run into the same folder leaves none of the first run's charts beside its own
+// JSON (a texture chart stayed there after a plate-only run), and never clears a scene it
+// reads: a --shell-scene saved there as accuracy.json is refused before anything is written.
+TEST(BenchAccuracyCharts, AnEarlierRunsChartsGoAndInputsStay) {
+  const fs::path out = fs::temp_directory_path() / ("dgtex_bench_accuracy_again_" + std::to_string(getpid()));
+  fs::remove_all(out);
+  fs::create_directories(out);
+  std::ofstream(out / "accuracy_texture.png") << "an earlier run's chart";
+  std::ofstream(out / "notes.txt") << "the user's";
+  const std::string plate_only = std::string(DGTEX_CLI) + " bench accuracy --charts plate --plate-divisions 2 --repeat 1 "
+                                 "--out " + out.string();
+  EXPECT_EQ(WEXITSTATUS(std::system((plate_only + " > /dev/null 2>&1").c_str())), 0);
+  EXPECT_FALSE(fs::exists(out / "accuracy_texture.png"));
+  EXPECT_TRUE(fs::exists(out / "accuracy_plate.png"));
+  EXPECT_TRUE(fs::exists(out / "notes.txt"));  // not a name it writes
+  fs::copy_file(std::string(DGTEX_SOURCE_DIR) + "/examples/scenes/cylinder_buckling.json", out / "accuracy.json",
+                fs::copy_options::overwrite_existing);
+  const std::string reads_it = plate_only + " --shell-scene " + (out / "accuracy.json").string() + " 2> " +
+                               (out / "err.txt").string();
+  EXPECT_EQ(WEXITSTATUS(std::system(reads_it.c_str())), 2);
+  std::ifstream err(out / "err.txt");
+  const std::string message((std::istreambuf_iterator<char>(err)), std::istreambuf_iterator<char>());
+  EXPECT_NE(message.find("the run writes or clears '" + (out / "accuracy.json").string() + "', the scene of --shell-scene"),
+            std::string::npos)
+      << message;
+  std::ifstream kept(out / "accuracy.json");
+  EXPECT_NE(std::string((std::istreambuf_iterator<char>(kept)), std::istreambuf_iterator<char>()).find("\"analysis\""),
+            std::string::npos);
+  EXPECT_TRUE(fs::exists(out / "accuracy_plate.png"));  // nothing cleared
+  fs::remove_all(out);
+}
+
 // The Navier series gives Timoshenko's 0.00406 q a^4 / D for the square plate (nu-free).
 TEST(BenchAccuracyNavier, SquarePlateCoefficient) {
   const double D = 2.0, q = -3.0, a = 1.5;

@@ -86,11 +86,12 @@ std::string write_chart(const std::string& path, const AccuracyChart& chart, con
   });
 }
 
+const std::vector<std::string> kChartNames = {"plate", "quadrature", "texture", "tolerance", "rotation",
+                                              "scene_quadrature"};
+
 std::vector<std::string> split_names(const std::vector<std::string>& names) {
-  static const std::vector<std::string> valid = {"plate",     "quadrature", "texture",
-                                                 "tolerance", "rotation",   "scene_quadrature"};
   for (const std::string& n : names)
-    if (std::find(valid.begin(), valid.end(), n) == valid.end())
+    if (std::find(kChartNames.begin(), kChartNames.end(), n) == kChartNames.end())
       throw std::invalid_argument("--charts: unknown chart '" + n +
                                   "'; valid: plate, quadrature, texture, tolerance, rotation, scene_quadrature");
   return names;
@@ -207,7 +208,18 @@ int bench_accuracy_command(int argc, char** argv) {
       std::fprintf(stderr, "dgtex bench accuracy: %s\n", e.what());
       return 2;
     }
+    // An earlier run's charts and tables in --out go first (a chart of a sweep not run now
+    // stayed beside a JSON without its data), never a scene the sweeps read.
+    std::vector<std::string> outputs = {"accuracy.json", "accuracy.md"};
+    for (const std::string& name : kChartNames)
+      for (const char* extension : {".png", ".svg"}) outputs.push_back("accuracy_" + name + extension);
+    check_outputs_spare_inputs(out_dir, outputs,
+                               {{"the scene of --shell-scene", tolerance.shell_scene},
+                                {"the scene of --rotation-scene", rotation.scene},
+                                {"the scene of --scene-quadrature-scene", scene_quadrature.scene}});
     create_output_folder(out_dir, "--out");
+    if (const int removed = remove_earlier_outputs(out_dir, outputs); removed > 0)
+      std::fprintf(stderr, "dgtex bench accuracy: removed %d files of an earlier run from %s\n", removed, out_dir.c_str());
     const std::string machine = describe_machine_and_probe();
     const auto start = std::chrono::steady_clock::now();
     const AccuracyProgress progress = [&](const std::string& line) {

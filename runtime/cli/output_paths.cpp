@@ -161,6 +161,13 @@ bool is_frame_file_name(const std::string& name) {
   return true;
 }
 
+// The files of `dgtex run` in its output folder but its frames.
+std::vector<std::string> run_output_names(const std::string& report_name) {
+  std::vector<std::string> names = {report_name};
+  names.insert(names.end(), std::begin(kRunOutputFiles), std::end(kRunOutputFiles));
+  return names;
+}
+
 bool remove_file(const fs::path& path) {
   std::error_code error;
   if (!fs::is_regular_file(path, error)) return false;
@@ -186,9 +193,7 @@ void check_report_name(const Scene& scene) {
 
 int remove_earlier_run_outputs(const std::string& folder, const std::string& report_name) {
   const fs::path out(folder);
-  int removed = 0;
-  for (const char* name : kRunOutputFiles) removed += remove_file(out / name);
-  removed += remove_file(out / report_name);
+  int removed = remove_earlier_outputs(folder, run_output_names(report_name));
   std::vector<fs::path> frames;  // listed first: removing while iterating may skip entries
   std::error_code error;
   if (fs::is_directory(out / "frames", error))
@@ -198,20 +203,33 @@ int remove_earlier_run_outputs(const std::string& folder, const std::string& rep
   return removed;
 }
 
-void check_run_outputs_spare_inputs(const std::string& folder, const std::string& report_name,
-                                    const std::vector<InputFile>& inputs) {
+void check_outputs_spare_inputs(const std::string& folder, const std::vector<std::string>& names,
+                                const std::vector<InputFile>& inputs) {
   const fs::path out(folder);
-  std::vector<fs::path> outputs = {out / report_name};
-  for (const char* name : kRunOutputFiles) outputs.push_back(out / name);
   for (const InputFile& input : inputs) {
     if (input.path.empty()) continue;
+    for (const std::string& name : names)
+      if (same_file(input.path, out / name))
+        throw std::invalid_argument("--out " + folder + ": the run writes or clears '" + input.path + "', " +
+                                    input.what + "; choose another output folder, or move the input out of it");
+  }
+}
+
+int remove_earlier_outputs(const std::string& folder, const std::vector<std::string>& names) {
+  int removed = 0;
+  for (const std::string& name : names) removed += remove_file(fs::path(folder) / name);
+  return removed;
+}
+
+void check_run_outputs_spare_inputs(const std::string& folder, const std::string& report_name,
+                                    const std::vector<InputFile>& inputs) {
+  check_outputs_spare_inputs(folder, run_output_names(report_name), inputs);
+  for (const InputFile& input : inputs) {
     const fs::path path(input.path);
-    bool taken = false;
-    for (const fs::path& output : outputs) taken = taken || same_file(path, output);
-    taken = taken || (is_frame_file_name(path.filename().string()) && same_file(path.parent_path(), out / "frames"));
-    if (taken)
-      throw std::invalid_argument("--out " + folder + ": the run writes or clears '" + input.path + "', " + input.what +
-                                  "; choose another output folder, or move the input out of it");
+    if (!input.path.empty() && is_frame_file_name(path.filename().string()) &&
+        same_file(path.parent_path(), fs::path(folder) / "frames"))
+      throw std::invalid_argument("--out " + folder + ": the run writes or clears '" + input.path + "', " +
+                                  input.what + "; choose another output folder, or move the input out of it");
   }
 }
 

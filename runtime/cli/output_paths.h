@@ -55,6 +55,16 @@ void check_report_name(const Scene& scene);
 // that could not be.
 int remove_earlier_run_outputs(const std::string& folder, const std::string& report_name);
 
+// Throws std::invalid_argument naming --out FOLDER and the input where one of the files
+// NAMES in FOLDER (what a command writes there, or clears of an earlier run) is one of
+// INPUTS.
+void check_outputs_spare_inputs(const std::string& folder, const std::vector<std::string>& names,
+                                const std::vector<InputFile>& inputs);
+
+// Removes those of the files NAMES in FOLDER that exist, an earlier run's; returns how many.
+// Throws std::runtime_error naming a file that could not be removed.
+int remove_earlier_outputs(const std::string& folder, const std::vector<std::string>& names);
+
 // Throws std::invalid_argument naming --out FOLDER and the input where a file that
 // `dgtex run` writes or removes in FOLDER (remove_earlier_run_outputs) is one of INPUTS (a
 // scene saved as FOLDER/final.state was deleted by the run it started).
