@@ -61,7 +61,7 @@ double measure_dense_gemm_gflops(int n, int repeat) {
 }
 
 ShellBenchRun run_shell_benchmark(const std::string& scene_path, int steps, int threads, bool reuse_factorization,
-                                  const FactorReuseOptions& solver) {
+                                  const FactorReuseOptions& solver, const std::function<void(int, int)>& progress) {
   const Scene scene = load_scene(scene_path);
   if (!scene.analysis.is_dynamic())
     throw std::invalid_argument("scene '" + scene_path + "' is a static analysis; the shell benchmark needs \"analysis\": {\"type\": \"dynamic\", ...}");
@@ -98,6 +98,7 @@ ShellBenchRun run_shell_benchmark(const std::string& scene_path, int steps, int 
     run.step.add(assembly + solve);
     run.assembly_ms.push_back(assembly);
     run.solve_ms.push_back(solve);
+    if (progress) progress(s + 1, steps);
   }
   run.elements = mesh.num_elements();
   run.nodes = mesh.num_nodes();

@@ -86,6 +86,8 @@ TEST(CliOptions, BadValuesAreOneLineNamingTheCommandAndOption) {
       {"run PLATE --out DIR/o --threads 0x10", "dgtex run: --threads: Value 0x10 is not a whole number in decimal digits"},
       {"render x.state --out DIR/r.png --width 2.5", "dgtex render: --width: Value 2.5 is not a whole number"},
       {"bench laplace --sizes 16,1e3", "dgtex bench laplace: --sizes: Value 1e3 is not a whole number"},
+      // Per-step times for 2^31 steps (32 GiB), with no word for hours.
+      {"bench shell --steps 2000000", "dgtex bench shell: --steps: Value 2000000 not in range 1 to 1000000"},
       // CLI11 dropped empty list items and kept repeats (a case run and reported twice).
       {"bench laplace --sizes 16,,32", "dgtex bench laplace: --sizes: '16,,32' has an empty item"},
       {"bench laplace --sizes=16,32,", "dgtex bench laplace: --sizes: '16,32,' has an empty item"},

@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <chrono>
 #include <cstdio>
 #include <cstdlib>
 #include <nlohmann/json.hpp>
@@ -75,7 +76,8 @@ int bench_shell_command(int argc, char** argv) {
   bool refactor_every_step = false;
   FactorReuseOptions solver;
   app.add_option("--scene", scene_path, "dynamic scene (JSON)")->capture_default_str()->check(CLI::ExistingFile);
-  app.add_option("--steps", steps, "time steps per case (from rest)")->capture_default_str()->check(at_least_one());
+  // Per-step times are kept (two doubles a step): 2^31 steps would take 32 GiB of them.
+  app.add_option("--steps", steps, "time steps per case (from rest)")->capture_default_str()->check(whole_number(1, 1000000));
   app.add_option("--threads-list", threads_list, "OpenMP thread counts, one case each")
       ->delimiter(',')
       ->capture_default_str()
@@ -163,7 +165,14 @@ int bench_shell_command(int argc, char** argv) {
                 "facts", "pcg_its");
     };
     for (int threads : threads_list) {
-      runs.push_back(run_shell_benchmark(scene_path, steps, threads, !refactor_every_step, solver));
+      // A line every 10 s on a long run (a million steps take hours).
+      auto last_line = std::chrono::steady_clock::now();
+      const auto progress = [&](int step, int total) {
+        if (std::chrono::steady_clock::now() - last_line < std::chrono::seconds(10)) return;
+        last_line = std::chrono::steady_clock::now();
+        std::fprintf(stderr, "bench shell: %d thread%s, step %d/%d\n", threads, threads == 1 ? "" : "s", step, total);
+      };
+      runs.push_back(run_shell_benchmark(scene_path, steps, threads, !refactor_every_step, solver, progress));
       if (runs.size() == 1) print_header();  // after the scene loaded: errors come alone
       omp_set_num_threads(threads);
       gemm.push_back(measure_dense_gemm_gflops(gemm_size));

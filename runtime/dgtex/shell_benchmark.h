@@ -8,6 +8,7 @@
 // thread count themselves, so run one at a time, and restore the caller's count before
 // they return. Times in ms, rates per second.
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -36,9 +37,11 @@ struct ShellBenchRun {
 };
 
 // Throws std::invalid_argument for a scene that is not a dynamic analysis or has cuts,
-// and SceneError / MeshError for a scene that does not load.
+// and SceneError / MeshError for a scene that does not load. progress (optional) is called
+// after every step with (steps done, steps).
 ShellBenchRun run_shell_benchmark(const std::string& scene_path, int steps, int threads,
-                                  bool reuse_factorization = true, const FactorReuseOptions& solver = {});
+                                  bool reuse_factorization = true, const FactorReuseOptions& solver = {},
+                                  const std::function<void(int, int)>& progress = {});
 
 // Counted floating-point operations of one assemble_stiffness call (corotated when
 // `corotated`): exact for the K and force products of the element and edge kernels,
