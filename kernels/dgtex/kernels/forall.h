@@ -10,7 +10,9 @@
 // Execution::parallel uses the OpenMP threads of the calling thread (less those busy beside
 // it, threads_busy_beside.h), Execution::serial one; both give the same result (bitwise where
 // documented).
+#include <atomic>
 #include <cstdint>
+#include <exception>
 
 #include "dgtex/kernels/threads_busy_beside.h"
 
@@ -36,12 +38,40 @@ void run_rejoining(std::int64_t n, Loop&& loop) {
   }
 }
 
+// An exception cannot leave an OpenMP region (std::terminate: chad out of memory in its
+// quadrature pass ended in "terminate called after throwing an instance of
+// 'std::bad_alloc'"). Inside one, each index runs through this: the first exception is
+// kept, the indices after it are skipped, and rethrow() passes it on once the region is
+// over, as the serial loop would have thrown it.
+class RegionFailure {
+ public:
+  template <class Body>
+  void run(Body& body, std::int64_t i) noexcept {
+    if (failed_.load(std::memory_order_relaxed)) return;
+    try {
+      body(i);
+    } catch (...) {
+      bool first = false;
+      if (failed_.compare_exchange_strong(first, true)) error_ = std::current_exception();
+    }
+  }
+  void rethrow() const {
+    if (error_) std::rethrow_exception(error_);
+  }
+
+ private:
+  std::atomic<bool> failed_{false};
+  std::exception_ptr error_;  // written once, by the thread that set failed_, read after the region
+};
+
 template <class Body>
 void forall(std::int64_t n, Body&& body, Execution execution = Execution::parallel) {
   if (execution == Execution::parallel) {
+    RegionFailure failure;
     run_rejoining(n, [&](std::int64_t begin, std::int64_t end, int team) {
 #pragma omp parallel for schedule(static) num_threads(team)
-      for (std::int64_t i = begin; i < end; ++i) body(i);
+      for (std::int64_t i = begin; i < end; ++i) failure.run(body, i);
+      failure.rethrow();
     });
   } else {
     for (std::int64_t i = 0; i < n; ++i) body(i);
@@ -54,9 +84,11 @@ void forall(std::int64_t n, Body&& body, Execution execution = Execution::parall
 template <class Body>
 void forall_dynamic(std::int64_t n, Body&& body, Execution execution = Execution::parallel) {
   if (execution == Execution::parallel) {
+    RegionFailure failure;
     run_rejoining(n, [&](std::int64_t begin, std::int64_t end, int team) {
 #pragma omp parallel for schedule(dynamic, 1) num_threads(team)
-      for (std::int64_t i = begin; i < end; ++i) body(i);
+      for (std::int64_t i = begin; i < end; ++i) failure.run(body, i);
+      failure.rethrow();
     });
   } else {
     for (std::int64_t i = 0; i < n; ++i) body(i);
@@ -75,13 +107,15 @@ void forall_then(std::int64_t n1, First&& first, std::int64_t n2, Second&& secon
     forall(n1, first, execution);
     forall(n2, second, execution);
   } else if (execution == Execution::parallel) {
+    RegionFailure failure;
 #pragma omp parallel num_threads(parallel_team_size())
     {
 #pragma omp for schedule(static)
-      for (std::int64_t i = 0; i < n1; ++i) first(i);
+      for (std::int64_t i = 0; i < n1; ++i) failure.run(first, i);
 #pragma omp for schedule(static)
-      for (std::int64_t i = 0; i < n2; ++i) second(i);
+      for (std::int64_t i = 0; i < n2; ++i) failure.run(second, i);
     }
+    failure.rethrow();
   } else {
     for (std::int64_t i = 0; i < n1; ++i) first(i);
     for (std::int64_t i = 0; i < n2; ++i) second(i);
