@@ -446,12 +446,13 @@ class SceneReader {
     if (!divisions.is_array() || divisions.size() != 2)
       fail(divisions_path, "expected an array of 2 integers", divisions, "e.g. [4, 4]");
     for (int i = 0; i < 2; ++i) mesh.divisions[i] = integer(divisions[i], item(divisions_path, i), 1, kMaxDivisions);
-    // A closed ring of one cell would join an element to itself along its seam.
+    // A closed ring of one cell would join an element to itself along its seam, and one of
+    // two would join two elements along both their sides (the generators need 3).
     const bool closed_ring = mesh.source == MeshSource::hemisphere || mesh.closed_cylinder();
     const int ring_index = mesh.source == MeshSource::hemisphere ? 1 : 0;
-    if (closed_ring && mesh.divisions[ring_index] < 2)
-      fail(item(divisions_path, ring_index), "a closed 360-degree ring needs at least 2 divisions", divisions[ring_index],
-           "expected an integer >= 2");
+    if (closed_ring && mesh.divisions[ring_index] < 3)
+      fail(item(divisions_path, ring_index), "a closed 360-degree ring needs at least 3 divisions", divisions[ring_index],
+           "expected an integer >= 3");
     if (static_cast<long long>(mesh.divisions[0]) * mesh.divisions[1] > kMaxGeneratedCells)
       fail(divisions_path, "too many cells", divisions, "at most 10000000 cells (product of the divisions)");
     mesh.element = ElementType::quad8;

@@ -73,6 +73,10 @@ void ShellSimulation::set_state(std::vector<double> u, std::vector<double> v) {
   v_ = std::move(v);
   previous_v_.clear();
   previous_previous_v_.clear();
+  const auto moved = [](const std::vector<double>& x) {
+    return std::any_of(x.begin(), x.end(), [](double value) { return value != 0; });
+  };
+  deformed_ = deformed_ || moved(u_) || moved(v_);  // a state carried over (a basis change)
 }
 
 std::string ShellSimulation::enrichment_hint() const {
@@ -311,12 +315,21 @@ void ShellSimulation::step(const DynamicsOptions& o) {
       system_.expand_vector(v_new_, v_);
     }
   } catch (const NotPositiveDefinite& e) {
+    // Away from rest (after steps, or from a state carried over a basis change) the deformed
+    // state is the likelier cause of a corotated failure (a load 1e5 times gravity on chad
+    // failed at its 36th step whatever the penalty): a failed run, not bad input.
+    if (o.corotational && deformed_)
+      throw std::runtime_error("dynamic system matrix not positive definite in the deformed state: the run has "
+                               "likely diverged (a smaller time step or smaller loads?), or the penalty = " +
+                               detail::short_number(model_.options().penalty) + " is too low for it; " + e.what() +
+                               pivot_location(e) + enrichment_hint());
     throw ModelError("dynamic system matrix not positive definite (penalty too low?): penalty = " +
                      detail::short_number(model_.options().penalty) + kDistortionHint + "; " + e.what() +
                      pivot_location(e) + enrichment_hint());
   }
   for (int d = 0; d < ndofs; ++d) u_[d] += dt * v_[d];
   time_ += dt;
+  deformed_ = true;
 }
 
 double ShellSimulation::kinetic_energy() const {

@@ -150,6 +150,27 @@ TEST(CliRun, AModelNearOrBeyondTheMemoryIsCautionedOrRefused) {
                   "mesh.divisions: 256 quad8 elements need at least 24 MiB", "DGTEX_MEMORY_LIMIT_MB=20");
 }
 
+// A run that loses definiteness after good corotated steps has diverged (chad under 3e4
+// m/s^2 sideways, at its 36th step, whatever the penalty): a failed run (exit code 1) whose
+// line names the step and the likely cause, not bad input blaming the penalty (exit 2).
+TEST(CliRun, ADivergedCorotatedStepIsAFailedRunNamingTheStep) {
+  const fs::path dir = fresh_dir("diverged");
+  nlohmann::json scene =
+      nlohmann::json::parse(std::ifstream(std::string(DGTEX_SOURCE_DIR) + "/examples/scenes/chad.json"));
+  scene["loads"][0]["acceleration"] = {3e4, 0, 0};
+  scene["analysis"]["steps"] = 60;
+  scene.erase("render");
+  std::ofstream(dir / "scene.json") << scene.dump();
+  const Result r = run_dgtex((dir / "scene.json").string() + " --out " + (dir / "out").string(), dir);
+  EXPECT_EQ(r.exit_code, 1) << r.stderr_text;
+  EXPECT_NE(r.stderr_text.find(": step "), std::string::npos) << r.stderr_text;
+  EXPECT_NE(r.stderr_text.find("dynamic system matrix not positive definite in the deformed state: the run has likely "
+                               "diverged"),
+            std::string::npos)
+      << r.stderr_text;
+  EXPECT_EQ(r.stderr_text.find("(penalty too low?)"), std::string::npos) << r.stderr_text;
+}
+
 // A penalty far above its threshold locks coarse meshes and fails nothing: the run says so
 // (dgtex/penalty_caution.h) and runs; the example plate at its own 0.8 runs without it.
 TEST(CliRun, APenaltyFarAboveItsThresholdIsCautioned) {

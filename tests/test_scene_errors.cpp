@@ -188,6 +188,13 @@ TEST(SceneErrors, MeshParameters) {
                "mesh.angle_deg", "[30,30]", "non-empty");
   expect_error(with(with(valid_scene(), "/mesh"_json_pointer, cylinder), "/mesh/size"_json_pointer, {1, 1}), "mesh.size",
                "[1,1]", "unknown key");
+  // A closed ring needs 3 divisions, as its generator does (the reader said 2 and let 2 through
+  // to the generator's own refusal).
+  json ring = cylinder;
+  ring["angle_deg"] = {0, 360};
+  ring["divisions"] = {2, 1};
+  expect_error(with(valid_scene(), "/mesh"_json_pointer, ring), "mesh.divisions[0]", "2",
+               "a closed 360-degree ring needs at least 3 divisions");
   const json dome = {{"generator", "hemisphere"}, {"radius", 1}, {"hole_deg", 90}, {"divisions", {2, 8}}};
   expect_error(with(valid_scene(), "/mesh"_json_pointer, dome), "mesh.hole_deg", "90", "0 < hole_deg < 90");
   expect_error(with(with(valid_scene(), "/mesh"_json_pointer, dome), "/mesh/hole_deg"_json_pointer, 0), "mesh.hole_deg",

@@ -181,6 +181,11 @@ int run_command(int argc, char** argv) {
         } catch (const std::invalid_argument& e) {  // the scene, met in a step: a progressive cut's new function
           throw ModelError("step " + std::to_string(step) +
                            " (to t = " + detail::short_number(step * scene.analysis.time_step) + "): " + e.what());
+        } catch (const ModelError&) {
+          throw;
+        } catch (const std::runtime_error& e) {  // a failed step (a diverged state): which one
+          throw std::runtime_error("step " + std::to_string(step) + " (to t = " +
+                                   detail::short_number(step * scene.analysis.time_step) + "): " + e.what());
         }
         if (!all_finite(run->displacement()))
           throw ModelError("analysis: the solution diverged at step " + std::to_string(step) + " (time step " +
