@@ -181,6 +181,15 @@ TEST(MeshOutputObj, Quad8CentreIsEvaluated) {
   EXPECT_NEAR(std::hypot(centre[0], centre[2]), 1.0, 1e-15);
 }
 
+// Runs CHECK, a Python script saved as NAME.py, with ARGUMENTS: its exit status.
+int python_check(const std::string& check, const std::string& name, const std::string& arguments) {
+  const std::string script = temp_path(name + ".py");
+  std::ofstream(script) << check;
+  const int status = std::system(("/usr/bin/python3 " + script + " " + arguments).c_str());
+  std::remove(script.c_str());
+  return status;
+}
+
 // meshio (python3-meshio, which bootstrap.sh installs; an independent reader of VTK's XML
 // formats) reads the file back: the cell type and count, the points, and the displacement
 // and extra field bit for bit (the writer's ASCII keeps 17 digits).
@@ -205,15 +214,10 @@ TEST_P(MeshOutput, MeshioReadsTheFileBack) {
       "     n == int(sys.argv[4]) and np.array_equal(m.point_data['displacement'].ravel(), u) and \\\n"
       "     np.array_equal(m.point_data['field'].ravel(), f)\n"
       "sys.exit(0 if ok else 1)\n";
-  const std::string script = temp_path("dgtex_mesh_output_meshio.py");
-  std::ofstream(script) << check;
-  const std::string command = "/usr/bin/python3 " + script + " " + path + " " +
-                              (type == ElementType::quad8 ? "quad8" : "triangle6") + " " +
-                              std::to_string(mesh.num_elements()) + " " + std::to_string(mesh.num_nodes());
-  const int status = std::system(command.c_str());
+  const std::string arguments = path + " " + (type == ElementType::quad8 ? "quad8" : "triangle6") + " " +
+                                std::to_string(mesh.num_elements()) + " " + std::to_string(mesh.num_nodes());
+  EXPECT_EQ(python_check(check, "dgtex_mesh_output_meshio", arguments), 0) << arguments;
   std::remove(path.c_str());
-  std::remove(script.c_str());
-  EXPECT_EQ(status, 0) << command;
 }
 
 // VTK's own reader (python3-vtk9, when installed) opens the file with the expected cells.
@@ -233,13 +237,8 @@ TEST_P(MeshOutput, VtkReaderOpensTheFile) {
       "g.GetNumberOfPoints() == int(sys.argv[3]) and types == {int(sys.argv[4])} and "
       "pd.GetVectors() is not None and pd.GetVectors().GetName() == 'displacement' and pd.GetArray('zero') is not None\n"
       "sys.exit(0 if ok else 1)\n";
-  const std::string script = temp_path("dgtex_mesh_output_vtk.py");
-  std::ofstream(script) << check;
-  const std::string command = "/usr/bin/python3 " + script + " " + path + " " + std::to_string(mesh.num_elements()) +
-                              " " + std::to_string(mesh.num_nodes()) + " " +
-                              (type == ElementType::quad8 ? "23" : "22");
-  const int status = std::system(command.c_str());
+  const std::string arguments = path + " " + std::to_string(mesh.num_elements()) + " " +
+                                std::to_string(mesh.num_nodes()) + " " + (type == ElementType::quad8 ? "23" : "22");
+  EXPECT_EQ(python_check(check, "dgtex_mesh_output_vtk", arguments), 0) << arguments;
   std::remove(path.c_str());
-  std::remove(script.c_str());
-  EXPECT_EQ(status, 0) << command;
 }
