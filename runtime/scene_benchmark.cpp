@@ -109,11 +109,15 @@ double SceneBenchResult::steps_per_second() const {
 
 double SceneBenchResult::peak_step_ms() const { return series_max(times.step); }
 
-SceneBenchResult run_scene_benchmark(const Scene& scene, const std::string& name, int steps,
-                                     const std::function<void(int, int)>& progress, const SceneRunOptions& options) {
+void check_scene_benchmark_scene(const Scene& scene) {
   if (!scene.analysis.is_dynamic())
     throw std::invalid_argument("scene '" + scene.source_name +
                                 "' is a static analysis; the scene benchmark steps \"analysis\": {\"type\": \"dynamic\", ...}");
+}
+
+SceneBenchResult run_scene_benchmark(const Scene& scene, const std::string& name, int steps,
+                                     const std::function<void(int, int)>& progress, const SceneRunOptions& options) {
+  check_scene_benchmark_scene(scene);
   if (steps < 0) throw std::invalid_argument("steps = " + std::to_string(steps) + ", need >= 0 (0: the scene's own)");
   if (steps == 0) steps = scene.analysis.steps;
 

@@ -225,7 +225,7 @@ TEST(CliOptions, BenchScenesReadsEverySceneBeforeTheFirstRuns) {
                                   "/clamped_plate.json --json " + (dir / "t.json").string(),
                               dir);
   EXPECT_EQ(r.exit_code, 2) << r.stderr_text;
-  EXPECT_EQ(r.stderr_text.rfind("dgtex bench scenes: --scenes: '" + kScenes + "/clamped_plate.json' is a static analysis", 0),
+  EXPECT_EQ(r.stderr_text.rfind("dgtex bench scenes: --scenes: scene '" + kScenes + "/clamped_plate.json' is a static analysis", 0),
             0u)
       << r.stderr_text;
   EXPECT_FALSE(fs::exists(dir / "t.json"));  // nothing ran

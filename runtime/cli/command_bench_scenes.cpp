@@ -419,13 +419,12 @@ int bench_scenes_command(int argc, char** argv) {
   for (const SceneEntry& entry : entries) {
     try {
       loaded.push_back(load_scene(entry.path));
+      check_scene_benchmark_scene(loaded.back());
     } catch (const SceneError& e) {
       std::fprintf(stderr, "dgtex bench scenes: %s\n", e.what());
       return 2;
-    }
-    if (!loaded.back().analysis.is_dynamic()) {
-      std::fprintf(stderr, "dgtex bench scenes: --scenes: '%s' is a static analysis; the scene benchmark steps "
-                   "\"analysis\": {\"type\": \"dynamic\", ...}\n", entry.path.c_str());
+    } catch (const std::invalid_argument& e) {
+      std::fprintf(stderr, "dgtex bench scenes: --scenes: %s\n", e.what());
       return 2;
     }
   }

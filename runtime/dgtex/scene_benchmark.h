@@ -89,6 +89,10 @@ double series_mean(const std::vector<double>& v);
 double series_max(const std::vector<double>& v);
 double series_median(std::vector<double> v);
 
+// Throws std::invalid_argument, naming the scene, unless it is a dynamic analysis (what
+// run_scene_benchmark steps; for a caller that checks its scenes before running any).
+void check_scene_benchmark_scene(const Scene& scene);
+
 // Runs a dynamic scene from rest for `steps` steps (0: the scene's own analysis.steps)
 // with the current OpenMP thread count. `progress(step, steps)` (may be empty) is called
 // after every step. Throws std::invalid_argument for a static scene or steps < 0, and

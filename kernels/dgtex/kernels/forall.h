@@ -44,7 +44,7 @@ void run_rejoining(std::int64_t n, Loop&& loop) {
 // 'std::bad_alloc'"). Inside one, work runs through run(): the first exception is kept, work
 // started after it is skipped, and rethrow() passes it on once the region is over, as the
 // serial loop would have thrown it. forall guards each thread's whole block of indices, not
-// each index: a guard per index cost the Table 5.1 scenes a third of their speed.
+// each index (a guard per index read a third slower in one sitting; bench_scenes_history.md).
 class RegionFailure {
  public:
   template <class Work>
