@@ -54,6 +54,8 @@ TEST(CliOptions, BadValuesAreOneLineNamingTheCommandAndOption) {
       {"render x.state --out DIR/r.png --camera-position 1 1 1 --camera-target 1 1 1",
        "dgtex render: --camera-target: 1 1 1: the camera's own position"},
       {"render x.state --out DIR/r.png --shading bogus", "dgtex render: --shading: shading 'bogus' (valid: flat, smooth)"},
+      {"render x.state --out DIR/r.png --camera-position 0 0 5 --camera-up 0 0 1",
+       "dgtex render: --camera-up: 0 0 1: parallel to the viewing direction"},
       {"bench scenes --threads 1 --cut-update-threads 1",
        "dgtex bench scenes: --cut-update-threads: 1 is more than the steps' threads (1) can spare"},
       {"bench scaling --threads-list 2,1", "dgtex bench scaling: --threads-list: 2,1; expected increasing thread counts"},

@@ -125,11 +125,12 @@ int render_command(int argc, char** argv) {
     if (!(norm3(view) > 0))
       return refuse("--camera-target: " + text({look[0], look[1], look[2]}) +
                     ": the camera's own position; expected a point away from it");
-    const std::vector<double> u = up.empty() ? std::vector<double>(settings.camera_up, settings.camera_up + 3) : up;
+    // A given up along the view is refused; without one the renderer picks a perpendicular
+    // (a camera straight above the shell, --camera-position 0 0 5).
     std::vector<double> side(3);
-    kernels::cross3(view.data(), u.data(), side.data());
-    if (!(norm3(side) > 1e-9 * norm3(view) * norm3(u)))
-      return refuse("--camera-up: " + text(u) + ": parallel to the viewing direction; expected another up");
+    if (!up.empty()) kernels::cross3(view.data(), up.data(), side.data());
+    if (!up.empty() && !(norm3(side) > 1e-9 * norm3(view) * norm3(up)))
+      return refuse("--camera-up: " + text(up) + ": parallel to the viewing direction; expected another up");
   }
   if (const std::string image = image_path(out_dir).string();
       !outputs_are_distinct(app, {{"--out", &image}}, {{"the state file", state_path}}))
