@@ -1,6 +1,5 @@
 #include "dgtex/shell_state.h"
 
-#include <array>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
@@ -10,6 +9,8 @@
 #include <stdexcept>
 #include <string>
 #include <type_traits>
+
+#include <zlib.h>
 
 namespace dgtex {
 namespace {
@@ -26,26 +27,14 @@ constexpr std::uint32_t kFirstVersionWithChecksum = 2;
 constexpr std::uint64_t kMaxCount = std::uint64_t(1) << 34;
 constexpr int kMaxResolution = 1 << 14;
 
-// CRC-32 (IEEE 802.3, reflected polynomial 0xEDB88320), as zlib and PNG compute it.
+// A running CRC-32 (IEEE 802.3), zlib's: the one PNG's chunks carry.
 class Crc32 {
  public:
-  void add(const void* data, size_t n) {
-    static const std::array<std::uint32_t, 256> table = [] {
-      std::array<std::uint32_t, 256> t{};
-      for (std::uint32_t i = 0; i < 256; ++i) {
-        std::uint32_t c = i;
-        for (int k = 0; k < 8; ++k) c = (c & 1) ? 0xEDB88320u ^ (c >> 1) : c >> 1;
-        t[i] = c;
-      }
-      return t;
-    }();
-    const auto* bytes = static_cast<const unsigned char*>(data);
-    for (size_t i = 0; i < n; ++i) state_ = table[(state_ ^ bytes[i]) & 0xFFu] ^ (state_ >> 8);
-  }
-  std::uint32_t value() const { return state_ ^ 0xFFFFFFFFu; }
+  void add(const void* data, size_t n) { state_ = crc32_z(state_, static_cast<const Bytef*>(data), n); }
+  std::uint32_t value() const { return static_cast<std::uint32_t>(state_); }
 
  private:
-  std::uint32_t state_ = 0xFFFFFFFFu;
+  uLong state_ = crc32_z(0, Z_NULL, 0);
 };
 
 bool host_is_little_endian() {
