@@ -73,10 +73,6 @@ void ShellSimulation::set_state(std::vector<double> u, std::vector<double> v) {
   v_ = std::move(v);
   previous_v_.clear();
   previous_previous_v_.clear();
-  const auto moved = [](const std::vector<double>& x) {
-    return std::any_of(x.begin(), x.end(), [](double value) { return value != 0; });
-  };
-  deformed_ = deformed_ || moved(u_) || moved(v_);  // a state carried over (a basis change)
 }
 
 std::string ShellSimulation::enrichment_hint() const {
@@ -318,7 +314,10 @@ void ShellSimulation::step(const DynamicsOptions& o) {
     // Away from rest (after steps, or from a state carried over a basis change) the deformed
     // state is the likelier cause of a corotated failure (a load 1e5 times gravity on chad
     // failed at its 36th step whatever the penalty): a failed run, not bad input.
-    if (o.corotational && deformed_)
+    const auto away_from_rest = [](const std::vector<double>& x) {
+      return std::any_of(x.begin(), x.end(), [](double value) { return value != 0; });
+    };
+    if (o.corotational && (away_from_rest(u_) || away_from_rest(v_)))
       throw std::runtime_error("dynamic system matrix not positive definite in the deformed state: the run has "
                                "likely diverged (a smaller time step or smaller loads?), or the penalty = " +
                                detail::short_number(model_.options().penalty) + " is too low for it; " + e.what() +
@@ -329,7 +328,6 @@ void ShellSimulation::step(const DynamicsOptions& o) {
   }
   for (int d = 0; d < ndofs; ++d) u_[d] += dt * v_[d];
   time_ += dt;
-  deformed_ = true;
 }
 
 double ShellSimulation::kinetic_energy() const {

@@ -87,7 +87,6 @@ class ShellSimulation {
   SparseCholesky cholesky_;
   std::vector<double> u_, v_;
   double time_ = 0;
-  bool deformed_ = false;  // stepped, or set to a state away from rest (for the failure messages)
   StageTimings timings_;
   std::vector<double> linear_k_;  // cached linear stiffness blocks
   double factorised_dt_ = -1;     // linear dynamics: the dt whose matrix is factorised
