@@ -124,9 +124,10 @@ void check_tolerance_accuracy_options(const ToleranceAccuracyOptions& options) {
   for (const auto& [series, list] : {std::pair{"shell", &options.shell_tolerances},
                                       std::pair{"multigrid", &options.multigrid_tolerances}})
     for (double tol : *list)
-      if (!(tol >= 1e-12 && tol < 1))  // below it round-off stalls the solves (they failed after the work began)
+      if (!(tol >= detail::kMinRelativeTolerance && tol < 1))
         throw std::invalid_argument("tolerance accuracy: " + std::string(series) + " tolerance " +
-                                    detail::short_number(tol) + "; need 1e-12 <= tol < 1");
+                                    detail::short_number(tol) + "; need " +
+                                    detail::short_number(detail::kMinRelativeTolerance) + " <= tol < 1");
   // The slit domain's size (T = 3 was refused only after the shell series had run; T =
   // 100000 ended in a bare std::bad_alloc). Its reference is a CHOLMOD solve, which at T =
   // 2048 took 63 s and 3.1 GB (dgtex bench laplace, 2-core EPYC); 4096 has 4x the texels.

@@ -12,6 +12,11 @@
 
 namespace dgtex::detail {
 
+// The smallest relative tolerance the solvers are asked for (the CLI's --tolerance options,
+// bench accuracy's sweeps): below it round-off stalls a double-precision solve (the
+// multigrid's residual near 1e-14), and 1e-300 failed only after the work began.
+inline constexpr double kMinRelativeTolerance = 1e-12;
+
 // A value in a message, "%g" ("-0.005", "nan", "inf").
 inline std::string short_number(double x) {
   char text[32];

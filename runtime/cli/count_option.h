@@ -14,6 +14,7 @@
 #include <string>
 #include <vector>
 
+#include "api_argument_checks.h"
 #include "dgtex/texel_memory_estimate.h"
 
 namespace dgtex::cli {
@@ -65,21 +66,19 @@ inline bool thread_counts_increase(const CLI::App& app, const std::vector<int>& 
   return false;
 }
 
-// A relative tolerance a double-precision solve can reach: kMinRelativeTolerance <= t < 1
-// (0, a negative or NaN could never be met, and 1e-300 failed after the work began: the
-// multigrid's residual stalls near 1e-14; 1 is met by any guess).
-inline constexpr double kMinRelativeTolerance = 1e-12;
+// A relative tolerance a double-precision solve can reach: detail::kMinRelativeTolerance <=
+// t < 1 (0, a negative or NaN could never be met; 1 is met by any guess).
 inline CLI::Validator relative_tolerance() {
+  const std::string valid = "[" + detail::short_number(detail::kMinRelativeTolerance) + ", 1)";
   return CLI::Validator(
-      [](std::string& value) -> std::string {
+      [valid](std::string& value) -> std::string {
         double t = 0;
-        if (!CLI::detail::lexical_cast(value, t) || !(t >= kMinRelativeTolerance && t < 1))
-          return "Value " + value +
-                 " is not a relative tolerance a double-precision solve can reach; expected a number in [1e-12, 1), "
-                 "e.g. 1e-8";
+        if (!CLI::detail::lexical_cast(value, t) || !(t >= detail::kMinRelativeTolerance && t < 1))
+          return "Value " + value + " is not a relative tolerance a double-precision solve can reach; expected a " +
+                 "number in " + valid + ", e.g. 1e-8";
         return "";
       },
-      "[1e-12, 1)");
+      valid);
 }
 
 // A colour component in [0, 1] (NaN refused).
