@@ -12,6 +12,14 @@ std::int64_t model_memory_lower_bound(ElementType type, std::int64_t elements) {
   return elements * (type == ElementType::tri6 ? kTri6ModelBytesPerElement : kQuad8ModelBytesPerElement);
 }
 
+SceneMeshSize scene_mesh_size(const Scene& scene) {
+  if (scene.mesh.source != MeshSource::file)
+    return {scene.mesh.element.value_or(ElementType::quad8), scene.mesh.generated_elements()};
+  const ObjFaceCount count = count_obj_faces(scene.mesh.file);
+  if (count.first_face_corners != 3 && count.first_face_corners != 4) return {};
+  return {count.first_face_corners == 3 ? ElementType::tri6 : ElementType::quad8, count.faces};
+}
+
 void check_model_memory(const Scene& scene, ElementType type, std::int64_t elements, std::int64_t available_bytes) {
   if (available_bytes < 0) return;
   const std::int64_t needed = model_memory_lower_bound(type, elements);
@@ -34,28 +42,18 @@ void check_model_memory(const Scene& scene, ElementType type, std::int64_t eleme
 
 std::string model_memory_caution(const Scene& scene, std::int64_t available_bytes) {
   if (available_bytes < 0) return "";
-  if (scene.mesh.source == MeshSource::file) {
-    // Its faces counted as the reader will read them (a line scan, cheap next to parsing).
-    const ObjFaceCount count = count_obj_faces(scene.mesh.file);
-    if (count.first_face_corners != 3 && count.first_face_corners != 4) return "";  // refused when read
-    const ElementType type = count.first_face_corners == 3 ? ElementType::tri6 : ElementType::quad8;
-    const std::int64_t needed = model_memory_lower_bound(type, count.faces);
-    if (!near_memory_limit(needed, available_bytes)) return "";
-    return "mesh.file \"" + scene.mesh.file + "\": the model of its " + std::to_string(count.faces) +
-           " elements needs at least " + memory_size_text(needed) + " of the " + memory_size_text(available_bytes) +
-           " of memory available, and runs measured 1.2-1.9x that bound; the run may be killed for memory (a coarser "
-           "mesh is safer)";
-  }
-  const std::int64_t elements = scene.mesh.generated_elements();
-  if (elements < 0) return "";
-  const ElementType type = scene.mesh.element.value_or(ElementType::quad8);
-  const std::int64_t needed = model_memory_lower_bound(type, elements);
+  const SceneMeshSize size = scene_mesh_size(scene);
+  if (size.elements < 0) return "";
+  const std::int64_t needed = model_memory_lower_bound(size.type, size.elements);
   if (!near_memory_limit(needed, available_bytes)) return "";
-  return "mesh.divisions [" + std::to_string(scene.mesh.divisions[0]) + ", " + std::to_string(scene.mesh.divisions[1]) +
-         "]: the model of its " + std::to_string(elements) + " elements needs at least " + memory_size_text(needed) +
-         " of the " + memory_size_text(available_bytes) +
-         " of memory available, and runs measured 1.2-1.9x that bound; the run may be killed for memory (fewer "
-         "divisions are safer)";
+  const bool generated = scene.mesh.source != MeshSource::file;
+  const std::string what = generated ? "mesh.divisions [" + std::to_string(scene.mesh.divisions[0]) + ", " +
+                                           std::to_string(scene.mesh.divisions[1]) + "]"
+                                     : "mesh.file \"" + scene.mesh.file + "\"";
+  return what + ": the model of its " + std::to_string(size.elements) + " elements needs at least " +
+         memory_size_text(needed) + " of the " + memory_size_text(available_bytes) +
+         " of memory available, and runs measured 1.2-1.9x that bound; the run may be killed for memory (" +
+         (generated ? "fewer divisions are safer)" : "a coarser mesh is safer)");
 }
 
 }  // namespace dgtex

@@ -21,14 +21,8 @@ Mesh build_scene_mesh(const Scene& scene) {
   const ElementType type = m.element.value_or(ElementType::quad8);
   // A model that cannot fit is refused before its mesh is built (a file's from its faces,
   // counted as load_obj will read them, before it is parsed).
-  if (const std::int64_t elements = m.generated_elements(); elements >= 0)
-    check_model_memory(scene, type, elements, available_memory_bytes());
-  if (m.source == MeshSource::file) {
-    const ObjFaceCount count = count_obj_faces(m.file);
-    if (count.first_face_corners == 3 || count.first_face_corners == 4)
-      check_model_memory(scene, count.first_face_corners == 3 ? ElementType::tri6 : ElementType::quad8, count.faces,
-                         available_memory_bytes());
-  }
+  if (const SceneMeshSize size = scene_mesh_size(scene); size.elements >= 0)
+    check_model_memory(scene, size.type, size.elements, available_memory_bytes());
   switch (m.source) {
     case MeshSource::rectangle:
       return make_rectangle(m.size[0], m.size[1], m.divisions[0], m.divisions[1], type, m.triangles);

@@ -4,8 +4,8 @@
 // rectangle of 400 x 400 quad8 elements outgrew a 23 GB machine and the system killed the
 // run minutes in, and a typo such as divisions [100000, 100] (within the scene file's 1e7
 // cells) would do so after building a mesh of 10 million elements. The scene's mesh is
-// checked against a lower bound of that memory before it is built (a file's after it is
-// read), and refused with one line (a SceneError naming mesh.divisions or mesh.file, the
+// checked against a lower bound of that memory before it is built (a file's from its
+// counted faces, before it is parsed), and refused with one line (a SceneError naming mesh.divisions or mesh.file, the
 // bound, the memory available and the most elements that could fit).
 //
 // The bound per element, from the peak resident memory of examples/scenes/clamped_plate.json
@@ -28,6 +28,16 @@ inline constexpr std::int64_t kTri6ModelBytesPerElement = 40 * 1024;
 
 // Lower bound of the peak memory of a model of `elements` elements of `type`, in bytes.
 std::int64_t model_memory_lower_bound(ElementType type, std::int64_t elements);
+
+// The element type and count of a scene's mesh before it is built: a generator's from its
+// divisions, a file's from its faces as load_obj will read them (count_obj_faces, a line
+// scan); elements -1 where there is none (a file whose first face is neither a triangle nor
+// a quad, which the reader refuses). For the check and the caution below.
+struct SceneMeshSize {
+  ElementType type = ElementType::quad8;
+  std::int64_t elements = -1;
+};
+SceneMeshSize scene_mesh_size(const Scene& scene);
 
 // Throws SceneError(scene.source_name, "mesh.divisions" (generators) or "mesh.file", ...)
 // when the lower bound for `elements` elements exceeds available_bytes, naming both and the
