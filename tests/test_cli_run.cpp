@@ -193,6 +193,50 @@ TEST(CliRun, APenaltyFarAboveItsThresholdIsCautioned) {
   EXPECT_EQ(plain.stderr_text, "");
 }
 
+// A linear result that turns the shell by more than kLinearRotationCautionAbove is
+// cautioned (dgtex/rotation_caution.h), in statics and, at the step where it was largest, in
+// linear dynamics; the same dynamics corotated is not. Both runs succeed.
+TEST(CliRun, ALinearResultWithLargeRotationsIsCautioned) {
+  const fs::path dir = fresh_dir("rotation_caution");
+  nlohmann::json plate;
+  std::ifstream(std::string(DGTEX_SOURCE_DIR) + "/examples/scenes/clamped_plate.json") >> plate;
+  plate["loads"][0]["force_per_area"] = {0, 0, -1000};  // 13.8 m at the centre of the 1 m plate
+  std::ofstream(dir / "plate.json") << plate.dump();
+  const Result statics = dgtex::test::run_cli("run " + (dir / "plate.json").string() + " --out " +
+                                              (dir / "plate").string() + " --quiet --no-render", dir);
+  EXPECT_EQ(statics.exit_code, 0) << statics.stderr_text;
+  EXPECT_NE(statics.stderr_text.find("dgtex run: warning: " + (dir / "plate.json").string() +
+                                     ": the linear solution moves two nodes of element "),
+            std::string::npos)
+      << statics.stderr_text;
+  EXPECT_NE(statics.stderr_text.find("\"corotational\": true"), std::string::npos) << statics.stderr_text;
+
+  nlohmann::json cantilever;
+  std::ifstream(std::string(DGTEX_SOURCE_DIR) + "/examples/scenes/demo_cantilever.json") >> cantilever;
+  cantilever.erase("render");
+  cantilever["loads"][0]["acceleration"] = {0, 0, -20};  // linear tip deflection ~0.6 m: ~0.8 rad
+  cantilever["analysis"]["steps"] = 40;
+  for (const bool corotational : {false, true}) {
+    cantilever["analysis"]["corotational"] = corotational;
+    const std::string name = corotational ? "corotated" : "linear";
+    std::ofstream(dir / (name + ".json")) << cantilever.dump();
+    const Result r = dgtex::test::run_cli("run " + (dir / (name + ".json")).string() + " --out " + (dir / name).string() +
+                                          " --quiet --no-render", dir);
+    EXPECT_EQ(r.exit_code, 0) << r.stderr_text;
+    if (corotational) {
+      EXPECT_EQ(r.stderr_text, "");
+    } else {
+      // Elements 9 and 19 end the 10 x 2 strip.
+      const bool at_tip = r.stderr_text.find(": the linear solution moves two nodes of element 9 relative to each other "
+                                             "by ") != std::string::npos ||
+                          r.stderr_text.find(": the linear solution moves two nodes of element 19 relative to each other "
+                                             "by ") != std::string::npos;
+      EXPECT_TRUE(at_tip) << r.stderr_text;
+      EXPECT_NE(r.stderr_text.find(" times their distance at step "), std::string::npos) << r.stderr_text;
+    }
+  }
+}
+
 // An OBJ whose two quads repeat the vertices of their shared side runs as two pieces: the
 // run says so (mesh_validation.h, unwelded_seam_caution) and runs.
 TEST(CliRun, AnUnweldedSeamIsCautioned) {

@@ -23,6 +23,7 @@
 #include "dgtex/model_error.h"
 #include "dgtex/model_memory_estimate.h"
 #include "dgtex/penalty_caution.h"
+#include "dgtex/rotation_caution.h"
 #include "dgtex/scene_io.h"
 #include "dgtex/scene_run.h"
 #include "dgtex/shell_state.h"
@@ -154,8 +155,20 @@ int run_command(int argc, char** argv) {
   }
   const fs::path out(out_dir);
   int vtu_frames = 0;
+  // A linear run's largest rotation (dgtex/rotation_caution.h), read at every frame.
+  const bool linear = !scene.analysis.is_dynamic() || !scene.analysis.corotational;
+  LargestRotation largest_rotation_seen;
+  int largest_rotation_step = 0;
+  auto track_rotation = [&](int step) {
+    const LargestRotation now = largest_rotation(mesh, run->displacement().data());
+    if (now.value > largest_rotation_seen.value) {
+      largest_rotation_seen = now;
+      largest_rotation_step = step;
+    }
+  };
   auto write_frame = [&](int index) {
     write_vtu((out / "frames" / frame_name(index)).string(), mesh, run->displacement().data());
+    if (linear) track_rotation(index);
     ++vtu_frames;
     if (png_frames) png_frames->write(run->state(), index);
   };
@@ -169,6 +182,7 @@ int run_command(int argc, char** argv) {
       std::fprintf(stderr, "dgtex run: removed %d files of an earlier run from %s\n", removed, out_dir.c_str());
     if (!scene.analysis.is_dynamic()) {
       run->solve_static();
+      if (linear) track_rotation(0);
       if (png_frames) png_frames->write(run->state(), 0);
     } else {
       const int every = scene.render ? scene.render->every_steps : 10;
@@ -290,6 +304,9 @@ int run_command(int argc, char** argv) {
                  "changes fast from step to step, e.g. a mode with almost no mass going unstable); check the "
                  "result, see README \"Stability where methods fail\"\n",
                  solver.stale_factor_failures, solver.solves);
+  const std::string when = scene.analysis.is_dynamic() ? "at step " + std::to_string(largest_rotation_step) : "";
+  if (const std::string caution = linear_rotation_caution(largest_rotation_seen, when); !caution.empty())
+    std::fprintf(stderr, "dgtex run: warning: %s: %s\n", scene_path.c_str(), caution.c_str());
   report["time"] = run->time();
   report["threads"] = omp_get_max_threads();
   report["reserved_step_memory_bytes"] = run->reserved_step_memory_bytes();
