@@ -8,7 +8,9 @@
 #include <type_traits>
 #include <utility>
 
+#include "dgtex/cut_path.h"
 #include "dgtex/kernels/forall.h"
+#include "dgtex/kernels/shape_functions.h"
 #include "dgtex/model_error.h"
 #include "dgtex/side_by_side.h"
 #include "api_argument_checks.h"
@@ -122,41 +124,44 @@ void ShellSimulation::check_statically_constrained() {
   double squared_radius = 0;
   for (int i = 0; i < n; ++i) squared_radius += (Eigen::Map<const Eigen::Vector3d>(mesh.node(i)) - centre).squaredNorm();
   const double radius = std::sqrt(squared_radius / n);
-  const int ndofs = model_.num_dofs();
-  Eigen::MatrixXd modes = Eigen::MatrixXd::Zero(ndofs, 6);
-  for (int i = 0; i < n; ++i) {
-    const Eigen::Vector3d x = (Eigen::Map<const Eigen::Vector3d>(mesh.node(i)) - centre) / radius;
+  // What holds them: each fixed DOF (the six modes' values there), and each clamped edge, which
+  // holds its normal n fixed in space (shell_edge_kernel.cpp) and so every rotation w with
+  // w x n != 0: rows (e_c' x n)_c over the rotation modes, scaled like them by the radius.
+  // Geometric, so a thin shell's clamp counts whatever its bending stiffness (a test of the
+  // stiffness's energy against its largest entry refused a cantilever 1 mm thick, whose
+  // membrane terms outweigh the clamp's bending terms by ~(h / element size)^2).
+  std::vector<Eigen::Matrix<double, 1, 6>> rows;
+  for (int d = 0; d < 3 * n; ++d) {
+    if (!fixed_[d]) continue;
+    const Eigen::Vector3d x = (Eigen::Map<const Eigen::Vector3d>(mesh.node(d / 3)) - centre) / radius;
+    Eigen::Matrix<double, 1, 6> row = Eigen::Matrix<double, 1, 6>::Zero();
+    row(d % 3) = 1;
+    for (int axis = 0; axis < 3; ++axis) row(3 + axis) = Eigen::Vector3d::Unit(axis).cross(x)(d % 3);
+    rows.push_back(row);
+  }
+  for (int k = 0; k < model_.num_clamped_edges(); ++k) {
+    const auto [element, local_edge] = model_.clamped_edge(k);
+    double xi[2], dxi[2];
+    kernels::local_edge_point(mesh.type, local_edge, 0.0, xi, dxi);
+    Vec3 position, normal;
+    element_surface_point(mesh, element, xi, position, normal);
+    const Eigen::Vector3d unit_normal(normal.data());
+    if (!(unit_normal.norm() > 0)) continue;
     for (int c = 0; c < 3; ++c) {
-      modes(3 * i + c, c) = 1;
-      const Eigen::Vector3d axis = Eigen::Vector3d::Unit(c);
-      modes.block<3, 1>(3 * i, 3 + c) = axis.cross(x);
+      Eigen::Matrix<double, 1, 6> row = Eigen::Matrix<double, 1, 6>::Zero();
+      for (int axis = 0; axis < 3; ++axis) row(3 + axis) = Eigen::Vector3d::Unit(axis).cross(unit_normal)(c);
+      rows.push_back(row);
     }
   }
-  int nfixed = 0;
-  for (char f : fixed_) nfixed += f != 0;
-  Eigen::MatrixXd held(std::max(nfixed, 1), 6);
-  held.setZero();
-  for (int d = 0, r = 0; d < 3 * n; ++d)
-    if (fixed_[d]) held.row(r++) = modes.row(d);
-  // Rigid motions that no fixed DOF sees: the null space of `held`.
+  Eigen::MatrixXd held = Eigen::MatrixXd::Zero(std::max<std::size_t>(rows.size(), 1), 6);
+  for (std::size_t r = 0; r < rows.size(); ++r) held.row(r) = rows[r];
+  // Rigid motions that nothing holds: the null space of `held`.
   Eigen::JacobiSVD<Eigen::MatrixXd> svd(held, Eigen::ComputeFullV);
   const double scale = std::max(1.0, svd.singularValues()(0));
   std::vector<int> free_modes;
   for (int k = 0; k < 6; ++k)
     if (k >= svd.singularValues().size() || svd.singularValues()(k) <= 1e-9 * scale) free_modes.push_back(k);
   if (free_modes.empty()) return;
-  Eigen::MatrixXd motions(ndofs, free_modes.size());
-  for (size_t k = 0; k < free_modes.size(); ++k) motions.col(k) = modes * svd.matrixV().col(free_modes[k]);
-  // Clamped edges may still hold them: check the energy the stiffness gives these motions.
-  const std::vector<double>& K = linear_stiffness();
-  double kmax = 0;
-  for (double value : K) kmax = std::max(kmax, std::abs(value));
-  Eigen::MatrixXd KW(ndofs, free_modes.size());
-  for (size_t k = 0; k < free_modes.size(); ++k) block_multiply(model_.pattern(), K.data(), motions.col(k).data(), KW.col(k).data());
-  const Eigen::MatrixXd energy = motions.transpose() * KW;
-  const Eigen::MatrixXd norm = motions.transpose() * motions;
-  Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::MatrixXd> eig(energy, norm);
-  if (eig.eigenvalues()(0) > 1e-8 * kmax) return;
   const Eigen::VectorXd w = svd.matrixV().col(free_modes[0]);
   int dominant = 0;
   w.cwiseAbs().maxCoeff(&dominant);

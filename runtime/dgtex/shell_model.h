@@ -12,10 +12,13 @@
 // enriched kernels (texel-resolving quadrature, enriched_quadrature.h); all others by the
 // standard ones. Without enrichments everything is exactly the plain DG shell.
 // Units: those of the scene.
-// Keeps no reference to the topology or sections it was built from.
+// Keeps no reference to the topology or sections it was built from. The references its
+// accessors return (pattern, mass_blocks, rest_state, enrichments, material_textures) hold
+// until the next set_enrichments or set_material_textures, which rebuild them.
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <utility>
 #include <vector>
 
 #include "dgtex/block_assembly.h"
@@ -62,7 +65,8 @@ class ShellModel {
   // clamped_edges: indices into topology.boundary_edges whose normal is held (clamp).
   // Checks its inputs first: MeshError for a mesh validate_mesh refuses; std::invalid_argument
   // for a topology of another mesh, #sections != #elements, a section that is no material,
-  // a clamped edge out of range or an option out of its range, naming the value.
+  // a clamped edge out of range or listed twice, or an option out of its range, naming the
+  // value.
   ShellModel(Mesh mesh, const Topology& topology, std::vector<kernels::ShellSection> sections,
              const std::vector<int>& clamped_edges, ShellModelOptions options);
 
@@ -72,6 +76,11 @@ class ShellModel {
   int num_edges() const { return static_cast<int>(edges_.size() / 4); }
   int num_interior_edges() const { return num_interior_edges_; }
   int num_clamped_edges() const { return num_edges() - num_interior_edges_; }
+  // Clamped edge k (0 <= k < num_clamped_edges(), unchecked): its element and local edge.
+  std::pair<int, int> clamped_edge(int k) const {
+    const int* edge = edges_.data() + 4 * static_cast<std::size_t>(num_interior_edges_ + k);
+    return {edge[0], edge[1]};
+  }
   std::int64_t num_quadrature_points() const;  // element + edge points (enriched ones included)
   const BlockAssembly& pattern() const { return assembly_; }
   const ShellModelOptions& options() const { return options_; }
@@ -100,8 +109,9 @@ class ShellModel {
   // Throws std::invalid_argument naming the function, element or node for: textures not
   // all T x T (T >= 1) or with non-finite values, unsorted/duplicate/out-of-range nodes or
   // elements, an element incident to an enriched node that has no texture of that
-  // function, or more than kernels::max_enrichments_per_element functions on one element;
-  // each before anything changes, so the model keeps its basis when it throws.
+  // function, more than kernels::max_enrichments_per_element functions on one element, or an
+  // enriched element that has a material texture; each before anything changes, so the
+  // model keeps its basis when it throws.
   // Enriched nodes below options().min_enrichment_mass_ratio are dropped (and functions
   // left without nodes), so enrichments() may hold less than was given.
   // Cost: an enriched element whose textures (and enriched nodes and shifts) are bitwise
@@ -197,12 +207,14 @@ class ShellModel {
   // row is complete only once the whole sum is.
   bool fuses_stiffness_products() const { return !enriched_elements_.empty() || !textured_index_.empty(); }
 
-  // Consistent mass blocks (same pattern), assembled at construction.
+  // Consistent mass blocks (same pattern), assembled at construction and with every new
+  // basis or set of material textures.
   const std::vector<double>& mass_blocks() const { return mass_blocks_; }
 
   // Load vectors (#dofs, enriched functions included): body force per unit mass (gravity), force per unit area, and a
-  // point force at a parametric point of an element (distributed by the basis functions). A vector of another size
-  // or an element out of range throws std::invalid_argument (so does interpolate).
+  // point force at a parametric point of an element (distributed by the basis functions). A vector of another size,
+  // an element out of range or an xi outside the reference element (quad8 [-1, 1]^2; tri6 xi1, xi2 >= 0,
+  // xi1 + xi2 <= 1) throws std::invalid_argument (so does interpolate).
   void add_gravity(const double acceleration[3], std::vector<double>& f) const;
   void add_area_force(const double force_per_area[3], std::vector<double>& f) const;
   void add_point_force(int element, const double xi[2], const double force[3], std::vector<double>& f) const;
@@ -223,6 +235,8 @@ class ShellModel {
   // the same coordinates in the same element), the source's values there are read instead
   // of evaluated; `points_read_from_source`, if given, receives how many points were. The
   // right-hand sides of the projection of a state onto this basis (basis_projection.h).
+  // std::invalid_argument for a source on another mesh or a field of another size than
+  // source.num_dofs().
   std::vector<std::vector<double>> moments_of_fields(const ShellModel& source,
                                                      const std::vector<const std::vector<double>*>& fields,
                                                      std::int64_t* points_read_from_source = nullptr) const;
