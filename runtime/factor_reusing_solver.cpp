@@ -343,6 +343,10 @@ int FactorReusingSolver::pcg(const ScaledBlockSum& A, const std::vector<double>&
 
 void FactorReusingSolver::solve(const ScaledBlockSum& A, const std::vector<double>& b, std::vector<double>& x,
                                 SparseCholesky& cholesky, const std::vector<double>* stiffness_times_x) {
+  detail::check_size("FactorReusingSolver::solve", "b", b.size(), "#dofs", free_.size());
+  detail::check_size("FactorReusingSolver::solve", "x", x.size(), "#dofs", free_.size());
+  if (stiffness_times_x)
+    detail::check_size("FactorReusingSolver::solve", "stiffness_times_x", stiffness_times_x->size(), "#dofs", free_.size());
   ++stats_.solves;
   for (size_t d = 0; d < x.size(); ++d)
     if (!free_[d]) x[d] = 0;

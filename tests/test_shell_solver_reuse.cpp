@@ -390,6 +390,30 @@ TEST(FactorReuse, FallsBackToTheWholePatternWhenElementLocalIsTooWeak) {
   EXPECT_EQ(solver.statistics().factorizations, 2);  // element-local once, then A once (reused by solve 2)
 }
 
+// Vectors of another size were read and written out of bounds: refused, naming which.
+TEST(FactorReuse, VectorsOfAnotherSizeAreRefused) {
+  CylinderSystem cylinder;
+  const CompressedCylinder& c = cylinder.c;
+  FactorReusingSolver solver(c.model->pattern(), cylinder.system, c.model->mass_blocks());
+  const ScaledBlockSum A{1.0, &cylinder.K, 4e-6};
+  const std::size_t dofs = c.model->num_dofs();
+  std::vector<double> x(dofs, 0.0), short_b(c.load.begin(), c.load.end() - 1);
+  EXPECT_THROW(solver.solve(A, short_b, x, cylinder.cholesky), std::invalid_argument);
+  std::vector<double> long_x(dofs + 3, 0.0);
+  try {
+    solver.solve(A, c.load, long_x, cylinder.cholesky);
+    ADD_FAILURE() << "no exception";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_EQ(std::string(e.what()), "FactorReusingSolver::solve: x has " + std::to_string(dofs + 3) +
+                                         " entries; expected #dofs = " + std::to_string(dofs));
+  }
+  const std::vector<double> short_kx(dofs - 3, 0.0);
+  EXPECT_THROW(solver.solve(A, c.load, x, cylinder.cholesky, &short_kx), std::invalid_argument);
+  EXPECT_EQ(solver.statistics().solves, 0);
+  solver.solve(A, c.load, x, cylinder.cholesky);  // the right sizes still solve
+  EXPECT_LE(solver.statistics().last_relative_residual, solver.options().relative_tolerance);
+}
+
 TEST(FactorReuse, ElementLocalDroppedRadiusIsTheDefinitionsOnTheDenseMatrix) {
   // The reference: A formed densely, an entry dropped where its two nodes share no element
   // (from the mesh, not from the mass blocks), the radius summed entry by entry.

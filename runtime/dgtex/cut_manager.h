@@ -78,17 +78,21 @@ struct CutUpdateStats {
 class CutManager {
  public:
   // The mesh must outlive the manager. Throws MeshError for a mesh validate_mesh refuses,
-  // std::invalid_argument for a topology that is not build_topology(mesh)'s and for a cut
-  // the mesh cannot take (messages name cuts[i].points[j]; see trace_cut_path).
+  // std::invalid_argument for a topology that is not build_topology(mesh)'s, for a cut
+  // the mesh cannot take (messages name cuts[i].points[j]; see trace_cut_path) and for
+  // options it cannot use (texture_resolution < 2, new_cut_length shorter than a texel).
   CutManager(const Mesh& mesh, const Topology& topology, const std::vector<Cut>& cuts,
              const EnrichmentOptions& options, CutManagerOptions manager_options = {});
   // The mesh is kept by reference: a temporary one would dangle.
   CutManager(Mesh&&, const Topology&, const std::vector<Cut>&, const EnrichmentOptions&, CutManagerOptions = {}) = delete;
 
   // Brings the functions to `time` (finite, else std::invalid_argument); true when they
-  // changed (added, removed or re-solved).
+  // changed (added, removed or re-solved). A Laplace solve that fails throws
+  // std::runtime_error, memory std::bad_alloc; the manager is then half updated (a later
+  // update to the same time reports no change): discard it, as SceneRun does.
   bool update(double time);
 
+  // The references returned below (and their contents) hold until the next update().
   // One function per visible segment with texel data, in order of first appearance (a
   // function keeps its index while its cut grows). N_i holds only the nodes where H_i adds
   // to the span of the earlier functions (enrichment_span.h); a segment that adds nowhere

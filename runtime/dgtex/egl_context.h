@@ -11,7 +11,8 @@
 // listing every attempt and why it failed.
 //
 // The context is made current on the constructing thread; call make_current() before
-// using it from another thread (one thread at a time).
+// using it from another thread (one thread at a time; it throws std::runtime_error when
+// EGL refuses, e.g. while the context is current on another thread).
 // EglContext owns the EGL display connection and context (released by the destructor;
 // not copyable); share it between renderers through std::shared_ptr.
 #include <stdexcept>

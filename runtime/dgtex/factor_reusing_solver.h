@@ -144,7 +144,8 @@ struct ScaledBlockSum {
 
 class FactorReusingSolver {
  public:
-  // mass: num_blocks x 9 (kept by reference: it must outlive the solver).
+  // mass: num_blocks x 9 (kept by reference: it must outlive the solver). Throws
+  // std::invalid_argument for options set_options refuses.
   FactorReusingSolver(const BlockAssembly& pattern, const FreeDofSystem& system, const std::vector<double>& mass,
                       FactorReuseOptions options = {});
   // The three are kept by reference: temporaries would dangle.
@@ -155,7 +156,9 @@ class FactorReusingSolver {
   // b: #dofs (fixed entries ignored). x: #dofs, in: initial guess, out: solution with
   // fixed entries zero. `cholesky` is the factorisation of the whole pattern it reuses and
   // refreshes (analysed on first use) when the preconditioner pattern is full or after a
-  // fallback; the element-local factor is the solver's own. Throws NotPositiveDefinite from a factorisation.
+  // fallback; the element-local factor is the solver's own. Throws NotPositiveDefinite from a
+  // factorisation, std::runtime_error for a b that is not finite or no convergence even with
+  // a fresh factor, std::invalid_argument for b, x or stiffness_times_x of another size.
   // stiffness_times_x (optional): K times the initial guess x, when the caller has it (e.g.
   // from block_multiply_pair): saves one pass over K; the result is bitwise the same.
   void solve(const ScaledBlockSum& A, const std::vector<double>& b, std::vector<double>& x, SparseCholesky& cholesky,

@@ -27,7 +27,8 @@ struct LargestRotation {
   double value = 0;
   int element = -1;  // -1: no element moved
 };
-// `nodal_displacement`: #nodes x 3.
+// `nodal_displacement`: #nodes x 3, finite (not checked: a NaN pair is skipped, so a
+// non-finite result reads as no rotation; runs that diverge end before this is read).
 LargestRotation largest_rotation(const Mesh& mesh, const double* nodal_displacement);
 
 // One sentence for `dgtex run` to print after a linear analysis whose largest rotation

@@ -1,7 +1,9 @@
 #pragma once
 // The scene, version 1: the plain data that a scene file (JSON, see DESIGN.md and
-// scene_io.h) describes. Everything here has already been validated by parse_scene:
-// numbers are finite and in range, vectors that must be unit are unit, names are unique.
+// scene_io.h) describes. A scene from load_scene or parse_scene is validated: numbers are
+// finite and in range, vectors that must be unit are unit, names are unique; one built in
+// code is checked the same way by validate_scene (SceneRun, build_scene_mesh and
+// build_scene_model call it).
 // Lengths, forces and times are in the scene's own consistent units; angles in degrees.
 // Defaults of optional keys are written next to each field ("default: ...").
 // Plain value types (copying copies everything; no references). Quantities per field in
@@ -94,8 +96,8 @@ struct Load {
 
 // "analysis.damping": Rayleigh damping C = mass * M + stiffness * K.
 struct RayleighDamping {
-  double mass = 0;       // default: 0, >= 0
-  double stiffness = 0;  // default: 0, >= 0
+  double mass = 0;       // default: 0, >= 0; per unit time (SI: 1/s)
+  double stiffness = 0;  // default: 0, >= 0; a time (SI: s)
 };
 
 // "analysis": default: {"type": "static"}.

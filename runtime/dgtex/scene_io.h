@@ -7,7 +7,9 @@
 //
 // Checks that need the mesh (empty boundary selections, statically unconstrained models,
 // surface points outside the mesh) live in scene_mesh_checks.h.
-// Pure functions (thread-safe); load_scene reads one file.
+// Thread-safe, but not pure: load_scene reads the file, and parse_scene and validate_scene
+// check that mesh.file and the material textures' images exist and are regular files
+// (validate_scene resolves relative paths against the working folder).
 #include <stdexcept>
 #include <string>
 

@@ -91,15 +91,22 @@ class SceneRun {
   // Throws MeshError / SceneError (bad mesh or scene; also cuts and creases whose texel
   // fields cannot fit in the memory available, dgtex/texel_memory_estimate.h),
   // std::invalid_argument (a cut or crease the mesh cannot take, naming cuts[i] or
-  // creases[i]), ModelError (statically unconstrained model).
+  // creases[i]; SceneRunOptions out of range: cut_update_threads < 0, solver options
+  // FactorReusingSolver::set_options refuses; a malformed DGTEX_MEMORY_LIMIT_MB with cuts or
+  // creases), ModelError (statically unconstrained model).
   explicit SceneRun(const Scene& scene, SceneRunOptions options = {});
   ~SceneRun();
 
-  // Static analysis: solve K u = f with the cuts present at time 0.
+  // Static analysis: solve K u = f with the current basis (the cuts at time 0 before any
+  // step); it replaces the displacement. A dynamic scene is not refused (its loads' static
+  // equilibrium). Throws what ShellSimulation::solve_static throws.
   void solve_static();
   // One dynamic step of the scene's time step; std::logic_error for a static scene, and
   // after a step that threw (its cut manager may have moved on without the new basis: a
-  // retry went on with the old one).
+  // retry went on with the old one). A failing step throws what the shell step
+  // (ShellSimulation::step: ModelError, std::runtime_error) or the cut update
+  // (CutManager::update) threw, std::bad_alloc when memory runs out; only a new SceneRun
+  // can go on after it.
   void step();
 
   // The model and simulation of the current basis, and the displacement below: valid until
@@ -126,7 +133,7 @@ class SceneRun {
   // The state for rendering and export: mesh, nodal displacement and, per enrichment
   // function and element of its Omega_i, the texture, node shifts and DOFs.
   ShellState state() const;
-  // Displacement (standard and enriched DOFs) and velocity, #dofs each.
+  // Displacement (standard and enriched DOFs), #dofs; the velocity is simulation().velocity().
   const std::vector<double>& displacement() const { return simulation_->displacement(); }
 
  private:

@@ -14,9 +14,12 @@
 // enrichments per element; with the geometry-shader method a tessellation triangle
 // crossed by more than kMaxCutsPerTriangle cuts is not drawn (a hole where that many
 // cuts meet within one triangle; a finer tessellation separates them).
-// ShellRenderer owns its OpenGL objects and shares the EglContext (std::shared_ptr); not
-// thread-safe: use it from the thread its context is current on. Positions in the mesh's
-// length unit (SI: m); images in pixels.
+// ShellRenderer owns its OpenGL objects and shares the EglContext (std::shared_ptr). Its
+// constructor, render() and destructor make that context current on the calling thread
+// themselves; not thread-safe: one thread at a time per renderer, and renderers sharing a
+// context must not render at the same time (EGL allows a context current on one thread
+// only: eglMakeCurrent then fails, std::runtime_error). Positions in the mesh's length unit
+// (SI: m); images in pixels.
 #include <memory>
 #include <string>
 

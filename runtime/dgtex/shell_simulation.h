@@ -12,7 +12,9 @@
 // Every stage's time is recorded ("assembly", "solve").
 // ShellSimulation owns its state (u, v), free-DOF system and Cholesky factor and keeps a
 // reference to the ShellModel (which must outlive it). Not thread-safe; each call uses all
-// OpenMP threads. Units: those of the model (SI: m, m/s, s, N, kg).
+// OpenMP threads. Simulations sharing one ShellModel must not run at the same time either,
+// const calls (the energies) included: the assembly writes the model's scratch buffers.
+// Units: those of the model (SI: m, m/s, s, N, kg).
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -26,30 +28,35 @@
 namespace dgtex {
 
 struct DynamicsOptions {
-  double time_step = 1e-3;
+  double time_step = 1e-3;  // in the model's time unit (SI: s)
   bool corotational = false;
-  double mass_damping = 0;       // a in D = a M + b K
-  double stiffness_damping = 0;  // b
+  double mass_damping = 0;       // a in D = a M + b K, per unit time (SI: 1/s)
+  double stiffness_damping = 0;  // b, a time (SI: s)
   bool reuse_factorization = true;  // corotated: PCG with a lagged factor (see above)
 };
 
 class ShellSimulation {
  public:
   // fixed: #dofs flags; external_force: #dofs, finite (std::invalid_argument otherwise).
-  // Every method below throws std::logic_error once the model's basis or material
-  // textures changed (ShellModel::revision): build a new simulation for the new DOFs.
+  // set_state, check_statically_constrained, solve_static, step and the energies throw
+  // std::logic_error once the model's basis or material textures changed
+  // (ShellModel::revision): build a new simulation for the new DOFs. The accessors then
+  // still return the old basis's data.
   ShellSimulation(const ShellModel& model, std::vector<char> fixed, std::vector<double> external_force);
   // The model is kept by reference: a temporary one would dangle.
   ShellSimulation(ShellModel&&, std::vector<char>, std::vector<double>) = delete;
 
-  // Throws ModelError naming a free rigid-body mode if the constraints (fixed DOFs and
-  // clamped edges) leave one. Assembles the linear stiffness once and keeps it for
-  // solve_static and linear steps (a textured plate's assembly takes seconds).
+  // Throws ModelError naming a free rigid-body mode of the whole mesh if the constraints
+  // (fixed DOFs, and clamped edges, which hold their normals) leave one. Geometric: it
+  // assembles nothing.
   void check_statically_constrained();
   // Throws ModelError "stiffness not positive definite (penalty too low?)" when K is not.
   void solve_static();
   // std::invalid_argument unless options.time_step is positive and finite and the damping
-  // coefficients finite and >= 0.
+  // coefficients finite and >= 0. A failed step throws ModelError when the step matrix is
+  // not positive definite at rest (penalty too low), std::runtime_error when a corotated
+  // step fails away from rest (its matrix not positive definite, a right-hand side that is
+  // not finite, or no convergence even with a fresh factor: the run has likely diverged).
   void step(const DynamicsOptions& options);
 
   const std::vector<double>& displacement() const { return u_; }

@@ -36,6 +36,7 @@ struct ShellState {
   double time = 0;
 };
 
+// These functions share no state (thread-safe; two saves to one path race on the file).
 // Checks sizes and indices, and that time, positions, displacements (and their sums) and
 // enrichments are finite; throws std::invalid_argument naming the offending field.
 void validate_state(const ShellState& state);
