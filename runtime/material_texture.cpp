@@ -28,21 +28,16 @@ std::vector<ElementMaterialTexture> scene_material_textures(const Scene& scene, 
     if (mesh.type != ElementType::quad8)
       throw SceneError(scene.source_name, path, "material textures need quad8 elements", "",
                        "use \"element\": \"quad8\" in the mesh");
-    Image image;
+    GrayLevels image;
     try {
-      image = read_png(t.image);
+      image = read_png_gray_levels(t.image);
     } catch (const std::exception& error) {
       throw SceneError(scene.source_name, path + ".image", std::string("unreadable image: ") + error.what(),
                        "\"" + t.image + "\"", "a grayscale or RGB PNG file");
     }
-    // Gray per texel: RGB mean (a grayscale PNG arrives with R = G = B).
-    std::vector<double> values(static_cast<size_t>(image.width) * image.height);
-    for (int y = 0; y < image.height; ++y)
-      for (int x = 0; x < image.width; ++x) {
-        const std::uint8_t* p = image.pixel(x, y);
-        const double gray = (p[0] + p[1] + p[2]) / (3.0 * 255.0);
-        values[static_cast<size_t>(y) * image.width + x] = t.range[0] + (t.range[1] - t.range[0]) * gray;
-      }
+    // Gray per texel: RGB mean as stored (8- or 16-bit).
+    std::vector<double> values(image.gray.size());
+    for (std::size_t i = 0; i < values.size(); ++i) values[i] = t.range[0] + (t.range[1] - t.range[0]) * image.gray[i];
     std::vector<int> elements = t.elements;
     if (elements.empty())
       for (int e = 0; e < ne; ++e) elements.push_back(e);

@@ -2,7 +2,9 @@
 
 #include <png.h>
 
+#include <cstdint>
 #include <cstring>
+#include <vector>
 #include <stdexcept>
 
 namespace dgtex {
@@ -28,8 +30,10 @@ void write_png(const std::string& path, const Image& image) {
   }
 }
 
-Image read_png(const std::string& path) {
-  png_image png;
+namespace {
+
+// Opens `path` and reads its header: the size checked against kMaxPngSide.
+void begin_read(png_image& png, const std::string& path) {
   std::memset(&png, 0, sizeof(png));
   png.version = PNG_IMAGE_VERSION;
   if (!png_image_begin_read_from_file(&png, path.c_str())) {
@@ -45,14 +49,57 @@ Image read_png(const std::string& path) {
     throw std::runtime_error("cannot read PNG '" + path + "': " + size + " pixels; at most " +
                              std::to_string(kMaxPngSide) + " x " + std::to_string(kMaxPngSide) + " are read");
   }
-  png.format = PNG_FORMAT_RGBA;
-  Image image(static_cast<int>(png.width), static_cast<int>(png.height));
-  if (!png_image_finish_read(&png, nullptr, image.rgba.data(), 0, nullptr)) {
+}
+
+// Decodes the opened file into `pixels` in png.format (set by the caller).
+void finish_read(png_image& png, const std::string& path, void* pixels) {
+  if (!png_image_finish_read(&png, nullptr, pixels, 0, nullptr)) {
     const std::string message = png.message;
     png_image_free(&png);
     throw std::runtime_error("cannot decode PNG '" + path + "': " + message);
   }
+}
+
+}  // namespace
+
+Image read_png(const std::string& path) {
+  png_image png;
+  begin_read(png, path);
+  png.format = PNG_FORMAT_RGBA;
+  Image image(static_cast<int>(png.width), static_cast<int>(png.height));
+  finish_read(png, path, image.rgba.data());
   return image;
+}
+
+GrayLevels read_png_gray_levels(const std::string& path) {
+  png_image png;
+  begin_read(png, path);
+  GrayLevels out;
+  out.width = static_cast<int>(png.width);
+  out.height = static_cast<int>(png.height);
+  const std::size_t pixels = static_cast<std::size_t>(out.width) * out.height;
+  out.gray.resize(pixels);
+  if (png.format & PNG_FORMAT_FLAG_LINEAR) {
+    // A 16-bit file: libpng takes its samples as linear, so a linear output format passes
+    // them through. Its linear formats premultiply by alpha: divided out again.
+    png.format = PNG_FORMAT_LINEAR_RGB_ALPHA;
+    std::vector<png_uint_16> rgba(4 * pixels);
+    finish_read(png, path, rgba.data());
+    for (std::size_t i = 0; i < pixels; ++i) {
+      const png_uint_16* p = rgba.data() + 4 * i;
+      out.gray[i] = p[3] == 0 ? 0.0 : (p[0] + p[1] + p[2]) / (3.0 * p[3]);
+    }
+  } else {
+    // An 8-bit file (or palette): its samples as stored, alpha left aside (as read_png).
+    png.format = PNG_FORMAT_RGBA;
+    std::vector<std::uint8_t> rgba(4 * pixels);
+    finish_read(png, path, rgba.data());
+    for (std::size_t i = 0; i < pixels; ++i) {
+      const std::uint8_t* p = rgba.data() + 4 * i;
+      out.gray[i] = (p[0] + p[1] + p[2]) / (3.0 * 255.0);
+    }
+  }
+  return out;
 }
 
 }  // namespace dgtex

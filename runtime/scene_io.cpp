@@ -759,10 +759,13 @@ class SceneReader {
       const Vec3 view = difference(*r.camera_target, *r.camera_position);
       if (!(norm(view) > 0))
         fail(child(path, "target"), "camera target equals its position", v["target"], "expected a target away from the camera");
+      // A given up along the view is refused; the default one, [0, 0, 1], is not: a camera
+      // looking straight down turns it to the y axis, as where the target is the mesh's centre
+      // (the renderer's rule) and as `dgtex render` does without --camera-up.
       const Vec3& u = r.camera_up;
       const Vec3 cross{view[1] * u[2] - view[2] * u[1], view[2] * u[0] - view[0] * u[2], view[0] * u[1] - view[1] * u[0]};
-      if (!(norm(cross) > 1e-9 * norm(view) * norm(u)))
-        fail(child(path, "up"), "up is parallel to the viewing direction", find(v, "up") ? v["up"] : json(u),
+      if (find(v, "up") && !(norm(cross) > 1e-9 * norm(view) * norm(u)))
+        fail(child(path, "up"), "up is parallel to the viewing direction", v["up"],
              "expected an up vector not parallel to target - position");
     }
   }
@@ -813,7 +816,8 @@ class SceneReader {
   }
 
   // Parametric coordinates must lie in the reference element (when the element type is
-  // known); element indices below the generator's element count.
+  // known: a file's faces decide it, and scene_mesh_checks judges its points once it is
+  // read); element indices below the generator's element count.
   void check_surface_points(const Cut& cut, const json& cut_json, const std::string& path, const MeshSpec& mesh) const {
     constexpr double kSlack = 1e-12;
     for (size_t k = 0; k < cut.surface_points.size(); ++k) {
@@ -821,7 +825,7 @@ class SceneReader {
       const std::string p = item(child(path, "surface_points"), k);
       const json& point = cut_json["surface_points"][k];
       const double a = sp.xi[0], b = sp.xi[1];
-      if (!mesh.element) {
+      if (!mesh.element || mesh.source == MeshSource::file) {
         if (std::abs(a) > 1 + kSlack || std::abs(b) > 1 + kSlack)
           fail(child(p, "xi"), "outside every reference element", point["xi"], "expected xi in [-1, 1]^2");
       } else if (*mesh.element == ElementType::quad8) {

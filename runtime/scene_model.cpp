@@ -21,8 +21,18 @@ Mesh build_scene_mesh(const Scene& scene) {
   const ElementType type = m.element.value_or(ElementType::quad8);
   // A model that cannot fit is refused before its mesh is built (a file's from its faces,
   // counted as load_obj will read them, before it is parsed).
-  if (const SceneMeshSize size = scene_mesh_size(scene); size.elements >= 0)
+  if (const SceneMeshSize size = scene_mesh_size(scene); size.elements >= 0) {
+    // A file's element type is its faces'; a declared one that differs would have judged
+    // the cuts' surface_points against the wrong reference element.
+    if (m.source == MeshSource::file && m.element && *m.element != size.type) {
+      const char* faces = size.type == ElementType::tri6 ? "tri6" : "quad8";
+      throw SceneError(scene.source_name.empty() ? "scene" : scene.source_name, "mesh.element",
+                       std::string("does not match mesh.file, whose faces make ") + faces + " elements",
+                       std::string("\"") + (*m.element == ElementType::tri6 ? "tri6" : "quad8") + "\"",
+                       std::string("expected \"") + faces + "\" or no element (a file's faces decide it)");
+    }
     check_model_memory(scene, size.type, size.elements, available_memory_bytes());
+  }
   switch (m.source) {
     case MeshSource::rectangle:
       return make_rectangle(m.size[0], m.size[1], m.divisions[0], m.divisions[1], type, m.triangles);

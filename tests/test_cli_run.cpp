@@ -237,6 +237,40 @@ TEST(CliRun, ALinearResultWithLargeRotationsIsCautioned) {
   }
 }
 
+// A file mesh's element type is its faces'. A declared "element" that differs was ignored
+// for the mesh but judged the cuts' surface_points against its own reference element
+// (quad points refused as "outside the tri6 reference element"): now the declaration is
+// refused, naming the faces' type, and the points are judged on the mesh read.
+TEST(CliRun, AFileMeshsDeclaredElementMustMatchItsFaces) {
+  const fs::path dir = fresh_dir("file_element");
+  std::ofstream(dir / "quads.obj") << "v 0 0 0\nv 0.5 0 0\nv 1 0 0\nv 0 0.5 0\nv 0.5 0.5 0\nv 1 0.5 0\nv 0 1 0\n"
+                                      "v 0.5 1 0\nv 1 1 0\nf 1 2 5 4\nf 2 3 6 5\nf 4 5 8 7\nf 5 6 9 8\n";
+  nlohmann::json scene = nlohmann::json::parse(R"({
+    "mesh": {"file": "quads.obj", "element": "tri6"},
+    "material": {"youngs_modulus": 1e6, "poisson_ratio": 0.3, "thickness": 0.01},
+    "penalty": 0.8,
+    "boundary": [{"select": {"plane": {"normal": [1, 0, 0], "offset": 0}}, "fix": ["x", "y", "z"], "clamp": true}],
+    "loads": [{"type": "area_force", "force_per_area": [0, 0, -1]}],
+    "cuts": [{"surface_points": [{"element": 3, "xi": [-0.5, -0.5]}, {"element": 3, "xi": [0.5, 0.5]}]}],
+    "enrichment": {"texture_resolution": 16}})");
+  for (const std::string element : {"tri6", "quad8"}) {
+    scene["mesh"]["element"] = element;
+    const fs::path path = dir / (element + ".json");
+    std::ofstream(path) << scene.dump();
+    const Result r = dgtex::test::run_cli("run " + path.string() + " --out " + (dir / element).string() +
+                                          " --quiet --no-render", dir);
+    if (element == "tri6") {
+      EXPECT_EQ(r.exit_code, 2) << r.stderr_text;
+      EXPECT_EQ(r.stderr_text, "dgtex run: " + path.string() + ": mesh.element: does not match mesh.file, whose faces "
+                               "make quad8 elements, got \"tri6\"; expected \"quad8\" or no element (a file's faces "
+                               "decide it)\n");
+      EXPECT_FALSE(fs::exists(dir / element));
+    } else {
+      EXPECT_EQ(r.exit_code, 0) << r.stderr_text;
+    }
+  }
+}
+
 // An OBJ whose two quads repeat the vertices of their shared side runs as two pieces: the
 // run says so (mesh_validation.h, unwelded_seam_caution) and runs.
 TEST(CliRun, AnUnweldedSeamIsCautioned) {

@@ -300,6 +300,10 @@ TEST(SceneErrors, RenderValues) {
   const json looking_down = {{"position", {0, 0, 5}}, {"target", {0, 0, 0}}, {"up", {0, 0, 1}}};
   expect_error(with(valid_scene(), "/render"_json_pointer, {{"camera", looking_down}}), "render.camera.up", "[0,0,1]",
                "parallel");
+  // The default up of a camera looking straight down is the renderer's to replace (as with
+  // a target left to the mesh's centre): not refused.
+  const json down_default_up = {{"position", {0, 0, 5}}, {"target", {0, 0, 0}}};
+  EXPECT_EQ(error_of_text(with(valid_scene(), "/render"_json_pointer, {{"camera", down_default_up}}).dump()), "");
   const json blind = {{"position", {1, 1, 1}}, {"target", {1, 1, 1}}};
   expect_error(with(valid_scene(), "/render"_json_pointer, {{"camera", blind}}), "render.camera.target", "[1,1,1]");
 }

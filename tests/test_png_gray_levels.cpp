@@ -1,0 +1,96 @@
+// Data textures read as stored (dgtex/png_io.h, read_png_gray_levels): 8- and 16-bit grey,
+// grey + alpha and RGB PNGs of the same levels give the same values, and so do the material
+// textures made from them. Through read_png (8-bit RGBA) libpng takes 16-bit samples as
+// linear light and encodes them to sRGB: 0x8080 (0.502) became 0.73 of a texture's range.
+#include <gtest/gtest.h>
+#include <png.h>
+
+#include <cstdint>
+#include <cstring>
+#include <filesystem>
+#include <string>
+#include <unistd.h>
+#include <vector>
+
+#include "dgtex/material_texture.h"
+#include "dgtex/png_io.h"
+#include "dgtex/scene_io.h"
+#include "dgtex/scene_model.h"
+
+namespace {
+
+using namespace dgtex;
+
+// Writes width x 1 pixels of `format` (libpng's simplified API) from raw samples.
+void write_samples(const std::string& path, int width, png_uint_32 format, const void* samples) {
+  png_image png;
+  std::memset(&png, 0, sizeof(png));
+  png.version = PNG_IMAGE_VERSION;
+  png.width = static_cast<png_uint_32>(width);
+  png.height = 1;
+  png.format = format;
+  ASSERT_TRUE(png_image_write_to_file(&png, path.c_str(), 0, samples, 0, nullptr)) << png.message;
+}
+
+class PngGrayLevels : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = std::filesystem::temp_directory_path() / ("dgtex_png_gray_" + std::to_string(::getpid()));
+    std::filesystem::create_directories(dir_);
+  }
+  void TearDown() override { std::filesystem::remove_all(dir_); }
+  std::string path(const std::string& name) const { return (dir_ / name).string(); }
+  std::filesystem::path dir_;
+};
+
+// Levels 0, 128, 255 of 255 (16-bit: 257 times those, the same fractions exactly).
+TEST_F(PngGrayLevels, EightAndSixteenBitFilesGiveTheSameLevels) {
+  const std::uint8_t grey8[3] = {0, 128, 255};
+  const png_uint_16 grey16[3] = {0, 128 * 257, 65535};
+  const png_uint_16 grey_alpha16[6] = {0, 65535, 128 * 257, 65535, 65535, 65535};
+  const std::uint8_t rgb8[9] = {0, 0, 0, 100, 128, 156, 255, 255, 255};  // mean 128 in the middle
+  write_samples(path("grey8.png"), 3, PNG_FORMAT_GRAY, grey8);
+  write_samples(path("grey16.png"), 3, PNG_FORMAT_LINEAR_Y, grey16);
+  write_samples(path("grey_alpha16.png"), 3, PNG_FORMAT_LINEAR_Y_ALPHA, grey_alpha16);
+  write_samples(path("rgb8.png"), 3, PNG_FORMAT_RGB, rgb8);
+  for (const char* name : {"grey8.png", "grey16.png", "grey_alpha16.png", "rgb8.png"}) {
+    const GrayLevels levels = read_png_gray_levels(path(name));
+    ASSERT_EQ(levels.width, 3) << name;
+    ASSERT_EQ(levels.height, 1) << name;
+    ASSERT_EQ(levels.gray.size(), 3u) << name;
+    EXPECT_EQ(levels.gray[0], 0.0) << name;
+    EXPECT_NEAR(levels.gray[1], 128.0 / 255, 1e-15) << name;
+    EXPECT_EQ(levels.gray[2], 1.0) << name;
+  }
+  // What read_png makes of the 16-bit file: sRGB-encoded, far from 128.
+  const Image encoded = read_png(path("grey16.png"));
+  EXPECT_GT(encoded.pixel(1, 0)[0], 180);
+  EXPECT_THROW(read_png_gray_levels(path("missing.png")), std::runtime_error);
+}
+
+// A thickness texture from a 16-bit grey image equals the one from the 8-bit image.
+TEST_F(PngGrayLevels, MaterialTexturesFromSixteenBitImagesAreTheStoredLevels) {
+  const std::uint8_t grey8[2] = {128, 64};
+  const png_uint_16 grey16[2] = {128 * 257, 64 * 257};
+  write_samples(path("t8.png"), 2, PNG_FORMAT_GRAY, grey8);
+  write_samples(path("t16.png"), 2, PNG_FORMAT_LINEAR_Y, grey16);
+  std::vector<double> thickness[2];
+  for (int k = 0; k < 2; ++k) {
+    const std::string image = k == 0 ? "t8.png" : "t16.png";
+    const Scene scene = parse_scene(
+        R"({"mesh": {"generator": "rectangle", "size": [1, 0.1], "divisions": [1, 1], "element": "quad8"},
+            "material": {"youngs_modulus": 1e6, "poisson_ratio": 0.3, "thickness": 0.01},
+            "boundary": [{"select": {"plane": {"normal": [1, 0, 0], "offset": 0}}, "fix": ["x", "y", "z"], "clamp": true}],
+            "material_textures": [{"field": "thickness", "image": ")" + image + R"(", "range": [0.002, 0.012]}]})",
+        path("scene.json"));
+    const std::vector<ElementMaterialTexture> textures = scene_material_textures(scene, build_scene_mesh(scene));
+    ASSERT_EQ(textures.size(), 1u);
+    thickness[k] = textures[0].thickness;
+  }
+  ASSERT_EQ(thickness[0].size(), 2u);
+  EXPECT_EQ(thickness[0], thickness[1]);
+  EXPECT_NEAR(thickness[1][0], 0.002 + 0.01 * 128 / 255, 1e-15);
+  EXPECT_NEAR(thickness[1][1], 0.002 + 0.01 * 64 / 255, 1e-15);
+}
+
+}  // namespace
