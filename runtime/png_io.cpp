@@ -4,8 +4,8 @@
 
 #include <cstdint>
 #include <cstring>
-#include <vector>
 #include <stdexcept>
+#include <vector>
 
 namespace dgtex {
 

@@ -1,9 +1,10 @@
 #pragma once
 // The one exception type of the mesh area (generators, OBJ import, topology, validation,
 // closest-point queries, mesh output) for bad meshes and files; a bad argument to the API
-// (e.g. SurfacePointSearch::closest_among's element list) is std::invalid_argument. The message names the offending element, edge,
-// node or file:line; elements() lists the element indices involved (possibly empty) so
-// callers such as the OBJ importer can translate them back to their own numbering.
+// (e.g. SurfacePointSearch::closest_among's element list) is std::invalid_argument. The
+// message names the offending element, edge, node or file:line; elements() lists the
+// element indices involved (possibly empty) so callers such as the OBJ importer can
+// translate them back to their own numbering.
 // An exception value type (owns its message and element list).
 #include <sstream>
 #include <stdexcept>
