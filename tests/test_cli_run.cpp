@@ -271,6 +271,64 @@ TEST(CliRun, AFileMeshsDeclaredElementMustMatchItsFaces) {
   }
 }
 
+// What a run leaves in a folder an earlier run wrote: a static scene whose solve fails
+// (penalty too low, exit 2) leaves it as it was; a dynamic run failing in its first step
+// clears the earlier run's outputs and leaves none of its own (it had left its frame 0); a
+// run with its own output.report clears the default report too; a static run without
+// render writes no frames/ folder, and every report has timings_ms.render.
+TEST(CliRun, AFailedRunLeavesNothingThatLooksLikeAResult) {
+  const fs::path dir = fresh_dir("failed_outputs");
+  const fs::path out = dir / "out";
+  nlohmann::json dynamic;
+  std::ifstream(std::string(DGTEX_SOURCE_DIR) + "/examples/scenes/demo_cantilever.json") >> dynamic;
+  dynamic.erase("render");
+  dynamic["analysis"]["steps"] = 10;
+  std::ofstream(dir / "dynamic.json") << dynamic.dump();
+  auto run = [&](const std::string& scene) {
+    return dgtex::test::run_cli("run " + (dir / scene).string() + " --out " + out.string() + " --quiet --no-render", dir);
+  };
+  ASSERT_EQ(run("dynamic.json").exit_code, 0);
+  ASSERT_TRUE(fs::exists(out / "frames" / "frame_00010.vtu"));
+
+  nlohmann::json plate;
+  std::ifstream(std::string(DGTEX_SOURCE_DIR) + "/examples/scenes/clamped_plate.json") >> plate;
+  plate["mesh"]["divisions"] = {4, 4};
+  plate["penalty"] = 0.2;
+  std::ofstream(dir / "plate_low.json") << plate.dump();
+  const Result refused = run("plate_low.json");
+  EXPECT_EQ(refused.exit_code, 2) << refused.stderr_text;
+  EXPECT_NE(refused.stderr_text.find("penalty too low?"), std::string::npos) << refused.stderr_text;
+  EXPECT_TRUE(fs::exists(out / "report.json"));
+  EXPECT_TRUE(fs::exists(out / "frames" / "frame_00010.vtu"));
+
+  dynamic["penalty"] = 0.2;
+  std::ofstream(dir / "dynamic_low.json") << dynamic.dump();
+  const Result failed = run("dynamic_low.json");
+  EXPECT_EQ(failed.exit_code, 2) << failed.stderr_text;
+  EXPECT_FALSE(fs::exists(out / "report.json"));
+  EXPECT_FALSE(fs::exists(out / "deformed.vtu"));
+  EXPECT_TRUE(fs::is_empty(out / "frames"));
+
+  ASSERT_EQ(run("dynamic.json").exit_code, 0);
+  dynamic["penalty"] = 1;
+  dynamic["output"] = {{"report", "r.json"}};
+  std::ofstream(dir / "own_report.json") << dynamic.dump();
+  ASSERT_EQ(run("own_report.json").exit_code, 0);
+  EXPECT_TRUE(fs::exists(out / "r.json"));
+  EXPECT_FALSE(fs::exists(out / "report.json"));
+
+  plate["penalty"] = 0.8;
+  std::ofstream(dir / "plate.json") << plate.dump();
+  const fs::path fresh = dir / "static_out";
+  ASSERT_EQ(dgtex::test::run_cli("run " + (dir / "plate.json").string() + " --out " + fresh.string() + " --quiet", dir)
+                .exit_code,
+            0);
+  EXPECT_FALSE(fs::exists(fresh / "frames"));
+  nlohmann::json report;
+  std::ifstream(fresh / "report.json") >> report;
+  EXPECT_EQ(report["timings_ms"]["render"]["calls"], 0);
+}
+
 // An OBJ whose two quads repeat the vertices of their shared side runs as two pieces: the
 // run says so (mesh_validation.h, unwelded_seam_caution) and runs.
 TEST(CliRun, AnUnweldedSeamIsCautioned) {

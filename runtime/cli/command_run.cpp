@@ -175,13 +175,27 @@ int run_command(int argc, char** argv) {
   std::vector<std::string> written;  // for the closing line
   int steps_completed = 0;
   int interrupted_by = 0;  // the signal that ended a dynamic run early
+  // Once an earlier run's outputs are cleared, a failure also takes this run's own
+  // frames: nothing that looks like a result stays behind.
+  bool cleared = false;
+  auto discard_this_runs_outputs = [&] {
+    if (!cleared) return;
+    try {
+      remove_earlier_run_outputs(out_dir, scene.output.report);
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "dgtex run: %s\n", e.what());
+    }
+  };
   try {
-    create_output_folder((out / "frames").string(), "--out");
+    // A static solve that fails (a penalty too low) is refused input: the folder stays as it was.
+    if (!scene.analysis.is_dynamic()) run->solve_static();
+    // frames/ holds VTU frames of dynamic runs and PNG frames of scenes with a render block.
+    create_output_folder((scene.analysis.is_dynamic() || png_frames ? out / "frames" : out).string(), "--out");
     const int removed = remove_earlier_run_outputs(out_dir, scene.output.report);
+    cleared = true;
     if (removed > 0 && !quiet)
       std::fprintf(stderr, "dgtex run: removed %d files of an earlier run from %s\n", removed, out_dir.c_str());
     if (!scene.analysis.is_dynamic()) {
-      run->solve_static();
       if (linear) track_rotation(0);
       if (png_frames) png_frames->write(run->state(), 0);
     } else {
@@ -246,14 +260,17 @@ int run_command(int argc, char** argv) {
     }
   } catch (const ModelError& e) {
     std::fprintf(stderr, "%sdgtex run: %s: %s\n", progress_line_open ? "\n" : "", scene_path.c_str(), e.what());
+    discard_this_runs_outputs();
     return 2;
   } catch (const std::bad_alloc&) {  // past the set-up's memory checks, which are lower bounds
     std::fprintf(stderr, "%sdgtex run: %s: out of memory after %d of %d steps; a smaller texture_resolution, fewer "
                  "enriched elements, or more memory (ulimit -v, the container's limit)\n", progress_line_open ? "\n" : "",
                  scene_path.c_str(), steps_completed, scene.analysis.is_dynamic() ? scene.analysis.steps : 1);
+    discard_this_runs_outputs();
     return 1;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "%sdgtex run: %s: %s\n", progress_line_open ? "\n" : "", scene_path.c_str(), e.what());
+    discard_this_runs_outputs();
     return 1;
   }
 
@@ -289,7 +306,7 @@ int run_command(int argc, char** argv) {
                           {"projection", stage_json(timings, "projection")},
                           {"assembly", stage_json(timings, "assembly")},
                           {"solve", stage_json(timings, "solve")}};
-  if (png_frames) report["timings_ms"]["render"] = stage_json(png_frames->timings(), "render");
+  report["timings_ms"]["render"] = stage_json(png_frames ? png_frames->timings() : StageTimings{}, "render");
   const FactorReuseStatistics solver = run->solver_statistics();
   report["solver"] = {{"solves", solver.solves},
                       {"pcg_iterations", solver.iterations},

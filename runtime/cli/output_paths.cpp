@@ -164,6 +164,10 @@ bool is_frame_file_name(const std::string& name) {
 // The files of `dgtex run` in its output folder but its frames.
 std::vector<std::string> run_output_names(const std::string& report_name) {
   std::vector<std::string> names = {report_name};
+  // A run with its own output.report clears the default one too: another scene's report
+  // must not stay beside it.
+  const std::string default_report = OutputOptions{}.report;
+  if (report_name != default_report) names.push_back(default_report);
   names.insert(names.end(), std::begin(kRunOutputFiles), std::end(kRunOutputFiles));
   return names;
 }
