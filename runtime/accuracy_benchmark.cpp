@@ -6,7 +6,9 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cstdint>
 #include <cstdio>
+#include <iterator>
 #include <nlohmann/json.hpp>
 #include <sstream>
 
@@ -27,6 +29,15 @@ std::vector<std::string> AccuracyChart::series() const {
   return out;
 }
 
+namespace {
+// The `extra` keys that count things (sizes, iterations, points): written as integers.
+bool is_count_key(const std::string& key) {
+  static const char* const counts[] = {"n",        "T",      "free_dofs", "iterations",       "pcg_iterations",
+                                       "clusters", "texels", "unknowns",  "quadrature_points", "factorizations"};
+  return std::find(std::begin(counts), std::end(counts), key) != std::end(counts);
+}
+}  // namespace
+
 std::string accuracy_charts_json(const std::vector<AccuracyChart>& charts, const std::string& machine,
                                  const std::string& command) {
   nlohmann::json list = nlohmann::json::array();
@@ -34,7 +45,13 @@ std::string accuracy_charts_json(const std::vector<AccuracyChart>& charts, const
     nlohmann::json points = nlohmann::json::array();
     for (const AccuracyPoint& p : chart.points) {
       nlohmann::json point = {{"series", p.series}, {"label", p.label}, {"ms", p.ms}, {"error", p.error}};
-      for (const auto& [key, value] : p.extra) point[key] = value;
+      for (const auto& [key, value] : p.extra) {
+        // Counts are whole numbers in the JSON ("n": 2, not 2.0), for typed readers.
+        if (is_count_key(key))
+          point[key] = static_cast<std::int64_t>(value);
+        else
+          point[key] = value;
+      }
       points.push_back(point);
     }
     nlohmann::json entry = {{"name", chart.name},

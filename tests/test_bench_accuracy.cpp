@@ -76,8 +76,16 @@ void check_WritesChartsJsonAndTable(const ReducedRun& run) {
       for (const char* key : {"series", "label", "ms", "error"}) EXPECT_TRUE(p.contains(key)) << name << " " << key;
       EXPECT_GT(p.at("ms").get<double>(), 0.0);  // measured
       EXPECT_TRUE(std::isfinite(p.at("error").get<double>()));
+      // Counts are JSON integers ("n": 2 was written 2.0).
+      for (const char* key : {"n", "T", "free_dofs", "iterations", "pcg_iterations", "factorizations", "clusters",
+                              "texels", "unknowns", "quadrature_points"}) {
+        if (p.contains(key)) {
+          EXPECT_TRUE(p.at(key).is_number_integer()) << name << " " << key << " " << p.at(key);
+        }
+      }
     }
   }
+  EXPECT_TRUE(run.chart("plate").at("points").at(0).contains("free_dofs"));
   EXPECT_FALSE(run.json.at("machine").get<std::string>().empty());
   EXPECT_NE(run.json.at("command").get<std::string>().find("dgtex bench accuracy"), std::string::npos);
   EXPECT_TRUE(fs::exists(run.dir / "accuracy.md"));

@@ -132,6 +132,11 @@ TEST(BenchScenes, JsonHasEveryRequestedSceneWithRequiredKeysAndThesisRatios) {
   EXPECT_TRUE(spiral["targets_missed"].is_null());
   EXPECT_TRUE(j["scenes"][1]["table_5_1"].is_null());
   EXPECT_TRUE(j["scenes"][1]["ratio_to_table_5_1"].is_null());
+  // No row, no targets: the keys are there, null (they were left out).
+  ASSERT_TRUE(j["scenes"][1].contains("targets_met"));
+  ASSERT_TRUE(j["scenes"][1].contains("targets_missed"));
+  EXPECT_TRUE(j["scenes"][1]["targets_met"].is_null());
+  EXPECT_TRUE(j["scenes"][1]["targets_missed"].is_null());
   EXPECT_EQ(j["scenes"][1]["counts"]["enrichments"], 0);
   // The Markdown file starts with the same heading as the printed tables: machine and probe.
   std::ifstream markdown(dir / "out.md");

@@ -191,9 +191,11 @@ nlohmann::json scene_json(const SceneBenchResult& r) {
       j["targets_missed"] = nlohmann::json::array();
       for (const Target& target : *missed) j["targets_missed"].push_back(target.json_name);
     }
-  } else {
+  } else {  // no Table 5.1 row, so no targets: every key still there, null
     j["table_5_1"] = nullptr;
     j["ratio_to_table_5_1"] = nullptr;
+    j["targets_met"] = nullptr;
+    j["targets_missed"] = nullptr;
   }
   return j;
 }
