@@ -69,19 +69,22 @@ TEST(CliOptions, BadValuesAreOneLineNamingTheCommandAndOption) {
       {"bench shell --refactor-after -1", "dgtex bench shell: --refactor-after: Value -1 not in range"},
       // A bad value of a later sweep ended the command after the earlier sweeps' minutes.
       {"bench accuracy --charts texture,plate --texture-sizes 16 --plate-divisions 3 --out DIR/acc",
-       "dgtex bench accuracy: plate divisions: n = 3; need an even n"},
+       "dgtex bench accuracy: --plate-divisions: plate divisions: n = 3; need an even n"},
+      {"bench accuracy --charts platee --out DIR/acc",
+       "dgtex bench accuracy: --charts: unknown chart 'platee'; valid: plate, quadrature, texture, tolerance, rotation, "
+       "scene_quadrature (see dgtex bench accuracy --help)"},
       {"bench accuracy --charts tolerance --no-shell --no-multigrid --out DIR/acc",
        "dgtex bench accuracy: tolerance accuracy: neither the shell nor the multigrid series is on"},
       // Sizes that failed only once their sweep ran (exit 1, or a bare std::bad_alloc), and a
       // reference looser than the runs measured against it.
       {"bench accuracy --charts quadrature --quadrature-resolution 100 --out DIR/acc",
-       "dgtex bench accuracy: quadrature resolution T = 100; need a power of two in 8..4096"},
+       "dgtex bench accuracy: --quadrature-resolution: quadrature resolution T = 100; need a power of two in 8..4096"},
       {"bench accuracy --charts texture --texture-sizes 16,100000 --out DIR/acc",
-       "dgtex bench accuracy: texture size T = 100000; need an even T in 16..4096"},
+       "dgtex bench accuracy: --texture-sizes: texture size T = 100000; need an even T in 16..4096"},
       {"bench accuracy --charts tolerance --no-shell --multigrid-size 3 --out DIR/acc",
-       "dgtex bench accuracy: tolerance accuracy: multigrid size T = 3; need 16..2048"},
+       "dgtex bench accuracy: --multigrid-size: tolerance accuracy: multigrid size T = 3; need 16..2048"},
       {"bench accuracy --charts tolerance --multigrid-tolerances 2 --out DIR/acc",
-       "dgtex bench accuracy: tolerance accuracy: multigrid tolerance 2; need 1e-12 <= tol < 1"},
+       "dgtex bench accuracy: --multigrid-tolerances: tolerance accuracy: multigrid tolerance 2; need 1e-12 <= tol < 1"},
       {"bench accuracy --charts scene_quadrature --scene-quadrature-reference 2 --out DIR/acc",
        "dgtex bench accuracy: scene quadrature accuracy: reference tolerance 2; need one at or below every swept"},
       // Numbers CLI11 read its own way: "1e3" and "2.5" called out of range, "0x10" taken as 16.
@@ -99,14 +102,14 @@ TEST(CliOptions, BadValuesAreOneLineNamingTheCommandAndOption) {
       {"bench laplace --tolerance 1e-300",
        "dgtex bench laplace: --tolerance: Value 1e-300 is not a relative tolerance a double-precision solve can reach"},
       {"bench accuracy --charts tolerance --shell-tolerances 1e-300 --out DIR/acc",
-       "dgtex bench accuracy: tolerance accuracy: shell tolerance 1e-300; need 1e-12 <= tol < 1"},
+       "dgtex bench accuracy: --shell-tolerances: tolerance accuracy: shell tolerance 1e-300; need 1e-12 <= tol < 1"},
       // Values the sweep's scene would refuse only once the sweep ran, and the options of a
       // chart not chosen (ignored without a word).
       {"bench accuracy --charts quadrature --quadrature-tolerances inf --out DIR/acc",
-       "dgtex bench accuracy: quadrature tolerance inf; need 0 < tol <= 1e30"},
+       "dgtex bench accuracy: --quadrature-tolerances: quadrature tolerance inf; need 0 < tol <= 1e30"},
       {"bench accuracy --charts rotation --rotation-blocks 100000 --out DIR/acc",
-       "dgtex bench accuracy: rotation accuracy: rotation block B = 100000 texels; need 1..4096"},
-      {"bench accuracy --charts plate --texture-sizes -5 --out DIR/acc", "dgtex bench accuracy: texture size T = -5"},
+       "dgtex bench accuracy: --rotation-blocks: rotation accuracy: rotation block B = 100000 texels; need 1..4096"},
+      {"bench accuracy --charts plate --texture-sizes -5 --out DIR/acc", "dgtex bench accuracy: --texture-sizes: texture size T = -5"},
       // One file for two outputs kept only the one written last.
       {"bench scaling --json DIR/a.json --markdown DIR/a.json",
        "dgtex bench scaling: --json and --markdown both name '"},

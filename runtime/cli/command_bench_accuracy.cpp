@@ -9,6 +9,7 @@
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
+#include <functional>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -115,6 +116,12 @@ int bench_accuracy_command(int argc, char** argv) {
   tolerance.shell_scene = example_scene("cylinder_buckling.json");
   rotation.scene = example_scene("accordion.json");
   scene_quadrature.scene = example_scene("slinky.json");
+  // The sweeps' defaults, to check the options one at a time against (below).
+  const PlateAccuracyOptions plate_defaults = plate;
+  const QuadratureAccuracyOptions quadrature_defaults = quadrature;
+  const ToleranceAccuracyOptions tolerance_defaults = tolerance;
+  const RotationAccuracyOptions rotation_defaults = rotation;
+  const SceneQuadratureAccuracyOptions scene_quadrature_defaults = scene_quadrature;
   app.add_option("--charts", charts, "plate, quadrature, texture, tolerance, rotation, scene_quadrature")
       ->delimiter(',')
       ->capture_default_str();
@@ -185,16 +192,56 @@ int bench_accuracy_command(int argc, char** argv) {
   }
   const std::string command = bench_command_line(argc, argv);
   try {
-    split_names(charts);
     plate.repeat = quadrature.repeat = texture.repeat = tolerance.repeat = repeat;
     const AccuracyClock which = clock == "cpu" ? AccuracyClock::cpu : AccuracyClock::wall;
     plate.clock = quadrature.clock = texture.clock = tolerance.clock = rotation.clock = scene_quadrature.clock = which;
     omp_set_num_threads(threads);
     // Every sweep's options before the first sweep runs: a bad value of the last sweep
     // ended the command minutes in, and those of a sweep not chosen were ignored without a
-    // word (their defaults are valid). The library names the sweep's field in words (plate
-    // divisions: --plate-divisions), so the line points to the options' help.
+    // word (their defaults are valid). The library names the sweep's field in words, so
+    // each option is first checked alone on the sweep's defaults, and a bad one is named
+    // (`--plate-divisions: plate divisions: n = 3; ...`); then the sweeps as given (options
+    // that are valid alone but not together).
     try {
+      split_names(charts);
+      auto alone = [](const char* option, const std::function<void()>& check) {
+        try {
+          check();
+        } catch (const std::invalid_argument& e) {
+          throw std::invalid_argument(std::string(option) + ": " + e.what());
+        }
+      };
+      auto with = [](auto defaults, auto set, auto check) {
+        set(defaults);
+        return [=] { check(defaults); };
+      };
+      alone("--plate-divisions", [&] { check_plate_accuracy_options(plate); });
+      alone("--quadrature-resolution", with(quadrature_defaults, [&](auto& o) { o.resolution = quadrature.resolution; },
+                                            check_quadrature_accuracy_options));
+      alone("--quadrature-tolerances", with(quadrature_defaults, [&](auto& o) { o.tolerances = quadrature.tolerances; },
+                                            check_quadrature_accuracy_options));
+      alone("--quadrature-elements", with(quadrature_defaults, [&](auto& o) { o.elements = quadrature.elements; },
+                                          check_quadrature_accuracy_options));
+      alone("--texture-sizes", [&] { check_texture_accuracy_options(texture); });
+      alone("--shell-steps", with(tolerance_defaults, [&](auto& o) { o.shell_steps = tolerance.shell_steps; },
+                                  check_tolerance_accuracy_options));
+      alone("--shell-tolerances", with(tolerance_defaults, [&](auto& o) { o.shell_tolerances = tolerance.shell_tolerances; },
+                                       check_tolerance_accuracy_options));
+      alone("--multigrid-size", with(tolerance_defaults, [&](auto& o) { o.multigrid_resolution = tolerance.multigrid_resolution; },
+                                     check_tolerance_accuracy_options));
+      alone("--multigrid-tolerances",
+            with(tolerance_defaults, [&](auto& o) { o.multigrid_tolerances = tolerance.multigrid_tolerances; },
+                 check_tolerance_accuracy_options));
+      alone("--rotation-steps", with(rotation_defaults, [&](auto& o) { o.steps = rotation.steps; },
+                                     check_rotation_accuracy_options));
+      alone("--rotation-blocks", with(rotation_defaults, [&](auto& o) { o.block_texels = rotation.block_texels; },
+                                      check_rotation_accuracy_options));
+      alone("--rotation-scene", with(rotation_defaults, [&](auto& o) { o.scene = rotation.scene; },
+                                     check_rotation_accuracy_options));
+      alone("--scene-quadrature-steps", with(scene_quadrature_defaults, [&](auto& o) { o.steps = scene_quadrature.steps; },
+                                             check_scene_quadrature_accuracy_options));
+      alone("--scene-quadrature-scene", with(scene_quadrature_defaults, [&](auto& o) { o.scene = scene_quadrature.scene; },
+                                             check_scene_quadrature_accuracy_options));
       check_plate_accuracy_options(plate);
       check_quadrature_accuracy_options(quadrature);
       check_texture_accuracy_options(texture);
