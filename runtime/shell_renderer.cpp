@@ -558,7 +558,6 @@ Image ShellRenderer::render(const ShellState& state, const RenderSettings& setti
     }
     glUniform1i(glGetUniformLocation(program, "u_first_instance"), first_instance);
     glUniformMatrix4fv(glGetUniformLocation(program, "u_view_projection"), 1, GL_FALSE, view_projection);
-    glUniform2f(glGetUniformLocation(program, "u_viewport_size"), float(settings.width), float(settings.height));
     glUniform1f(glGetUniformLocation(program, "u_cut_threshold"), settings.cut_threshold);
     glUniform1i(glGetUniformLocation(program, "u_kill_radius"), settings.kill_radius_texels);
     glUniform1i(glGetUniformLocation(program, "u_tessellation"), settings.tessellation);

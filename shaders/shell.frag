@@ -15,7 +15,7 @@ in FragmentData {
   flat uint side_bits;
   flat uint cut_bits;
 #if WIREFRAME
-  noperspective vec3 edge_distance;
+  vec3 barycentric;
 #endif
 } g;
 
@@ -77,7 +77,10 @@ void main() {
 #endif
   vec3 color = base_color * (0.3 + 0.7 * diffuse);
 #if WIREFRAME
-  float d = min(g.edge_distance.x, min(g.edge_distance.y, g.edge_distance.z));
+  // Pixels to the nearest edge: each barycentric coordinate over its screen gradient.
+  vec3 gradient = sqrt(dFdx(g.barycentric) * dFdx(g.barycentric) + dFdy(g.barycentric) * dFdy(g.barycentric));
+  vec3 pixels = g.barycentric / max(gradient, vec3(1e-9));
+  float d = min(pixels.x, min(pixels.y, pixels.z));
   color = mix(vec3(0.85, 0.05, 0.05), color, clamp(d - 0.5, 0.0, 1.0));
 #endif
   out_color = vec4(color, 1.0);

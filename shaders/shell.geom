@@ -18,7 +18,6 @@ layout(triangles) in;
 layout(triangle_strip, max_vertices = GEOMETRY_MAX_VERTICES) out;
 
 uniform mat4 u_view_projection;
-uniform vec2 u_viewport_size;
 uniform float u_cut_threshold;
 #if MAX_ENRICHMENTS > 0 && CUT_METHOD == CUT_GEOMETRY_SHADER
 uniform int u_tessellation;  // subdivisions per element edge
@@ -43,7 +42,10 @@ out FragmentData {
   flat uint side_bits;  // bit k: this copy shows the side h_k >= 0 of enrichment slot k
   flat uint cut_bits;   // bit k: enrichment slot k cuts this triangle
 #if WIREFRAME
-  noperspective vec3 edge_distance;  // pixels to the three edges
+  // Barycentric coordinates: the fragment stage reads its distance to each edge in pixels
+  // from their screen derivatives. (Heights computed here from the projected corners, and
+  // interpolated noperspective, painted triangles the viewport clipped solid red.)
+  vec3 barycentric;
 #endif
 } g;
 
@@ -51,15 +53,6 @@ void emit_triangle(vec3 p[3], uint side_bits, uint cut_bits) {
   vec4 clip[3];
   for (int i = 0; i < 3; ++i) clip[i] = u_view_projection * vec4(p[i], 1.0);
   vec3 face_normal = cross(p[1] - p[0], p[2] - p[0]);
-#if WIREFRAME
-  vec2 screen[3];
-  for (int i = 0; i < 3; ++i) screen[i] = 0.5 * u_viewport_size * clip[i].xy / clip[i].w;
-  float twice_area = abs((screen[1].x - screen[0].x) * (screen[2].y - screen[0].y) -
-                         (screen[2].x - screen[0].x) * (screen[1].y - screen[0].y));
-  float height[3];
-  for (int i = 0; i < 3; ++i)
-    height[i] = twice_area / max(length(screen[(i + 2) % 3] - screen[(i + 1) % 3]), 1e-6);
-#endif
   for (int i = 0; i < 3; ++i) {
     gl_Position = clip[i];
     g.xi = v[i].xi;
@@ -73,8 +66,8 @@ void emit_triangle(vec3 p[3], uint side_bits, uint cut_bits) {
     g.side_bits = side_bits;
     g.cut_bits = cut_bits;
 #if WIREFRAME
-    g.edge_distance = vec3(0.0);
-    g.edge_distance[i] = height[i];
+    g.barycentric = vec3(0.0);
+    g.barycentric[i] = 1.0;
 #endif
     EmitVertex();
   }

@@ -4,6 +4,7 @@
 #include <sys/wait.h>
 
 #include <algorithm>
+#include <cstdint>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -64,6 +65,42 @@ TEST(RenderCli, RendersAStateToFramePng) {
   EXPECT_EQ(image.width, 96);
   EXPECT_EQ(image.height, 64);
   EXPECT_NE(r.out.find("frame.png"), std::string::npos);
+}
+
+// A view close enough that the viewport clips triangles (the demo cantilever's final state,
+// from above): the wireframe stays lines. Edge distances computed in the geometry stage from
+// the projected corners, interpolated noperspective, painted the clipped corner triangles
+// solid red (25k of 360k pixels).
+TEST(RenderCli, AClippedWireframeStaysLines) {
+  const fs::path dir = work_dir() / "clipped_wireframe";
+  fs::remove_all(dir);
+  const std::string run = "'" + std::string(DGTEX_CLI) + "' run '" + std::string(DGTEX_SOURCE_DIR) +
+                          "/examples/scenes/demo_cantilever.json' --out '" + dir.string() +
+                          "' --save-state --no-render --quiet";
+  ASSERT_EQ(std::system(run.c_str()), 0);
+  const std::string png = (dir / "zoom.png").string();
+  const CliResult r = run_cli("", "'" + (dir / "final.state").string() + "' --out '" + png +
+                                      "' --width 600 --height 600 --camera-position 0.5 0.1 0.12 --camera-target 0.5 "
+                                      "0.1 -0.05 --camera-up 0 1 0 --fov 30 --wireframe");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const Image image = read_png(png);
+  auto red = [&](int x, int y) {
+    const std::uint8_t* p = image.pixel(x, y);
+    return p[0] > 180 && p[1] < 40 && p[2] < 40;
+  };
+  int red_pixels = 0, red_blocks = 0;
+  for (int y = 0; y < image.height; ++y)
+    for (int x = 0; x < image.width; ++x) red_pixels += red(x, y);
+  // Lines are 1-2 pixels wide (2-3 where they cross): no 5 x 5 block is all red.
+  for (int y = 0; y + 5 <= image.height; ++y)
+    for (int x = 0; x + 5 <= image.width; ++x) {
+      bool all = true;
+      for (int j = 0; j < 5 && all; ++j)
+        for (int i = 0; i < 5 && all; ++i) all = red(x + i, y + j);
+      red_blocks += all;
+    }
+  EXPECT_GT(red_pixels, 2000);  // the lines are there
+  EXPECT_EQ(red_blocks, 0) << red_pixels << " red pixels";
 }
 
 // `--out NAME.png` is the image itself (it was a folder NAME.png holding frame.png); an
