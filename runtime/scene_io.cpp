@@ -15,6 +15,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include "dgtex/kernels/vec3.h"
+
 namespace dgtex {
 
 using json = nlohmann::json;
@@ -762,9 +764,7 @@ class SceneReader {
       // A given up along the view is refused; the default one, [0, 0, 1], is not: a camera
       // looking straight down turns it to the y axis, as where the target is the mesh's centre
       // (the renderer's rule) and as `dgtex render` does without --camera-up.
-      const Vec3& u = r.camera_up;
-      const Vec3 cross{view[1] * u[2] - view[2] * u[1], view[2] * u[0] - view[0] * u[2], view[0] * u[1] - view[1] * u[0]};
-      if (find(v, "up") && !(norm(cross) > 1e-9 * norm(view) * norm(u)))
+      if (find(v, "up") && kernels::parallel3(view.data(), r.camera_up.data()))
         fail(child(path, "up"), "up is parallel to the viewing direction", v["up"],
              "expected an up vector not parallel to target - position");
     }

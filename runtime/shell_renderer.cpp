@@ -14,6 +14,7 @@
 
 #include "dgtex/deformed_shell.h"
 #include "dgtex/kernels/enriched_basis.h"
+#include "dgtex/kernels/vec3.h"
 #include "dgtex_embedded_shaders.h"
 
 namespace dgtex {
@@ -72,7 +73,7 @@ ResolvedCamera resolve_camera(const DeformedShell& shell, const RenderSettings& 
   Vec3 direction = sub(c.eye, c.target);
   if (norm(direction) == 0) direction = {0, -1, 1};
   direction = normalized(direction);
-  if (norm(c.up) == 0 || norm(cross(direction, normalized(c.up))) < 1e-9) {
+  if (kernels::parallel3(direction.data(), c.up.data())) {
     // Up parallel to the view direction: pick any perpendicular axis.
     c.up = std::abs(direction[2]) < 0.9 ? Vec3{0, 0, 1} : Vec3{0, 1, 0};
   }

@@ -127,9 +127,7 @@ int render_command(int argc, char** argv) {
                     ": the camera's own position; expected a point away from it");
     // A given up along the view is refused; without one the renderer picks a perpendicular
     // (a camera straight above the shell, --camera-position 0 0 5).
-    std::vector<double> side(3);
-    if (!up.empty()) kernels::cross3(view.data(), up.data(), side.data());
-    if (!up.empty() && !(norm3(side) > 1e-9 * norm3(view) * norm3(up)))
+    if (!up.empty() && kernels::parallel3(view.data(), up.data()))
       return refuse("--camera-up: " + text(up) + ": parallel to the viewing direction; expected another up");
   }
   if (const std::string image = image_path(out_dir).string();

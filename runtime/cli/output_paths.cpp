@@ -207,15 +207,20 @@ int remove_earlier_run_outputs(const std::string& folder, const std::string& rep
   return removed;
 }
 
+namespace {
+[[noreturn]] void refuse_output_on_input(const std::string& folder, const InputFile& input) {
+  throw std::invalid_argument("--out " + folder + ": the run writes or clears '" + input.path + "', " + input.what +
+                              "; choose another output folder, or move the input out of it");
+}
+}  // namespace
+
 void check_outputs_spare_inputs(const std::string& folder, const std::vector<std::string>& names,
                                 const std::vector<InputFile>& inputs) {
   const fs::path out(folder);
   for (const InputFile& input : inputs) {
     if (input.path.empty()) continue;
     for (const std::string& name : names)
-      if (same_file(input.path, out / name))
-        throw std::invalid_argument("--out " + folder + ": the run writes or clears '" + input.path + "', " +
-                                    input.what + "; choose another output folder, or move the input out of it");
+      if (same_file(input.path, out / name)) refuse_output_on_input(folder, input);
   }
 }
 
@@ -232,8 +237,7 @@ void check_run_outputs_spare_inputs(const std::string& folder, const std::string
     const fs::path path(input.path);
     if (!input.path.empty() && is_frame_file_name(path.filename().string()) &&
         same_file(path.parent_path(), fs::path(folder) / "frames"))
-      throw std::invalid_argument("--out " + folder + ": the run writes or clears '" + input.path + "', " +
-                                  input.what + "; choose another output folder, or move the input out of it");
+      refuse_output_on_input(folder, input);
   }
 }
 

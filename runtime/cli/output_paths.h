@@ -51,8 +51,8 @@ void check_report_name(const Scene& scene);
 // another run's files beside its own (a longer run's later frames, or the report of a run
 // that finished where this one failed): frames/frame_NNNNN.vtu and .png, REPORT_NAME (and
 // report.json, the default name), deformed.vtu, cut_surface.obj, final.state and
-// textures/enrichment.vdb. Nothing else is touched. Returns how many files were removed; throws std::runtime_error naming a file
-// that could not be.
+// textures/enrichment.vdb. Nothing else is touched. Returns how many files were removed;
+// throws std::runtime_error naming a file that could not be.
 int remove_earlier_run_outputs(const std::string& folder, const std::string& report_name);
 
 // Throws std::invalid_argument naming --out FOLDER and the input where one of the files

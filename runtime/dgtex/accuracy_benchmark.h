@@ -138,8 +138,9 @@ struct RotationAccuracyOptions {
 // error = |u - u_ref| / |u_ref| of the final displacement (all DOFs) against per-point
 // rotations (the reference, error 0; the scene's own setting is overridden), ms = the
 // whole run (set-up, cuts, steps); extra "clusters", "cluster_mb" (their rest sums) and
-// "assembly_wall_ms". std::invalid_argument for steps < 1, a block outside 1..4096 or a scene that is
-// not dynamic and corotated; what load_scene and SceneRun throw for a bad scene.
+// "assembly_wall_ms". std::invalid_argument for steps < 1, a block outside 1..4096 or a
+// scene that is not dynamic and corotated; what load_scene and SceneRun throw for a bad
+// scene.
 void check_rotation_accuracy_options(const RotationAccuracyOptions& options);
 AccuracyChart run_rotation_accuracy(const RotationAccuracyOptions& options, const AccuracyProgress& progress = {});
 
@@ -161,8 +162,8 @@ struct SceneQuadratureAccuracyOptions {
 // and "assembly_wall_ms". With the time-step point, the conclusion names the largest swept
 // tolerance whose error stays below the time-step error, at the end and over the run (or
 // that none does): the coarsest quadrature the scene can afford.
-// std::invalid_argument for steps < 0, a tolerance outside [1e-30, 1e30], or a scene that is not dynamic or has
-// no cuts; what load_scene and SceneRun throw for a bad scene.
+// std::invalid_argument for steps < 0, a tolerance outside [1e-30, 1e30], or a scene that
+// is not dynamic or has no cuts; what load_scene and SceneRun throw for a bad scene.
 void check_scene_quadrature_accuracy_options(const SceneQuadratureAccuracyOptions& options);
 AccuracyChart run_scene_quadrature_accuracy(const SceneQuadratureAccuracyOptions& options,
                                             const AccuracyProgress& progress = {});

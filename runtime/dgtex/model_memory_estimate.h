@@ -5,8 +5,9 @@
 // run minutes in, and a typo such as divisions [100000, 100] (within the scene file's 1e7
 // cells) would do so after building a mesh of 10 million elements. The scene's mesh is
 // checked against a lower bound of that memory before it is built (a file's from its
-// counted faces, before it is parsed), and refused with one line (a SceneError naming mesh.divisions or mesh.file, the
-// bound, the memory available and the most elements that could fit).
+// counted faces, before it is parsed), and refused with one line (a SceneError naming
+// mesh.divisions or mesh.file, the bound, the memory available and the most elements that
+// could fit).
 //
 // The bound per element, from the peak resident memory of examples/scenes/clamped_plate.json
 // at divisions n x n (n = 50, 100, 200; static, and dynamic with two corotated steps), less

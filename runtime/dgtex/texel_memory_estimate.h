@@ -55,10 +55,10 @@ std::int64_t texel_memory_lower_bound(const TexelFields& fields);
 // capped by the cgroup's limit less its usage (cgroup v2 memory.max, v1
 // memory.limit_in_bytes) where one is set, by the address space left under `ulimit -v`
 // (RLIMIT_AS less the process's virtual size) where that is set, and by the environment's
-// DGTEX_MEMORY_LIMIT_MB
-// (MiB; to share a machine, or to try a scene's limits) where that is set; -1 when none of
-// /proc/meminfo, `ulimit -v` and DGTEX_MEMORY_LIMIT_MB gives a figure. Throws std::invalid_argument
-// naming DGTEX_MEMORY_LIMIT_MB when it is set but not a whole number >= 1.
+// DGTEX_MEMORY_LIMIT_MB (MiB; to share a machine, or to try a scene's limits) where that is
+// set; -1 when none of /proc/meminfo, `ulimit -v` and DGTEX_MEMORY_LIMIT_MB gives a figure.
+// Throws std::invalid_argument naming DGTEX_MEMORY_LIMIT_MB when it is set but not a whole
+// number >= 1.
 std::int64_t available_memory_bytes();
 
 // A memory size as every memory refusal and caution writes it, in the binary units of

@@ -11,6 +11,14 @@ inline void cross3(const double* a, const double* b, double* c) {
   c[1] = a[2] * b[0] - a[0] * b[2];
   c[2] = a[0] * b[1] - a[1] * b[0];
 }
+// Whether a and b lie along one line: a x b vanishes to 1e-9 of |a| |b| (so also when
+// either is zero). The one test of a camera's up against its view (the renderer replaces
+// such an up; scene files and `dgtex render` refuse one that was given).
+inline bool parallel3(const double* a, const double* b) {
+  double c[3];
+  cross3(a, b, c);
+  return !(std::sqrt(dot3(c, c)) > 1e-9 * std::sqrt(dot3(a, a)) * std::sqrt(dot3(b, b)));
+}
 inline void normalize3(double* v) {
   const double l = std::sqrt(dot3(v, v));
   v[0] /= l, v[1] /= l, v[2] /= l;
