@@ -28,12 +28,32 @@ std::vector<ElementMaterialTexture> scene_material_textures(const Scene& scene, 
     if (mesh.type != ElementType::quad8)
       throw SceneError(scene.source_name, path, "material textures need quad8 elements", "",
                        "use \"element\": \"quad8\" in the mesh");
+    const auto unreadable = [&](const std::exception& error) {
+      return SceneError(scene.source_name, path + ".image", std::string("unreadable image: ") + error.what(),
+                        "\"" + t.image + "\"", "a grayscale or RGB PNG file");
+    };
+    PngSize size;
+    try {
+      size = read_png_size(t.image);
+    } catch (const std::exception& error) {
+      throw unreadable(error);
+    }
+    // Weighed from its header: decoding a large image first could take gigabytes (16 bytes
+    // a pixel) that the copies' check below would then refuse.
+    const std::int64_t read_bytes = kGrayLevelsReadBytesPerPixel * size.width * size.height;
+    if (available_bytes >= 0 && texel_bytes + read_bytes > available_bytes)
+      throw SceneError(scene.source_name, path + ".image",
+                       "reading its " + std::to_string(size.width) + "x" + std::to_string(size.height) +
+                           " pixels takes " + memory_size_text(read_bytes) + " (" +
+                           std::to_string(kGrayLevelsReadBytesPerPixel) + " bytes a pixel) beside the " +
+                           memory_size_text(texel_bytes) + " of the textures before it, more than the " +
+                           memory_size_text(available_bytes) + " of memory available",
+                       "\"" + t.image + "\"", "a smaller image");
     GrayLevels image;
     try {
       image = read_png_gray_levels(t.image);
     } catch (const std::exception& error) {
-      throw SceneError(scene.source_name, path + ".image", std::string("unreadable image: ") + error.what(),
-                       "\"" + t.image + "\"", "a grayscale or RGB PNG file");
+      throw unreadable(error);
     }
     // Gray per texel: RGB mean as stored (8- or 16-bit).
     std::vector<double> values(image.gray.size());

@@ -71,6 +71,14 @@ Image read_png(const std::string& path) {
   return image;
 }
 
+PngSize read_png_size(const std::string& path) {
+  png_image png;
+  begin_read(png, path);
+  const PngSize size{static_cast<int>(png.width), static_cast<int>(png.height)};
+  png_image_free(&png);
+  return size;
+}
+
 GrayLevels read_png_gray_levels(const std::string& path) {
   png_image png;
   begin_read(png, path);

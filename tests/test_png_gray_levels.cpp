@@ -8,6 +8,8 @@
 #include <cstdint>
 #include <cstring>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <string>
 #include <unistd.h>
 #include <vector>
@@ -30,6 +32,20 @@ void write_samples(const std::string& path, int width, png_uint_32 format, const
   png.height = 1;
   png.format = format;
   ASSERT_TRUE(png_image_write_to_file(&png, path.c_str(), 0, samples, 0, nullptr)) << png.message;
+}
+
+// The PNG chunk checksum (CRC-32, ISO 3309 polynomial), bit by bit.
+std::uint32_t png_crc(const std::uint8_t* bytes, std::size_t n) {
+  std::uint32_t c = 0xffffffffu;
+  for (std::size_t i = 0; i < n; ++i) {
+    c ^= bytes[i];
+    for (int k = 0; k < 8; ++k) c = (c >> 1) ^ (0xedb88320u & (0u - (c & 1u)));
+  }
+  return c ^ 0xffffffffu;
+}
+
+void put_big_endian(std::vector<std::uint8_t>& bytes, std::size_t at, std::uint32_t value) {
+  for (int k = 0; k < 4; ++k) bytes[at + k] = static_cast<std::uint8_t>(value >> (24 - 8 * k));
 }
 
 class PngGrayLevels : public ::testing::Test {
@@ -91,6 +107,64 @@ TEST_F(PngGrayLevels, MaterialTexturesFromSixteenBitImagesAreTheStoredLevels) {
   EXPECT_EQ(thickness[0], thickness[1]);
   EXPECT_NEAR(thickness[1][0], 0.002 + 0.01 * 128 / 255, 1e-15);
   EXPECT_NEAR(thickness[1][1], 0.002 + 0.01 * 64 / 255, 1e-15);
+}
+
+// A header claiming 16384 x 16384 pixels (4 GiB to decode, the pixels themselves missing)
+// is weighed against the memory available before anything is decoded.
+TEST_F(PngGrayLevels, ImagesBeyondTheMemoryAvailableAreRefusedFromTheirHeader) {
+  const std::uint8_t grey8[2] = {128, 64};
+  write_samples(path("small.png"), 2, PNG_FORMAT_GRAY, grey8);
+  std::ifstream in(path("small.png"), std::ios::binary);
+  std::vector<std::uint8_t> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  ASSERT_GT(bytes.size(), 33u);
+  ASSERT_EQ(std::string(bytes.begin() + 12, bytes.begin() + 16), "IHDR");
+  put_big_endian(bytes, 16, kMaxPngSide);  // width
+  put_big_endian(bytes, 20, kMaxPngSide);  // height
+  put_big_endian(bytes, 29, png_crc(bytes.data() + 12, 17));  // over the chunk's type and data
+  std::ofstream(path("huge.png"), std::ios::binary).write(reinterpret_cast<const char*>(bytes.data()),
+                                                          static_cast<std::streamsize>(bytes.size()));
+  const PngSize size = read_png_size(path("huge.png"));
+  EXPECT_EQ(size.width, static_cast<int>(kMaxPngSide));
+  EXPECT_EQ(size.height, static_cast<int>(kMaxPngSide));
+
+  const Scene scene = parse_scene(
+      R"({"mesh": {"generator": "rectangle", "size": [1, 0.1], "divisions": [1, 1], "element": "quad8"},
+          "material": {"youngs_modulus": 1e6, "poisson_ratio": 0.3, "thickness": 0.01},
+          "boundary": [{"select": {"plane": {"normal": [1, 0, 0], "offset": 0}}, "fix": ["x", "y", "z"], "clamp": true}],
+          "material_textures": [{"field": "thickness", "image": "huge.png", "range": [0.002, 0.012]}]})",
+      path("scene.json"));
+  const std::int64_t one_gib = std::int64_t{1} << 30;
+  try {
+    scene_material_textures(scene, build_scene_mesh(scene), one_gib);
+    FAIL() << "a 16384 x 16384 image was read with 1 GiB available";
+  } catch (const SceneError& e) {
+    EXPECT_EQ(e.json_path(), "material_textures[0].image");
+    const std::string what = e.what();
+    for (const char* part : {"reading its 16384x16384 pixels", "16 bytes a pixel", "a smaller image"})
+      EXPECT_NE(what.find(part), std::string::npos) << part << " not in: " << what;
+  }
+}
+
+// The read's weighing at its line: a 2 x 1 image takes 2 x 16 bytes to read (and as many for
+// the element's copies of E and h afterwards).
+TEST_F(PngGrayLevels, AnImageIsReadWhenItsDecodingFits) {
+  const std::uint8_t grey8[2] = {128, 64};
+  write_samples(path("small.png"), 2, PNG_FORMAT_GRAY, grey8);
+  const Scene scene = parse_scene(
+      R"({"mesh": {"generator": "rectangle", "size": [1, 0.1], "divisions": [1, 1], "element": "quad8"},
+          "material": {"youngs_modulus": 1e6, "poisson_ratio": 0.3, "thickness": 0.01},
+          "boundary": [{"select": {"plane": {"normal": [1, 0, 0], "offset": 0}}, "fix": ["x", "y", "z"], "clamp": true}],
+          "material_textures": [{"field": "thickness", "image": "small.png", "range": [0.002, 0.012]}]})",
+      path("scene.json"));
+  const Mesh mesh = build_scene_mesh(scene);
+  EXPECT_EQ(scene_material_textures(scene, mesh, 2 * kGrayLevelsReadBytesPerPixel).size(), 1u);
+  try {
+    scene_material_textures(scene, mesh, 2 * kGrayLevelsReadBytesPerPixel - 1);
+    FAIL() << "read with one byte too few";
+  } catch (const SceneError& e) {
+    EXPECT_EQ(e.json_path(), "material_textures[0].image");
+    EXPECT_NE(std::string(e.what()).find("reading its 2x1 pixels"), std::string::npos) << e.what();
+  }
 }
 
 }  // namespace

@@ -1,6 +1,7 @@
 #pragma once
 // PNG files through libpng. Errors throw std::runtime_error naming the file.
 // Functions that read/write one file and keep nothing (thread-safe for distinct files).
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -29,5 +30,18 @@ struct GrayLevels {
   std::vector<double> gray;  // width * height, gray[y * width + x]
 };
 GrayLevels read_png_gray_levels(const std::string& path);
+
+// What read_png_gray_levels holds at once for each pixel: its result and the decoded
+// samples (16-bit RGBA at most). Callers weigh an image against the memory available with
+// it before reading (read_png_size) rather than after.
+inline constexpr std::int64_t kGrayLevelsReadBytesPerPixel = sizeof(double) + 4 * sizeof(std::uint16_t);
+
+// The width and height in a PNG's header, checked as read_png checks them; decodes no
+// pixel. Throws as read_png.
+struct PngSize {
+  int width = 0;
+  int height = 0;
+};
+PngSize read_png_size(const std::string& path);
 
 }  // namespace dgtex
