@@ -1,11 +1,16 @@
-// select_nodes on a small hand-built mesh: planes (any orientation), boxes, tolerances.
+// select_nodes on a small hand-built mesh: planes (any orientation), boxes, tolerances;
+// the caution for tolerances of the mesh's size (dgtex/selection_caution.h).
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <filesystem>
+#include <string>
 #include <vector>
 
 #include "dgtex/boundary_selection.h"
 #include "dgtex/scene_io.h"
+#include "dgtex/scene_model.h"
+#include "dgtex/selection_caution.h"
 
 namespace {
 
@@ -113,6 +118,42 @@ TEST(BoundarySelection, PointRuleMatchesNodeRule) {
   const double outside[3] = {1.2500001, 0.5, 0.5};
   EXPECT_TRUE(point_is_selected(s, inside));
   EXPECT_FALSE(point_is_selected(s, outside));
+}
+
+// A tolerance is a length in the mesh's units: the default 1e-6 is 45 % of the two quads
+// measured in micrometres, and cautioned; in metres, or below 1 % of the mesh, it is not.
+TEST(SelectionCaution, AToleranceOfAPercentOfTheMeshOrMoreIsCautioned) {
+  Scene scene;
+  BoundaryCondition held;
+  held.select = plane({1, 0, 0}, 0, 1e-6);
+  held.fixed = {true, true, true};
+  scene.boundary = {held, held};
+  const Mesh metres = two_quads();
+  EXPECT_EQ(selection_tolerance_caution(scene, metres), "");
+  Mesh micrometres = metres;
+  for (double& x : micrometres.positions) x *= 1e-6;
+  const std::string caution = selection_tolerance_caution(scene, micrometres);
+  for (const char* part : {"boundary[0].select.tolerance 1e-06 is 45 % of the mesh's size", "2.23607e-06",
+                           "selects 8 of its 14 nodes", "a length in the mesh's units (default 1e-6)"})
+    EXPECT_NE(caution.find(part), std::string::npos) << part << " not in: " << caution;
+  // The line: 1 % of the diagonal, for the first selection that reaches it.
+  const double diagonal = std::sqrt(5.0);
+  scene.boundary[0].select.tolerance = 0.0099 * diagonal;
+  scene.boundary[1].select.tolerance = 0.01 * diagonal;
+  EXPECT_NE(selection_tolerance_caution(scene, metres).find("boundary[1].select.tolerance"), std::string::npos);
+  scene.boundary[1].select.tolerance = 0.0099 * diagonal;
+  EXPECT_EQ(selection_tolerance_caution(scene, metres), "");
+}
+
+TEST(SelectionCaution, NoExampleSceneIsCautioned) {
+  int scenes = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(std::string(DGTEX_SOURCE_DIR) + "/examples/scenes")) {
+    if (entry.path().extension() != ".json") continue;
+    const Scene scene = load_scene(entry.path().string());
+    EXPECT_EQ(selection_tolerance_caution(scene, build_scene_mesh(scene)), "") << entry.path();
+    ++scenes;
+  }
+  EXPECT_GE(scenes, 10);
 }
 
 }  // namespace

@@ -26,6 +26,7 @@
 #include "dgtex/rotation_caution.h"
 #include "dgtex/scene_io.h"
 #include "dgtex/scene_run.h"
+#include "dgtex/selection_caution.h"
 #include "dgtex/shell_state.h"
 #include "dgtex/surface_point.h"
 #include "dgtex/texel_memory_estimate.h"
@@ -137,8 +138,11 @@ int run_command(int argc, char** argv) {
     return 1;
   }
   const Mesh& mesh = run->mesh();
-  // Valid but likely not what was meant (dgtex/penalty_caution.h, mesh_validation.h): say so.
+  // Valid but likely not what was meant (dgtex/penalty_caution.h, selection_caution.h,
+  // mesh_validation.h): say so.
   if (const std::string caution = penalty_caution(scene.penalty, mesh.type); !caution.empty())
+    std::fprintf(stderr, "dgtex run: warning: %s: %s\n", scene_path.c_str(), caution.c_str());
+  if (const std::string caution = selection_tolerance_caution(scene, mesh); !caution.empty())
     std::fprintf(stderr, "dgtex run: warning: %s: %s\n", scene_path.c_str(), caution.c_str());
   if (const std::string caution = unwelded_seam_caution(mesh); !caution.empty())
     std::fprintf(stderr, "dgtex run: warning: %s: mesh: %s\n", scene_path.c_str(), caution.c_str());
