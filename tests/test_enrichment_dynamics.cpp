@@ -119,7 +119,7 @@ TEST(EnrichedDynamics, ACorotatedClampedEnrichedPlateUnderASmallLoadDeflectsAsTh
   }
   std::printf("free corner deflection: linear %.6e, corotated %.6e\n", corner[0], corner[1]);
   EXPECT_LT(corner[0], -1e-4);
-  EXPECT_NEAR(corner[1] / corner[0], 1.0, 1e-3);
+  EXPECT_NEAR(corner[1] / corner[0], 1.0, 1e-4);  // measured 1.5e-6
 }
 
 }  // namespace

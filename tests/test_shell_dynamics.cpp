@@ -121,7 +121,7 @@ TEST(Dynamics, ACorotatedClampedStripUnderASmallLoadDeflectsAsTheLinearOne) {
     std::printf("%s strip, tip deflection: linear %.6e, corotated %.6e\n", type == ElementType::quad8 ? "quad8" : "tri6",
                 tip[0], tip[1]);
     EXPECT_LT(tip[0], -1e-4);  // it sags
-    EXPECT_NEAR(tip[1] / tip[0], 1.0, 1e-3);
+    EXPECT_NEAR(tip[1] / tip[0], 1.0, 1e-4);  // measured 1.0e-5 (quad8), 9.2e-6 (tri6)
   }
 }
 

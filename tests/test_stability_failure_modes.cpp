@@ -303,9 +303,11 @@ TEST(PenaltyTooHigh, CoarsePlatesLockAndTheLineCautions) {
     EXPECT_NE(caution.find("penalty " + std::string(quad8 ? "100" : "10") + " is far above"), std::string::npos) << caution;
     EXPECT_NE(caution.find(quad8 ? "8 x 8 quad8" : "8 x 8 tri6"), std::string::npos) << caution;
   }
-  // Finer meshes lock less: quad8 32 x 32 at 1000 within 1 % of penalty 1.
-  EXPECT_NEAR(clamped_plate_deflection_ratio(ElementType::quad8, 32, 1000, m),
-              clamped_plate_deflection_ratio(ElementType::quad8, 32, 1, m), 0.01);
+  // Finer meshes lock less: quad8 32 x 32 at 1000 within 0.5 % of penalty 1.
+  const double fine_at_one = clamped_plate_deflection_ratio(ElementType::quad8, 32, 1, m);
+  const double fine_at_1000 = clamped_plate_deflection_ratio(ElementType::quad8, 32, 1000, m);
+  std::printf("clamped plate quad8 32x32, w / Timoshenko: penalty 1 %.4f, 1000 %.4f\n", fine_at_one, fine_at_1000);
+  EXPECT_NEAR(fine_at_1000 / fine_at_one, 1.0, 0.005);
 }
 
 // ---------------------------------------------------------------------------------------
