@@ -7,11 +7,11 @@
 #include <fstream>
 #include <sstream>
 #include <stdexcept>
-#include <utility>
 
 #include <sys/resource.h>
 #include <unistd.h>
 
+#include "cgroup_memory.h"
 #include "dgtex/scene_io.h"
 
 namespace dgtex {
@@ -29,14 +29,6 @@ std::int64_t meminfo_bytes(const std::string& text, const std::string& key) {
   long long kib = -1;
   if (std::sscanf(text.c_str() + at + key.size() + 2, "%lld", &kib) != 1) return -1;
   return static_cast<std::int64_t>(kib) * 1024;
-}
-
-// A number in a file (a cgroup's limit or usage); -1 for "max", a missing file or text.
-std::int64_t file_number(const char* path) {
-  std::ifstream file(path);
-  long long value = -1;
-  if (!(file >> value)) return -1;
-  return value;
 }
 
 // The bound's bytes a texel of a cut's region: its Laplace solves decide it.
@@ -103,15 +95,8 @@ std::int64_t available_memory_bytes() {
   const std::int64_t available = meminfo_bytes(text.str(), "MemAvailable");
   if (available < 0) return bytes;
   cap(available + std::max<std::int64_t>(0, meminfo_bytes(text.str(), "SwapFree")));
-  // A container's limit (the cgroup's) can be far below the host's memory. v1 reports "no
-  // limit" as a number near 2^63.
-  const std::int64_t no_limit = std::int64_t{1} << 60;
-  for (const auto& [limit_file, usage_file] : {std::pair{"/sys/fs/cgroup/memory.max", "/sys/fs/cgroup/memory.current"},
-                                                 std::pair{"/sys/fs/cgroup/memory/memory.limit_in_bytes",
-                                                           "/sys/fs/cgroup/memory/memory.usage_in_bytes"}}) {
-    const std::int64_t limit = file_number(limit_file), usage = file_number(usage_file);
-    if (limit > 0 && limit < no_limit && usage >= 0) cap(std::max<std::int64_t>(0, limit - usage));
-  }
+  cap(detail::cgroup_memory_left(detail::kCgroupV2LimitFile, detail::kCgroupV2UsageFile));
+  cap(detail::cgroup_memory_left(detail::kCgroupV1LimitFile, detail::kCgroupV1UsageFile));
   return bytes;
 }
 

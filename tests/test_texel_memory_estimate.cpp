@@ -6,12 +6,16 @@
 #include <sys/resource.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cstdint>
+#include <cstdio>
 #include <cstdlib>
 #include <fstream>
 #include <stdexcept>
 #include <string>
+#include <utility>
 
+#include "cgroup_memory.h"
 #include "dgtex/crease_enrichment.h"
 #include "dgtex/cut_manager.h"
 #include "dgtex/scene_io.h"
@@ -202,6 +206,40 @@ TEST(TexelMemoryEstimate, AvailableMemoryIsPositiveAndAtMostWhatTheMachineHas) {
   const std::int64_t available = available_memory_bytes();
   EXPECT_GT(available, 0);
   EXPECT_LE(available, total);
+}
+
+// A container's limit from its cgroup's files (written here in a temporary folder): the
+// limit less the usage, 0 past it, nothing for v2's "max", v1's "no limit" near 2^63, or a
+// missing or unreadable file. And the machine's own: what is available lies within the room
+// its cgroup leaves, where it has a limit.
+TEST(TexelMemoryEstimate, AContainersLimitIsTheRoomItsCgroupLeaves) {
+  const std::string dir = ::testing::TempDir() + "dgtex_cgroup_" + std::to_string(::getpid()) + "_";
+  auto write = [&](const std::string& name, const std::string& text) {
+    std::ofstream(dir + name) << text;
+    return dir + name;
+  };
+  const std::string limit = write("limit", "1073741824\n"), usage = write("usage", "314572800\n");
+  EXPECT_EQ(detail::cgroup_memory_left(limit, usage), 1073741824 - 314572800);
+  EXPECT_EQ(detail::cgroup_memory_left(write("small_limit", "1000\n"), usage), 0);  // over it: no room
+  EXPECT_EQ(detail::cgroup_memory_left(write("v2_none", "max\n"), usage), -1);
+  EXPECT_EQ(detail::cgroup_memory_left(write("v1_none", "9223372036854771712\n"), usage), -1);
+  EXPECT_EQ(detail::cgroup_memory_left(dir + "missing", usage), -1);
+  EXPECT_EQ(detail::cgroup_memory_left(limit, dir + "missing"), -1);
+  EXPECT_EQ(detail::cgroup_memory_left(limit, write("garbage", "lots\n")), -1);
+  for (const char* name : {"limit", "usage", "small_limit", "v2_none", "v1_none", "garbage"}) std::remove((dir + name).c_str());
+
+  for (const auto& [limit_file, usage_file] :
+       {std::pair{detail::kCgroupV2LimitFile, detail::kCgroupV2UsageFile},
+        std::pair{detail::kCgroupV1LimitFile, detail::kCgroupV1UsageFile}}) {
+    // Read on both sides, as other processes of the group (tests beside this one) move its
+    // usage; a missing cap would show as the host's memory, gigabytes above.
+    const std::int64_t before = detail::cgroup_memory_left(limit_file, usage_file);
+    const std::int64_t available = available_memory_bytes();
+    const std::int64_t after = detail::cgroup_memory_left(limit_file, usage_file);
+    if (before >= 0 && after >= 0) {
+      EXPECT_LE(available, std::max(before, after) + (std::int64_t{256} << 20)) << limit_file;
+    }
+  }
 }
 
 // DGTEX_MEMORY_LIMIT_MB caps what the memory checks may use (one process per test: the
