@@ -1,6 +1,13 @@
 #include "cholmod_lock.h"
 
+#include <cholmod.h>
 #include <omp.h>
+
+#include <cstdint>
+#include <stdexcept>
+#include <string>
+
+#include "address_space.h"
 
 namespace dgtex::detail {
 
@@ -16,5 +23,33 @@ CholmodLock::CholmodLock() : lock_(cholmod_mutex()), max_active_levels_(omp_get_
 }
 
 CholmodLock::~CholmodLock() { omp_set_max_active_levels(max_active_levels_); }
+
+void reserve_blas_workspace(const CholmodLock&) {
+  static bool reserved = false;  // guarded by the lock the caller holds
+  if (reserved) return;
+  const std::int64_t left = address_space_left();
+  if (left >= 0 && left < kBlasWorkspaceAddressSpace)
+    throw std::runtime_error("sparse Cholesky factorisation: OpenBLAS needs " +
+                             std::to_string(kBlasWorkspaceAddressSpace >> 20) + " MiB of address space for its workspace, and " +
+                             std::to_string(left >> 20) + " MiB are left under the process's address-space limit (ulimit -v): "
+                             "raise the limit by " + std::to_string((kBlasWorkspaceAddressSpace - left + (1 << 20) - 1) >> 20) +
+                             " MiB or more");
+  cholmod_common common;
+  cholmod_start(&common);
+  common.supernodal = CHOLMOD_SUPERNODAL;
+  common.print = 0;
+  common.error_handler = nullptr;
+  cholmod_sparse* one = cholmod_speye(1, 1, CHOLMOD_REAL, &common);
+  if (one) {
+    one->stype = -1;
+    if (cholmod_factor* factor = cholmod_analyze(one, &common)) {
+      cholmod_factorize(one, factor, &common);  // dpotrf on one supernode: OpenBLAS's workspace
+      cholmod_free_factor(&factor, &common);
+    }
+    cholmod_free_sparse(&one, &common);
+  }
+  cholmod_finish(&common);
+  reserved = true;
+}
 
 }  // namespace dgtex::detail

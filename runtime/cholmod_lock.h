@@ -38,4 +38,18 @@ class CholmodLock {
 
 inline CholmodLock lock_cholmod() { return {}; }
 
+// Debian's OpenBLAS takes a workspace of 128 MiB (its BUFFER_SIZE on x86-64) at its first
+// call, and when malloc refuses it, as under a `ulimit -v` near the process's size, it
+// retries forever: the cylinder under `ulimit -v 300000` spun at 100 % of a core in its first
+// factorisation instead of failing. Call while holding the lock, before a CHOLMOD call that
+// may reach BLAS (a supernodal factorisation). Its first call in the process checks the
+// address space left and has OpenBLAS take its workspace at once (a 1 x 1 supernodal
+// factorisation), which it keeps; later calls return at once. Throws std::runtime_error
+// naming the room needed and left (nothing is taken then, and the next call checks again).
+void reserve_blas_workspace(const CholmodLock& held);
+
+// What reserve_blas_workspace asks to be left: the workspace and a margin for the arena
+// glibc may map for a thread's first allocation.
+inline constexpr long long kBlasWorkspaceAddressSpace = 192LL << 20;
+
 }  // namespace dgtex::detail

@@ -138,6 +138,7 @@ LaplaceBenchRun run_once(LaplaceBenchSolver solver, const kernels::TexelTile& pr
       auto start = Clock::now();
       Eigen::CholmodSupernodalLLT<Eigen::SparseMatrix<double>, Eigen::Lower> cholesky;
       const auto lock = detail::lock_cholmod();  // as dgtex's own CHOLMOD calls (cholmod_lock.h)
+      detail::reserve_blas_workspace(lock);
       cholesky.compute(system.A);
       if (cholesky.info() != Eigen::Success) throw std::runtime_error("bench: CHOLMOD factorisation failed");
       if (solver == LaplaceBenchSolver::cholmod_solve) start = Clock::now();

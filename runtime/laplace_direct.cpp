@@ -64,6 +64,7 @@ LaplaceSolveStats solve_laplace_direct(kernels::TexelTile& tile) {
   if (system.b.size() > 0 && system.b.squaredNorm() > 0) {
     Eigen::CholmodSupernodalLLT<Eigen::SparseMatrix<double>, Eigen::Lower> cholesky;
     const auto lock = detail::lock_cholmod();  // held through the solve below
+    detail::reserve_blas_workspace(lock);
     cholesky.compute(system.A);
     if (cholesky.info() != Eigen::Success)
       throw std::runtime_error("Laplace solve: CHOLMOD could not factor the " + std::to_string(system.b.size()) +

@@ -198,10 +198,12 @@ void SparseCholesky::factorize(const std::vector<double>& values) {
     for (std::size_t k = 0; k < m.permuted_source.size(); ++k) x[k] = values[m.permuted_source[k]];
     double beta[2] = {0, 0};
     const auto lock = detail::lock_cholmod();
+    detail::reserve_blas_workspace(lock);
     cholmod_super_numeric(m.permuted, nullptr, beta, m.factor, &m.common);
   } else {
     std::memcpy(m.matrix->x, values.data(), sizeof(double) * values.size());
     const auto lock = detail::lock_cholmod();
+    detail::reserve_blas_workspace(lock);
     cholmod_factorize(m.matrix, m.factor, &m.common);
   }
   if (m.common.status == CHOLMOD_NOT_POSDEF || m.factor->minor < static_cast<size_t>(n_)) {

@@ -8,9 +8,7 @@
 #include <sstream>
 #include <stdexcept>
 
-#include <sys/resource.h>
-#include <unistd.h>
-
+#include "address_space.h"
 #include "cgroup_memory.h"
 #include "dgtex/scene_io.h"
 
@@ -37,19 +35,6 @@ std::int64_t cut_bytes_per_texel(const TexelFields& fields) {
 }
 
 std::string count_of(int n, const std::string& noun) { return std::to_string(n) + " " + noun + (n == 1 ? "" : "s"); }
-
-// The address space left under `ulimit -v` (RLIMIT_AS): its limit less the process's
-// virtual size (/proc/self/statm), where allocations fail long before the machine's memory
-// runs out; -1 without a limit.
-std::int64_t address_space_left() {
-  rlimit limit{};
-  if (getrlimit(RLIMIT_AS, &limit) != 0 || limit.rlim_cur == RLIM_INFINITY) return -1;
-  std::ifstream statm("/proc/self/statm");
-  long long pages = 0;
-  if (!(statm >> pages)) pages = 0;
-  const std::int64_t used = static_cast<std::int64_t>(pages) * sysconf(_SC_PAGESIZE);
-  return std::max<std::int64_t>(0, static_cast<std::int64_t>(limit.rlim_cur) - used);
-}
 
 // DGTEX_MEMORY_LIMIT_MB as bytes; -1 when unset or empty. Throws std::invalid_argument for
 // anything but a whole number of MiB >= 1.
@@ -87,7 +72,7 @@ std::int64_t available_memory_bytes() {
     if (figure >= 0) bytes = bytes < 0 ? figure : std::min(bytes, figure);
   };
   cap(memory_limit_from_environment());
-  cap(address_space_left());
+  cap(detail::address_space_left());
   std::ifstream meminfo("/proc/meminfo");
   if (!meminfo) return bytes;
   std::stringstream text;

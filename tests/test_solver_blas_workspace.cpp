@@ -1,0 +1,92 @@
+// Debian's OpenBLAS takes a 128 MiB workspace at its first call and retries forever when
+// malloc refuses it: the cylinder under `ulimit -v 300000` spun at 100 % of a core in its
+// first factorisation. The first supernodal factorisation in a process now checks the
+// address space left and has OpenBLAS take its workspace at once (cholmod_lock.h,
+// reserve_blas_workspace). One test in its own executable: a process whose BLAS has run
+// before holds its workspace already.
+#include <gtest/gtest.h>
+#include <sys/resource.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdint>
+#include <fstream>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "cholmod_lock.h"
+#include "dgtex/sparse_cholesky.h"
+
+namespace {
+
+using namespace dgtex;
+
+// The 1-D Laplacian of n unknowns plus the identity, lower triangle by columns.
+struct Tridiagonal {
+  int n;
+  std::vector<int> column_start, row_index;
+  std::vector<double> values;
+  explicit Tridiagonal(int size) : n(size) {
+    for (int j = 0; j < n; ++j) {
+      column_start.push_back(static_cast<int>(row_index.size()));
+      row_index.push_back(j);
+      values.push_back(3.0);
+      if (j + 1 < n) {
+        row_index.push_back(j + 1);
+        values.push_back(-1.0);
+      }
+    }
+    column_start.push_back(static_cast<int>(row_index.size()));
+  }
+};
+
+TEST(BlasWorkspace, ATightAddressSpaceIsRefusedInsteadOfSpinningInOpenBlas) {
+#if defined(__SANITIZE_ADDRESS__)
+  GTEST_SKIP() << "ASan reserves terabytes of address space for its shadow memory";
+#else
+  std::ifstream statm("/proc/self/statm");
+  long long pages = 0;
+  if (!(statm >> pages)) GTEST_SKIP() << "no /proc/self/statm";
+  rlimit original{};
+  ASSERT_EQ(getrlimit(RLIMIT_AS, &original), 0);
+  const std::int64_t used = static_cast<std::int64_t>(pages) * sysconf(_SC_PAGESIZE);
+  const std::int64_t room = std::int64_t{96} << 20;  // below the workspace's 128 MiB
+  if (original.rlim_cur != RLIM_INFINITY && static_cast<std::int64_t>(original.rlim_cur) < used + room)
+    GTEST_SKIP() << "the limit leaves less than 96 MiB already";
+
+  const Tridiagonal system(300);
+  SparseCholesky cholesky(0);  // always CHOLMOD, supernodal: its factorisation calls dpotrf
+  cholesky.analyze(system.n, system.column_start, system.row_index);
+  ASSERT_FALSE(cholesky.dense());
+  // A regression spins in OpenBLAS for ever: end the process instead.
+  ::alarm(120);
+  rlimit limited = original;
+  limited.rlim_cur = static_cast<rlim_t>(used + room);
+  ASSERT_EQ(setrlimit(RLIMIT_AS, &limited), 0);
+  std::string message;
+  try {
+    cholesky.factorize(system.values);
+  } catch (const std::runtime_error& error) {
+    message = error.what();
+  }
+  ASSERT_EQ(setrlimit(RLIMIT_AS, &original), 0);  // back before any assertion can fail
+  for (const char* part : {"OpenBLAS needs 192 MiB of address space", "(ulimit -v)", "raise the limit by"})
+    EXPECT_NE(message.find(part), std::string::npos) << part << " not in: '" << message << "'";
+
+  // With the limit lifted the same factorisation runs, and solves.
+  cholesky.factorize(system.values);
+  ::alarm(0);
+  std::vector<double> b(system.n, 1.0), x;
+  cholesky.solve(b, x);
+  ASSERT_EQ(x.size(), b.size());
+  for (int i = 0; i < system.n; ++i) {
+    double product = 3.0 * x[i];
+    if (i > 0) product -= x[i - 1];
+    if (i + 1 < system.n) product -= x[i + 1];
+    EXPECT_NEAR(product, 1.0, 1e-12) << i;
+  }
+#endif
+}
+
+}  // namespace
