@@ -21,26 +21,35 @@ using namespace dgtex;
 TEST(KeptReferences, ATemporaryIsRefusedWhereAReferenceIsKept) {
   static_assert(std::is_constructible_v<DeformedShell, const ShellState&>);
   static_assert(!std::is_constructible_v<DeformedShell, ShellState>, "DeformedShell(run.state()) would dangle");
+  // A const temporary (a getter returning `const ShellState`) bound to `const T&` until
+  // session 71: each kept reference also refuses `const T&&`.
+  static_assert(!std::is_constructible_v<DeformedShell, const ShellState>);
 
   using Fixed = std::vector<char>;
   using Force = std::vector<double>;
   static_assert(std::is_constructible_v<ShellSimulation, const ShellModel&, Fixed, Force>);
   static_assert(!std::is_constructible_v<ShellSimulation, ShellModel, Fixed, Force>);
+  static_assert(!std::is_constructible_v<ShellSimulation, const ShellModel, Fixed, Force>);
 
   using Cuts = std::vector<Cut>;
   static_assert(std::is_constructible_v<CutManager, const Mesh&, const Topology&, const Cuts&, const EnrichmentOptions&>);
   static_assert(!std::is_constructible_v<CutManager, Mesh, const Topology&, const Cuts&, const EnrichmentOptions&>);
+  static_assert(!std::is_constructible_v<CutManager, const Mesh, const Topology&, const Cuts&, const EnrichmentOptions&>);
   // The topology is read by the constructor only (build_topology(mesh) as an argument is fine).
   static_assert(std::is_constructible_v<CutManager, const Mesh&, Topology, const Cuts&, const EnrichmentOptions&>);
 
   static_assert(std::is_constructible_v<SurfacePointSearch, const Mesh&>);
   static_assert(!std::is_constructible_v<SurfacePointSearch, Mesh>, "SurfacePointSearch(make_rectangle(...)) would dangle");
+  static_assert(!std::is_constructible_v<SurfacePointSearch, const Mesh>);
 
   using Mass = std::vector<double>;
   static_assert(std::is_constructible_v<FactorReusingSolver, const BlockAssembly&, const FreeDofSystem&, const Mass&>);
   static_assert(!std::is_constructible_v<FactorReusingSolver, BlockAssembly, const FreeDofSystem&, const Mass&>);
   static_assert(!std::is_constructible_v<FactorReusingSolver, const BlockAssembly&, FreeDofSystem, const Mass&>);
   static_assert(!std::is_constructible_v<FactorReusingSolver, const BlockAssembly&, const FreeDofSystem&, Mass>);
+  static_assert(!std::is_constructible_v<FactorReusingSolver, const BlockAssembly, const FreeDofSystem&, const Mass&>);
+  static_assert(!std::is_constructible_v<FactorReusingSolver, const BlockAssembly&, const FreeDofSystem, const Mass&>);
+  static_assert(!std::is_constructible_v<FactorReusingSolver, const BlockAssembly&, const FreeDofSystem&, const Mass>);
   SUCCEED() << "checked at compile time";
 }
 

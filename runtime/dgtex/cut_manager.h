@@ -83,8 +83,10 @@ class CutManager {
   // options it cannot use (texture_resolution < 2, new_cut_length shorter than a texel).
   CutManager(const Mesh& mesh, const Topology& topology, const std::vector<Cut>& cuts,
              const EnrichmentOptions& options, CutManagerOptions manager_options = {});
-  // The mesh is kept by reference: a temporary one would dangle.
+  // The mesh is kept by reference: a temporary one would dangle, a const one too.
   CutManager(Mesh&&, const Topology&, const std::vector<Cut>&, const EnrichmentOptions&, CutManagerOptions = {}) = delete;
+  CutManager(const Mesh&&, const Topology&, const std::vector<Cut>&, const EnrichmentOptions&,
+             CutManagerOptions = {}) = delete;
 
   // Brings the functions to `time` (finite, else std::invalid_argument); true when they
   // changed (added, removed or re-solved). A Laplace solve that fails throws

@@ -29,8 +29,9 @@ class DeformedShell {
  public:
   // Keeps a reference to state (which must outlive this object); validates it.
   explicit DeformedShell(const ShellState& state);
-  // A temporary state (DeformedShell(run.state())) would dangle.
+  // A temporary state (DeformedShell(run.state())) would dangle, a const one too.
   explicit DeformedShell(ShellState&&) = delete;
+  explicit DeformedShell(const ShellState&&) = delete;
 
   const ShellState& state() const { return state_; }
   // Indices into state.enrichments of the enrichments of one element, in state order.

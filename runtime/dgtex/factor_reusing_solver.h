@@ -148,10 +148,16 @@ class FactorReusingSolver {
   // std::invalid_argument for options set_options refuses.
   FactorReusingSolver(const BlockAssembly& pattern, const FreeDofSystem& system, const std::vector<double>& mass,
                       FactorReuseOptions options = {});
-  // The three are kept by reference: temporaries would dangle.
+  // The three are kept by reference: temporaries would dangle, const ones too.
   FactorReusingSolver(BlockAssembly&&, const FreeDofSystem&, const std::vector<double>&, FactorReuseOptions = {}) = delete;
   FactorReusingSolver(const BlockAssembly&, FreeDofSystem&&, const std::vector<double>&, FactorReuseOptions = {}) = delete;
   FactorReusingSolver(const BlockAssembly&, const FreeDofSystem&, std::vector<double>&&, FactorReuseOptions = {}) = delete;
+  FactorReusingSolver(const BlockAssembly&&, const FreeDofSystem&, const std::vector<double>&,
+                      FactorReuseOptions = {}) = delete;
+  FactorReusingSolver(const BlockAssembly&, const FreeDofSystem&&, const std::vector<double>&,
+                      FactorReuseOptions = {}) = delete;
+  FactorReusingSolver(const BlockAssembly&, const FreeDofSystem&, const std::vector<double>&&,
+                      FactorReuseOptions = {}) = delete;
 
   // b: #dofs (fixed entries ignored). x: #dofs, in: initial guess, out: solution with
   // fixed entries zero. `cholesky` is the factorisation of the whole pattern it reuses and

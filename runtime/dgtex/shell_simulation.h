@@ -43,8 +43,9 @@ class ShellSimulation {
   // (ShellModel::revision): build a new simulation for the new DOFs. The accessors then
   // still return the old basis's data.
   ShellSimulation(const ShellModel& model, std::vector<char> fixed, std::vector<double> external_force);
-  // The model is kept by reference: a temporary one would dangle.
+  // The model is kept by reference: a temporary one would dangle, a const one too.
   ShellSimulation(ShellModel&&, std::vector<char>, std::vector<double>) = delete;
+  ShellSimulation(const ShellModel&&, std::vector<char>, std::vector<double>) = delete;
 
   // Throws ModelError naming a free rigid-body mode of the whole mesh if the constraints
   // (fixed DOFs, and clamped edges, which hold their normals) leave one. Geometric: it

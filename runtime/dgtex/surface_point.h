@@ -51,8 +51,9 @@ class BoxHierarchy;
 class SurfacePointSearch {
  public:
   explicit SurfacePointSearch(const Mesh& mesh);
-  // The mesh is kept by reference: a temporary one would dangle.
+  // The mesh is kept by reference: a temporary one would dangle, a const one too.
   explicit SurfacePointSearch(Mesh&&) = delete;
+  explicit SurfacePointSearch(const Mesh&&) = delete;
   // == closest_surface_point(mesh, p).
   SurfacePoint closest(const double p[3]) const;
   // == closest_surface_point of the sub-mesh made of these elements (distinct, ascending),
