@@ -4,6 +4,7 @@
 #include <fstream>
 #include <iomanip>
 #include <limits>
+#include <string>
 
 namespace dgtex {
 namespace {
@@ -34,11 +35,47 @@ void deformed_node(const Mesh& mesh, const double* displacement, int n, double x
   }
 }
 
+// The mesh's arrays as the writers read them: a known element type, whole nodes and
+// elements, at least one element, node indices in range (a bad index was written as is
+// into a .vtu and read out of bounds by write_obj).
+void require_readable_mesh(const Mesh& mesh, const char* what) {
+  if (mesh.type != ElementType::quad8 && mesh.type != ElementType::tri6)
+    throw MeshError(std::string(what) + ": element type " + std::to_string(static_cast<int>(mesh.type)) +
+                    " (expected quad8 or tri6)");
+  const int npe = mesh.nodes_per_element();
+  if (mesh.positions.size() % 3 != 0 || mesh.elements.size() % npe != 0 || mesh.elements.empty())
+    throw MeshError(std::string(what) + ": " + std::to_string(mesh.positions.size()) + " position values and " +
+                    std::to_string(mesh.elements.size()) + " element node indices (expected 3 a node and " +
+                    std::to_string(npe) + " an element, at least one element)");
+  const int nodes = mesh.num_nodes();
+  for (std::size_t k = 0; k < mesh.elements.size(); ++k)
+    if (mesh.elements[k] < 0 || mesh.elements[k] >= nodes)
+      throw MeshError(std::string(what) + ": element " + std::to_string(k / npe) + " uses node " +
+                      std::to_string(mesh.elements[k]) + " (the mesh has nodes 0.." + std::to_string(nodes - 1) + ")");
+}
+
+// A name as XML attribute text.
+std::string xml_escaped(const std::string& text) {
+  std::string out;
+  for (char c : text) {
+    switch (c) {
+      case '&': out += "&amp;"; break;
+      case '<': out += "&lt;"; break;
+      case '>': out += "&gt;"; break;
+      case '"': out += "&quot;"; break;
+      case '\'': out += "&apos;"; break;
+      default: out += c;
+    }
+  }
+  return out;
+}
+
 }  // namespace
 
 void write_vtu(const std::string& path, const Mesh& mesh, const double* displacement,
                const std::vector<std::pair<std::string, std::vector<double>>>& point_scalars) {
   const char* what = "write_vtu";
+  require_readable_mesh(mesh, what);
   const int nodes = mesh.num_nodes(), elements = mesh.num_elements(), npe = mesh.nodes_per_element();
   for (const auto& [name, values] : point_scalars) {
     if (static_cast<int>(values.size()) != nodes)
@@ -82,7 +119,7 @@ void write_vtu(const std::string& path, const Mesh& mesh, const double* displace
   }
   out << "        </DataArray>\n";
   for (const auto& [name, values] : point_scalars) {
-    out << "        <DataArray type=\"Float64\" Name=\"" << name << "\" format=\"ascii\">\n";
+    out << "        <DataArray type=\"Float64\" Name=\"" << xml_escaped(name) << "\" format=\"ascii\">\n";
     for (double v : values) out << "          " << v << '\n';
     out << "        </DataArray>\n";
   }
@@ -92,6 +129,7 @@ void write_vtu(const std::string& path, const Mesh& mesh, const double* displace
 
 void write_obj(const std::string& path, const Mesh& mesh, const double* displacement) {
   const char* what = "write_obj";
+  require_readable_mesh(mesh, what);
   const int nodes = mesh.num_nodes(), elements = mesh.num_elements();
   const int corners = kernels::corners_per_element(mesh.type);
   std::ofstream out = open_for_writing(path, what);

@@ -132,6 +132,45 @@ TEST(MeshOutputErrors, VtuReportsPathAndBadArrays) {
   EXPECT_THROW(write_obj("/nonexistent/dir/out.obj", mesh, nullptr), MeshError);
 }
 
+// A mesh the writers cannot read is refused naming what is wrong (a node index of -1 was
+// written into a .vtu as is and read out of bounds by write_obj); array names are escaped.
+TEST(MeshOutputErrors, UnreadableMeshesAreRefusedAndNamesEscaped) {
+  const Mesh good = make_rectangle(1, 1, 1, 1, ElementType::quad8);
+  const std::string path = temp_path("dgtex_mesh_output_unreadable");
+  auto refusal = [&](const Mesh& mesh) {
+    std::string messages;
+    for (int writer = 0; writer < 2; ++writer) {
+      try {
+        writer == 0 ? write_vtu(path, mesh, nullptr) : write_obj(path, mesh, nullptr);
+        ADD_FAILURE() << (writer == 0 ? "write_vtu" : "write_obj") << " wrote the mesh";
+      } catch (const MeshError& error) {
+        messages += std::string(error.what()) + "\n";
+      }
+    }
+    return messages;
+  };
+  Mesh bad_index = good;
+  bad_index.elements[3] = -1;
+  EXPECT_NE(refusal(bad_index).find("write_obj: element 0 uses node -1 (the mesh has nodes 0..7)"), std::string::npos)
+      << refusal(bad_index);
+  bad_index.elements[3] = 8;
+  EXPECT_NE(refusal(bad_index).find("write_vtu: element 0 uses node 8"), std::string::npos) << refusal(bad_index);
+  Mesh empty;
+  EXPECT_NE(refusal(empty).find("at least one element"), std::string::npos) << refusal(empty);
+  Mesh partial_node = good;
+  partial_node.positions.pop_back();
+  EXPECT_NE(refusal(partial_node).find("23 position values"), std::string::npos) << refusal(partial_node);
+  Mesh unknown_type = good;
+  unknown_type.type = static_cast<ElementType>(5);
+  EXPECT_NE(refusal(unknown_type).find("element type 5 (expected quad8 or tri6)"), std::string::npos)
+      << refusal(unknown_type);
+
+  write_vtu(path, good, nullptr, {{"stress \"von Mises\" <Pa> & more", std::vector<double>(8, 1.0)}});
+  const std::string text = read_text(path);
+  std::remove(path.c_str());
+  EXPECT_NE(text.find("Name=\"stress &quot;von Mises&quot; &lt;Pa&gt; &amp; more\""), std::string::npos) << text;
+}
+
 // The OBJ triangulation re-imports as a valid (manifold, consistently oriented) mesh whose
 // triangles keep the element normals; for a flat mesh its area is exact.
 TEST_P(MeshOutput, ObjTriangulationRoundTrip) {

@@ -17,8 +17,10 @@ namespace dgtex {
 // displacement is #nodes x 3 row-major, or nullptr for none (the "displacement" vector
 // array is then zero). point_scalars: extra named per-node arrays, each #nodes long.
 // Values are written with 17 significant digits (round-trip exact).
-// Throws MeshError naming the path on I/O failure, and for a wrong scalar array length or
-// a non-finite value (naming the array and node).
+// Array names are written as XML text (escaped). Throws MeshError naming the path on I/O
+// failure, for a wrong scalar array length or a non-finite value (naming the array and
+// node), and for a mesh the writers cannot read: an unknown element type, arrays that are
+// not whole nodes and elements, no element, or a node index out of range (naming it).
 void write_vtu(const std::string& path, const Mesh& mesh, const double* displacement,
                const std::vector<std::pair<std::string, std::vector<double>>>& point_scalars = {});
 
@@ -28,7 +30,8 @@ void write_vtu(const std::string& path, const Mesh& mesh, const double* displace
 // (4 corner triangles + 4 around an extra vertex at the element centre x(0, 0), evaluated
 // with the shape functions; the centre vertices follow the nodes, one per element in
 // element order). All triangles keep the element's orientation (counter-clockwise seen
-// from the normal side). Throws MeshError naming the path on I/O failure.
+// from the normal side). Throws MeshError naming the path on I/O failure, and for a mesh
+// the writers cannot read (as write_vtu).
 void write_obj(const std::string& path, const Mesh& mesh, const double* displacement);
 
 }  // namespace dgtex
