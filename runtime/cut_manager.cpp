@@ -13,6 +13,7 @@
 
 #include <omp.h>
 
+#include "api_argument_checks.h"
 #include "dgtex/enrichment_span.h"
 #include "dgtex/kernels/forall.h"
 #include "dgtex/stage_timer.h"
@@ -207,6 +208,34 @@ void CutManager::trim_shared_end_spurs(std::vector<std::vector<std::pair<int, Cu
 }
 
 
+namespace {
+
+// What validate_scene takes of the cuts' schedules and the options the manager reads, for
+// a caller that builds them in code: a NaN speed or angle was taken silently (the cut never
+// appeared, or split nowhere), and a resolution of 65536 allocated a 32 GiB tile.
+void check_cut_options(const std::vector<Cut>& cuts, const EnrichmentOptions& options) {
+  auto refuse = [](const std::string& what, double value, const std::string& valid) {
+    throw std::invalid_argument("CutManager: " + what + " is " + detail::short_number(value) + "; expected " + valid);
+  };
+  const int T = options.texture_resolution;
+  if (T < 2 || T > kMaxTextureResolution)
+    refuse("enrichment.texture_resolution", T, "2.." + std::to_string(kMaxTextureResolution) + " (a scene file: a power of two in " +
+                                                   std::to_string(kMinTextureResolution) + "..)");
+  if (options.new_cut_length && !(std::isfinite(*options.new_cut_length) && *options.new_cut_length > 0))
+    refuse("enrichment.new_cut_length", *options.new_cut_length, "a finite number > 0");
+  if (options.new_cut_angle_deg && !(std::isfinite(*options.new_cut_angle_deg) && *options.new_cut_angle_deg > 0))
+    refuse("enrichment.new_cut_angle_deg", *options.new_cut_angle_deg, "a finite number > 0");
+  for (size_t c = 0; c < cuts.size(); ++c) {
+    const std::string path = "cuts[" + std::to_string(c) + "]";
+    if (!(std::isfinite(cuts[c].start_time) && cuts[c].start_time >= 0))
+      refuse(path + ".start_time", cuts[c].start_time, "a finite number >= 0");
+    if (cuts[c].speed && !(std::isfinite(*cuts[c].speed) && *cuts[c].speed > 0))
+      refuse(path + ".speed", *cuts[c].speed, "a finite number > 0");
+  }
+}
+
+}  // namespace
+
 CutManager::CutManager(const Mesh& mesh, const Topology& topology, const std::vector<Cut>& cuts,
                        const EnrichmentOptions& options, CutManagerOptions manager_options)
     // Checked before the adjacency reads them: a topology of another (finer) mesh wrote
@@ -218,8 +247,7 @@ CutManager::CutManager(const Mesh& mesh, const Topology& topology, const std::ve
       manager_options_(manager_options),
       resolution_(options.texture_resolution),
       edge_walls_(options.texture_resolution) {
-  if (resolution_ < 2)
-    throw std::invalid_argument("enrichment.texture_resolution: must be at least 2, got " + std::to_string(resolution_));
+  check_cut_options(cuts, options);
   // The cuts trace independently (each reads only the mesh and the one search), one per
   // thread: fracture's six took 9.7 ms in a row. The first failing cut's error is the one
   // reported, as in a loop.

@@ -3,10 +3,27 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <stdexcept>
+#include <string>
+
+#include "api_argument_checks.h"
 
 namespace dgtex {
+namespace {
+
+// xi reaches a cast to int in the texel lookup (NaN is undefined there); points outside the
+// reference element are evaluated as the shape functions extrapolate them.
+void check_finite_point(const char* function, double xi1, double xi2) {
+  const double xi[2] = {xi1, xi2};
+  detail::check_finite(function, "xi", xi, 2);
+}
+
+}  // namespace
 
 void enrichment_texel(ElementType type, int resolution, double xi1, double xi2, int& i, int& j) {
+  if (resolution < 1)
+    throw std::invalid_argument("enrichment_texel: resolution " + std::to_string(resolution) + "; expected 1 or more");
+  check_finite_point("enrichment_texel", xi1, xi2);
   const int T = resolution;
   const double u = type == ElementType::quad8 ? 0.5 * (xi1 + 1) : xi1;
   const double v = type == ElementType::quad8 ? 0.5 * (xi2 + 1) : xi2;
@@ -22,6 +39,9 @@ void enrichment_texel(ElementType type, int resolution, double xi1, double xi2, 
 }
 
 float sample_enrichment(ElementType type, const ElementEnrichment& e, double xi1, double xi2) {
+  if (e.resolution < 1 || e.values.size() != static_cast<size_t>(e.resolution) * e.resolution)
+    throw std::invalid_argument("sample_enrichment: " + std::to_string(e.values.size()) + " values for resolution " +
+                                std::to_string(e.resolution) + "; expected resolution^2, resolution 1 or more");
   int i, j;
   enrichment_texel(type, e.resolution, xi1, xi2, i, j);
   return e.values[static_cast<size_t>(j) * e.resolution + i];
@@ -35,9 +55,16 @@ DeformedShell::DeformedShell(const ShellState& state) : state_(state) {
   for (const auto& list : by_element_) max_per_element_ = std::max(max_per_element_, static_cast<int>(list.size()));
 }
 
+const std::vector<int>& DeformedShell::enrichments_of(int element) const {
+  detail::check_index("DeformedShell::enrichments_of", "element", element, "elements", state_.mesh.num_elements());
+  return by_element_[element];
+}
+
 void DeformedShell::decompose(int element, double xi1, double xi2, double base[3],
                               std::vector<std::array<double, 3>>& A) const {
   const Mesh& m = state_.mesh;
+  detail::check_index("DeformedShell::decompose", "element", element, "elements", m.num_elements());
+  check_finite_point("DeformedShell::decompose", xi1, xi2);
   const int npe = m.nodes_per_element();
   kernels::ShapeValues sv;
   kernels::evaluate_shape(m.type, xi1, xi2, sv);
@@ -69,7 +96,7 @@ void DeformedShell::position(int element, double xi1, double xi2, const double* 
 }
 
 void DeformedShell::position(int element, double xi1, double xi2, double x[3]) const {
-  const auto& list = by_element_[element];
+  const auto& list = enrichments_of(element);
   std::vector<double> h(list.size());
   for (size_t k = 0; k < list.size(); ++k)
     h[k] = sample_enrichment(state_.mesh.type, state_.enrichments[list[k]], xi1, xi2);

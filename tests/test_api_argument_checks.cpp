@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "dgtex/cut_manager.h"
+#include "dgtex/deformed_shell.h"
 #include "dgtex/mesh_error.h"
 #include "dgtex/mesh_generators.h"
 #include "dgtex/model_error.h"
@@ -158,6 +159,42 @@ TEST(ApiArgumentChecks, CutManagerUpdatesToFiniteTimesOnly) {
   EXPECT_EQ(cuts.functions().size(), 1u);
 }
 
+// What validate_scene refuses of a scene file is refused of cuts and options built in code
+// (helper audit, session 71): a NaN or negative speed was taken (the cut never appeared),
+// a NaN angle split nowhere, and a resolution of 65536 allocated a 32 GiB tile.
+TEST(ApiArgumentChecks, CutManagerRefusesSchedulesAndOptionsAScenesValidationWould) {
+  const Mesh mesh = make_rectangle(1, 1, 2, 2, ElementType::quad8);
+  const Topology topology = build_topology(mesh);
+  Cut cut;
+  cut.points = {{0, 0.5, 0}, {1, 0.5, 0}};
+  cut.has_schedule = true;
+  EnrichmentOptions options;
+  options.texture_resolution = 32;
+  auto refusal = [&](const Cut& c, const EnrichmentOptions& o) {
+    return message_of<std::invalid_argument>([&] { CutManager(mesh, topology, {c}, o); });
+  };
+  for (double speed : {-1.0, 0.0, std::nan(""), double(INFINITY)}) {
+    Cut bad = cut;
+    bad.speed = speed;
+    EXPECT_NE(refusal(bad, options).find("CutManager: cuts[0].speed is "), std::string::npos) << speed;
+  }
+  Cut late = cut;
+  late.start_time = std::nan("");
+  EXPECT_EQ(refusal(late, options), "CutManager: cuts[0].start_time is nan; expected a finite number >= 0");
+  EnrichmentOptions bad = options;
+  bad.new_cut_angle_deg = -5;
+  EXPECT_NE(refusal(cut, bad).find("enrichment.new_cut_angle_deg is -5"), std::string::npos);
+  bad = options;
+  bad.new_cut_length = std::nan("");
+  EXPECT_NE(refusal(cut, bad).find("enrichment.new_cut_length is nan"), std::string::npos);
+  bad = options;
+  bad.texture_resolution = 65536;
+  EXPECT_NE(refusal(cut, bad).find("enrichment.texture_resolution is 65536; expected 2..4096"), std::string::npos);
+  Cut good = cut;
+  good.speed = 2.0;
+  EXPECT_EQ(refusal(good, options), "");
+}
+
 // Found by reading the public headers (session 68): each read or wrote out of bounds, or
 // was taken silently.
 TEST(ApiArgumentChecks, ShellSimulationRefusesNonFiniteInputsNegativeDampingAndBadSolverOptions) {
@@ -271,6 +308,36 @@ TEST(ApiArgumentChecks, IndicesAndParametricPointsOfModelCutsAndSearchAreChecked
   EXPECT_NE(message_of<std::invalid_argument>([&] { search.closest_among({2, 1}, p); }).find("ascending"),
             std::string::npos);
   EXPECT_EQ(search.closest_among({0, 1}, p).element, 0);
+}
+
+// DeformedShell validated its state but not the element and xi of each call, and
+// sample_enrichment not the size of its texture (helper audit, session 71): each read out of
+// bounds.
+TEST(ApiArgumentChecks, DeformedShellChecksItsElementsAndPoints) {
+  SceneRun run(strip_built_in_code(true, false));
+  const ShellState state = run.state();
+  const DeformedShell shell(state);
+  const int elements = state.mesh.num_elements();
+  double x[3];
+  EXPECT_NE(message_of<std::invalid_argument>([&] { shell.enrichments_of(elements); })
+                .find("DeformedShell::enrichments_of: element " + std::to_string(elements) + " is out of range"),
+            std::string::npos);
+  EXPECT_NE(message_of<std::invalid_argument>([&] { shell.position(-1, 0, 0, x); }).find("element -1 is out of range"),
+            std::string::npos);
+  EXPECT_NE(message_of<std::invalid_argument>([&] { shell.position(0, std::nan(""), 0, x); })
+                .find("xi[0] is nan; expected a finite number"),
+            std::string::npos);
+  EXPECT_EQ(message_of<std::invalid_argument>([&] { shell.position(0, 0, 0, x); }), "");
+  ElementEnrichment texture;
+  texture.resolution = 64;
+  texture.values.assign(16 * 16, 0.5f);
+  EXPECT_NE(message_of<std::invalid_argument>([&] { sample_enrichment(state.mesh.type, texture, 0, 0); })
+                .find("sample_enrichment: 256 values for resolution 64"),
+            std::string::npos);
+  texture.resolution = 16;
+  EXPECT_EQ(sample_enrichment(state.mesh.type, texture, 0, 0), 0.5f);
+  int i, j;
+  EXPECT_THROW(enrichment_texel(state.mesh.type, 0, 0, 0, i, j), std::invalid_argument);
 }
 
 // A step that threw (here: a penalty below the definiteness threshold) ends the run: a

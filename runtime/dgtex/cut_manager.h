@@ -80,7 +80,9 @@ class CutManager {
   // The mesh must outlive the manager. Throws MeshError for a mesh validate_mesh refuses,
   // std::invalid_argument for a topology that is not build_topology(mesh)'s, for a cut
   // the mesh cannot take (messages name cuts[i].points[j]; see trace_cut_path) and for
-  // options it cannot use (texture_resolution < 2, new_cut_length shorter than a texel).
+  // options or schedules it cannot use (texture_resolution outside 2..4096, a new_cut_length
+  // or new_cut_angle_deg that is not a finite number > 0 or a new_cut_length shorter than a
+  // texel, a cut's start_time not finite and >= 0, its speed not finite and > 0).
   CutManager(const Mesh& mesh, const Topology& topology, const std::vector<Cut>& cuts,
              const EnrichmentOptions& options, CutManagerOptions manager_options = {});
   // The mesh is kept by reference: a temporary one would dangle, a const one too.

@@ -20,9 +20,11 @@ namespace dgtex {
 // The texel (i, j) of a T x T enrichment texture that contains parameter point xi
 // (nearest-texel lookup; layout in shell_state.h). Points on the border are clamped into
 // the grid; on a tri6 texture points are clamped to the texels with i + j <= T - 1.
+// Throws std::invalid_argument for a resolution below 1 or a non-finite xi.
 void enrichment_texel(ElementType type, int resolution, double xi1, double xi2, int& i, int& j);
 
-// H at xi (the value of the containing texel).
+// H at xi (the value of the containing texel). Throws std::invalid_argument for values
+// that are not resolution^2, or as enrichment_texel.
 float sample_enrichment(ElementType type, const ElementEnrichment& enrichment, double xi1, double xi2);
 
 class DeformedShell {
@@ -35,10 +37,11 @@ class DeformedShell {
 
   const ShellState& state() const { return state_; }
   // Indices into state.enrichments of the enrichments of one element, in state order.
-  const std::vector<int>& enrichments_of(int element) const { return by_element_[element]; }
+  const std::vector<int>& enrichments_of(int element) const;
   int max_enrichments_per_element() const { return max_per_element_; }
 
-  // base and A_k (enrichments_of(element).size() x 3) at xi.
+  // base and A_k (enrichments_of(element).size() x 3) at xi. These and enrichments_of throw
+  // std::invalid_argument for an element out of range or a non-finite xi.
   void decompose(int element, double xi1, double xi2, double base[3], std::vector<std::array<double, 3>>& A) const;
   // x with given enrichment values h (one per enrichments_of(element) entry).
   void position(int element, double xi1, double xi2, const double* h, double x[3]) const;
