@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <functional>
+#include <limits>
 #include <string>
 
 namespace dgtex {
@@ -37,6 +38,18 @@ void require_divisions(const char* generator, const char* name, int value, int m
   require(value >= minimum, std::string(generator) + ": " + name + " must be at least " + std::to_string(minimum) +
                                 (minimum == 3 ? " around a closed 360 degree ring" : "") + ", got " +
                                 std::to_string(value));
+}
+
+// The node and element indices are ints: a grid whose positions or element arrays would
+// not fit overflowed in the index arithmetic (INT_MAX divisions, undefined behaviour).
+void require_indexable(const char* generator, int nu, int nv) {
+  constexpr long long limit = std::numeric_limits<int>::max();
+  const long long grid_values = 3 * (2LL * nu + 1) * (2LL * nv + 1);  // positions, before dropping cell centres
+  const long long index_values = 12LL * nu * nv;                      // tri6: 2 triangles of 6 nodes a cell
+  require(grid_values <= limit && index_values <= limit,
+          std::string(generator) + ": " + std::to_string(nu) + " x " + std::to_string(nv) +
+              " divisions give more nodes or element indices than an int counts (at most " + std::to_string(limit) +
+              " values an array; a scene file takes 10000000 cells)");
 }
 
 void require_element_type(const char* generator, ElementType type) {
@@ -104,6 +117,7 @@ Mesh make_rectangle(double size_x, double size_y, int nx, int ny, ElementType ty
   require_positive_length("rectangle", "size y", size_y);
   require_divisions("rectangle", "divisions x", nx, 1);
   require_divisions("rectangle", "divisions y", ny, 1);
+  require_indexable("rectangle", nx, ny);
   require_element_type("rectangle", type);
   ParametricSurface s;
   s.nu = nx;
@@ -131,6 +145,7 @@ Mesh make_cylinder(double radius, double length, double angle0_deg, double angle
               mesh_number(angle0_deg) + ", " + mesh_number(angle1_deg) + "]");
   require_divisions("cylinder", "angle divisions", n_angle, closed ? 3 : 1);
   require_divisions("cylinder", "length divisions", n_length, 1);
+  require_indexable("cylinder", n_angle, n_length);
   require_element_type("cylinder", type);
   ParametricSurface s;
   s.nu = n_angle;
@@ -155,6 +170,7 @@ Mesh make_hemisphere(double radius, double hole_deg, int n_polar, int n_azimuth,
               mesh_number(hole_deg));
   require_divisions("hemisphere", "polar divisions", n_polar, 1);
   require_divisions("hemisphere", "azimuth divisions", n_azimuth, 3);
+  require_indexable("hemisphere", n_polar, n_azimuth);
   require_element_type("hemisphere", type);
   ParametricSurface s;
   s.nu = n_polar;

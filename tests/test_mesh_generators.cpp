@@ -254,4 +254,19 @@ TEST(GeneratorErrors, RejectInvalidArguments) {
   } catch (const MeshError& e) {
     EXPECT_NE(std::string(e.what()).find("hole_deg"), std::string::npos) << e.what();
   }
+  // Divisions whose indices would not fit an int overflowed (undefined behaviour) before the
+  // generator could fail on memory (helper audit, session 71).
+  for (auto generate : {+[] { make_rectangle(1, 1, 2147483647, 1, ElementType::quad8); },
+                        +[] { make_cylinder(1, 1, 0, 360, 1 << 30, 1, ElementType::quad8); },
+                        +[] { make_hemisphere(1, 10, 1, 2147483647, ElementType::tri6); },
+                        +[] { make_rectangle(1, 1, 20000, 20000, ElementType::tri6); }}) {
+    try {
+      generate();
+      ADD_FAILURE() << "generated";
+    } catch (const MeshError& e) {
+      EXPECT_NE(std::string(e.what()).find("divisions give more nodes or element indices than an int counts"),
+                std::string::npos)
+          << e.what();
+    }
+  }
 }
