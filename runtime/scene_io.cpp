@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <fstream>
 #include <initializer_list>
+#include <utility>
 #include <set>
 #include <sstream>
 #include <vector>
@@ -358,6 +359,9 @@ class SceneReader {
   }
   std::string string(const json& v, const std::string& path) const {
     if (!v.is_string()) fail(path, "expected a string", v, "write a string in double quotes");
+    // A file's strings are checked as they are parsed; a Scene built in code is read here.
+    if (v.get_ref<const std::string&>().find('\0') != std::string::npos)
+      fail(path, "a string with a NUL character", v, "expected text without NUL characters");
     return v.get<std::string>();
   }
   // One of the given words; returns its index.
@@ -881,18 +885,37 @@ namespace {
 
 json to_json(const Vec3& v) { return json::array({v[0], v[1], v[2]}); }
 
+// An enum value outside its type (cast in code) as text that the reader refuses at that
+// place, naming its path (such values were written as a valid neighbour: a Load::Type of 9
+// as no load at all, an Analysis::Type of 4 as static).
+template <class Enum>
+std::string not_a(const char* type, Enum value) {
+  return "<not a " + std::string(type) + ": " + std::to_string(static_cast<long long>(value)) + ">";
+}
+
+template <class Enum>
+std::string enum_name(const char* type, Enum value, std::initializer_list<std::pair<Enum, const char*>> names) {
+  for (const auto& [known, name] : names)
+    if (value == known) return name;
+  return not_a(type, value);
+}
+
 json select_to_json(const BoundarySelect& s) {
   json out;
   if (s.kind == BoundarySelect::Kind::plane) {
     out["plane"] = {{"normal", to_json(s.normal)}, {"offset", s.offset}};
-  } else {
+  } else if (s.kind == BoundarySelect::Kind::box) {
     out["box"] = {{"min", to_json(s.min)}, {"max", to_json(s.max)}};
+  } else {
+    out["plane"] = not_a("BoundarySelect::Kind", s.kind);
   }
   out["tolerance"] = s.tolerance;
   return out;
 }
 
-const char* element_name(ElementType type) { return type == ElementType::quad8 ? "quad8" : "tri6"; }
+std::string element_name(ElementType type) {
+  return enum_name("ElementType", type, {{ElementType::quad8, "quad8"}, {ElementType::tri6, "tri6"}});
+}
 
 json mesh_to_json(const MeshSpec& m) {
   json out;
@@ -902,7 +925,8 @@ json mesh_to_json(const MeshSpec& m) {
     return out;
   }
   out["element"] = element_name(m.element.value_or(ElementType::quad8));
-  if (m.triangles == TriangleSplit::square) out["triangles"] = "square";  // the reader refuses it on quad8
+  if (m.triangles != TriangleSplit::sheared)  // the reader refuses "square" on quad8
+    out["triangles"] = enum_name("TriangleSplit", m.triangles, {{TriangleSplit::square, "square"}});
   out["divisions"] = {m.divisions[0], m.divisions[1]};
   switch (m.source) {
     case MeshSource::rectangle:
@@ -922,6 +946,8 @@ json mesh_to_json(const MeshSpec& m) {
       break;
     case MeshSource::file:
       break;
+    default:
+      out["generator"] = not_a("MeshSource", m.source);
   }
   return out;
 }
@@ -954,6 +980,8 @@ json scene_to_json(const Scene& scene) {
       case Load::Type::point:
         out["loads"].push_back({{"type", "point"}, {"position", to_json(load.position)}, {"force", to_json(load.force)}});
         break;
+      default:
+        out["loads"].push_back({{"type", not_a("Load::Type", load.type)}});
     }
   }
   const Analysis& a = scene.analysis;
@@ -963,8 +991,10 @@ json scene_to_json(const Scene& scene) {
                        {"steps", a.steps},
                        {"corotational", a.corotational},
                        {"damping", {{"mass", a.damping.mass}, {"stiffness", a.damping.stiffness}}}};
-  } else {
+  } else if (a.type == Analysis::Type::static_equilibrium) {
     out["analysis"] = {{"type", "static"}};
+  } else {
+    out["analysis"] = {{"type", not_a("Analysis::Type", a.type)}};
   }
   out["probes"] = json::array();
   for (const Probe& p : scene.probes) out["probes"].push_back({{"name", p.name}, {"position", to_json(p.position)}});
@@ -974,6 +1004,8 @@ json scene_to_json(const Scene& scene) {
     if (cut.kind == Cut::Kind::points) {
       c["points"] = json::array();
       for (const Vec3& p : cut.points) c["points"].push_back(to_json(p));
+    } else if (cut.kind != Cut::Kind::surface_points) {
+      c["points"] = not_a("Cut::Kind", cut.kind);
     } else {
       c["surface_points"] = json::array();
       for (const CutSurfacePoint& sp : cut.surface_points)
@@ -991,6 +1023,8 @@ json scene_to_json(const Scene& scene) {
       if (crease.kind == Cut::Kind::points) {
         c["points"] = json::array();
         for (const Vec3& p : crease.points) c["points"].push_back(to_json(p));
+      } else if (crease.kind != Cut::Kind::surface_points) {
+        c["points"] = not_a("Cut::Kind", crease.kind);
       } else {
         c["surface_points"] = json::array();
         for (const CutSurfacePoint& sp : crease.surface_points)
@@ -1002,7 +1036,9 @@ json scene_to_json(const Scene& scene) {
   if (!scene.material_textures.empty()) {
     out["material_textures"] = json::array();
     for (const MaterialTexture& t : scene.material_textures) {
-      json m = {{"field", t.field == MaterialTexture::Field::thickness ? "thickness" : "youngs_modulus"},
+      json m = {{"field", enum_name("MaterialTexture::Field", t.field,
+                                    {{MaterialTexture::Field::thickness, "thickness"},
+                                     {MaterialTexture::Field::youngs_modulus, "youngs_modulus"}})},
                 {"image", t.image},
                 {"range", {t.range[0], t.range[1]}}};
       if (!t.elements.empty()) m["elements"] = t.elements;
@@ -1011,7 +1047,9 @@ json scene_to_json(const Scene& scene) {
   }
   const EnrichmentOptions& e = scene.enrichment;
   out["enrichment"] = {{"texture_resolution", e.texture_resolution},
-                       {"solver", e.solver == EnrichmentOptions::Solver::multigrid ? "multigrid" : "cholmod"}};
+                       {"solver", enum_name("EnrichmentOptions::Solver", e.solver,
+                                            {{EnrichmentOptions::Solver::multigrid, "multigrid"},
+                                             {EnrichmentOptions::Solver::cholmod, "cholmod"}})}};
   if (e.new_cut_length) out["enrichment"]["new_cut_length"] = *e.new_cut_length;
   if (e.new_cut_angle_deg) out["enrichment"]["new_cut_angle_deg"] = *e.new_cut_angle_deg;
   out["enrichment"]["quadrature_tolerance"] = e.quadrature_tolerance;
@@ -1025,7 +1063,9 @@ json scene_to_json(const Scene& scene) {
                      {"height", r.height},
                      {"camera", camera},
                      {"every_steps", r.every_steps},
-                     {"shading", r.shading == RenderOptions::Shading::flat ? "flat" : "smooth"},
+                     {"shading", enum_name("RenderOptions::Shading", r.shading,
+                                           {{RenderOptions::Shading::flat, "flat"},
+                                            {RenderOptions::Shading::smooth, "smooth"}})},
                      {"background", to_json(r.background)}};
   }
   out["output"] = {{"report", scene.output.report}};

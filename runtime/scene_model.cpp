@@ -12,6 +12,7 @@
 #include "dgtex/surface_point.h"
 #include "dgtex/texel_memory_estimate.h"
 #include "dgtex/topology.h"
+#include "scene_model_parts.h"
 
 namespace dgtex {
 
@@ -76,12 +77,12 @@ SceneModel build_scene_model(const Scene& scene, const Mesh& mesh) {
                                   scene.source_name.empty() ? "scene" : scene.source_name);
     out.model->set_material_textures(std::move(textures));
   }
-  out.fixed = scene_fixed_dofs(scene, *out.model);
-  out.external_force = scene_external_force(scene, *out.model);
+  out.fixed = detail::fixed_dofs_of_valid_scene(scene, *out.model);
+  out.external_force = detail::external_force_of_valid_scene(scene, *out.model);
   return out;
 }
 
-std::vector<char> scene_fixed_dofs(const Scene& scene, const ShellModel& model) {
+std::vector<char> detail::fixed_dofs_of_valid_scene(const Scene& scene, const ShellModel& model) {
   const Mesh& mesh = model.mesh();
   std::vector<char> fixed(model.num_dofs(), 0);  // enriched DOFs stay free (see the header)
   for (const BoundaryCondition& bc : scene.boundary)
@@ -91,7 +92,7 @@ std::vector<char> scene_fixed_dofs(const Scene& scene, const ShellModel& model) 
   return fixed;
 }
 
-std::vector<double> scene_external_force(const Scene& scene, const ShellModel& model) {
+std::vector<double> detail::external_force_of_valid_scene(const Scene& scene, const ShellModel& model) {
   std::vector<double> f(model.num_dofs(), 0.0);
   for (const Load& load : scene.loads) {
     switch (load.type) {
@@ -105,6 +106,18 @@ std::vector<double> scene_external_force(const Scene& scene, const ShellModel& m
     }
   }
   return f;
+}
+
+// A zero plane normal held nothing, a NaN load reached the simulation's own check naming
+// external_force[i]: the scene's fields are named here instead.
+std::vector<char> scene_fixed_dofs(const Scene& scene, const ShellModel& model) {
+  validate_scene(scene);
+  return detail::fixed_dofs_of_valid_scene(scene, model);
+}
+
+std::vector<double> scene_external_force(const Scene& scene, const ShellModel& model) {
+  validate_scene(scene);
+  return detail::external_force_of_valid_scene(scene, model);
 }
 
 }  // namespace dgtex

@@ -18,6 +18,7 @@
 #include "dgtex/texel_memory_estimate.h"
 #include "dgtex/topology.h"
 #include "cut_update_team.h"
+#include "scene_model_parts.h"
 
 namespace dgtex {
 
@@ -97,8 +98,8 @@ SceneRun::SceneRun(const Scene& scene, SceneRunOptions options)
     }
     if (cuts_) model_->set_cut_edge_texels(cuts_->edge_walls().resolution(), cuts_->edge_walls().flags(mesh_.num_elements()));
     model_->set_enrichments(enrichment_functions());
-    built.fixed = scene_fixed_dofs(scene_, *model_);
-    built.external_force = scene_external_force(scene_, *model_);
+    built.fixed = detail::fixed_dofs_of_valid_scene(scene_, *model_);
+    built.external_force = detail::external_force_of_valid_scene(scene_, *model_);
   }
   simulation_ = std::make_unique<ShellSimulation>(*model_, std::move(built.fixed), std::move(built.external_force));
   simulation_->set_solver_options(options_.solver);
@@ -225,8 +226,8 @@ void SceneRun::change_basis(std::vector<EnrichmentFunction> functions, int edge_
   // for the next one, which reads them where the two bases share points.
   next->keep_basis_values();
   next->set_enrichments(std::move(functions));
-  std::vector<char> fixed = scene_fixed_dofs(scene_, *next);
-  std::vector<double> force = scene_external_force(scene_, *next);
+  std::vector<char> fixed = detail::fixed_dofs_of_valid_scene(scene_, *next);
+  std::vector<double> force = detail::external_force_of_valid_scene(scene_, *next);
   auto simulation = std::make_unique<ShellSimulation>(*next, std::move(fixed), std::move(force));
   ProjectedState projected = project_onto_basis(*model_, simulation_->displacement(), simulation_->velocity(), *next,
                                                 simulation->system());

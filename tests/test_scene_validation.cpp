@@ -64,6 +64,24 @@ std::vector<BadValue> bad_values() {
        "enrichment.rotation_cluster_texels", "got -1"},
       {"render width 0", [](Scene& s) { s.render = RenderOptions{}, s.render->width = 0; }, "render.width", "got 0"},
       {"report path", [](Scene& s) { s.output.report = "../report.json"; }, "output.report", "not a plain file name"},
+      // Enum values outside their types (a cast in code) were written as a valid neighbour:
+      // a Load::Type of 9 as no load, an Analysis::Type of 4 as static (session 71).
+      {"load type 9", [](Scene& s) { s.loads[0].type = static_cast<Load::Type>(9); }, "loads[0].type",
+       "<not a Load::Type: 9>"},
+      {"analysis type 4", [](Scene& s) { s.analysis.type = static_cast<Analysis::Type>(4); }, "analysis.type",
+       "<not a Analysis::Type: 4>"},
+      {"element type 7", [](Scene& s) { s.mesh.element = static_cast<ElementType>(7); }, "mesh.element",
+       "<not a ElementType: 7>"},
+      {"select kind 5", [](Scene& s) { s.boundary[0].select.kind = static_cast<BoundarySelect::Kind>(5); },
+       "boundary[0].select.plane", "<not a BoundarySelect::Kind: 5>"},
+      {"cut kind 3", [](Scene& s) { s.cuts[0].kind = static_cast<Cut::Kind>(3); }, "cuts[0].points",
+       "<not a Cut::Kind: 3>"},
+      {"solver 7", [](Scene& s) { s.enrichment.solver = static_cast<EnrichmentOptions::Solver>(7); },
+       "enrichment.solver", "<not a EnrichmentOptions::Solver: 7>"},
+      {"shading 9", [](Scene& s) { s.render = RenderOptions{}, s.render->shading = static_cast<RenderOptions::Shading>(9); },
+       "render.shading", "<not a RenderOptions::Shading: 9>"},
+      {"probe name with a NUL", [](Scene& s) { s.probes = {Probe{std::string("tip\0x", 5), {1, 0.1, 0}}}; },
+       "probes[0].name", "a string with a NUL character"},
   };
 }
 
@@ -116,7 +134,17 @@ TEST(SceneValidation, TheSceneBuildersRefuseABadValue) {
   bad.material.poisson_ratio = -1;
   EXPECT_THROW(build_scene_mesh(bad), SceneError);
   EXPECT_THROW(build_scene_model(bad, mesh), SceneError);
-  EXPECT_NO_THROW(build_scene_model(good, mesh));
+  const SceneModel model = build_scene_model(good, mesh);
+  // The held DOFs and loads of a scene check it too: a zero plane normal held nothing, a
+  // NaN load reached the simulation named as external_force[i] (session 71).
+  Scene unheld = good;
+  unheld.boundary[0].select.normal = {0, 0, 0};
+  EXPECT_THROW(scene_fixed_dofs(unheld, *model.model), SceneError);
+  Scene unloaded = good;
+  unloaded.loads[0].acceleration[2] = kNaN;
+  EXPECT_THROW(scene_external_force(unloaded, *model.model), SceneError);
+  EXPECT_EQ(scene_fixed_dofs(good, *model.model), model.fixed);
+  EXPECT_EQ(scene_external_force(good, *model.model), model.external_force);
 }
 
 TEST(SceneValidation, ASceneWithoutASourceNameIsCalledScene) {
