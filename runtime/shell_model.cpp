@@ -1247,6 +1247,8 @@ std::vector<std::vector<double>> ShellModel::moments_of_fields(const ShellModel&
                                 std::to_string(mesh_.num_elements()) + ")");
   const int nf = static_cast<int>(fields.size());
   for (int f = 0; f < nf; ++f)
+    if (!fields[f]) throw std::invalid_argument("moments_of_fields: field " + std::to_string(f) + " is a null pointer");
+  for (int f = 0; f < nf; ++f)
     if (static_cast<int>(fields[f]->size()) != source.num_dofs())
       throw std::invalid_argument("moments_of_fields: field " + std::to_string(f) + " has " +
                                   std::to_string(fields[f]->size()) + " values, the source model " +

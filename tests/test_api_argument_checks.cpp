@@ -291,6 +291,10 @@ TEST(ApiArgumentChecks, IndicesAndParametricPointsOfModelCutsAndSearchAreChecked
   EXPECT_NE(message_of<std::invalid_argument>([&] { model.node_shift(0); }).find("virtual node 0 is out of range"),
             std::string::npos);
 
+  // A null field was read (helper audit, session 71).
+  EXPECT_EQ(message_of<std::invalid_argument>([&] { model.moments_of_fields(model, {&u, nullptr}); }),
+            "moments_of_fields: field 1 is a null pointer");
+
   // A topology of another (finer) mesh wrote out of bounds in the cut manager's adjacency.
   Cut cut;
   cut.points = {{0, 0.5, 0}, {1, 0.5, 0}};

@@ -235,8 +235,8 @@ class ShellModel {
   // the same coordinates in the same element), the source's values there are read instead
   // of evaluated; `points_read_from_source`, if given, receives how many points were. The
   // right-hand sides of the projection of a state onto this basis (basis_projection.h).
-  // std::invalid_argument for a source on another mesh or a field of another size than
-  // source.num_dofs().
+  // std::invalid_argument for a source on another mesh, a null field or a field of another
+  // size than source.num_dofs().
   std::vector<std::vector<double>> moments_of_fields(const ShellModel& source,
                                                      const std::vector<const std::vector<double>*>& fields,
                                                      std::int64_t* points_read_from_source = nullptr) const;
