@@ -4,6 +4,8 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <stdexcept>
+#include <string>
 #include <utility>
 
 #include "dgtex/deformed_shell.h"
@@ -99,6 +101,8 @@ FrameWriter::FrameWriter(const RenderOptions& options, std::string frames_dir, s
 FrameWriter::~FrameWriter() = default;
 
 std::string FrameWriter::write(const ShellState& state, int index) {
+  // frame_-0001.png was written for -1.
+  if (index < 0) throw std::invalid_argument("FrameWriter::write: frame index " + std::to_string(index) + " (expected >= 0)");
   ScopedStage whole(timings_, "render");
   if (!camera_fixed_) {
     settings_ = scene_render_settings(options_, state);

@@ -115,6 +115,18 @@ void validate_settings(const RenderSettings& s) {
   for (int d = 0; d < 3; ++d)
     if (!std::isfinite(s.camera_position[d]) || !std::isfinite(s.camera_target[d]) || !std::isfinite(s.camera_up[d]))
       throw std::invalid_argument("camera position, target and up must be finite");
+  if (norm(Vec3{s.camera_up[0], s.camera_up[1], s.camera_up[2]}) == 0)
+    throw std::invalid_argument("camera up is the zero vector (expected a direction)");
+  for (int c = 0; c < 3; ++c)
+    if (!(s.background[c] >= 0 && s.background[c] <= 1))
+      throw std::invalid_argument("background[" + std::to_string(c) + "] = " + std::to_string(s.background[c]) +
+                                  " (valid: 0..1)");
+  if (s.shading != RenderSettings::Shading::flat && s.shading != RenderSettings::Shading::smooth)
+    throw std::invalid_argument("shading " + std::to_string(static_cast<int>(s.shading)) + " (valid: flat, smooth)");
+  if (s.cut_method != RenderSettings::CutMethod::geometry_shader && s.cut_method != RenderSettings::CutMethod::drop_triangles &&
+      s.cut_method != RenderSettings::CutMethod::kill_pixels)
+    throw std::invalid_argument("cut_method " + std::to_string(static_cast<int>(s.cut_method)) +
+                                " (valid: geometry_shader, drop_triangles, kill_pixels)");
   if (!s.auto_camera && norm(sub(Vec3{s.camera_position[0], s.camera_position[1], s.camera_position[2]},
                                  Vec3{s.camera_target[0], s.camera_target[1], s.camera_target[2]})) == 0)
     throw std::invalid_argument("camera position equals camera target (or set auto_camera)");

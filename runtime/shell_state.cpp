@@ -239,8 +239,8 @@ ShellState read_state(Reader& r) {
   // node values and DOFs.
   const std::uint64_t smallest = 2 * 4 + 4 + npe * 4 + 3 * npe * 8;
   if (count > r.remaining() / smallest)
-    r.fail("truncated or damaged: " + std::to_string(count) + " enrichments need at least " +
-           std::to_string(count * smallest) + " bytes, " + std::to_string(r.remaining()) + " remain in the file");
+    r.fail("truncated or damaged: " + std::to_string(count) + " enrichments need at least " + std::to_string(smallest) +
+           " bytes each, " + std::to_string(r.remaining()) + " remain in the file");  // (count x smallest may overflow)
   s.enrichments.resize(count);
   for (ElementEnrichment& e : s.enrichments) {
     e.element = r.value<std::int32_t>("an enrichment's element");

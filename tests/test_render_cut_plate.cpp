@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <functional>
 #include <limits>
 #include <memory>
 #include <string>
@@ -295,6 +296,19 @@ TEST(RenderCutPlate, RejectsTooManyEnrichmentsAndBadSettings) {
   s = test::top_view();
   s.tessellation = 0;
   EXPECT_THROW(renderer().render(ok.state, s), std::invalid_argument);
+  // Drawn before (helper audit, session 71): a NaN background, a zero up, enum values
+  // outside their types.
+  const std::vector<std::function<void(RenderSettings&)>> bad = {
+      [](RenderSettings& r) { r.background[1] = std::nanf(""); },
+      [](RenderSettings& r) { r.background[2] = 2.0f; },
+      [](RenderSettings& r) { r.camera_up[0] = r.camera_up[1] = r.camera_up[2] = 0; },
+      [](RenderSettings& r) { r.shading = static_cast<RenderSettings::Shading>(9); },
+      [](RenderSettings& r) { r.cut_method = static_cast<RenderSettings::CutMethod>(9); }};
+  for (size_t k = 0; k < bad.size(); ++k) {
+    s = test::top_view();
+    bad[k](s);
+    EXPECT_THROW(renderer().render(ok.state, s), std::invalid_argument) << k;
+  }
 }
 
 // One element [0,1]^2 with complete straight cuts k (vertical ones at x = c, horizontal

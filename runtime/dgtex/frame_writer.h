@@ -49,8 +49,8 @@ class FrameWriter {
   FrameWriter& operator=(const FrameWriter&) = delete;
 
   // Renders `state` and writes frames_dir/png_frame_name(index); returns the file's path.
-  // The first call fixes the camera. Errors: std::invalid_argument (bad state),
-  // std::runtime_error (OpenGL or file failure).
+  // The first call fixes the camera. Errors: std::invalid_argument (bad state, a negative
+  // index), std::runtime_error (OpenGL or file failure).
   std::string write(const ShellState& state, int index);
 
   // Stage "render": one call per frame (render + PNG); "render.draw" (GPU draw and
