@@ -1,5 +1,7 @@
 #include "dgtex/scene_model.h"
 
+#include <optional>
+#include <string>
 #include <utility>
 
 #include "dgtex/boundary_selection.h"
@@ -50,6 +52,14 @@ Mesh build_scene_mesh(const Scene& scene) {
 
 SceneModel build_scene_model(const Scene& scene, const Mesh& mesh) {
   validate_scene(scene);
+  // A mesh of another element type than the scene's, built elsewhere, was taken as it is. A
+  // generator's default is quad8; a file without "element" takes its faces' type.
+  const std::optional<ElementType> declared =
+      scene.mesh.source == MeshSource::file ? scene.mesh.element : scene.mesh.element.value_or(ElementType::quad8);
+  auto name = [](ElementType type) { return type == ElementType::quad8 ? "quad8" : "tri6"; };
+  if (declared && *declared != mesh.type)
+    throw SceneError(scene.source_name, "mesh.element", "the mesh given has other elements", name(mesh.type),
+                     std::string("the scene's mesh is ") + name(*declared));
   check_scene_against_mesh(scene, mesh);
   const Topology topology = build_topology(mesh);
   std::vector<char> clamp_node(mesh.num_nodes(), 0);

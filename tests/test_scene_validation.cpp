@@ -134,6 +134,15 @@ TEST(SceneValidation, TheSceneBuildersRefuseABadValue) {
   bad.material.poisson_ratio = -1;
   EXPECT_THROW(build_scene_mesh(bad), SceneError);
   EXPECT_THROW(build_scene_model(bad, mesh), SceneError);
+  Scene triangles = good;
+  triangles.mesh.element = ElementType::tri6;
+  try {
+    build_scene_model(good, build_scene_mesh(triangles));
+    ADD_FAILURE() << "a tri6 mesh was taken for the quad8 scene";
+  } catch (const SceneError& e) {
+    EXPECT_EQ(e.json_path(), "mesh.element") << e.what();
+    EXPECT_NE(std::string(e.what()).find("the mesh given has other elements, got tri6"), std::string::npos) << e.what();
+  }
   const SceneModel model = build_scene_model(good, mesh);
   // The held DOFs and loads of a scene check it too: a zero plane normal held nothing, a
   // NaN load reached the simulation named as external_force[i] (session 71).

@@ -93,7 +93,10 @@ class CutManager {
   // Brings the functions to `time` (finite, else std::invalid_argument); true when they
   // changed (added, removed or re-solved). A Laplace solve that fails throws
   // std::runtime_error, memory std::bad_alloc; the manager is then half updated (a later
-  // update to the same time reports no change): discard it, as SceneRun does.
+  // update to the same time reports no change): discard it, as SceneRun does. Times are
+  // meant not to decrease: an update to an earlier time draws the cuts as far as that time,
+  // but with CutManagerOptions::freeze_settled_elements it keeps the textures it settled
+  // later (0.23 off a fresh manager's at the earlier time, in a test of session 71).
   bool update(double time);
 
   // The references returned below (and their contents) hold until the next update().
