@@ -1,9 +1,12 @@
 #include "dgtex/cut_segments.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <map>
+#include <utility>
+#include <vector>
 
 namespace dgtex {
 namespace {
@@ -37,6 +40,30 @@ std::vector<double> turning_angles(const MeshCutPath& path) {
     angle[k] = std::atan2(s, c);
   }
   return angle;
+}
+
+// The pairs (a, b), a < b, of n straight pieces whose parameter boxes (`box(i, lo, hi)`)
+// overlap, in the order of a double loop over a then b: only they can cross. Swept along xi1
+// (a cut of 20,000 points in one element took 5.6 s pair by pair, most of it in
+// segment_cut_paths).
+template <class Box>
+std::vector<std::pair<std::size_t, std::size_t>> overlapping_piece_pairs(std::size_t n, Box box) {
+  std::vector<std::array<double, 4>> boxes(n);  // lo1, lo2, hi1, hi2
+  for (std::size_t i = 0; i < n; ++i) box(i, &boxes[i][0], &boxes[i][2]);
+  std::vector<std::size_t> order(n);
+  for (std::size_t i = 0; i < n; ++i) order[i] = i;
+  std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return boxes[a][0] < boxes[b][0]; });
+  std::vector<std::pair<std::size_t, std::size_t>> pairs;
+  for (std::size_t x = 0; x < n; ++x) {
+    const std::array<double, 4>& p = boxes[order[x]];
+    for (std::size_t y = x + 1; y < n && boxes[order[y]][0] <= p[2]; ++y) {
+      const std::array<double, 4>& q = boxes[order[y]];
+      if (q[1] <= p[3] && p[1] <= q[3])
+        pairs.push_back({std::min(order[x], order[y]), std::max(order[x], order[y])});
+    }
+  }
+  std::sort(pairs.begin(), pairs.end());
+  return pairs;
 }
 
 struct CrossingHit {
@@ -73,36 +100,40 @@ std::vector<std::vector<double>> segment_cut_paths(std::vector<MeshCutPath>& pat
   std::vector<std::vector<double>> forced(n);
   std::vector<CrossingHit> inserts;
   for (const auto& [element, pieces] : by_element) {
-    for (std::size_t a = 0; a < pieces.size(); ++a)
-      for (std::size_t b = a + 1; b < pieces.size(); ++b) {
-        const Piece pa = pieces[a], pb = pieces[b];
-        if (pa.cut == pb.cut && pb.k <= pa.k + 1) continue;  // neighbouring pieces share a vertex
-        const CutPathVertex &a0 = paths[pa.cut].vertices[pa.k], &a1 = paths[pa.cut].vertices[pa.k + 1];
-        const CutPathVertex &b0 = paths[pb.cut].vertices[pb.k], &b1 = paths[pb.cut].vertices[pb.k + 1];
-        const double r[2] = {a1.xi[0] - a0.xi[0], a1.xi[1] - a0.xi[1]};
-        const double s[2] = {b1.xi[0] - b0.xi[0], b1.xi[1] - b0.xi[1]};
-        const double den = r[0] * s[1] - r[1] * s[0];
-        // Parallel pieces (overlapping cuts) are not split: their walls coincide.
-        if (std::abs(den) <= 1e-14 * std::hypot(r[0], r[1]) * std::hypot(s[0], s[1])) continue;
-        const double q[2] = {b0.xi[0] - a0.xi[0], b0.xi[1] - a0.xi[1]};
-        const double alpha = (q[0] * s[1] - q[1] * s[0]) / den;
-        const double beta = (q[0] * r[1] - q[1] * r[0]) / den;
-        if (alpha < 0 || alpha > 1 || beta < 0 || beta > 1) continue;
-        const double arc_a = a0.arc_length + alpha * (a1.arc_length - a0.arc_length);
-        const double arc_b = b0.arc_length + beta * (b1.arc_length - b0.arc_length);
-        const double len_a = paths[pa.cut].length(), len_b = paths[pb.cut].length();
-        const bool interior = arc_a > arc_tolerance && arc_a < len_a - arc_tolerance && arc_b > arc_tolerance &&
-                              arc_b < len_b - arc_tolerance;
-        if (!interior) continue;  // a T-junction (or touching ends): no split
-        if (pa.cut == pb.cut && std::abs(arc_a - arc_b) <= arc_tolerance) continue;
-        const double ta = cut_point_appear_time(cuts[pa.cut], arc_a), tb = cut_point_appear_time(cuts[pb.cut], arc_b);
-        // pieces are ordered (cut, k), so on a tie b is the later one (higher cut or arc)
-        const bool a_later = ta > tb;
-        if (a_later) forced[pa.cut].push_back(arc_a);
-        else forced[pb.cut].push_back(arc_b);
-        inserts.push_back({pa.cut, arc_a, element});
-        inserts.push_back({pb.cut, arc_b, element});
-      }
+    const auto box = [&](std::size_t i, double lo[2], double hi[2]) {
+      const auto& v = paths[pieces[i].cut].vertices;
+      const CutPathVertex &v0 = v[pieces[i].k], &v1 = v[pieces[i].k + 1];
+      for (int d = 0; d < 2; ++d) lo[d] = std::min(v0.xi[d], v1.xi[d]), hi[d] = std::max(v0.xi[d], v1.xi[d]);
+    };
+    for (const auto& [a, b] : overlapping_piece_pairs(pieces.size(), box)) {
+      const Piece pa = pieces[a], pb = pieces[b];
+      if (pa.cut == pb.cut && pb.k <= pa.k + 1) continue;  // neighbouring pieces share a vertex
+      const CutPathVertex &a0 = paths[pa.cut].vertices[pa.k], &a1 = paths[pa.cut].vertices[pa.k + 1];
+      const CutPathVertex &b0 = paths[pb.cut].vertices[pb.k], &b1 = paths[pb.cut].vertices[pb.k + 1];
+      const double r[2] = {a1.xi[0] - a0.xi[0], a1.xi[1] - a0.xi[1]};
+      const double s[2] = {b1.xi[0] - b0.xi[0], b1.xi[1] - b0.xi[1]};
+      const double den = r[0] * s[1] - r[1] * s[0];
+      // Parallel pieces (overlapping cuts) are not split: their walls coincide.
+      if (std::abs(den) <= 1e-14 * std::hypot(r[0], r[1]) * std::hypot(s[0], s[1])) continue;
+      const double q[2] = {b0.xi[0] - a0.xi[0], b0.xi[1] - a0.xi[1]};
+      const double alpha = (q[0] * s[1] - q[1] * s[0]) / den;
+      const double beta = (q[0] * r[1] - q[1] * r[0]) / den;
+      if (alpha < 0 || alpha > 1 || beta < 0 || beta > 1) continue;
+      const double arc_a = a0.arc_length + alpha * (a1.arc_length - a0.arc_length);
+      const double arc_b = b0.arc_length + beta * (b1.arc_length - b0.arc_length);
+      const double len_a = paths[pa.cut].length(), len_b = paths[pb.cut].length();
+      const bool interior = arc_a > arc_tolerance && arc_a < len_a - arc_tolerance && arc_b > arc_tolerance &&
+                            arc_b < len_b - arc_tolerance;
+      if (!interior) continue;  // a T-junction (or touching ends): no split
+      if (pa.cut == pb.cut && std::abs(arc_a - arc_b) <= arc_tolerance) continue;
+      const double ta = cut_point_appear_time(cuts[pa.cut], arc_a), tb = cut_point_appear_time(cuts[pb.cut], arc_b);
+      // pieces are ordered (cut, k), so on a tie b is the later one (higher cut or arc)
+      const bool a_later = ta > tb;
+      if (a_later) forced[pa.cut].push_back(arc_a);
+      else forced[pb.cut].push_back(arc_b);
+      inserts.push_back({pa.cut, arc_a, element});
+      inserts.push_back({pb.cut, arc_b, element});
+    }
   }
   for (const CrossingHit& hit : inserts) insert_path_vertex(paths[hit.cut], hit.arc, hit.element);
 
