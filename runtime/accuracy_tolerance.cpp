@@ -121,6 +121,8 @@ void check_tolerance_accuracy_options(const ToleranceAccuracyOptions& options) {
   if (options.shell && options.shell_steps < 1)
     throw std::invalid_argument("tolerance accuracy: shell steps = " + std::to_string(options.shell_steps) +
                                 "; need >= 1");
+  // Before the sweeps: a scene that did not load ended the command after the others' work.
+  if (options.shell) load_shell_benchmark_scene(options.shell_scene);
   for (const auto& [series, list] : {std::pair{"shell", &options.shell_tolerances},
                                       std::pair{"multigrid", &options.multigrid_tolerances}})
     for (double tol : *list)

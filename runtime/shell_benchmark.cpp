@@ -60,13 +60,18 @@ double measure_dense_gemm_gflops(int n, int repeat) {
   return 2.0 * n * n * n / (best * 1e-3) / 1e9;
 }
 
-ShellBenchRun run_shell_benchmark(const std::string& scene_path, int steps, int threads, bool reuse_factorization,
-                                  const FactorReuseOptions& solver, const std::function<void(int, int)>& progress) {
-  const Scene scene = load_scene(scene_path);
+Scene load_shell_benchmark_scene(const std::string& scene_path) {
+  Scene scene = load_scene(scene_path);
   if (!scene.analysis.is_dynamic())
     throw std::invalid_argument("scene '" + scene_path + "' is a static analysis; the shell benchmark needs \"analysis\": {\"type\": \"dynamic\", ...}");
   if (!scene.cuts.empty())
     throw std::invalid_argument("scene '" + scene_path + "' has cuts, which the shell benchmark does not time; remove \"cuts\"");
+  return scene;
+}
+
+ShellBenchRun run_shell_benchmark(const std::string& scene_path, int steps, int threads, bool reuse_factorization,
+                                  const FactorReuseOptions& solver, const std::function<void(int, int)>& progress) {
+  const Scene scene = load_shell_benchmark_scene(scene_path);
   if (steps < 1) throw std::invalid_argument("steps = " + std::to_string(steps) + ", need >= 1");
   const Mesh mesh = build_scene_mesh(scene);
   SceneModel setup = build_scene_model(scene, mesh);

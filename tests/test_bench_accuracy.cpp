@@ -260,6 +260,14 @@ TEST(BenchAccuracyArguments, BadValuesAreRejectedWithExitCode2) {
   EXPECT_EQ(WEXITSTATUS(std::system((cli + " bench accuracy --charts scene_quadrature --scene-quadrature-tolerances 0"
                                      " --out " + out + " 2>/dev/null").c_str())),
             2);
+  // The shell tolerance sweep's scene is checked up front, chosen or not: a scene with cuts
+  // (or one that did not load) ended the command with exit code 1 after the other sweeps,
+  // and passed unread with --charts plate (helper audit, session 71).
+  for (const char* charts : {"tolerance", "plate"})
+    EXPECT_EQ(WEXITSTATUS(std::system((cli + " bench accuracy --charts " + charts + " --shell-scene " + DGTEX_SOURCE_DIR +
+                                       "/examples/scenes/spiral1.json --out " + out + " 2>/dev/null").c_str())),
+              2)
+        << charts;
   fs::remove_all(out);
 }
 

@@ -229,6 +229,8 @@ int bench_accuracy_command(int argc, char** argv) {
                                        check_tolerance_accuracy_options));
       alone("--multigrid-size", with(tolerance_defaults, [&](auto& o) { o.multigrid_resolution = tolerance.multigrid_resolution; },
                                      check_tolerance_accuracy_options));
+      alone("--shell-scene", with(tolerance_defaults, [&](auto& o) { o.shell_scene = tolerance.shell_scene; },
+                                  check_tolerance_accuracy_options));
       alone("--multigrid-tolerances",
             with(tolerance_defaults, [&](auto& o) { o.multigrid_tolerances = tolerance.multigrid_tolerances; },
                  check_tolerance_accuracy_options));

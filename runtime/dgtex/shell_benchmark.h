@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "dgtex/factor_reusing_solver.h"
+#include "dgtex/scene.h"
 #include "dgtex/shell_model.h"
 #include "dgtex/stage_timer.h"
 
@@ -36,9 +37,14 @@ struct ShellBenchRun {
   std::vector<double> displacement;       // final state (for the thread-independence check)
 };
 
-// Throws std::invalid_argument for a scene that is not a dynamic analysis or has cuts,
-// and SceneError / MeshError for a scene that does not load. progress (optional) is called
-// after every step with (steps done, steps).
+// Loads the scene at `scene_path` and checks that the benchmark can time it; returns it.
+// Throws SceneError for a scene that does not load, std::invalid_argument for one that is
+// not a dynamic analysis or has cuts.
+Scene load_shell_benchmark_scene(const std::string& scene_path);
+
+// Throws as load_shell_benchmark_scene, std::invalid_argument for steps < 1, and MeshError
+// for a mesh that does not build. progress (optional) is called after every step with
+// (steps done, steps).
 ShellBenchRun run_shell_benchmark(const std::string& scene_path, int steps, int threads,
                                   bool reuse_factorization = true, const FactorReuseOptions& solver = {},
                                   const std::function<void(int, int)>& progress = {});
