@@ -39,6 +39,9 @@ TEST(CliOptions, BadValuesAreOneLineNamingTheCommandAndOption) {
       // Names over 255 bytes failed only when written, after the work.
       {"bench scaling --json DIR/NAME300.json", "dgtex bench scaling: --json: a name in '"},
       {"run PLATE --out DIR/NAME300", "dgtex run: --out: a name in '"},
+      // So did paths over the system's 4096 bytes made of short names (session 71).
+      {"run PLATE --out DIR/LONGPATH", "dgtex run: --out: the path has "},
+      {"bench scaling --json DIR/LONGPATH.json", "dgtex bench scaling: --json: the path has "},
       // The permission bits, which root passes, took /proc: the run failed after its work.
       {"run PLATE --out /proc/dgtex_out", "dgtex run: --out: folder '/proc' is not writable"},
       {"bench scenes --json /proc/dgtex.json", "dgtex bench scenes: --json: folder '/proc' is not writable"},
@@ -122,6 +125,9 @@ TEST(CliOptions, BadValuesAreOneLineNamingTheCommandAndOption) {
         args.replace(at, from.size(), to);
     };
     replace("NAME300", std::string(300, 'n'));
+    std::string long_path = "p";
+    while (long_path.size() < 4200) long_path += "/abcdefgh";
+    replace("LONGPATH", long_path);
     replace("PLATE", plate);
     replace("DIR", dir.string());
     const CliResult r = run_cli(args, dir);

@@ -42,13 +42,21 @@ bool can_write(const fs::path& file) {
   return true;
 }
 
-// "" when every name in PATH fits the file systems' limit (NAME_MAX, 255 bytes), else why
-// not: such a path fails only when the command writes it, after its work.
-std::string check_name_lengths(const fs::path& path) {
+// The longest path the commands write below an output folder ("/frames/frame_NNNNN.png",
+// "/textures/enrichment.vdb", with room to spare).
+constexpr std::size_t kLongestWrittenName = 64;
+
+// "" when every name in PATH fits the file systems' limit (NAME_MAX, 255 bytes) and the
+// whole path, with what the commands write below it, the system's (PATH_MAX, 4096), else
+// why not: such a path fails only when the command writes it, after its work.
+std::string check_path_lengths(const fs::path& path) {
   for (const fs::path& part : path)
     if (part.native().size() > NAME_MAX)
       return "a name in '" + path.string() + "' has " + std::to_string(part.native().size()) +
              " bytes; file systems take at most " + std::to_string(NAME_MAX);
+  if (path.native().size() + kLongestWrittenName >= PATH_MAX)
+    return "the path has " + std::to_string(path.native().size()) + " bytes; with the names written in it the system takes at most " +
+           std::to_string(PATH_MAX - 1 - kLongestWrittenName);
   return "";
 }
 
@@ -68,7 +76,7 @@ CLI::Validator writable_file() {
         // Called only for a given option: an empty value is a mistake, not "no file".
         if (value.empty()) return "an empty path; give a file name";
         const fs::path path(value);
-        if (std::string why = check_name_lengths(path); !why.empty()) return why;
+        if (std::string why = check_path_lengths(path); !why.empty()) return why;
         std::error_code error;
         if (fs::is_directory(path, error)) return "'" + value + "' is a folder; give a file name";
         // An existing file is written in place (write_output_file): its folder need not be
@@ -87,7 +95,7 @@ CLI::Validator creatable_folder() {
         // An empty --out would write into (and clear an earlier run's files from) the
         // working folder.
         if (value.empty()) return "an empty path; give a folder (\".\" for the working folder)";
-        if (std::string why = check_name_lengths(fs::path(value)); !why.empty()) return why;
+        if (std::string why = check_path_lengths(fs::path(value)); !why.empty()) return why;
         fs::path existing = fs::absolute(fs::path(value)).lexically_normal();
         std::error_code error;
         while (!fs::exists(existing, error) && existing.has_relative_path()) existing = existing.parent_path();
