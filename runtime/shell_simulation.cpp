@@ -34,6 +34,18 @@ constexpr const char* kDistortionHint =
     ", whose threshold (0.35-0.40 on regular elements) grows with their distortion: an edge much shorter than the "
     "opposite one needs a larger penalty or a better mesh";
 
+// Far above the definiteness threshold a factorisation fails for the opposite reason: the
+// penalty terms drown the rest of the stiffness in round-off (a dynamic plate at penalty
+// 1e14, fuzzing in session 71, read "penalty too low?").
+constexpr double kRoundOffPenalty = 1e6;
+std::string penalty_problem(const char* matrix, double penalty) {
+  if (penalty > kRoundOffPenalty)
+    return std::string(matrix) + " not positive definite (penalty too high? at penalty = " + detail::short_number(penalty) +
+           " its terms drown the rest of the stiffness in round-off; 0.8-1 is recommended)";
+  return std::string(matrix) + " not positive definite (penalty too low?): penalty = " + detail::short_number(penalty) +
+         kDistortionHint;
+}
+
 }  // namespace
 
 ShellSimulation::ShellSimulation(const ShellModel& model, std::vector<char> fixed, std::vector<double> external_force)
@@ -185,8 +197,7 @@ void ShellSimulation::solve_static() {
       solver_.invalidate();
       cholesky_.factorize(values);
     } catch (const NotPositiveDefinite& e) {
-      throw ModelError("stiffness not positive definite (penalty too low?): penalty = " +
-                       detail::short_number(model_.options().penalty) + kDistortionHint + "; " + e.what() +
+      throw ModelError(penalty_problem("stiffness", model_.options().penalty) + "; " + e.what() +
                        pivot_location(e) + enrichment_hint());
     }
     system_.restrict_vector(f_ext_, rhs);
@@ -327,9 +338,8 @@ void ShellSimulation::step(const DynamicsOptions& o) {
                                "likely diverged (a smaller time step or smaller loads?), or the penalty = " +
                                detail::short_number(model_.options().penalty) + " is too low for it; " + e.what() +
                                pivot_location(e) + enrichment_hint());
-    throw ModelError("dynamic system matrix not positive definite (penalty too low?): penalty = " +
-                     detail::short_number(model_.options().penalty) + kDistortionHint + "; " + e.what() +
-                     pivot_location(e) + enrichment_hint());
+    throw ModelError(penalty_problem("dynamic system matrix", model_.options().penalty) + "; " +
+                     e.what() + pivot_location(e) + enrichment_hint());
   }
   for (int d = 0; d < ndofs; ++d) u_[d] += dt * v_[d];
   time_ += dt;

@@ -9,11 +9,13 @@
 #include <cstdio>
 #include <memory>
 #include <random>
+#include <string>
 
 #include "cut_test_support.h"
 #include "dense_matrix_support.h"
 #include "dgtex/cut_manager.h"
 #include "dgtex/kernels/shell_point.h"
+#include "dgtex/model_error.h"
 #include "dgtex/penalty_caution.h"
 #include "dgtex/rotation_caution.h"
 #include "dgtex/shell_simulation.h"
@@ -308,6 +310,34 @@ TEST(PenaltyTooHigh, CoarsePlatesLockAndTheLineCautions) {
   const double fine_at_1000 = clamped_plate_deflection_ratio(ElementType::quad8, 32, 1000, m);
   std::printf("clamped plate quad8 32x32, w / Timoshenko: penalty 1 %.4f, 1000 %.4f\n", fine_at_one, fine_at_1000);
   EXPECT_NEAR(fine_at_1000 / fine_at_one, 1.0, 0.005);
+}
+
+// Far above it the factorisation fails for the opposite reason: the penalty terms drown the
+// rest of the stiffness in round-off. The message says so; it read "penalty too low?"
+// (fuzzing, session 71: the demo cantilever, dynamic, failed from ~1e14 on).
+TEST(PenaltyTooHigh, ARoundOffFailureNamesTheHighPenalty) {
+  TestMaterial m;
+  m.E = 5e8;
+  const Mesh mesh = make_rectangle(1, 0.2, 10, 2, ElementType::quad8);
+  auto at_root = [](const double* x) { return std::abs(x[0]) < 1e-9; };
+  auto model = make_model(mesh, m, 1e20, at_root);
+  std::vector<char> fixed;
+  fix_nodes(mesh, at_root, true, true, true, fixed);
+  std::vector<double> f(model->num_dofs(), 0.0);
+  const double g[3] = {0, 0, -9.81};
+  model->add_gravity(g, f);
+  ShellSimulation sim(*model, fixed, f);
+  DynamicsOptions options;
+  options.time_step = 0.005;
+  options.corotational = true;
+  try {
+    sim.step(options);
+    FAIL() << "a step at penalty 1e20 passed";
+  } catch (const ModelError& e) {
+    const std::string message = e.what();
+    EXPECT_NE(message.find("not positive definite (penalty too high? at penalty = 1e+20"), std::string::npos) << message;
+    EXPECT_EQ(message.find("penalty too low?"), std::string::npos) << message;
+  }
 }
 
 // ---------------------------------------------------------------------------------------
