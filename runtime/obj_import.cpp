@@ -22,15 +22,36 @@ struct ObjFace {
 
 std::string where(const std::string& path, int line) { return path + ":" + std::to_string(line); }
 
+// File text as a message shows it: bytes outside printable ASCII as \xHH (a NUL ended the
+// message, escape sequences reached the terminal), and at most 64 of them (a 5 MB number
+// was printed whole).
+std::string shown(const std::string& text) {
+  constexpr std::size_t kShown = 64;
+  std::string out;
+  for (std::size_t i = 0; i < text.size() && i < kShown; ++i) {
+    const unsigned char c = static_cast<unsigned char>(text[i]);
+    if (c >= 0x20 && c < 0x7f) {
+      out += static_cast<char>(c);
+    } else {
+      static const char* digits = "0123456789abcdef";
+      out += "\\x";
+      out += digits[c >> 4];
+      out += digits[c & 15];
+    }
+  }
+  if (text.size() > kShown) out += "... (" + std::to_string(text.size()) + " bytes)";
+  return out;
+}
+
 double parse_coordinate(const std::string& token, const std::string& path, int line) {
   char* end = nullptr;
   const double value = std::strtod(token.c_str(), &end);
   // The whole token (a NUL inside it ended the number silently).
   if (token.empty() || end != token.c_str() + token.size() || !std::isfinite(value))
-    throw MeshError(where(path, line) + ": vertex coordinate '" + token + "' is not a finite number");
+    throw MeshError(where(path, line) + ": vertex coordinate '" + shown(token) + "' is not a finite number");
   // As for the scene's numbers: beyond this, element areas (squares of lengths) overflow.
   if (std::abs(value) > 1e30)
-    throw MeshError(where(path, line) + ": vertex coordinate '" + token +
+    throw MeshError(where(path, line) + ": vertex coordinate '" + shown(token) +
                     "' is out of range; magnitudes up to 1e30 are accepted");
   return value;
 }
@@ -41,10 +62,10 @@ int parse_face_corner(const std::string& token, int vertices_so_far, const std::
   char* end = nullptr;
   const long index = std::strtol(index_text.c_str(), &end, 10);
   if (index_text.empty() || end != index_text.c_str() + index_text.size())
-    throw MeshError(where(path, line) + ": face corner '" + token + "' does not start with a vertex index");
+    throw MeshError(where(path, line) + ": face corner '" + shown(token) + "' does not start with a vertex index");
   const long resolved = index > 0 ? index - 1 : vertices_so_far + index;
   if (index == 0 || resolved < 0 || resolved >= vertices_so_far)
-    throw MeshError(where(path, line) + ": face corner '" + token + "' refers to vertex " + std::to_string(index) +
+    throw MeshError(where(path, line) + ": face corner '" + shown(token) + "' refers to vertex " + std::to_string(index) +
                     ", but only " + std::to_string(vertices_so_far) + " vertices are defined before this line " +
                     "(valid: 1.." + std::to_string(vertices_so_far) + " or -1..-" + std::to_string(vertices_so_far) +
                     ")");
@@ -89,7 +110,7 @@ void read_statement(std::string text, int line, const std::string& path, std::ve
   if (keyword == "v") {
     std::string c[3];
     if (!(tokens >> c[0] >> c[1] >> c[2]))
-      throw MeshError(where(path, line) + ": vertex needs three coordinates 'v x y z', got '" + text + "'");
+      throw MeshError(where(path, line) + ": vertex needs three coordinates 'v x y z', got '" + shown(text) + "'");
     for (int d = 0; d < 3; ++d) vertices.push_back(parse_coordinate(c[d], path, line));
   } else if (keyword == "f") {
     ObjFace face;
@@ -110,7 +131,7 @@ void read_statement(std::string text, int line, const std::string& path, std::ve
                       "; a mesh must be all triangles or all quads");
     faces.push_back(std::move(face));
   } else if (!is_skipped_obj_statement(keyword)) {
-    throw MeshError(where(path, line) + ": unknown OBJ statement '" + keyword +
+    throw MeshError(where(path, line) + ": unknown OBJ statement '" + shown(keyword) +
                     "'; a mesh takes 'v x y z' and 'f a b c [d]' (skipped: vt, vn, vp, l, p, g, o, s, mtllib, "
                     "usemtl, and comments after #)");
   }

@@ -124,6 +124,13 @@ TEST(ObjImport, MalformedLinesNameTheLine) {
   EXPECT_CONTAINS(load_error_of_text("v 0 0 0\nv 1 0 0\nv 2 0 0\n\nf 1 2 3\n"), "face at ");
   EXPECT_CONTAINS(load_error_of_text("v 0 0 0\nv 1 0 0\nv 2 0 0\n\nf 1 2 3\n"), "degenerate");
   EXPECT_CONTAINS(load_error("/nonexistent/dir/mesh.obj"), "/nonexistent/dir/mesh.obj: cannot open");
+  // The file's bytes as a message shows them (fuzzing, session 71): a NUL ended the message,
+  // escape sequences reached the terminal, and a 5 MB number was printed whole.
+  EXPECT_CONTAINS(load_error_of_text(std::string("v 0\0 0 0\n", 9)), ".obj:1: vertex coordinate '0\\x00' is not a finite number");
+  EXPECT_CONTAINS(load_error_of_text("\x1b[31mX\x07 1 2\n"), ".obj:1: unknown OBJ statement '\\x1b[31mX\\x07'");
+  const std::string long_number = load_error_of_text("v " + std::string(100000, '1') + " 0 0\n");
+  EXPECT_CONTAINS(long_number, "'" + std::string(64, '1') + "... (100000 bytes)' is");
+  EXPECT_LT(long_number.size(), 400u);
 }
 
 // Old Mac files end lines with CR alone: they read as one line ("no faces").
