@@ -15,6 +15,7 @@
 #include "dgtex/deformed_shell.h"
 #include "dgtex/kernels/enriched_basis.h"
 #include "dgtex/kernels/vec3.h"
+#include "api_argument_checks.h"
 #include "dgtex_embedded_shaders.h"
 
 namespace dgtex {
@@ -61,9 +62,18 @@ struct ResolvedCamera {
   double near_plane, far_plane;
 };
 
+// The shaders draw in 32-bit floats: a state whose coordinates pass their range (a damaged
+// or hand-made state file with positions of 1e39) drew a blank image with success.
+constexpr double kLargestDrawnCoordinate = 1e30;
+
 ResolvedCamera resolve_camera(const DeformedShell& shell, const RenderSettings& s) {
   double lo[3], hi[3];
   shell.bounding_box(lo, hi);
+  for (int d = 0; d < 3; ++d)
+    for (double x : {lo[d], hi[d]})
+      if (!(std::abs(x) <= kLargestDrawnCoordinate))
+        throw std::invalid_argument("the deformed shell reaches coordinate " + detail::short_number(x) +
+                                    ", beyond what the renderer's 32-bit floats draw (magnitudes up to 1e30)");
   const Vec3 center = {0.5 * (lo[0] + hi[0]), 0.5 * (lo[1] + hi[1]), 0.5 * (lo[2] + hi[2])};
   const double radius = std::max(0.5 * norm(sub(Vec3{hi[0], hi[1], hi[2]}, Vec3{lo[0], lo[1], lo[2]})), 1e-9);
   ResolvedCamera c;

@@ -309,6 +309,15 @@ TEST(RenderCutPlate, RejectsTooManyEnrichmentsAndBadSettings) {
     bad[k](s);
     EXPECT_THROW(renderer().render(ok.state, s), std::invalid_argument) << k;
   }
+  // Coordinates past the shaders' 32-bit floats drew a blank image (fuzzing, session 71).
+  auto far = test::straight_cut_plate();
+  for (double& x : far.state.mesh.positions) x *= 1e35;
+  try {
+    renderer().render(far.state, test::top_view());
+    ADD_FAILURE() << "drew a shell of 1e35";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("beyond what the renderer's 32-bit floats draw"), std::string::npos) << e.what();
+  }
 }
 
 // One element [0,1]^2 with complete straight cuts k (vertical ones at x = c, horizontal

@@ -164,8 +164,8 @@ int render_command(int argc, char** argv) {
     std::printf("dgtex render: wrote %s (%d x %d; upload %.1f ms, shader setup %.1f ms, draw %.1f ms; %s)\n",
                 frame.c_str(), image.width, image.height, renderer.last_upload_ms(), renderer.last_setup_ms(),
                 renderer.last_draw_ms(), renderer.context().description().c_str());
-  } catch (const std::invalid_argument& e) {
-    std::fprintf(stderr, "dgtex render: %s\n", e.what());
+  } catch (const std::invalid_argument& e) {  // the settings are checked above: the state's contents
+    std::fprintf(stderr, "dgtex render: state file '%s': %s\n", state_path.c_str(), e.what());
     return 2;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "dgtex render: %s\n", e.what());
