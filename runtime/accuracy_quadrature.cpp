@@ -89,9 +89,11 @@ void check_quadrature_accuracy_options(const QuadratureAccuracyOptions& options)
   if (!is_texture_resolution(T))
     throw std::invalid_argument("quadrature resolution T = " + std::to_string(T) +
                                 "; need a power of two in 8..4096 (8, 16, ..., 4096)");
+  // The range of the scene's enrichment.quadrature_tolerance, which they become (inf failed
+  // in the sweep; 1e-300 ran, and the chart's log axis failed in gnuplot, exit code 1).
   for (double tol : options.tolerances)
-    if (!(tol > 0 && tol <= 1e30))  // as the scene's enrichment.quadrature_tolerance (inf failed in the sweep)
-      throw std::invalid_argument("quadrature tolerance " + detail::short_number(tol) + "; need 0 < tol <= 1e30");
+    if (!(tol >= 1e-30 && tol <= 1e30))
+      throw std::invalid_argument("quadrature tolerance " + detail::short_number(tol) + "; need 1e-30 <= tol <= 1e30");
   for (const std::string& e : options.elements)
     if (e != "quad8" && e != "tri6")
       throw std::invalid_argument("quadrature element '" + e + "'; valid: quad8, tri6");

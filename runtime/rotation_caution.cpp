@@ -12,14 +12,13 @@ LargestRotation largest_rotation(const Mesh& mesh, const double* nodal_displacem
     const int* nodes = mesh.element_nodes(e);
     for (int a = 0; a < n; ++a)
       for (int b = a + 1; b < n; ++b) {
-        double du = 0, dx = 0;
+        double u[3], x[3];
         for (int k = 0; k < 3; ++k) {
-          const double u = nodal_displacement[3 * nodes[a] + k] - nodal_displacement[3 * nodes[b] + k];
-          const double x = mesh.node(nodes[a])[k] - mesh.node(nodes[b])[k];
-          du += u * u;
-          dx += x * x;
+          u[k] = nodal_displacement[3 * nodes[a] + k] - nodal_displacement[3 * nodes[b] + k];
+          x[k] = mesh.node(nodes[a])[k] - mesh.node(nodes[b])[k];
         }
-        const double ratio = std::sqrt(du / dx);
+        // hypot: squares of lengths near 1e30 (the scene file's largest) overflowed to inf.
+        const double ratio = std::hypot(u[0], u[1], u[2]) / std::hypot(x[0], x[1], x[2]);
         if (ratio > largest.value) largest = {ratio, e};
       }
   }

@@ -204,6 +204,13 @@ std::string source_line_column(const std::string& source, const std::string& tex
 }
 
 json parse_json_text(const std::string& text, const std::string& source) {
+  // A file saved as UTF-16 (some Windows editors' "Unicode") read as "1:2: unexpected end
+  // of input": its byte order mark, or a NUL in every other byte of its ASCII.
+  const bool utf16_mark = text.size() >= 2 && ((text[0] == '\xff' && text[1] == '\xfe') ||
+                                               (text[0] == '\xfe' && text[1] == '\xff'));
+  const bool utf16_text = text.size() >= 2 && (text[0] == '\0' || text[1] == '\0');
+  if (utf16_mark || utf16_text)
+    throw SceneError(source, "the file is UTF-16 text (or binary); JSON scene files are UTF-8: save it as UTF-8");
   try {
     return json::parse(text, ParseTimeChecks(source), /*allow_exceptions=*/true, /*ignore_comments=*/false);
   } catch (const json::parse_error& e) {

@@ -46,7 +46,8 @@ std::int64_t memory_limit_from_environment() {
   const long long mib = std::strtoll(text, &end, 10);
   if (*end != '\0' || errno == ERANGE || mib < 1 || mib > (std::int64_t{1} << 40))
     throw std::invalid_argument(std::string("DGTEX_MEMORY_LIMIT_MB = '") + text +
-                                "': expected a whole number of MiB, 1 or more (or unset: the machine's memory)");
+                                "': expected a whole number of MiB from 1 to " + std::to_string(std::int64_t{1} << 40) +
+                                " (or unset: the machine's memory)");
   return static_cast<std::int64_t>(mib) << 20;
 }
 

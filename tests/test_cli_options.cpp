@@ -109,7 +109,13 @@ TEST(CliOptions, BadValuesAreOneLineNamingTheCommandAndOption) {
       // Values the sweep's scene would refuse only once the sweep ran, and the options of a
       // chart not chosen (ignored without a word).
       {"bench accuracy --charts quadrature --quadrature-tolerances inf --out DIR/acc",
-       "dgtex bench accuracy: --quadrature-tolerances: quadrature tolerance inf; need 0 < tol <= 1e30"},
+       "dgtex bench accuracy: --quadrature-tolerances: quadrature tolerance inf; need 1e-30 <= tol <= 1e30"},
+      // 1e-300 ran, and the chart's log axis failed in gnuplot (exit code 1; session 71).
+      {"bench accuracy --charts quadrature --quadrature-tolerances 1e-300 --out DIR/acc",
+       "dgtex bench accuracy: --quadrature-tolerances: quadrature tolerance 1e-300; need 1e-30 <= tol <= 1e30"},
+      // Finite, but its length overflowed, and the message called it not finite.
+      {"render x.state --out DIR/x.png --camera-position 1e200 0 0",
+       "dgtex render: --camera-position: 1e+200 0 0: expected finite numbers of magnitude up to 1e30"},
       {"bench accuracy --charts rotation --rotation-blocks 100000 --out DIR/acc",
        "dgtex bench accuracy: --rotation-blocks: rotation accuracy: rotation block B = 100000 texels; need 1..4096"},
       {"bench accuracy --charts plate --texture-sizes -5 --out DIR/acc", "dgtex bench accuracy: --texture-sizes: texture size T = -5"},

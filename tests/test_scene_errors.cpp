@@ -342,6 +342,11 @@ TEST(SceneErrors, MalformedJsonReportsLineAndColumn) {
   EXPECT_NE(error_of_text("// comment\n{}").find("invalid JSON"), std::string::npos);
   EXPECT_NE(error_of_text("{\"mesh\": {},}").find("invalid JSON"), std::string::npos);
   EXPECT_NE(error_of_text("").find("invalid JSON"), std::string::npos);
+  // UTF-16, with or without its byte order mark, read as "1:2: unexpected end of input".
+  for (const std::string& utf16 : {std::string("\xff\xfe{\0}\0", 6), std::string("{\0}\0", 4)})
+    EXPECT_NE(error_of_text(utf16).find("the file is UTF-16 text (or binary); JSON scene files are UTF-8"),
+              std::string::npos)
+        << error_of_text(utf16);
   EXPECT_NE(error_of_text("{\"penalty\": 1e400}").find("number overflow"), std::string::npos);
   // nlohmann reports no position for an overflowing number; the literal's first place is it.
   EXPECT_EQ(error_of_text("{\n  \"mesh\": {},\n  \"penalty\": -1e400}").rfind("bad.json:3:14: invalid JSON: number overflow", 0),

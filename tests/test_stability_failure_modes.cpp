@@ -248,6 +248,19 @@ TEST(LargeRotations, TheLinearDriftGrowsWithTheRotationAndTheLineCautions) {
 // takes ~5): each step is then a fixed-point iteration towards equilibrium without the
 // geometric stiffness; it stays bounded but does not settle and the strip stretches (a
 // limit: use dt of the order of the motion's time scale with corotation).
+// The caution's measure in the scene file's largest lengths: squares of 1e30 overflowed,
+// and a static plate of that size was cautioned for an "inf" rotation (fuzzing, session 71).
+TEST(LargeRotations, TheCautionsMeasureHoldsAtAnyLengthScale) {
+  Mesh mesh = make_rectangle(1, 1, 2, 2, ElementType::quad8);
+  std::vector<double> u(mesh.positions.size(), 0.0);
+  for (int n = 0; n < mesh.num_nodes(); ++n) u[3 * n + 2] = 0.1 * mesh.node(n)[0];  // a slope of 0.1
+  const double at_metres = largest_rotation(mesh, u.data()).value;
+  EXPECT_NEAR(at_metres, 0.1, 1e-12);
+  for (double& x : mesh.positions) x *= 1e30;
+  for (double& x : u) x *= 1e30;
+  EXPECT_NEAR(largest_rotation(mesh, u.data()).value, at_metres, 1e-12);
+}
+
 TEST(LargeTimeSteps, CorotatedHugeStepsStayBoundedButDoNotSettle) {
   ClampedStrip s = clamped_strip(10, TestMaterial{});
   const ShellModel& model = *s.model;

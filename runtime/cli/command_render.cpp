@@ -116,8 +116,12 @@ int render_command(int argc, char** argv) {
     return refuse("--fov: " + detail::short_number(settings.fov_deg) + ": expected more than 0 and less than 180 degrees");
   for (double c : background)
     if (!(c >= 0 && c <= 1)) return refuse("--background: " + text(background) + ": expected three numbers in [0, 1]");
+  // Each component, and their lengths at most 1e30: 1e200 passed std::isfinite but its norm
+  // overflowed (and the message called it not finite).
   for (const auto& [option, v] : {std::pair{"--camera-position", &position}, {"--camera-target", &target}, {"--camera-up", &up}})
-    if (!v->empty() && !std::isfinite(norm3(*v))) return refuse(std::string(option) + ": " + text(*v) + ": expected finite numbers");
+    for (double x : *v)
+      if (!(std::abs(x) <= 1e30))
+        return refuse(std::string(option) + ": " + text(*v) + ": expected finite numbers of magnitude up to 1e30");
   if (!up.empty() && !(norm3(up) > 0)) return refuse("--camera-up: " + text(up) + ": expected a non-zero direction");
   if (!position.empty()) {
     const double* look = target.empty() ? settings.camera_target : target.data();
