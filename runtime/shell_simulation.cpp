@@ -227,9 +227,11 @@ void ShellSimulation::set_solver_options(const FactorReuseOptions& options) { so
 void ShellSimulation::step(const DynamicsOptions& o) {
   check_model_unchanged("ShellSimulation::step");
   const double dt = o.time_step;
-  if (!(dt > 0 && std::isfinite(dt)))
+  // At most the scene file's largest magnitude: dt^2 K of 1e300 overflowed, and the failed
+  // factorisation read "penalty too low?".
+  if (!(dt > 0 && dt <= 1e30))
     throw std::invalid_argument("ShellSimulation::step: time_step " + detail::short_number(dt) +
-                                " is not a positive finite time");
+                                " is not a positive time up to 1e30");
   // Negative damping read as "not positive definite (penalty too low?)" once 1 + dt a <= 0.
   for (const auto& [name, value] : {std::pair{"mass_damping", o.mass_damping}, {"stiffness_damping", o.stiffness_damping}})
     if (!(value >= 0 && std::isfinite(value)))
