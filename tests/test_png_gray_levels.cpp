@@ -48,6 +48,17 @@ void put_big_endian(std::vector<std::uint8_t>& bytes, std::size_t at, std::uint3
   for (int k = 0; k < 4; ++k) bytes[at + k] = static_cast<std::uint8_t>(value >> (24 - 8 * k));
 }
 
+// A one-element quad8 strip, clamped at x = 0, whose thickness texture is `image`.
+Scene textured_strip(const std::string& image, const std::string& scene_path) {
+  return parse_scene(
+      R"({"mesh": {"generator": "rectangle", "size": [1, 0.1], "divisions": [1, 1], "element": "quad8"},
+          "material": {"youngs_modulus": 1e6, "poisson_ratio": 0.3, "thickness": 0.01},
+          "boundary": [{"select": {"plane": {"normal": [1, 0, 0], "offset": 0}}, "fix": ["x", "y", "z"], "clamp": true}],
+          "material_textures": [{"field": "thickness", "image": ")" +
+          image + R"(", "range": [0.002, 0.012]}]})",
+      scene_path);
+}
+
 class PngGrayLevels : public ::testing::Test {
  protected:
   void SetUp() override {
@@ -93,12 +104,7 @@ TEST_F(PngGrayLevels, MaterialTexturesFromSixteenBitImagesAreTheStoredLevels) {
   std::vector<double> thickness[2];
   for (int k = 0; k < 2; ++k) {
     const std::string image = k == 0 ? "t8.png" : "t16.png";
-    const Scene scene = parse_scene(
-        R"({"mesh": {"generator": "rectangle", "size": [1, 0.1], "divisions": [1, 1], "element": "quad8"},
-            "material": {"youngs_modulus": 1e6, "poisson_ratio": 0.3, "thickness": 0.01},
-            "boundary": [{"select": {"plane": {"normal": [1, 0, 0], "offset": 0}}, "fix": ["x", "y", "z"], "clamp": true}],
-            "material_textures": [{"field": "thickness", "image": ")" + image + R"(", "range": [0.002, 0.012]}]})",
-        path("scene.json"));
+    const Scene scene = textured_strip(image, path("scene.json"));
     const std::vector<ElementMaterialTexture> textures = scene_material_textures(scene, build_scene_mesh(scene));
     ASSERT_EQ(textures.size(), 1u);
     thickness[k] = textures[0].thickness;
@@ -127,12 +133,7 @@ TEST_F(PngGrayLevels, ImagesBeyondTheMemoryAvailableAreRefusedFromTheirHeader) {
   EXPECT_EQ(size.width, static_cast<int>(kMaxPngSide));
   EXPECT_EQ(size.height, static_cast<int>(kMaxPngSide));
 
-  const Scene scene = parse_scene(
-      R"({"mesh": {"generator": "rectangle", "size": [1, 0.1], "divisions": [1, 1], "element": "quad8"},
-          "material": {"youngs_modulus": 1e6, "poisson_ratio": 0.3, "thickness": 0.01},
-          "boundary": [{"select": {"plane": {"normal": [1, 0, 0], "offset": 0}}, "fix": ["x", "y", "z"], "clamp": true}],
-          "material_textures": [{"field": "thickness", "image": "huge.png", "range": [0.002, 0.012]}]})",
-      path("scene.json"));
+  const Scene scene = textured_strip("huge.png", path("scene.json"));
   const std::int64_t one_gib = std::int64_t{1} << 30;
   try {
     scene_material_textures(scene, build_scene_mesh(scene), one_gib);
@@ -150,12 +151,7 @@ TEST_F(PngGrayLevels, ImagesBeyondTheMemoryAvailableAreRefusedFromTheirHeader) {
 TEST_F(PngGrayLevels, AnImageIsReadWhenItsDecodingFits) {
   const std::uint8_t grey8[2] = {128, 64};
   write_samples(path("small.png"), 2, PNG_FORMAT_GRAY, grey8);
-  const Scene scene = parse_scene(
-      R"({"mesh": {"generator": "rectangle", "size": [1, 0.1], "divisions": [1, 1], "element": "quad8"},
-          "material": {"youngs_modulus": 1e6, "poisson_ratio": 0.3, "thickness": 0.01},
-          "boundary": [{"select": {"plane": {"normal": [1, 0, 0], "offset": 0}}, "fix": ["x", "y", "z"], "clamp": true}],
-          "material_textures": [{"field": "thickness", "image": "small.png", "range": [0.002, 0.012]}]})",
-      path("scene.json"));
+  const Scene scene = textured_strip("small.png", path("scene.json"));
   const Mesh mesh = build_scene_mesh(scene);
   EXPECT_EQ(scene_material_textures(scene, mesh, 2 * kGrayLevelsReadBytesPerPixel).size(), 1u);
   try {

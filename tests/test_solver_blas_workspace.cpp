@@ -10,11 +10,11 @@
 
 #include <cmath>
 #include <cstdint>
-#include <fstream>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
+#include "address_space_support.h"
 #include "cholmod_lock.h"
 #include "dgtex/sparse_cholesky.h"
 
@@ -45,12 +45,10 @@ TEST(BlasWorkspace, ATightAddressSpaceIsRefusedInsteadOfSpinningInOpenBlas) {
 #if defined(__SANITIZE_ADDRESS__)
   GTEST_SKIP() << "ASan reserves terabytes of address space for its shadow memory";
 #else
-  std::ifstream statm("/proc/self/statm");
-  long long pages = 0;
-  if (!(statm >> pages)) GTEST_SKIP() << "no /proc/self/statm";
+  const std::int64_t used = test::virtual_size_bytes();
+  if (used < 0) GTEST_SKIP() << "no /proc/self/statm";
   rlimit original{};
   ASSERT_EQ(getrlimit(RLIMIT_AS, &original), 0);
-  const std::int64_t used = static_cast<std::int64_t>(pages) * sysconf(_SC_PAGESIZE);
   const std::int64_t room = std::int64_t{96} << 20;  // below the workspace's 128 MiB
   if (original.rlim_cur != RLIM_INFINITY && static_cast<std::int64_t>(original.rlim_cur) < used + room)
     GTEST_SKIP() << "the limit leaves less than 96 MiB already";

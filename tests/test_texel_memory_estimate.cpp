@@ -15,6 +15,7 @@
 #include <string>
 #include <utility>
 
+#include "address_space_support.h"
 #include "cgroup_memory.h"
 #include "dgtex/crease_enrichment.h"
 #include "dgtex/cut_manager.h"
@@ -272,12 +273,10 @@ TEST(TexelMemoryEstimate, TheAddressSpaceLimitCapsTheMemoryAvailable) {
 #if defined(__SANITIZE_ADDRESS__)
   GTEST_SKIP() << "ASan reserves terabytes of address space for its shadow memory";
 #else
-  std::ifstream statm("/proc/self/statm");
-  long long pages = 0;
-  if (!(statm >> pages)) GTEST_SKIP() << "no /proc/self/statm";
+  const std::int64_t used = test::virtual_size_bytes();
+  if (used < 0) GTEST_SKIP() << "no /proc/self/statm";
   rlimit original{};
   ASSERT_EQ(getrlimit(RLIMIT_AS, &original), 0);
-  const std::int64_t used = static_cast<std::int64_t>(pages) * sysconf(_SC_PAGESIZE);
   const std::int64_t room = std::int64_t{256} << 20;
   if (original.rlim_max != RLIM_INFINITY && static_cast<std::int64_t>(original.rlim_max) < used + room)
     GTEST_SKIP() << "the hard limit leaves less than 256 MiB";
