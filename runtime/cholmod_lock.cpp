@@ -28,12 +28,14 @@ void reserve_blas_workspace(const CholmodLock&) {
   static bool reserved = false;  // guarded by the lock the caller holds
   if (reserved) return;
   const std::int64_t left = address_space_left();
-  if (left >= 0 && left < kBlasWorkspaceAddressSpace)
+  if (left >= 0 && left < kBlasWorkspaceAddressSpace) {
+    const long long mib = 1 << 20, missing = (kBlasWorkspaceAddressSpace - left + mib - 1) / mib;
     throw std::runtime_error("sparse Cholesky factorisation: OpenBLAS needs " +
-                             std::to_string(kBlasWorkspaceAddressSpace >> 20) + " MiB of address space for its workspace, and " +
-                             std::to_string(left >> 20) + " MiB are left under the process's address-space limit (ulimit -v): "
-                             "raise the limit by " + std::to_string((kBlasWorkspaceAddressSpace - left + (1 << 20) - 1) >> 20) +
-                             " MiB or more");
+                             std::to_string(kBlasWorkspaceAddressSpace / mib) +
+                             " MiB of address space for its workspace, and " + std::to_string(left / mib) +
+                             " MiB are left under the process's address-space limit (ulimit -v): raise the limit by " +
+                             std::to_string(missing) + " MiB or more");
+  }
   cholmod_common common;
   cholmod_start(&common);
   common.supernodal = CHOLMOD_SUPERNODAL;

@@ -219,8 +219,9 @@ void check_cut_options(const std::vector<Cut>& cuts, const EnrichmentOptions& op
   };
   const int T = options.texture_resolution;
   if (T < 2 || T > kMaxTextureResolution)
-    refuse("enrichment.texture_resolution", T, "2.." + std::to_string(kMaxTextureResolution) + " (a scene file: a power of two in " +
-                                                   std::to_string(kMinTextureResolution) + "..)");
+    refuse("enrichment.texture_resolution", T,
+           "2.." + std::to_string(kMaxTextureResolution) + " (a scene file: a power of two in " +
+               std::to_string(kMinTextureResolution) + "..)");
   if (options.new_cut_length && !(std::isfinite(*options.new_cut_length) && *options.new_cut_length > 0))
     refuse("enrichment.new_cut_length", *options.new_cut_length, "a finite number > 0");
   if (options.new_cut_angle_deg && !(std::isfinite(*options.new_cut_angle_deg) && *options.new_cut_angle_deg > 0))

@@ -102,7 +102,8 @@ FrameWriter::~FrameWriter() = default;
 
 std::string FrameWriter::write(const ShellState& state, int index) {
   // frame_-0001.png was written for -1.
-  if (index < 0) throw std::invalid_argument("FrameWriter::write: frame index " + std::to_string(index) + " (expected >= 0)");
+  if (index < 0)
+    throw std::invalid_argument("FrameWriter::write: frame index " + std::to_string(index) + " (expected >= 0)");
   ScopedStage whole(timings_, "render");
   if (!camera_fixed_) {
     settings_ = scene_render_settings(options_, state);

@@ -65,8 +65,9 @@ int parse_face_corner(const std::string& token, int vertices_so_far, const std::
     throw MeshError(where(path, line) + ": face corner '" + shown(token) + "' does not start with a vertex index");
   const long resolved = index > 0 ? index - 1 : vertices_so_far + index;
   if (index == 0 || resolved < 0 || resolved >= vertices_so_far)
-    throw MeshError(where(path, line) + ": face corner '" + shown(token) + "' refers to vertex " + std::to_string(index) +
-                    ", but only " + std::to_string(vertices_so_far) + " vertices are defined before this line " +
+    throw MeshError(where(path, line) + ": face corner '" + shown(token) + "' refers to vertex " +
+                    std::to_string(index) + ", but only " + std::to_string(vertices_so_far) +
+                    " vertices are defined before this line " +
                     "(valid: 1.." + std::to_string(vertices_so_far) + " or -1..-" + std::to_string(vertices_so_far) +
                     ")");
   return static_cast<int>(resolved);

@@ -133,8 +133,8 @@ void validate_settings(const RenderSettings& s) {
                                   " (valid: 0..1)");
   if (s.shading != RenderSettings::Shading::flat && s.shading != RenderSettings::Shading::smooth)
     throw std::invalid_argument("shading " + std::to_string(static_cast<int>(s.shading)) + " (valid: flat, smooth)");
-  if (s.cut_method != RenderSettings::CutMethod::geometry_shader && s.cut_method != RenderSettings::CutMethod::drop_triangles &&
-      s.cut_method != RenderSettings::CutMethod::kill_pixels)
+  using Cut = RenderSettings::CutMethod;
+  if (s.cut_method != Cut::geometry_shader && s.cut_method != Cut::drop_triangles && s.cut_method != Cut::kill_pixels)
     throw std::invalid_argument("cut_method " + std::to_string(static_cast<int>(s.cut_method)) +
                                 " (valid: geometry_shader, drop_triangles, kill_pixels)");
   if (!s.auto_camera && norm(sub(Vec3{s.camera_position[0], s.camera_position[1], s.camera_position[2]},

@@ -40,7 +40,8 @@ constexpr const char* kDistortionHint =
 constexpr double kRoundOffPenalty = 1e6;
 std::string penalty_problem(const char* matrix, double penalty) {
   if (penalty > kRoundOffPenalty)
-    return std::string(matrix) + " not positive definite (penalty too high? at penalty = " + detail::short_number(penalty) +
+    return std::string(matrix) + " not positive definite (penalty too high? at penalty = " +
+           detail::short_number(penalty) +
            " its terms drown the rest of the stiffness in round-off; 0.8-1 is recommended)";
   return std::string(matrix) + " not positive definite (penalty too low?): penalty = " + detail::short_number(penalty) +
          kDistortionHint;

@@ -55,7 +55,8 @@ std::string check_path_lengths(const fs::path& path) {
       return "a name in '" + path.string() + "' has " + std::to_string(part.native().size()) +
              " bytes; file systems take at most " + std::to_string(NAME_MAX);
   if (path.native().size() + kLongestWrittenName >= PATH_MAX)
-    return "the path has " + std::to_string(path.native().size()) + " bytes; with the names written in it the system takes at most " +
+    return "the path has " + std::to_string(path.native().size()) +
+           " bytes; with the names written in it the system takes at most " +
            std::to_string(PATH_MAX - 1 - kLongestWrittenName);
   return "";
 }

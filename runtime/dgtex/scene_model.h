@@ -24,10 +24,11 @@ Mesh build_scene_mesh(const Scene& scene);
 SceneModel build_scene_model(const Scene& scene, const Mesh& mesh);
 
 // The scene's held DOFs for a model (#dofs); like the two above, it and
-// scene_external_force check the scene first (validate_scene). Supports act on the standard DOFs of the
-// selected nodes only: the shifted enrichment vanishes at every node (thesis §5.3), so a
-// held node stays put, while its enriched DOFs stay free to move what a cut separates
-// from it (a chad cut out of an element whose nodes are all held still falls out).
+// scene_external_force check the scene first (validate_scene). Supports act on the
+// standard DOFs of the selected nodes only: the shifted enrichment vanishes at every node
+// (thesis §5.3), so a held node stays put, while its enriched DOFs stay free to move what
+// a cut separates from it (a chad cut out of an element whose nodes are all held still
+// falls out).
 std::vector<char> scene_fixed_dofs(const Scene& scene, const ShellModel& model);
 // The scene's loads on a model's basis (#dofs, enriched functions included).
 std::vector<double> scene_external_force(const Scene& scene, const ShellModel& model);
