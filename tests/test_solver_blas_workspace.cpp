@@ -5,7 +5,6 @@
 // reserve_blas_workspace). One test in its own executable: a process whose BLAS has run
 // before holds its workspace already.
 #include <gtest/gtest.h>
-#include <sys/resource.h>
 #include <unistd.h>
 
 #include <cmath>
@@ -15,7 +14,6 @@
 #include <vector>
 
 #include "address_space_support.h"
-#include "cholmod_lock.h"
 #include "dgtex/sparse_cholesky.h"
 
 namespace {
@@ -42,33 +40,20 @@ struct Tridiagonal {
 };
 
 TEST(BlasWorkspace, ATightAddressSpaceIsRefusedInsteadOfSpinningInOpenBlas) {
-#if defined(__SANITIZE_ADDRESS__)
-  GTEST_SKIP() << "ASan reserves terabytes of address space for its shadow memory";
-#else
-  const std::int64_t used = test::virtual_size_bytes();
-  if (used < 0) GTEST_SKIP() << "no /proc/self/statm";
-  rlimit original{};
-  ASSERT_EQ(getrlimit(RLIMIT_AS, &original), 0);
-  const std::int64_t room = std::int64_t{96} << 20;  // below the workspace's 128 MiB
-  if (original.rlim_cur != RLIM_INFINITY && static_cast<std::int64_t>(original.rlim_cur) < used + room)
-    GTEST_SKIP() << "the limit leaves less than 96 MiB already";
-
   const Tridiagonal system(300);
   SparseCholesky cholesky(0);  // always CHOLMOD, supernodal: its factorisation calls dpotrf
   cholesky.analyze(system.n, system.column_start, system.row_index);
   ASSERT_FALSE(cholesky.dense());
-  // A regression spins in OpenBLAS for ever: end the process instead.
-  ::alarm(120);
-  rlimit limited = original;
-  limited.rlim_cur = static_cast<rlim_t>(used + room);
-  ASSERT_EQ(setrlimit(RLIMIT_AS, &limited), 0);
+  test::ScopedAddressSpaceLimit limit(std::int64_t{96} << 20);  // below the workspace's 128 MiB
+  if (!limit.why_not().empty()) GTEST_SKIP() << limit.why_not();
+  ::alarm(120);  // a regression spins in OpenBLAS for ever: end the process instead
   std::string message;
   try {
     cholesky.factorize(system.values);
   } catch (const std::runtime_error& error) {
     message = error.what();
   }
-  ASSERT_EQ(setrlimit(RLIMIT_AS, &original), 0);  // back before any assertion can fail
+  limit.restore();  // before any assertion can fail
   for (const char* part : {"OpenBLAS needs 192 MiB of address space", "(ulimit -v)", "raise the limit by"})
     EXPECT_NE(message.find(part), std::string::npos) << part << " not in: '" << message << "'";
 
@@ -84,7 +69,6 @@ TEST(BlasWorkspace, ATightAddressSpaceIsRefusedInsteadOfSpinningInOpenBlas) {
     if (i + 1 < system.n) product -= x[i + 1];
     EXPECT_NEAR(product, 1.0, 1e-12) << i;
   }
-#endif
 }
 
 }  // namespace

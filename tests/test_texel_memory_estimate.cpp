@@ -3,7 +3,6 @@
 // of GB, and the system killed such a run minutes in. The footprints the bound counts come
 // from the traced cuts and creases alone and are checked against the fields they build.
 #include <gtest/gtest.h>
-#include <sys/resource.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -270,25 +269,14 @@ TEST(TexelMemoryEstimate, TheEnvironmentsLimitCapsTheMemoryAvailable) {
 // has free: the memory available is at most what the limit leaves (the checks read the
 // machine's memory alone, and a scene past the limit ended in std::bad_alloc).
 TEST(TexelMemoryEstimate, TheAddressSpaceLimitCapsTheMemoryAvailable) {
-#if defined(__SANITIZE_ADDRESS__)
-  GTEST_SKIP() << "ASan reserves terabytes of address space for its shadow memory";
-#else
-  const std::int64_t used = test::virtual_size_bytes();
-  if (used < 0) GTEST_SKIP() << "no /proc/self/statm";
-  rlimit original{};
-  ASSERT_EQ(getrlimit(RLIMIT_AS, &original), 0);
   const std::int64_t room = std::int64_t{256} << 20;
-  if (original.rlim_max != RLIM_INFINITY && static_cast<std::int64_t>(original.rlim_max) < used + room)
-    GTEST_SKIP() << "the hard limit leaves less than 256 MiB";
-  rlimit limited = original;
-  limited.rlim_cur = static_cast<rlim_t>(used + room);
-  ASSERT_EQ(setrlimit(RLIMIT_AS, &limited), 0);
+  test::ScopedAddressSpaceLimit limit(room);
+  if (!limit.why_not().empty()) GTEST_SKIP() << limit.why_not();
   const std::int64_t available = available_memory_bytes();
-  ASSERT_EQ(setrlimit(RLIMIT_AS, &original), 0);  // back before any assertion can fail
+  limit.restore();  // before any assertion can fail
   EXPECT_LE(available, room);
   EXPECT_GT(available, room / 2);  // the process grew by less than 128 MiB between the two reads
   EXPECT_GT(available_memory_bytes(), room) << "the machine should have more than 256 MiB free";
-#endif
 }
 
 // The whole path: fracture.json at T = 4096 through SceneRun, refused in the set-up before
