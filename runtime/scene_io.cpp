@@ -12,6 +12,7 @@
 #include <map>
 #include <set>
 #include <sstream>
+#include <system_error>
 #include <utility>
 #include <vector>
 
@@ -64,13 +65,22 @@ std::string number_text(double x) {
   return out.str();
 }
 
+// Why `path` names no file that exists: "no such file", or the system's reason where it
+// is another (a loop of symbolic links, a name too long, a folder not searchable), which
+// read as "no such file".
+std::string missing_file_reason(const std::string& path) {
+  std::error_code error;
+  (void)std::filesystem::status(path, error);
+  return error && error != std::errc::no_such_file_or_directory ? error.message() : "no such file";
+}
+
 // "" for a regular file, else why a file name (resolved) does not name one: a folder or a
 // device such as /dev/null exists but is no file to read.
 std::string not_a_file(const std::string& resolved) {
   std::error_code error;
   if (std::filesystem::is_regular_file(resolved, error)) return "";
-  return (std::filesystem::exists(resolved, error) ? "not a regular file (resolved to " : "no such file (resolved to ") +
-         resolved + ")";
+  if (std::filesystem::exists(resolved, error)) return "not a regular file (resolved to " + resolved + ")";
+  return missing_file_reason(resolved) + " (resolved to " + resolved + ")";
 }
 
 std::string child(const std::string& path, const std::string& key) { return path.empty() ? key : path + "." + key; }
@@ -880,7 +890,8 @@ Scene parse_scene(const std::string& json_text, const std::string& source_name) 
 Scene load_scene(const std::string& path) {
   if (path.empty()) throw SceneError("''", "an empty scene file path; give a scene file (JSON)");
   std::error_code error;
-  if (!std::filesystem::exists(path, error)) throw SceneError(path, "cannot read the scene file: no such file");
+  if (!std::filesystem::exists(path, error))
+    throw SceneError(path, "cannot read the scene file: " + missing_file_reason(path));
   if (!std::filesystem::is_regular_file(path, error)) throw SceneError(path, "cannot read the scene file: not a regular file");
   std::ifstream in(path, std::ios::binary);
   if (!in) throw SceneError(path, "cannot read the scene file: permission denied or unreadable");

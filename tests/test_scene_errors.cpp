@@ -1,7 +1,9 @@
 // Every class of invalid scene gives one SceneError line that names the JSON path and the
 // offending value: "<file>: <path>: <problem>, got <value>; <what is valid>".
 #include <gtest/gtest.h>
+#include <unistd.h>
 
+#include <filesystem>
 #include <functional>
 #include <string>
 
@@ -422,6 +424,21 @@ TEST(SceneErrors, MissingSceneFile) {
   } catch (const SceneError& e) {
     EXPECT_EQ(std::string(e.what()), "/nonexistent/scene.json: cannot read the scene file: no such file");
   }
+  // A loop of symbolic links read as "no such file" (fuzzing, session 71): the system's reason.
+  const std::filesystem::path dir =
+      std::filesystem::temp_directory_path() / ("dgtex_link_loop_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  std::filesystem::create_symlink(dir / "b.json", dir / "a.json");
+  std::filesystem::create_symlink(dir / "a.json", dir / "b.json");
+  try {
+    dgtex::load_scene((dir / "a.json").string());
+    ADD_FAILURE() << "no error";
+  } catch (const SceneError& e) {
+    EXPECT_NE(std::string(e.what()).find("cannot read the scene file: Too many levels of symbolic links"),
+              std::string::npos)
+        << e.what();
+  }
+  std::filesystem::remove_all(dir);
 }
 
 }  // namespace
