@@ -97,7 +97,7 @@ AccuracyChart run_plate_accuracy(const PlateAccuracyOptions& options, const Accu
   const double D = kernels::bending_rigidity(1e6, 0.3, 0.01);
   const double reference = navier_plate_centre_deflection(1, 1, -1, D);
   for (ElementType type : {ElementType::quad8, ElementType::tri6}) {
-    const std::string series = type == ElementType::quad8 ? "quad8" : "tri6";
+    const std::string series = kernels::element_type_name(type);
     for (int n : options.divisions) {
       PlateSolve best;
       best.ms = std::numeric_limits<double>::infinity();

@@ -134,7 +134,7 @@ void write_obj(const std::string& path, const Mesh& mesh, const double* displace
   const int corners = kernels::corners_per_element(mesh.type);
   std::ofstream out = open_for_writing(path, what);
   out << "# dgtex shell surface: " << nodes << " nodes, " << elements << ' '
-      << (mesh.type == ElementType::quad8 ? "quad8" : "tri6") << " elements\n";
+      << kernels::element_type_name(mesh.type) << " elements\n";
   for (int n = 0; n < nodes; ++n) {
     double x[3];
     deformed_node(mesh, displacement, n, x, what);

@@ -26,7 +26,7 @@ void check_model_memory(const Scene& scene, ElementType type, std::int64_t eleme
   if (needed <= available_bytes) return;
   const bool generated = scene.mesh.source != MeshSource::file;
   const std::int64_t per_element = model_memory_lower_bound(type, 1);
-  const std::string kind = type == ElementType::tri6 ? "tri6" : "quad8";
+  const std::string kind = kernels::element_type_name(type);
   const std::string problem = std::to_string(elements) + " " + kind + " elements need at least " +
                               memory_size_text(needed) + " for the model and its factor (" +
                               std::to_string(per_element / 1024) + " KiB an element), more than the " +

@@ -28,10 +28,10 @@ Mesh build_scene_mesh(const Scene& scene) {
     // A file's element type is its faces'; a declared one that differs would have judged
     // the cuts' surface_points against the wrong reference element.
     if (m.source == MeshSource::file && m.element && *m.element != size.type) {
-      const char* faces = size.type == ElementType::tri6 ? "tri6" : "quad8";
+      const char* faces = kernels::element_type_name(size.type);
       throw SceneError(scene.source_name.empty() ? "scene" : scene.source_name, "mesh.element",
                        std::string("does not match mesh.file, whose faces make ") + faces + " elements",
-                       std::string("\"") + (*m.element == ElementType::tri6 ? "tri6" : "quad8") + "\"",
+                       std::string("\"") + kernels::element_type_name(*m.element) + "\"",
                        std::string("expected \"") + faces + "\" or no element (a file's faces decide it)");
     }
     check_model_memory(scene, size.type, size.elements, available_memory_bytes());
@@ -56,10 +56,10 @@ SceneModel build_scene_model(const Scene& scene, const Mesh& mesh) {
   // generator's default is quad8; a file without "element" takes its faces' type.
   const std::optional<ElementType> declared =
       scene.mesh.source == MeshSource::file ? scene.mesh.element : scene.mesh.element.value_or(ElementType::quad8);
-  auto name = [](ElementType type) { return type == ElementType::quad8 ? "quad8" : "tri6"; };
   if (declared && *declared != mesh.type)
-    throw SceneError(scene.source_name, "mesh.element", "the mesh given has other elements", name(mesh.type),
-                     std::string("the scene's mesh is ") + name(*declared));
+    throw SceneError(scene.source_name, "mesh.element", "the mesh given has other elements",
+                     kernels::element_type_name(mesh.type),
+                     std::string("the scene's mesh is ") + kernels::element_type_name(*declared));
   check_scene_against_mesh(scene, mesh);
   const Topology topology = build_topology(mesh);
   std::vector<char> clamp_node(mesh.num_nodes(), 0);

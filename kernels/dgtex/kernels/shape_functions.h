@@ -17,6 +17,8 @@ enum class ElementType : int { quad8 = 0, tri6 = 1 };
 constexpr int nodes_per_element(ElementType type) { return type == ElementType::quad8 ? 8 : 6; }
 constexpr int corners_per_element(ElementType type) { return type == ElementType::quad8 ? 4 : 3; }
 constexpr int max_element_nodes = 8;
+// "quad8" or "tri6", as scene files and messages write the type.
+constexpr const char* element_type_name(ElementType type) { return type == ElementType::quad8 ? "quad8" : "tri6"; }
 
 // Values and parametric derivatives of all basis functions at one point.
 // d2N columns: d2/dxi1^2, d2/dxi2^2, d2/dxi1dxi2.
