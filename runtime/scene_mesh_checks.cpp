@@ -48,22 +48,6 @@ std::string describe(const BoundarySelect& s) {
 
 Eigen::Vector3d node_position(const Mesh& mesh, int n) { return Eigen::Vector3d(mesh.node(n)); }
 
-// Position and (unnormalised) normal of element e at parametric point xi.
-void surface_point(const Mesh& mesh, int e, const double xi[2], Eigen::Vector3d& x, Eigen::Vector3d& normal) {
-  kernels::ShapeValues shape;
-  kernels::evaluate_shape(mesh.type, xi[0], xi[1], shape);
-  Eigen::Vector3d a1 = Eigen::Vector3d::Zero(), a2 = Eigen::Vector3d::Zero();
-  x.setZero();
-  const int* nodes = mesh.element_nodes(e);
-  for (int a = 0; a < shape.count; ++a) {
-    const Eigen::Vector3d p = node_position(mesh, nodes[a]);
-    x += shape.N[a] * p;
-    a1 += shape.dN[a][0] * p;
-    a2 += shape.dN[a][1] * p;
-  }
-  normal = a1.cross(a2);
-}
-
 void check_selections(const Scene& scene, const Mesh& mesh) {
   Eigen::Vector3d lo = Eigen::Vector3d::Constant(INFINITY), hi = Eigen::Vector3d::Constant(-INFINITY);
   for (int n = 0; n < mesh.num_nodes(); ++n) {
@@ -95,8 +79,9 @@ void check_surface_points(const Scene& scene, const Mesh& mesh) {
       if (!kernels::inside_reference_element(mesh.type, a, b))
         throw SceneError(scene.source_name, p + ".xi", "outside the reference element", "[" + fmt(a) + ", " + fmt(b) + "]",
                          kernels::reference_element_rule(mesh.type));
-      Eigen::Vector3d x, normal;
-      surface_point(mesh, sp.element, sp.xi.data(), x, normal);
+      Vec3 position, normal;
+      element_surface_point(mesh, sp.element, sp.xi.data(), position, normal);
+      const Eigen::Vector3d x(position.data());
       if (k > 0) total += (x - previous).norm();
       previous = x;
     }
@@ -227,10 +212,10 @@ void check_rigid_motions(const Scene& scene, const Mesh& mesh) {
       if (!(is_selected[edge.nodes[0]] && is_selected[edge.nodes[1]] && is_selected[edge.nodes[2]])) continue;
       double xi[2], dxi[2];
       kernels::local_edge_point(mesh.type, edge.plus_local_edge, 0.0, xi, dxi);
-      Eigen::Vector3d x, normal;
-      surface_point(mesh, edge.plus_element, xi, x, normal);
+      Vec3 position, unit_normal;
+      element_surface_point(mesh, edge.plus_element, xi, position, unit_normal);
+      const Eigen::Vector3d normal(unit_normal.data());
       if (!(normal.norm() > 0)) continue;
-      normal.normalize();
       for (int c = 0; c < 3; ++c) {
         Row row;
         row << Eigen::Vector3d::Zero(), normal.cross(Eigen::Vector3d::Unit(c));
