@@ -4,7 +4,8 @@
 #      dgtex tool from there (also a one-step bench of an installed example scene),
 #   2. configure examples/consumer against that prefix only (CMAKE_PREFIX_PATH), check that
 #      find_package(dgtex) found the package there and not some other installed copy,
-#   3. build it, with a translation unit that includes every installed header (-Werror),
+#   3. build it, with a translation unit that includes every installed header (-Werror), at
+#      -std=c++14 unless the package itself asks for the C++17 its headers need,
 #   4. run the cut_plate program (it checks its own results), and README.md's C++ example
 #      (built beside it from the README's text).
 # Any failing step fails the test with that step's output.
@@ -73,6 +74,8 @@ file(WRITE ${WORK_DIR}/readme_example.cpp
 set(configure_args -S ${CONSUMER_SOURCE_DIR} -B ${consumer_build} -G ${GENERATOR}
     -DCMAKE_BUILD_TYPE=Release -DCMAKE_PREFIX_PATH=${prefix} -DCMAKE_CXX_COMPILER=${CXX_COMPILER}
     -DCMAKE_FIND_USE_PACKAGE_REGISTRY=OFF -DDGTEX_CONSUMER_HEADER_CHECK=ON
+    # Below what the headers need: only the package's own requirement (cxx_std_17) lifts it.
+    -DCMAKE_CXX_STANDARD=14 -DCMAKE_CXX_EXTENSIONS=OFF
     -DDGTEX_CONSUMER_README_EXAMPLE=${WORK_DIR}/readme_example.cpp)
 if(MAKE_PROGRAM)
   list(APPEND configure_args -DCMAKE_MAKE_PROGRAM=${MAKE_PROGRAM})

@@ -1,5 +1,5 @@
 #pragma once
-// Structured shell meshes of the scene file's generators (DESIGN.md, "The scene file").
+// Structured shell meshes of the scene file's generators (README.md, "Scene file reference", `mesh`).
 // Divisions count elements along each parameter. Every node, midside nodes included, is
 // placed ON the exact surface at its parameter value (not on chords), so curved meshes are
 // as exact as quadratic elements allow. Corner order follows the parameters, so each

@@ -1,9 +1,9 @@
 #pragma once
-// The scene, version 1: the plain data that a scene file (JSON, see DESIGN.md and
-// scene_io.h) describes. A scene from load_scene or parse_scene is validated: numbers are
-// finite and in range, vectors that must be unit are unit, names are unique; one built in
-// code is checked the same way by validate_scene (SceneRun, build_scene_mesh and
-// build_scene_model call it).
+// The scene, version 1: the plain data that a scene file (JSON, see README.md's "Scene
+// file reference" and scene_io.h) describes. A scene from load_scene or parse_scene is
+// validated: numbers are finite and in range, vectors that must be unit are unit, names are
+// unique; one built in code is checked the same way by validate_scene (SceneRun,
+// build_scene_mesh and build_scene_model call it).
 // Lengths, forces and times are in the scene's own consistent units; angles in degrees.
 // Defaults of optional keys are written next to each field ("default: ...").
 // Plain value types (copying copies everything; no references). Quantities per field in

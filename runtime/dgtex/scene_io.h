@@ -1,9 +1,9 @@
 #pragma once
-// Reading a scene file (JSON, version 1, format in DESIGN.md and README.md) into a
-// validated Scene. Validation is strict so that typos never pass silently: unknown keys,
-// duplicate keys, wrong types, missing required keys, non-integers where an integer is
-// needed, out-of-range values and inconsistent combinations (zero density in a dynamic
-// run, a progressive cut in a static run, ...) all throw SceneError.
+// Reading a scene file (JSON, version 1, format in README.md's "Scene file reference")
+// into a validated Scene. Validation is strict so that typos never pass silently:
+// unknown keys, duplicate keys, wrong types, missing required keys, non-integers where an
+// integer is needed, out-of-range values and inconsistent combinations (zero density in a
+// dynamic run, a progressive cut in a static run, ...) all throw SceneError.
 //
 // Checks that need the mesh (empty boundary selections, statically unconstrained models,
 // surface points outside the mesh) live in scene_mesh_checks.h.
