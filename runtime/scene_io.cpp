@@ -1076,7 +1076,10 @@ json scene_to_json(const Scene& scene) {
   out["enrichment"]["rotation_cluster_texels"] = e.rotation_cluster_texels;
   if (scene.render) {
     const RenderOptions& r = *scene.render;
-    json camera = {{"up", to_json(r.camera_up)}, {"fov_deg", r.fov_deg}};
+    json camera = {{"fov_deg", r.fov_deg}};
+    // The default up is left out, as a file that gives none: a camera looking straight down
+    // keeps it (the renderer turns it), which the reader refuses of an up given.
+    if (r.camera_up != RenderOptions{}.camera_up) camera["up"] = to_json(r.camera_up);
     if (r.camera_position) camera["position"] = to_json(*r.camera_position);
     if (r.camera_target) camera["target"] = to_json(*r.camera_target);
     out["render"] = {{"width", r.width},

@@ -181,4 +181,25 @@ TEST(SceneValidation, EveryExampleSceneAsLoadedPasses) {
   EXPECT_GE(scenes, 11);
 }
 
+// A camera looking straight down with the default up passes again once loaded (the
+// renderer turns that up; validate_scene re-reads the scene through its JSON, which until
+// session 72 always wrote the up and so refused it as given along the view).
+TEST(SceneValidation, ACameraLookingStraightDownWithTheDefaultUpPasses) {
+  Scene scene = strip_built_in_code();
+  scene.render = RenderOptions{};
+  scene.render->camera_position = Vec3{0.5, 0.5, 2};
+  scene.render->camera_target = Vec3{0.5, 0.5, 0};
+  EXPECT_NO_THROW(validate_scene(scene));
+  // An up along the view that is not the default is still refused.
+  scene.render->camera_up = Vec3{0, 0, -1};
+  try {
+    validate_scene(scene);
+    ADD_FAILURE() << "an up along the view was accepted";
+  } catch (const SceneError& e) {
+    EXPECT_NE(std::string(e.what()).find("render.camera.up: up is parallel to the viewing direction"),
+              std::string::npos)
+        << e.what();
+  }
+}
+
 }  // namespace

@@ -177,7 +177,9 @@ struct RenderOptions {
   // Camera. Without position/target the renderer frames the mesh's bounding box.
   std::optional<Vec3> camera_position;
   std::optional<Vec3> camera_target;
-  Vec3 camera_up{0, 0, 1};  // default: +z; non-zero, not parallel to the view direction
+  // default: +z, which the renderer turns where it lies along the view (a camera looking
+  // straight down); any other up is non-zero and not parallel to the view direction
+  Vec3 camera_up{0, 0, 1};
   double fov_deg = 40;      // vertical field of view; default: 40, in (0, 180)
   int every_steps = 10;     // dynamic runs: a frame every N steps; default: 10, >= 1
   Shading shading = Shading::flat;  // default: flat
