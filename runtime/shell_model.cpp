@@ -148,10 +148,7 @@ void ShellModel::rebuild(std::vector<double>* integrated_mass) {
   }
   if (textured) families.push_back({num_textured_elements(), npe, textured_connectivity_, {}});
   assembly_ = BlockAssembly(mesh_.num_nodes() + num_enriched_nodes(), families);
-  workspace_.element_rest_rows.clear();  // the plain elements and edges may have changed
-  workspace_.edge_rest_rows.clear();
-  workspace_.cluster_rest.reset();  // the enriched quadrature may have changed
-  workspace_.edge_rest_sides = {};
+  workspace_.forget_rest_data();  // the elements, edges and enriched quadrature may have changed
 
   // Mass and load weights depend on the rest geometry only.
   std::vector<double> element_mass(static_cast<size_t>(num_plain) * npe * npe);

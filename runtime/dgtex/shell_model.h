@@ -317,7 +317,8 @@ class ShellModel {
                                  kernels::Execution execution) const;
 
   // Buffers of assemble_stiffness's plain elements and edges, kept between calls (the
-  // calls on one instance are not concurrent, see above). A copy starts empty.
+  // calls on one instance are not concurrent, see above). A copy starts empty, and so does
+  // an assigned model's (a move assignment copies).
   // Without enrichments and material textures the plain elements read their rest rows from
   // element_rest_rows and the plain edges are assembled from factors over edge_rest_rows
   // (kernels::shell_element_stiffness_cached, shell_edge_factors); both filled on first
@@ -342,9 +343,22 @@ class ShellModel {
     // corotated assembly after the enrichment changed (rebuild clears them; offset is empty
     // until then).
     kernels::EnrichedEdgeRestSides edge_rest_sides;
+    // Drops what was built for the model's rest geometry and basis (the scratch buffers are
+    // resized by each call). A model assigned another's starts over as a copy does: until
+    // session 72 it kept its own rest rows, read for the other model's elements.
+    void forget_rest_data() {
+      element_rest_rows.clear();
+      edge_rest_rows.clear();
+      cluster_rest.reset();
+      cluster_rest_size = 0;
+      edge_rest_sides = {};
+    }
     AssemblyWorkspace() = default;
     AssemblyWorkspace(const AssemblyWorkspace&) {}
-    AssemblyWorkspace& operator=(const AssemblyWorkspace&) { return *this; }
+    AssemblyWorkspace& operator=(const AssemblyWorkspace&) {
+      forget_rest_data();
+      return *this;
+    }
   };
   mutable AssemblyWorkspace workspace_;
 
