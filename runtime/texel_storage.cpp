@@ -1,7 +1,11 @@
 #include "dgtex/texel_storage.h"
 
 #include <algorithm>
+#include <cerrno>
+#include <climits>
+#include <cstdlib>
 #include <mutex>
+#include <optional>
 #include <sstream>
 #include <stdexcept>
 #include <unordered_map>
@@ -25,10 +29,38 @@ void initialize_openvdb_once() {
   std::call_once(once, [] { openvdb::initialize(); });
 }
 
+bool is_power_of_two(int resolution) { return resolution >= 1 && (resolution & (resolution - 1)) == 0; }
+
 void validate_resolution(int resolution) {
-  if (resolution < 1 || (resolution & (resolution - 1)) != 0)
+  if (!is_power_of_two(resolution))
     throw std::invalid_argument("texel storage: the texture resolution must be a positive power of two, got " +
                                 std::to_string(resolution));
+}
+
+// A grid's slot list as write_vdb writes it: comma-separated element indices, -1 for a
+// free slot, each element once. Anything else throws std::runtime_error naming the file.
+std::vector<int> parse_slot_list(const std::string& text, const std::string& path, const std::string& grid) {
+  const auto refuse = [&](const std::string& problem) {
+    throw std::runtime_error("texel storage: '" + path + "' grid '" + grid + "': " + slots_key + " \"" + text +
+                             "\" " + problem + "; expected element indices (>= 0) or -1, comma-separated, each once");
+  };
+  std::vector<int> elements;
+  std::unordered_map<int, bool> seen;
+  if (text.empty()) return elements;
+  std::istringstream in(text);
+  for (std::string item; std::getline(in, item, ',');) {
+    const char* begin = item.c_str();
+    char* end = nullptr;
+    errno = 0;
+    const long value = std::strtol(begin, &end, 10);
+    if (item.empty() || end != begin + item.size() || errno == ERANGE || value < -1 || value > INT_MAX)
+      refuse("holds '" + item + "'");
+    if (value >= 0 && !seen.emplace(static_cast<int>(value), true).second)
+      refuse("lists element " + item + " twice");
+    elements.push_back(static_cast<int>(value));
+  }
+  if (text.back() == ',') refuse("ends in a comma");
+  return elements;
 }
 
 }  // namespace
@@ -226,24 +258,24 @@ TexelStorage TexelStorage::read_vdb(const std::string& path) {
   } catch (const std::exception& e) {
     throw std::runtime_error("texel storage: cannot read '" + path + "': " + e.what());
   }
-  int resolution = 0;
+  std::optional<int> resolution;
   std::vector<std::pair<openvdb::FloatGrid::Ptr, std::vector<int>>> loaded;
   for (const openvdb::GridBase::Ptr& base : *grids) {
     openvdb::FloatGrid::Ptr grid = openvdb::gridPtrCast<openvdb::FloatGrid>(base);
     const auto res = base->getMetadata<openvdb::Int32Metadata>(resolution_key);
     const auto slots = base->getMetadata<openvdb::StringMetadata>(slots_key);
-    if (!grid || !res || !slots || (resolution && res->value() != resolution))
+    if (!grid || !res || !slots || (resolution && res->value() != *resolution))
       throw std::runtime_error("texel storage: '" + path + "' grid '" + base->getName() +
                                "' is not a dgtex texel field (float grid with " + resolution_key + " and " +
                                slots_key + " metadata, one resolution for all)");
+    if (!is_power_of_two(res->value()))
+      throw std::runtime_error("texel storage: '" + path + "' grid '" + base->getName() + "': " + resolution_key +
+                               " is " + std::to_string(res->value()) + "; expected a positive power of two");
     resolution = res->value();
-    std::vector<int> elements;
-    std::istringstream in(slots->value());
-    for (std::string item; std::getline(in, item, ',');) elements.push_back(std::stoi(item));
-    loaded.emplace_back(grid, elements);
+    loaded.emplace_back(grid, parse_slot_list(slots->value(), path, base->getName()));
   }
-  if (resolution == 0) throw std::runtime_error("texel storage: '" + path + "' holds no dgtex texel fields");
-  TexelStorage storage(resolution);
+  if (!resolution) throw std::runtime_error("texel storage: '" + path + "' holds no dgtex texel fields");
+  TexelStorage storage(*resolution);
   for (auto& [grid, elements] : loaded) {
     auto field = std::make_unique<Field>();
     field->grid = grid;

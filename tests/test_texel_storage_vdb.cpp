@@ -140,3 +140,63 @@ TEST(TexelStorage, InvalidUseIsAnError) {
   EXPECT_THROW(storage.copy_tile_in("H", -1, TexelTile(16, 16)), std::invalid_argument);
   EXPECT_THROW(storage.copy_tile_in("", 0, TexelTile(16, 16)), std::invalid_argument);
 }
+
+// A .vdb file whose dgtex metadata was not written by write_vdb (edited, or another
+// program's) is refused with the std::runtime_error the header promises, naming the file,
+// the grid and the value. Until session 72 a slot list such as "3,x" escaped as
+// std::invalid_argument from std::stoi, a resolution of 3 as the constructor's
+// invalid_argument, and "3,3" was read: an erase then left the element's texels behind.
+TEST(TexelStorage, ReadingRefusesMetadataWriteVdbDoesNotWrite) {
+  const auto dir = std::filesystem::temp_directory_path() / ("dgtex_texel_metadata_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  const std::string written = (dir / "written.vdb").string();
+  TexelStorage storage(4);
+  storage.copy_tile_in("f", 3, random_values(4, 21));
+  storage.copy_tile_in("f", 5, random_values(4, 22));
+  storage.write_vdb(written);
+
+  // The written file with one metadata value replaced.
+  const auto edited = [&](const std::string& name, const std::string& key, const openvdb::Metadata& value) {
+    openvdb::io::File in(written);
+    in.open();
+    const openvdb::GridPtrVecPtr grids = in.getGrids();
+    in.close();
+    for (const openvdb::GridBase::Ptr& grid : *grids) {
+      grid->removeMeta(key);
+      grid->insertMeta(key, value);
+    }
+    const std::string path = (dir / (name + ".vdb")).string();
+    openvdb::io::File out(path);
+    out.write(*grids);
+    out.close();
+    return path;
+  };
+  const auto expect_refused = [](const std::string& path, const std::string& message_part) {
+    SCOPED_TRACE(path);
+    try {
+      TexelStorage::read_vdb(path);
+      ADD_FAILURE() << "read";
+    } catch (const std::runtime_error& e) {
+      const std::string message = e.what();
+      EXPECT_NE(message.find("'" + path + "' grid 'f'"), std::string::npos) << message;
+      EXPECT_NE(message.find(message_part), std::string::npos) << message;
+    } catch (const std::exception& e) {
+      ADD_FAILURE() << "not a std::runtime_error: " << e.what();
+    }
+  };
+  const std::string slots = "dgtex_slot_elements", resolution = "dgtex_texel_resolution";
+  expect_refused(edited("letter", slots, openvdb::StringMetadata("3,x")), "holds 'x'");
+  expect_refused(edited("too_large", slots, openvdb::StringMetadata("3,99999999999")), "holds '99999999999'");
+  expect_refused(edited("below_free", slots, openvdb::StringMetadata("-2,5")), "holds '-2'");
+  expect_refused(edited("empty_item", slots, openvdb::StringMetadata("3,,5")), "holds ''");
+  expect_refused(edited("trailing_comma", slots, openvdb::StringMetadata("3,5,")), "ends in a comma");
+  expect_refused(edited("twice", slots, openvdb::StringMetadata("3,3")), "lists element 3 twice");
+  expect_refused(edited("resolution_3", resolution, openvdb::Int32Metadata(3)), "dgtex_texel_resolution is 3");
+  expect_refused(edited("resolution_0", resolution, openvdb::Int32Metadata(0)), "dgtex_texel_resolution is 0");
+
+  // What write_vdb writes reads back, a free slot (-1) included.
+  const std::string freed = edited("freed", slots, openvdb::StringMetadata("3,-1"));
+  EXPECT_EQ(TexelStorage::read_vdb(freed).stored_elements("f"), (std::vector<int>{3}));
+  EXPECT_EQ(TexelStorage::read_vdb(written).stored_elements("f"), (std::vector<int>{3, 5}));
+  std::filesystem::remove_all(dir);
+}
