@@ -38,6 +38,15 @@ void DenseCholesky::factorize(const std::vector<double>& values) {
                               bad);
 }
 
+std::vector<double> DenseCholesky::pivots() const {
+  std::vector<double> out(n_);
+  for (int j = 0; j < n_; ++j) {
+    const double l = factor_[static_cast<std::size_t>(j) * ld_ + j];
+    out[j] = l * l;
+  }
+  return out;
+}
+
 void DenseCholesky::solve(const std::vector<double>& b, std::vector<double>& x) const {
   x.assign(b.begin(), b.begin() + n_);
   kernels::dense_cholesky_solve(n_, ld_, factor_.data(), x.data());

@@ -38,6 +38,8 @@ class DenseCholesky {
   // the current factor, solve() otherwise.
   void solve_single_precision(const std::vector<double>& b, std::vector<double>& x) const;
   std::int64_t factor_nonzeros() const { return static_cast<std::int64_t>(n_) * (n_ + 1) / 2; }
+  // The current factor's pivots L_jj^2 (SparseCholesky::pivots).
+  std::vector<double> pivots() const;
 
  private:
   int n_ = 0;

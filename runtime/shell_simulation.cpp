@@ -2,6 +2,7 @@
 
 #include <Eigen/Dense>
 #include <algorithm>
+#include <limits>
 #include <cmath>
 #include <stdexcept>
 #include <string>
@@ -90,18 +91,21 @@ void ShellSimulation::set_state(std::vector<double> u, std::vector<double> v) {
   previous_previous_v_.clear();
 }
 
-std::string ShellSimulation::enrichment_hint() const {
+std::string ShellSimulation::enrichment_hint(bool static_analysis) const {
   if (model_.num_enriched_dofs() == 0) return "";
   // Exact dependencies between cuts' functions are removed by the cut manager
   // (enrichment_span.h); what remains are near dependencies: slivers between cuts that
-  // almost touch, or a cut passing a node at a fraction of a texel.
-  return "; with cuts, also check for cuts that almost touch each other or a node (slivers narrower than a texel)";
+  // almost touch, or a cut passing a node at a fraction of a texel. In statics, a piece cut
+  // loose is a mechanism, whose pivot rounding may leave negative (check_no_mechanism).
+  return std::string("; with cuts, also check for ") +
+         (static_analysis ? "a piece that a cut separates from every support, and for " : "") +
+         "cuts that almost touch each other or a node (slivers narrower than a texel)";
 }
 
-std::string ShellSimulation::pivot_location(const NotPositiveDefinite& failure) const {
-  if (failure.column() < 0 || failure.column() >= system_.size()) return "";
+std::string ShellSimulation::unknown_location(int column) const {
+  if (column < 0 || column >= system_.size()) return "";
   const Mesh& mesh = model_.mesh();
-  const int dof = system_.dof_of_unknown(failure.column());
+  const int dof = system_.dof_of_unknown(column);
   int node = dof / 3;
   std::string what = std::string("the failing column is the ") + "xyz"[dof % 3] + " unknown of node ";
   if (node >= mesh.num_nodes()) {  // an enriched node: its function and mesh node
@@ -185,6 +189,32 @@ void ShellSimulation::check_statically_constrained() {
                    "); fix more displacement components or clamp an edge");
 }
 
+void ShellSimulation::check_no_mechanism(const std::vector<double>& values) const {
+  // A mechanism makes K singular, but rounding may leave its pivot positive: a tri6 plate
+  // whose cut along element edges left a piece hanging on one held node (free to turn
+  // about it) solved to displacements of 1e10 with exit 0 until session 72. Its pivot was
+  // 4.9e-16 of its diagonal entry, rounding; the smallest of the test suite's and the
+  // example scenes' static solves are 9.4e-8 of theirs (bending of thin plates, ~(h/L)^2).
+  constexpr double kMechanismPivotRatio = 1e-12;
+  const std::vector<double> pivots = cholesky_.pivots();
+  const std::vector<int>& column_start = system_.column_start();
+  const std::vector<int>& row_index = system_.row_index();
+  double smallest = std::numeric_limits<double>::infinity();
+  int column = -1;
+  for (int j = 0; j < system_.size(); ++j)
+    for (int k = column_start[j]; k < column_start[j + 1]; ++k)
+      if (row_index[k] == j && pivots[j] < smallest * values[k]) {
+        smallest = pivots[j] / values[k];
+        column = j;
+      }
+  if (!(smallest < kMechanismPivotRatio)) return;
+  throw ModelError("boundary: the stiffness is singular to working precision (a pivot " + detail::short_number(smallest) +
+                   " times its diagonal entry, below " + detail::short_number(kMechanismPivotRatio) +
+                   "): part of the model is free to move, e.g. a piece that a cut separates from every support or "
+                   "leaves hanging on one held node, free to turn about it" +
+                   unknown_location(column) + "; hold that part, or run it as a dynamic analysis");
+}
+
 void ShellSimulation::solve_static() {
   check_model_unchanged("ShellSimulation::solve_static");
   check_statically_constrained();
@@ -199,8 +229,9 @@ void ShellSimulation::solve_static() {
       cholesky_.factorize(values);
     } catch (const NotPositiveDefinite& e) {
       throw ModelError(penalty_problem("stiffness", model_.options().penalty) + "; " + e.what() +
-                       pivot_location(e) + enrichment_hint());
+                       unknown_location(e.column()) + enrichment_hint(true));
     }
+    check_no_mechanism(values);
     system_.restrict_vector(f_ext_, rhs);
     cholesky_.solve(rhs, x);
     system_.expand_vector(x, u_);
@@ -340,9 +371,9 @@ void ShellSimulation::step(const DynamicsOptions& o) {
       throw std::runtime_error("dynamic system matrix not positive definite in the deformed state: the run has "
                                "likely diverged (a smaller time step or smaller loads?), or the penalty = " +
                                detail::short_number(model_.options().penalty) + " is too low for it; " + e.what() +
-                               pivot_location(e) + enrichment_hint());
+                               unknown_location(e.column()) + enrichment_hint(false));
     throw ModelError(penalty_problem("dynamic system matrix", model_.options().penalty) + "; " +
-                     e.what() + pivot_location(e) + enrichment_hint());
+                     e.what() + unknown_location(e.column()) + enrichment_hint(false));
   }
   for (int d = 0; d < ndofs; ++d) u_[d] += dt * v_[d];
   time_ += dt;

@@ -373,6 +373,29 @@ void SparseCholesky::solve_single_precision(const std::vector<double>& b, std::v
   for (int k = 0; k < n_; ++k) x[perm[k]] = y[k];
 }
 
+std::vector<double> SparseCholesky::pivots() const {
+  const Impl& m = *impl_;
+  if (m.dense) return m.dense->pivots();
+  if (!m.factor || !m.factor->is_super || !m.factor->x || m.factor->itype != CHOLMOD_INT)
+    throw std::logic_error("SparseCholesky::pivots needs a numeric supernodal factor (call factorize first)");
+  const cholmod_factor& L = *m.factor;
+  const int* super = static_cast<const int*>(L.super);  // an int factor (CHOLMOD_INT)
+  const int* pi = static_cast<const int*>(L.pi);
+  const int* px = static_cast<const int*>(L.px);
+  const auto* perm = static_cast<const int*>(L.Perm);
+  const auto* x = static_cast<const double*>(L.x);
+  std::vector<double> out(n_);
+  for (std::size_t s = 0; s < L.nsuper; ++s) {
+    const std::int64_t rows = pi[s + 1] - pi[s];
+    for (int k = 0; k < super[s + 1] - super[s]; ++k) {
+      const double l = x[px[s] + k * rows + k];  // column-major block of `rows` rows
+      const int column = super[s] + k;
+      out[perm ? perm[column] : column] = l * l;
+    }
+  }
+  return out;
+}
+
 std::int64_t SparseCholesky::factor_nonzeros() const {
   if (impl_->dense) return impl_->dense->factor_nonzeros();
   const cholmod_factor* f = impl_->factor;

@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <cholmod.h>
+#include <Eigen/Dense>
 
 #include <cmath>
 #include <cstring>
@@ -97,4 +98,36 @@ TEST(SparseCholesky, ReportsAMatrixThatIsNotPositiveDefinite) {
   for (int k = 0; k < good.size; ++k) b[k] = std::cos(0.21 * k);
   cholesky.solve(b, x);
   EXPECT_TRUE(bitwise_equal(x, cholmod_solution(good, b)));
+}
+
+// pivots(): L_jj^2 in the matrix's own column order, for the CHOLMOD and the dense path.
+// Their product is det(A) whatever the fill-reducing order; a column coupled to nothing has
+// its own diagonal entry as pivot in any order, so it shows the order is undone.
+TEST(SparseCholesky, PivotsAreInTheMatrixsOwnOrderAndMultiplyToItsDeterminant) {
+  for (int side : {20, 6}) {  // 400 unknowns through CHOLMOD, 36 densely
+    SCOPED_TRACE(side);
+    ShiftedLaplacian A(side, 0.05);
+    const int isolated = A.size / 2 + 1;
+    for (int j = 0; j < A.size; ++j)
+      for (int t = A.column_start[j]; t < A.column_start[j + 1]; ++t)
+        if ((j == isolated) != (A.row_index[t] == isolated)) A.values[t] = 0;  // its couplings
+    A.values[A.column_start[isolated]] = 1e-3;
+    SparseCholesky cholesky;
+    cholesky.analyze(A.size, A.column_start, A.row_index);
+    EXPECT_EQ(cholesky.dense(), side == 6);
+    cholesky.factorize(A.values);
+    const std::vector<double> pivots = cholesky.pivots();
+    ASSERT_EQ(static_cast<int>(pivots.size()), A.size);
+    EXPECT_NEAR(pivots[isolated], 1e-3, 1e-18);
+
+    Eigen::MatrixXd dense = Eigen::MatrixXd::Zero(A.size, A.size);
+    for (int j = 0; j < A.size; ++j)
+      for (int t = A.column_start[j]; t < A.column_start[j + 1]; ++t)
+        dense(A.row_index[t], j) = dense(j, A.row_index[t]) = A.values[t];
+    const Eigen::LLT<Eigen::MatrixXd> llt(dense);
+    const double log_det = 2 * llt.matrixLLT().diagonal().array().log().sum();
+    double log_product = 0;
+    for (double p : pivots) log_product += std::log(p);
+    EXPECT_NEAR(log_product, log_det, 1e-10 * std::abs(log_det));
+  }
 }

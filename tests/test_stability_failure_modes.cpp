@@ -18,6 +18,8 @@
 #include "dgtex/model_error.h"
 #include "dgtex/penalty_caution.h"
 #include "dgtex/rotation_caution.h"
+#include "dgtex/scene.h"
+#include "dgtex/scene_run.h"
 #include "dgtex/shell_simulation.h"
 #include "shell_test_support.h"
 #include "square_plate_support.h"
@@ -503,6 +505,53 @@ TEST(CutAlongElementEdges, EdgeTermsAcrossTheCutAreDropped) {
     EXPECT_GT(along.clamped_motion, 0.1);
     EXPECT_GT(tied.fall_error, 1e-2);  // the failure mode the remedy removes (measured 0.058 / 0.098)
   }
+}
+
+// A static piece that a cut leaves hanging on one held node: a 2 x 2 plate clamped at
+// x = 0, cut along the diagonal from the clamped corner (0, 0) to (1, 1). The lower piece
+// touches the support only at that node and is free to turn about it, so K is singular;
+// rounding decides the sign of the mechanism's pivot. Negative, the factorisation fails
+// ("not positive definite"); positive (tri6 at penalty 1: 4.9e-16 of its diagonal entry),
+// the static solve gave displacements of 1e10 with exit 0 until session 72. Either way it is
+// refused now, and the message names a piece cut loose among the causes. The smallest
+// pivots of healthy static solves are ~1e-7 of their diagonal entries (test suite and
+// examples; a clamped plate 1e-8 of its span thick passes).
+TEST(StaticMechanisms, APieceACutLeavesHangingOnOneHeldNodeIsRefused) {
+  for (ElementType type : {ElementType::tri6, ElementType::quad8})
+    for (double penalty : {1.0, 10.0}) {
+      SCOPED_TRACE(std::string(type == ElementType::tri6 ? "tri6" : "quad8") + ", penalty " + std::to_string(penalty));
+      Scene scene;
+      scene.source_name = "hanging piece";
+      scene.mesh.element = type;
+      scene.mesh.size = {1, 1};
+      scene.mesh.divisions = {2, 2};
+      scene.material = {1e6, 0.3, 0.01, 1000};
+      scene.penalty = penalty;
+      BoundaryCondition clamp;
+      clamp.select.normal = {1, 0, 0};
+      clamp.fixed = {true, true, true};
+      clamp.clamp = true;
+      scene.boundary.push_back(clamp);
+      Load load;
+      load.type = Load::Type::area_force;
+      load.force_per_area = {0, 0, -1e-3};
+      scene.loads.push_back(load);
+      Cut cut;
+      cut.points = {{0, 0, 0}, {1, 1, 0}};
+      scene.cuts.push_back(cut);
+      scene.enrichment.texture_resolution = 16;
+      SceneRun run(scene);
+      try {
+        run.solve_static();
+        ADD_FAILURE() << "solved";
+      } catch (const ModelError& e) {
+        const std::string message = e.what();
+        EXPECT_NE(message.find("a piece that a cut separates from every support"), std::string::npos) << message;
+        if (type == ElementType::tri6 && penalty == 1.0) {  // the case that solved
+          EXPECT_NE(message.find("singular to working precision (a pivot"), std::string::npos) << message;
+        }
+      }
+    }
 }
 
 }  // namespace

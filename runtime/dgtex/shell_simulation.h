@@ -51,7 +51,9 @@ class ShellSimulation {
   // (fixed DOFs, and clamped edges, which hold their normals) leave one. Geometric: it
   // assembles nothing.
   void check_statically_constrained();
-  // Throws ModelError "stiffness not positive definite (penalty too low?)" when K is not.
+  // Throws ModelError "stiffness not positive definite (penalty too low?)" when K is not,
+  // and "singular to working precision" when a pivot is below 1e-12 of its diagonal entry
+  // (a mechanism that rounding left positive, e.g. a piece a cut leaves hanging on a node).
   void solve_static();
   // std::invalid_argument unless options.time_step is positive and finite and the damping
   // coefficients finite and >= 0. A failed step throws ModelError when the step matrix is
@@ -106,9 +108,11 @@ class ShellSimulation {
   std::vector<double> spread_pair_;         // u_ and guess_ spread for the fused products
 
   const std::vector<double>& linear_stiffness();
-  std::string enrichment_hint() const;  // appended to "not positive definite" errors
-  // Where a failed factorisation's column lies: its node, component and elements.
-  std::string pivot_location(const NotPositiveDefinite& failure) const;
+  std::string enrichment_hint(bool static_analysis) const;  // appended to "not positive definite" errors
+  // Where a column of the factorised system lies: its node, component and elements.
+  std::string unknown_location(int column) const;
+  // Throws ModelError when a pivot of the static factor is rounding (a mechanism).
+  void check_no_mechanism(const std::vector<double>& values) const;
 };
 
 }  // namespace dgtex

@@ -65,6 +65,10 @@ class SparseCholesky {
   int size() const { return n_; }
   // Non-zeros of the factor L (after factorize).
   std::int64_t factor_nonzeros() const;
+  // The pivots of the current factor, L_jj^2, indexed by the matrix's own columns (n; after
+  // factorize). A pivot far below its column's diagonal entry A_jj is what rounding left of
+  // a singular direction (a mechanism), which a factorisation need not refuse.
+  std::vector<double> pivots() const;
   // Whether the analysed pattern is factored densely rather than by CHOLMOD.
   bool dense() const;
 
