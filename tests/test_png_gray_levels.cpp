@@ -10,6 +10,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <new>
 #include <string>
 #include <unistd.h>
 #include <vector>
@@ -18,6 +19,7 @@
 #include "dgtex/png_io.h"
 #include "dgtex/scene_io.h"
 #include "dgtex/scene_model.h"
+#include "address_space_support.h"
 
 namespace {
 
@@ -67,6 +69,22 @@ class PngGrayLevels : public ::testing::Test {
   }
   void TearDown() override { std::filesystem::remove_all(dir_); }
   std::string path(const std::string& name) const { return (dir_ / name).string(); }
+  // A small gray PNG whose header claims kMaxPngSide x kMaxPngSide pixels (its CRC redone):
+  // 4 GiB to decode, the pixels themselves missing.
+  std::string write_huge_header_png() const {
+    const std::uint8_t grey8[2] = {128, 64};
+    write_samples(path("small.png"), 2, PNG_FORMAT_GRAY, grey8);
+    std::ifstream in(path("small.png"), std::ios::binary);
+    std::vector<std::uint8_t> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    EXPECT_GT(bytes.size(), 33u);
+    EXPECT_EQ(std::string(bytes.begin() + 12, bytes.begin() + 16), "IHDR");
+    put_big_endian(bytes, 16, kMaxPngSide);  // width
+    put_big_endian(bytes, 20, kMaxPngSide);  // height
+    put_big_endian(bytes, 29, png_crc(bytes.data() + 12, 17));  // over the chunk's type and data
+    std::ofstream(path("huge.png"), std::ios::binary).write(reinterpret_cast<const char*>(bytes.data()),
+                                                            static_cast<std::streamsize>(bytes.size()));
+    return path("huge.png");
+  }
   std::filesystem::path dir_;
 };
 
@@ -115,21 +133,10 @@ TEST_F(PngGrayLevels, MaterialTexturesFromSixteenBitImagesAreTheStoredLevels) {
   EXPECT_NEAR(thickness[1][1], 0.002 + 0.01 * 64 / 255, 1e-15);
 }
 
-// A header claiming 16384 x 16384 pixels (4 GiB to decode, the pixels themselves missing)
-// is weighed against the memory available before anything is decoded.
+// A header claiming 16384 x 16384 pixels is weighed against the memory available before
+// anything is decoded.
 TEST_F(PngGrayLevels, ImagesBeyondTheMemoryAvailableAreRefusedFromTheirHeader) {
-  const std::uint8_t grey8[2] = {128, 64};
-  write_samples(path("small.png"), 2, PNG_FORMAT_GRAY, grey8);
-  std::ifstream in(path("small.png"), std::ios::binary);
-  std::vector<std::uint8_t> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  ASSERT_GT(bytes.size(), 33u);
-  ASSERT_EQ(std::string(bytes.begin() + 12, bytes.begin() + 16), "IHDR");
-  put_big_endian(bytes, 16, kMaxPngSide);  // width
-  put_big_endian(bytes, 20, kMaxPngSide);  // height
-  put_big_endian(bytes, 29, png_crc(bytes.data() + 12, 17));  // over the chunk's type and data
-  std::ofstream(path("huge.png"), std::ios::binary).write(reinterpret_cast<const char*>(bytes.data()),
-                                                          static_cast<std::streamsize>(bytes.size()));
-  const PngSize size = read_png_size(path("huge.png"));
+  const PngSize size = read_png_size(write_huge_header_png());
   EXPECT_EQ(size.width, static_cast<int>(kMaxPngSide));
   EXPECT_EQ(size.height, static_cast<int>(kMaxPngSide));
 
@@ -144,6 +151,24 @@ TEST_F(PngGrayLevels, ImagesBeyondTheMemoryAvailableAreRefusedFromTheirHeader) {
     for (const char* part : {"reading its 16384x16384 pixels", "16 bytes a pixel", "a smaller image"})
       EXPECT_NE(what.find(part), std::string::npos) << part << " not in: " << what;
   }
+}
+
+// A read whose pixels cannot be allocated (the library's readers weigh nothing) closes its
+// file: until session 72 each such read left a file descriptor and libpng's state behind.
+TEST_F(PngGrayLevels, AReadThatCannotAllocateItsPixelsClosesItsFile) {
+  const std::string huge = write_huge_header_png();
+  const auto open_files = [] {
+    return std::distance(std::filesystem::directory_iterator("/proc/self/fd"), std::filesystem::directory_iterator());
+  };
+  test::ScopedAddressSpaceLimit limit(std::int64_t{512} << 20);  // below read_png's 1 GiB of pixels
+  if (!limit.why_not().empty()) GTEST_SKIP() << limit.why_not();
+  const auto before = open_files();
+  for (int k = 0; k < 3; ++k) {
+    EXPECT_THROW(read_png(huge), std::bad_alloc);
+    EXPECT_THROW(read_png_gray_levels(huge), std::bad_alloc);
+  }
+  limit.restore();
+  EXPECT_EQ(open_files(), before);
 }
 
 // The read's weighing at its line: a 2 x 1 image takes 2 x 16 bytes to read (and as many for
