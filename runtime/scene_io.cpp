@@ -107,7 +107,9 @@ std::string join(const std::vector<std::string>& words, const std::string& separ
   return out;
 }
 
-double norm(const Vec3& v) { return std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]); }
+// hypot: squares of components below ~1e-154 underflow, and a normal [1e-170, 0, 0] read as
+// "zero" (session 72).
+double norm(const Vec3& v) { return std::hypot(v[0], v[1], v[2]); }
 Vec3 difference(const Vec3& a, const Vec3& b) { return {a[0] - b[0], a[1] - b[1], a[2] - b[2]}; }
 
 // Whether two cuts or creases run along the same polyline, in either direction.
@@ -445,7 +447,7 @@ class SceneReader {
         check_keys(v, path, {"generator", "radius", "length", "angle_deg", "divisions", "element", "triangles"});
         mesh.radius = positive(require(v, path, "radius", "a radius > 0"), child(path, "radius"));
         mesh.length = positive(require(v, path, "length", "a length > 0"), child(path, "length"));
-        const json& angles = require(v, path, "angle_deg", "[t0, t1] in degrees with t0 < t1 <= t0 + 360");
+        const json& angles = require(v, path, "angle_deg", "[t0, t1] in degrees with 0 < |t1 - t0| <= 360");
         mesh.angle_deg = numbers<2>(angles, child(path, "angle_deg"));
         const double range = std::abs(mesh.angle_deg[1] - mesh.angle_deg[0]);
         if (!(range > 0) || range > 360)
@@ -774,7 +776,9 @@ class SceneReader {
     if (const json* t = find(v, "target")) r.camera_target = vec3(*t, child(path, "target"));
     if (const json* u = find(v, "up")) {
       r.camera_up = vec3(*u, child(path, "up"));
-      if (!(norm(r.camera_up) > 0)) fail(child(path, "up"), "zero up vector", *u, "expected a non-zero vector");
+      const double length = norm(r.camera_up);
+      if (!(length > 0)) fail(child(path, "up"), "zero up vector", *u, "expected a non-zero vector");
+      for (double& c : r.camera_up) c /= length;  // a direction: the renderer's products of it stay in range
     }
     if (const json* f = find(v, "fov_deg")) {
       r.fov_deg = number(*f, child(path, "fov_deg"));

@@ -51,7 +51,7 @@ Vec3 cross(const Vec3& a, const Vec3& b) {
   return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
 }
 double dot(const Vec3& a, const Vec3& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
-double norm(const Vec3& a) { return std::sqrt(dot(a, a)); }
+double norm(const Vec3& a) { return std::hypot(a[0], a[1], a[2]); }  // no underflow of tiny vectors
 Vec3 normalized(const Vec3& a) {
   const double n = norm(a);
   return {a[0] / n, a[1] / n, a[2] / n};
@@ -79,7 +79,7 @@ ResolvedCamera resolve_camera(const DeformedShell& shell, const RenderSettings& 
   ResolvedCamera c;
   c.eye = {s.camera_position[0], s.camera_position[1], s.camera_position[2]};
   c.target = {s.camera_target[0], s.camera_target[1], s.camera_target[2]};
-  c.up = {s.camera_up[0], s.camera_up[1], s.camera_up[2]};
+  c.up = normalized({s.camera_up[0], s.camera_up[1], s.camera_up[2]});  // a tiny up's cross products underflowed
   Vec3 direction = sub(c.eye, c.target);
   if (norm(direction) == 0) direction = {0, -1, 1};
   direction = normalized(direction);

@@ -228,4 +228,16 @@ TEST(SceneParse, CanonicalJsonRoundTrips) {
   }
 }
 
+// Directions are directions at any length: a plane normal or camera up of 1e-170 squared to
+// 0 and read as "zero" until session 72. Both are read as unit vectors.
+TEST(SceneParse, TinyDirectionsAreReadAsUnitVectors) {
+  const Scene s = parse_scene(R"({"mesh": {"generator": "rectangle", "size": [1, 1], "divisions": [1, 1]},
+      "material": {"youngs_modulus": 1e6, "poisson_ratio": 0.3, "thickness": 0.01},
+      "boundary": [{"select": {"plane": {"normal": [1e-170, 0, 0], "offset": 0}}, "fix": ["x", "y", "z"]}],
+      "render": {"camera": {"position": [0.5, -2, 1], "target": [0.5, 0.5, 0], "up": [0, 0, 1e-200]}}})",
+                              "tiny.json");
+  EXPECT_EQ(s.boundary[0].select.normal, (Vec3{1, 0, 0}));
+  EXPECT_EQ(s.render->camera_up, (Vec3{0, 0, 1}));
+}
+
 }  // namespace
