@@ -127,10 +127,20 @@ std::vector<std::vector<double>> segment_cut_paths(std::vector<MeshCutPath>& pat
       if (!interior) continue;  // a T-junction (or touching ends): no split
       if (pa.cut == pb.cut && std::abs(arc_a - arc_b) <= arc_tolerance) continue;
       const double ta = cut_point_appear_time(cuts[pa.cut], arc_a), tb = cut_point_appear_time(cuts[pb.cut], arc_b);
-      // pieces are ordered (cut, k), so on a tie b is the later one (higher cut or arc)
-      const bool a_later = ta > tb;
-      if (a_later) forced[pa.cut].push_back(arc_a);
-      else forced[pb.cut].push_back(arc_b);
+      if (pa.cut == pb.cut && std::abs(arc_b - arc_a) >= 8 * arc_tolerance) {
+        // A cut crossing itself around a loop that can enclose a texel (four texels long)
+        // splits at both passes: the loop becomes a segment of its own, a closed curve whose
+        // function is +-1 inside and outside. With the tail before it in one function (a rho
+        // shape), that function varied outside the loop and the loop's inside stayed
+        // attached (session 72). A smaller loop, a jagged crack's kink, encloses no texel:
+        // a function of its own would be a fragment, so it splits as two cuts do.
+        forced[pa.cut].push_back(arc_a);
+        forced[pa.cut].push_back(arc_b);
+      } else if (ta > tb) {  // pieces are ordered (cut, k): on a tie b is the later (higher cut)
+        forced[pa.cut].push_back(arc_a);
+      } else {
+        forced[pb.cut].push_back(arc_b);
+      }
       inserts.push_back({pa.cut, arc_a, element});
       inserts.push_back({pb.cut, arc_b, element});
     }

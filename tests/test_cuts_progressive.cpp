@@ -168,15 +168,20 @@ TEST(CutsProgressive, CrossingCutIsSplitButTJunctionIsNot) {
   }
 }
 
-TEST(CutsProgressive, SelfIntersectingCutSplitsAtItsOwnCrossing) {
+// A cut crossing itself splits at both passes, so the loop between them is a segment of its
+// own (a closed curve). Until session 72 only the later pass split it: the loop and the tail
+// before it were one function, and the loop's inside stayed attached
+// (test_scene_cut_loops: SceneCutLoops.TheInsideOfASelfCrossingCutsLoopFallsFreely).
+TEST(CutsProgressive, SelfIntersectingCutSplitsAtBothPassesOfItsCrossing) {
   const Mesh mesh = make_rectangle(2, 2, 2, 2, ElementType::tri6);
   // A loop that crosses its own beginning at (0.5, 1.0).
   const Cut loop = points_cut({{0.2, 1.0, 0}, {1.5, 1.0, 0}, {1.5, 1.6, 0}, {0.5, 1.6, 0}, {0.5, 0.3, 0}});
   CutManager m(mesh, build_topology(mesh), {loop}, cholmod_enrichment(16));
-  ASSERT_EQ(m.total_segments(), 2);
-  EXPECT_NEAR(m.segment_boundaries()[0][1], 1.3 + 0.6 + 1.0 + 0.6, 1e-9);
+  ASSERT_EQ(m.total_segments(), 3);
+  EXPECT_NEAR(m.segment_boundaries()[0][1], 0.3, 1e-9);                          // the first pass
+  EXPECT_NEAR(m.segment_boundaries()[0][2], 1.3 + 0.6 + 1.0 + 0.6, 1e-9);  // the second
   m.update(0);
-  EXPECT_EQ(m.functions().size(), 2u);
+  EXPECT_EQ(m.functions().size(), 3u);
   for (const auto& f : m.functions())
     for (const auto& et : f.elements)
       for (double v : et.tile.values) EXPECT_TRUE(std::isfinite(v) && std::abs(v) <= 1.0);

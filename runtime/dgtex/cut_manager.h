@@ -22,7 +22,8 @@
 //    the border, so it separates like any complete cut;
 //  - a cut running along the mesh's free boundary separates nothing: those texel edges are
 //    dropped (a segment made only of them gets no enrichment);
-//  - a self-intersecting cut: split where it crosses its earlier part (cut_segments.h);
+//  - a self-intersecting cut: split at both passes of its crossing, the loop between them a
+//    segment of its own, where the loop is four texels long or more (cut_segments.h);
 //  - a fragment shorter than half a texel has no texel edge: no enrichment for it (its
 //    H would be 0 and its DOFs singular); fragments of a few texels work as any cut.
 //  - segments continuing one crack (the next segment of a cut, a cut starting or ending

@@ -11,9 +11,11 @@
 //  - Crossings: where two cuts cross (both pass through the point, neither ends there),
 //    the one that reaches the point later (appearance time start_time + s / speed; on a
 //    tie the higher cut index) ends its segment there and a new one starts. A cut
-//    crossing its own earlier part splits the same way (self-intersections). The crossing
-//    point becomes a path vertex of both cuts so their texel paths meet at one lattice
-//    point. A cut merely ending on another (T-junction) is not split: splitting there
+//    crossing its own earlier part around a loop at least four texels long splits at both
+//    passes, so that the loop is a segment of its own (a closed curve: its function is +-1
+//    inside and outside); a shorter loop (a jagged crack's kink) splits as two cuts do. The
+//    crossing point becomes a path vertex of both cuts so their texel paths meet at one
+//    lattice point. A cut merely ending on another (T-junction) is not split: splitting there
 //    would add an enrichment that is linearly dependent on the others (App. A.2).
 // Pure functions over value types (thread-safe). Lengths in the mesh's unit (SI: m),
 // times in the scene's (s), angles in degrees.
