@@ -314,7 +314,9 @@ void ShellModel::install_enrichments(std::vector<EnrichmentFunction> functions, 
     if (functions_on[e] == 0) continue;
     if (!textured_index_.empty() && textured_index_[e] >= 0)
       throw std::invalid_argument("enrichment: element " + std::to_string(e) +
-                                  " has a material texture; cuts through material-textured elements are not supported");
+                                  " has a material texture and a cut's or crease's enrichment (the elements a cut or "
+                                  "crease touches and their neighbours carry it); enriched material-textured elements "
+                                  "are not supported");
     if (functions_on[e] > kernels::max_enrichments_per_element)
       throw std::invalid_argument("enrichment: element " + std::to_string(e) + " carries " +
                                   std::to_string(functions_on[e]) + " enrichment functions; at most " +

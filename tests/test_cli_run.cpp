@@ -383,6 +383,21 @@ TEST(CliRun, AProgressiveCutsFunctionTooManyOnAnElementNamesTheStep) {
                   "step 31 (to t = 0.155): enrichment: element 1 carries 32 enrichment functions; at most 31");
 }
 
+// A material texture on an element next to a cut (not one the cut runs through): the
+// element carries the cut's enrichment, and the message says so (it read "cuts through
+// material-textured elements are not supported" until session 72).
+TEST(CliRun, AMaterialTextureNextToACutIsRefusedNamingTheEnrichment) {
+  const std::string image = std::string(DGTEX_SOURCE_DIR) + "/examples/scenes/thickness_texture.png";
+  expect_rejected("texture_next_to_cut", R"({"mesh": {"generator": "rectangle", "size": [1, 1], "divisions": [2, 2]},
+      "material": {"youngs_modulus": 1e6, "poisson_ratio": 0.3, "thickness": 0.01}, "penalty": 1,
+      "boundary": [{"select": {"plane": {"normal": [1, 0, 0], "offset": 0}}, "fix": ["x", "y", "z"], "clamp": true}],
+      "loads": [{"type": "area_force", "force_per_area": [0, 0, -0.001]}],
+      "material_textures": [{"field": "thickness", "image": ")" + image + R"(", "range": [0.005, 0.01], "elements": [0]}],
+      "cuts": [{"points": [[0.6, 0.1, 0], [0.9, 0.4, 0]]}]})",
+                  "element 0 has a material texture and a cut's or crease's enrichment (the elements a cut or crease "
+                  "touches and their neighbours carry it)");
+}
+
 TEST(CliRun, AnOutputFolderThatCannotBeCreatedIsRefusedBeforeTheScene) {
   const fs::path dir = fresh_dir("out_under_file");
   std::ofstream(dir / "file") << "not a folder";
