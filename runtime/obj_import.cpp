@@ -113,6 +113,18 @@ void read_statement(std::string text, int line, const std::string& path, std::ve
     if (!(tokens >> c[0] >> c[1] >> c[2]))
       throw MeshError(where(path, line) + ": vertex needs three coordinates 'v x y z', got '" + shown(text) + "'");
     for (int d = 0; d < 3; ++d) vertices.push_back(parse_coordinate(c[d], path, line));
+    // What may follow: a weight w, or a colour r g b (a common extension); numbers only, so
+    // that a typo is not read past ('v 0 0 0 junk' was, until session 72).
+    int extra = 0;
+    bool numbers = true;
+    for (std::string token; tokens >> token; ++extra) {
+      char* end = nullptr;
+      std::strtod(token.c_str(), &end);
+      numbers = numbers && end == token.c_str() + token.size();
+    }
+    if (!numbers || (extra != 0 && extra != 1 && extra != 3))
+      throw MeshError(where(path, line) + ": after 'v x y z' a vertex takes a weight w or a colour r g b (numbers), got '" +
+                      shown(text) + "'");
   } else if (keyword == "f") {
     ObjFace face;
     face.line = line;

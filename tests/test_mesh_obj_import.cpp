@@ -115,6 +115,11 @@ TEST(ObjImport, MalformedLinesNameTheLine) {
   EXPECT_CONTAINS(load_error_of_text("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 0 1 2\n"), "refers to vertex 0");
   EXPECT_CONTAINS(load_error_of_text("v 0 0\n"), ".obj:1: vertex needs three coordinates");
   EXPECT_CONTAINS(load_error_of_text("v 0 0 zero\n"), ".obj:1: vertex coordinate 'zero'");
+  // After x y z only a weight or a colour (numbers): junk was read past until session 72.
+  EXPECT_CONTAINS(load_error_of_text("v 0 0 0 junk\n"), ".obj:1: after 'v x y z' a vertex takes a weight w or a colour");
+  EXPECT_CONTAINS(load_error_of_text("v 0 0 0 1 0.5 0.5 0.5\n"), ".obj:1: after 'v x y z'");
+  const std::string weighted_and_coloured = "v 0 0 0 1\nv 1 0 0 0.2 0.4 0.6\nv 1 1 0\nv 0 1 0\nf 1 2 3 4\n";
+  EXPECT_EQ(load_error_of_text(weighted_and_coloured), "");
   // 1e300 would pass as finite, and the area Jacobian would overflow to inf downstream.
   EXPECT_CONTAINS(load_error_of_text("v 1e300 0 0\n"), ".obj:1: vertex coordinate '1e300' is out of range");
   EXPECT_CONTAINS(load_error_of_text("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 x/1\n"), ".obj:4: face corner 'x/1'");
