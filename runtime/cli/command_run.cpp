@@ -23,6 +23,7 @@
 #include "dgtex/model_error.h"
 #include "dgtex/model_memory_estimate.h"
 #include "dgtex/penalty_caution.h"
+#include "dgtex/point_caution.h"
 #include "dgtex/rotation_caution.h"
 #include "dgtex/scene_io.h"
 #include "dgtex/scene_run.h"
@@ -138,11 +139,13 @@ int run_command(int argc, char** argv) {
     return 1;
   }
   const Mesh& mesh = run->mesh();
-  // Valid but likely not what was meant (dgtex/penalty_caution.h, selection_caution.h,
+  // Valid but likely not what was meant (dgtex/penalty_caution.h, selection_caution.h, point_caution.h,
   // mesh_validation.h): say so.
   if (const std::string caution = penalty_caution(scene.penalty, mesh.type); !caution.empty())
     std::fprintf(stderr, "dgtex run: warning: %s: %s\n", scene_path.c_str(), caution.c_str());
   if (const std::string caution = selection_tolerance_caution(scene, mesh); !caution.empty())
+    std::fprintf(stderr, "dgtex run: warning: %s: %s\n", scene_path.c_str(), caution.c_str());
+  if (const std::string caution = far_point_caution(scene, mesh); !caution.empty())
     std::fprintf(stderr, "dgtex run: warning: %s: %s\n", scene_path.c_str(), caution.c_str());
   if (const std::string caution = unwelded_seam_caution(mesh); !caution.empty())
     std::fprintf(stderr, "dgtex run: warning: %s: mesh: %s\n", scene_path.c_str(), caution.c_str());
