@@ -398,6 +398,18 @@ TEST(CliRun, AMaterialTextureNextToACutIsRefusedNamingTheEnrichment) {
                   "touches and their neighbours carry it)");
 }
 
+// A scene whose supports hold every node ran and wrote zeros without a word until session 72.
+TEST(CliRun, ASceneThatHoldsEveryDisplacementIsCautioned) {
+  const fs::path dir = fresh_dir("all_held");
+  std::ofstream(dir / "scene.json") << scene("0.3", "1", R"("boundary": [{"select": {"box": {"min": [-1, -1, -1], "max": [2, 2, 1]}}, "fix": ["x", "y", "z"]}],)");
+  const Result r = dgtex::test::run_cli("run " + (dir / "scene.json").string() + " --out " + (dir / "out").string() +
+                                            " --quiet --no-render",
+                                        dir);
+  EXPECT_EQ(r.exit_code, 0) << r.stderr_text;
+  EXPECT_NE(r.stderr_text.find("boundary: every displacement is held (x, y and z of all "), std::string::npos)
+      << r.stderr_text;
+}
+
 TEST(CliRun, AnOutputFolderThatCannotBeCreatedIsRefusedBeforeTheScene) {
   const fs::path dir = fresh_dir("out_under_file");
   std::ofstream(dir / "file") << "not a folder";

@@ -147,6 +147,9 @@ int run_command(int argc, char** argv) {
     std::fprintf(stderr, "dgtex run: warning: %s: %s\n", scene_path.c_str(), caution.c_str());
   if (const std::string caution = far_point_caution(scene, mesh); !caution.empty())
     std::fprintf(stderr, "dgtex run: warning: %s: %s\n", scene_path.c_str(), caution.c_str());
+  if (run->simulation().system().size() == 0)  // ran, and wrote zeros, without a word
+    std::fprintf(stderr, "dgtex run: warning: %s: boundary: every displacement is held (x, y and z of all %d nodes): "
+                 "nothing can move\n", scene_path.c_str(), mesh.num_nodes());
   if (const std::string caution = unwelded_seam_caution(mesh); !caution.empty())
     std::fprintf(stderr, "dgtex run: warning: %s: mesh: %s\n", scene_path.c_str(), caution.c_str());
   // PNG frames (dgtex/frame_writer.h). The EGL context opens before the run, so a machine
