@@ -38,4 +38,23 @@ inline Scene strip_built_in_code(bool dynamic = true, bool with_cut = true) {
   return scene;
 }
 
+// A 1 m x 1 m plate of 2 x 2 elements (h = 1 cm, density 1000), clamped along x = 0, with
+// cut textures of T = 16: no loads, no cuts, static.
+inline Scene square_plate_built_in_code(ElementType element, double youngs_modulus) {
+  Scene scene;
+  scene.source_name = "square plate (built in code)";
+  scene.mesh.source = MeshSource::rectangle;
+  scene.mesh.element = element;
+  scene.mesh.size = {1, 1};
+  scene.mesh.divisions = {2, 2};
+  scene.material = {youngs_modulus, 0.3, 0.01, 1000};
+  BoundaryCondition clamp;
+  clamp.select.normal = {1, 0, 0};
+  clamp.fixed = {true, true, true};
+  clamp.clamp = true;
+  scene.boundary.push_back(clamp);
+  scene.enrichment.texture_resolution = 16;
+  return scene;
+}
+
 }  // namespace dgtex::test

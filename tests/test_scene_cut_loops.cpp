@@ -14,6 +14,7 @@
 #include "dgtex/scene.h"
 #include "dgtex/scene_run.h"
 #include "dgtex/surface_point.h"
+#include "scene_in_code_support.h"
 
 namespace {
 
@@ -22,16 +23,7 @@ using namespace dgtex;
 // A 1 x 1 plate of 2 x 2 quad8 clamped at x = 0, under gravity g = 1, for 100 steps of 10
 // ms, cut along `points` (T = 16); the displacement at `probe` at the end.
 Vec3 displacement_after_a_second(const std::vector<Vec3>& points, const Vec3& probe) {
-  Scene scene;
-  scene.source_name = "plate with a loop";
-  scene.mesh.size = {1, 1};
-  scene.mesh.divisions = {2, 2};
-  scene.material = {1e9, 0.3, 0.01, 1000};
-  BoundaryCondition clamp;
-  clamp.select.normal = {1, 0, 0};
-  clamp.fixed = {true, true, true};
-  clamp.clamp = true;
-  scene.boundary.push_back(clamp);
+  Scene scene = test::square_plate_built_in_code(ElementType::quad8, 1e9);
   Load gravity;
   gravity.acceleration = {0, 0, -1};
   scene.loads.push_back(gravity);
@@ -42,7 +34,6 @@ Vec3 displacement_after_a_second(const std::vector<Vec3>& points, const Vec3& pr
   Cut cut;
   cut.points = points;
   scene.cuts.push_back(cut);
-  scene.enrichment.texture_resolution = 16;
   SceneRun run(scene);
   while (run.steps_taken() < scene.analysis.steps) run.step();
   const SurfacePoint p = closest_surface_point(run.model().mesh(), probe.data());

@@ -21,6 +21,7 @@
 #include "dgtex/scene.h"
 #include "dgtex/scene_run.h"
 #include "dgtex/shell_simulation.h"
+#include "scene_in_code_support.h"
 #include "shell_test_support.h"
 #include "square_plate_support.h"
 
@@ -520,18 +521,8 @@ TEST(StaticMechanisms, APieceACutLeavesHangingOnOneHeldNodeIsRefused) {
   for (ElementType type : {ElementType::tri6, ElementType::quad8})
     for (double penalty : {1.0, 10.0}) {
       SCOPED_TRACE(std::string(type == ElementType::tri6 ? "tri6" : "quad8") + ", penalty " + std::to_string(penalty));
-      Scene scene;
-      scene.source_name = "hanging piece";
-      scene.mesh.element = type;
-      scene.mesh.size = {1, 1};
-      scene.mesh.divisions = {2, 2};
-      scene.material = {1e6, 0.3, 0.01, 1000};
+      Scene scene = test::square_plate_built_in_code(type, 1e6);
       scene.penalty = penalty;
-      BoundaryCondition clamp;
-      clamp.select.normal = {1, 0, 0};
-      clamp.fixed = {true, true, true};
-      clamp.clamp = true;
-      scene.boundary.push_back(clamp);
       Load load;
       load.type = Load::Type::area_force;
       load.force_per_area = {0, 0, -1e-3};
@@ -539,7 +530,6 @@ TEST(StaticMechanisms, APieceACutLeavesHangingOnOneHeldNodeIsRefused) {
       Cut cut;
       cut.points = {{0, 0, 0}, {1, 1, 0}};
       scene.cuts.push_back(cut);
-      scene.enrichment.texture_resolution = 16;
       SceneRun run(scene);
       try {
         run.solve_static();
