@@ -65,64 +65,68 @@ struct TwoLevels {
 class MultigridKernels : public ::testing::TestWithParam<LaplaceDomain> {};
 
 TEST_P(MultigridKernels, ParallelFormsEqualReferenceBitwise) {
-  const test::ThreadCountGuard set_threads(2);
-  TwoLevels L(make_laplace_domain(GetParam(), 96));
-  // Smoothers.
-  for (int color = 0; color < 2; ++color) {
-    std::vector<double> ref = L.x, par = L.x;
-    smooth_texels_color_reference(L.fine, L.bits.data(), L.b.data(), ref.data(), color);
-    smooth_texels_color(L.fine, L.bits.data(), L.b.data(), par.data(), color);
-    EXPECT_EQ(ref, par);
-  }
-  for (int color = 0; color < 4; ++color) {
-    std::vector<double> ref = L.xc, par = L.xc;
-    smooth_stencil9_color_reference(L.coarse, L.A().view(), L.bc.data(), ref.data(), color);
-    smooth_stencil9_color(L.coarse, L.A().view(), L.bc.data(), par.data(), color);
-    EXPECT_EQ(ref, par);
-  }
-  // Residuals and their row norms.
-  {
-    std::vector<double> r1(L.x.size(), 0.0), r2 = r1, n1(L.fine.ny), n2(L.fine.ny);
-    residual_texels_reference(L.fine, L.bits.data(), L.b.data(), L.x.data(), r1.data(), n1.data());
-    residual_texels(L.fine, L.bits.data(), L.b.data(), L.x.data(), r2.data(), n2.data());
-    EXPECT_EQ(r1, r2);
-    EXPECT_EQ(n1, n2);
-    std::vector<double> c1(L.xc.size(), 0.0), c2 = c1, m1(L.coarse.ny), m2(L.coarse.ny);
-    residual_stencil9_reference(L.coarse, L.A().view(), L.bc.data(), L.xc.data(), c1.data(), m1.data());
-    residual_stencil9(L.coarse, L.A().view(), L.bc.data(), L.xc.data(), c2.data(), m2.data());
-    EXPECT_EQ(c1, c2);
-    EXPECT_EQ(m1, m2);
-  }
-  // Transfers.
-  {
-    std::vector<double> b1(L.xc.size(), 0.0), b2 = b1;
-    restrict_residual_reference(L.fine, L.coarse, L.P().view(), L.x.data(), b1.data());
-    restrict_residual(L.fine, L.coarse, L.P().view(), L.x.data(), b2.data());
-    EXPECT_EQ(b1, b2);
-    std::vector<std::uint8_t> active(L.bits.size());
-    for (std::size_t t = 0; t < active.size(); ++t) active[t] = (L.bits[t] & is_unknown) ? 1 : 0;
-    std::vector<double> x1 = L.x, x2 = L.x;
-    prolong_correction_reference(L.fine, L.coarse, L.P().view(), L.xc.data(), active.data(), x1.data());
-    prolong_correction(L.fine, L.coarse, L.P().view(), L.xc.data(), active.data(), x2.data());
-    EXPECT_EQ(x1, x2);
-  }
-  // The level-0 product of conjugate gradients (the seamed patch solves use it).
-  {
-    std::vector<double> y1(L.x.size(), 0.0), y2 = y1, d1(L.fine.ny), d2(L.fine.ny);
-    apply_texels(L.fine, L.bits.data(), L.x.data(), y1.data(), d1.data(), Execution::serial);
-    apply_texels(L.fine, L.bits.data(), L.x.data(), y2.data(), d2.data(), Execution::parallel);
-    EXPECT_EQ(y1, y2);
-    EXPECT_EQ(d1, d2);
-  }
-  // Setup kernels: serial and parallel forms.
-  {
-    TwoLevels M(make_laplace_domain(GetParam(), 96));
-    for (auto& v : M.p) std::fill(v.begin(), v.end(), 0.0);
-    for (auto& v : M.a) std::fill(v.begin(), v.end(), 0.0);
-    build_interpolation_texels(M.fine, M.bits.data(), M.P(), Execution::parallel);
-    galerkin_texels(M.fine, M.bits.data(), M.P().view(), M.A(), Execution::parallel);
-    EXPECT_EQ(M.p, L.p);
-    EXPECT_EQ(M.a, L.a);
+  // Even and uneven splits of the rows among the threads.
+  for (int threads : {2, 3}) {
+    SCOPED_TRACE(std::to_string(threads) + " threads");
+    const test::ThreadCountGuard set_threads(threads);
+    TwoLevels L(make_laplace_domain(GetParam(), 96));
+    // Smoothers.
+    for (int color = 0; color < 2; ++color) {
+      std::vector<double> ref = L.x, par = L.x;
+      smooth_texels_color_reference(L.fine, L.bits.data(), L.b.data(), ref.data(), color);
+      smooth_texels_color(L.fine, L.bits.data(), L.b.data(), par.data(), color);
+      EXPECT_EQ(ref, par);
+    }
+    for (int color = 0; color < 4; ++color) {
+      std::vector<double> ref = L.xc, par = L.xc;
+      smooth_stencil9_color_reference(L.coarse, L.A().view(), L.bc.data(), ref.data(), color);
+      smooth_stencil9_color(L.coarse, L.A().view(), L.bc.data(), par.data(), color);
+      EXPECT_EQ(ref, par);
+    }
+    // Residuals and their row norms.
+    {
+      std::vector<double> r1(L.x.size(), 0.0), r2 = r1, n1(L.fine.ny), n2(L.fine.ny);
+      residual_texels_reference(L.fine, L.bits.data(), L.b.data(), L.x.data(), r1.data(), n1.data());
+      residual_texels(L.fine, L.bits.data(), L.b.data(), L.x.data(), r2.data(), n2.data());
+      EXPECT_EQ(r1, r2);
+      EXPECT_EQ(n1, n2);
+      std::vector<double> c1(L.xc.size(), 0.0), c2 = c1, m1(L.coarse.ny), m2(L.coarse.ny);
+      residual_stencil9_reference(L.coarse, L.A().view(), L.bc.data(), L.xc.data(), c1.data(), m1.data());
+      residual_stencil9(L.coarse, L.A().view(), L.bc.data(), L.xc.data(), c2.data(), m2.data());
+      EXPECT_EQ(c1, c2);
+      EXPECT_EQ(m1, m2);
+    }
+    // Transfers.
+    {
+      std::vector<double> b1(L.xc.size(), 0.0), b2 = b1;
+      restrict_residual_reference(L.fine, L.coarse, L.P().view(), L.x.data(), b1.data());
+      restrict_residual(L.fine, L.coarse, L.P().view(), L.x.data(), b2.data());
+      EXPECT_EQ(b1, b2);
+      std::vector<std::uint8_t> active(L.bits.size());
+      for (std::size_t t = 0; t < active.size(); ++t) active[t] = (L.bits[t] & is_unknown) ? 1 : 0;
+      std::vector<double> x1 = L.x, x2 = L.x;
+      prolong_correction_reference(L.fine, L.coarse, L.P().view(), L.xc.data(), active.data(), x1.data());
+      prolong_correction(L.fine, L.coarse, L.P().view(), L.xc.data(), active.data(), x2.data());
+      EXPECT_EQ(x1, x2);
+    }
+    // The level-0 product of conjugate gradients (the seamed patch solves use it).
+    {
+      std::vector<double> y1(L.x.size(), 0.0), y2 = y1, d1(L.fine.ny), d2(L.fine.ny);
+      apply_texels(L.fine, L.bits.data(), L.x.data(), y1.data(), d1.data(), Execution::serial);
+      apply_texels(L.fine, L.bits.data(), L.x.data(), y2.data(), d2.data(), Execution::parallel);
+      EXPECT_EQ(y1, y2);
+      EXPECT_EQ(d1, d2);
+    }
+    // Setup kernels: serial and parallel forms.
+    {
+      TwoLevels M(make_laplace_domain(GetParam(), 96));
+      for (auto& v : M.p) std::fill(v.begin(), v.end(), 0.0);
+      for (auto& v : M.a) std::fill(v.begin(), v.end(), 0.0);
+      build_interpolation_texels(M.fine, M.bits.data(), M.P(), Execution::parallel);
+      galerkin_texels(M.fine, M.bits.data(), M.P().view(), M.A(), Execution::parallel);
+      EXPECT_EQ(M.p, L.p);
+      EXPECT_EQ(M.a, L.a);
+    }
   }
 }
 
@@ -216,53 +220,61 @@ TEST_P(MultigridKernels, SolveIsIndependentOfThreadCount) {
 }
 
 TEST_P(MultigridKernels, FusedSweepsEqualColourByColourReference) {
-  const test::ThreadCountGuard set_threads(2);
-  TwoLevels L(make_laplace_domain(GetParam(), 100));  // 100 rows: blocks of 32 plus a partial one
-  for (Execution ex : {Execution::serial, Execution::parallel}) {
-    for (bool forward : {true, false}) {
-      std::vector<double> ref = L.x, fused = L.x;
-      smooth_texels_color_reference(L.fine, L.bits.data(), L.b.data(), ref.data(), forward ? 0 : 1);
-      smooth_texels_color_reference(L.fine, L.bits.data(), L.b.data(), ref.data(), forward ? 1 : 0);
-      smooth_texels_sweep(L.fine, L.bits.data(), L.b.data(), fused.data(), forward, ex);
+  // Even and uneven splits of the rows among the threads.
+  for (int threads : {2, 3}) {
+    SCOPED_TRACE(std::to_string(threads) + " threads");
+    const test::ThreadCountGuard set_threads(threads);
+    TwoLevels L(make_laplace_domain(GetParam(), 100));  // 100 rows: blocks of 32 plus a partial one
+    for (Execution ex : {Execution::serial, Execution::parallel}) {
+      for (bool forward : {true, false}) {
+        std::vector<double> ref = L.x, fused = L.x;
+        smooth_texels_color_reference(L.fine, L.bits.data(), L.b.data(), ref.data(), forward ? 0 : 1);
+        smooth_texels_color_reference(L.fine, L.bits.data(), L.b.data(), ref.data(), forward ? 1 : 0);
+        smooth_texels_sweep(L.fine, L.bits.data(), L.b.data(), fused.data(), forward, ex);
+        EXPECT_EQ(ref, fused);
+        std::vector<double> ref9 = L.xc, fused9 = L.xc;
+        for (int k = 0; k < 4; ++k)
+          smooth_stencil9_color_reference(L.coarse, L.A().view(), L.bc.data(), ref9.data(), forward ? k : 3 - k);
+        smooth_stencil9_sweep(L.coarse, L.A().view(), L.bc.data(), fused9.data(), forward, ex);
+        EXPECT_EQ(ref9, fused9);
+      }
+      // From a zero guess: x need not be initialised, non-unknowns end at 0.
+      std::vector<double> ref(L.x.size(), 0.0), fused(L.x.size(), 0.0);
+      smooth_texels_color_reference(L.fine, L.bits.data(), L.b.data(), ref.data(), 0);
+      smooth_texels_color_reference(L.fine, L.bits.data(), L.b.data(), ref.data(), 1);
+      for (int j = 0; j < L.fine.ny; ++j)
+        for (int i = 0; i < L.fine.nx; ++i) fused[L.fine.at(i, j)] = 7.0;  // garbage in the interior
+      smooth_texels_sweep_from_zero(L.fine, L.bits.data(), L.b.data(), fused.data(), ex);
       EXPECT_EQ(ref, fused);
-      std::vector<double> ref9 = L.xc, fused9 = L.xc;
-      for (int k = 0; k < 4; ++k)
-        smooth_stencil9_color_reference(L.coarse, L.A().view(), L.bc.data(), ref9.data(), forward ? k : 3 - k);
-      smooth_stencil9_sweep(L.coarse, L.A().view(), L.bc.data(), fused9.data(), forward, ex);
-      EXPECT_EQ(ref9, fused9);
     }
-    // From a zero guess: x need not be initialised, non-unknowns end at 0.
-    std::vector<double> ref(L.x.size(), 0.0), fused(L.x.size(), 0.0);
-    smooth_texels_color_reference(L.fine, L.bits.data(), L.b.data(), ref.data(), 0);
-    smooth_texels_color_reference(L.fine, L.bits.data(), L.b.data(), ref.data(), 1);
-    for (int j = 0; j < L.fine.ny; ++j)
-      for (int i = 0; i < L.fine.nx; ++i) fused[L.fine.at(i, j)] = 7.0;  // garbage in the interior
-    smooth_texels_sweep_from_zero(L.fine, L.bits.data(), L.b.data(), fused.data(), ex);
-    EXPECT_EQ(ref, fused);
   }
 }
 
 TEST_P(MultigridKernels, FusedConjugateGradientStepsEqualReference) {
-  const test::ThreadCountGuard set_threads(2);
-  TwoLevels L(make_laplace_domain(GetParam(), 100));
-  const double alpha = 0.37, beta = -0.61;
-  for (Execution ex : {Execution::serial, Execution::parallel}) {
-    std::vector<double> x1 = L.x, r1 = L.b, z1(L.x.size(), 0.0), n1(L.fine.ny);
-    std::vector<double> x2 = L.x, r2 = L.b, z2(L.x.size(), 0.0), n2(L.fine.ny);
-    cg_update_and_smooth_texels_from_zero_reference(L.fine, L.bits.data(), alpha, L.x.data(), L.b.data(), x1.data(),
-                                                    r1.data(), z1.data(), n1.data());
-    cg_update_and_smooth_texels_from_zero(L.fine, L.bits.data(), alpha, L.x.data(), L.b.data(), x2.data(), r2.data(),
-                                          z2.data(), n2.data(), ex);
-    EXPECT_EQ(x1, x2);
-    EXPECT_EQ(r1, r2);
-    EXPECT_EQ(z1, z2);
-    EXPECT_EQ(n1, n2);
-    std::vector<double> p1 = L.x, q1(L.x.size(), 0.0), d1(L.fine.ny), p2 = L.x, q2 = q1, d2(L.fine.ny);
-    update_direction_and_apply_texels_reference(L.fine, L.bits.data(), L.b.data(), beta, p1.data(), q1.data(), d1.data());
-    update_direction_and_apply_texels(L.fine, L.bits.data(), L.b.data(), beta, p2.data(), q2.data(), d2.data(), ex);
-    EXPECT_EQ(p1, p2);
-    EXPECT_EQ(q1, q2);
-    EXPECT_EQ(d1, d2);
+  // Even and uneven splits of the rows among the threads.
+  for (int threads : {2, 3}) {
+    SCOPED_TRACE(std::to_string(threads) + " threads");
+    const test::ThreadCountGuard set_threads(threads);
+    TwoLevels L(make_laplace_domain(GetParam(), 100));
+    const double alpha = 0.37, beta = -0.61;
+    for (Execution ex : {Execution::serial, Execution::parallel}) {
+      std::vector<double> x1 = L.x, r1 = L.b, z1(L.x.size(), 0.0), n1(L.fine.ny);
+      std::vector<double> x2 = L.x, r2 = L.b, z2(L.x.size(), 0.0), n2(L.fine.ny);
+      cg_update_and_smooth_texels_from_zero_reference(L.fine, L.bits.data(), alpha, L.x.data(), L.b.data(), x1.data(),
+                                                      r1.data(), z1.data(), n1.data());
+      cg_update_and_smooth_texels_from_zero(L.fine, L.bits.data(), alpha, L.x.data(), L.b.data(), x2.data(), r2.data(),
+                                            z2.data(), n2.data(), ex);
+      EXPECT_EQ(x1, x2);
+      EXPECT_EQ(r1, r2);
+      EXPECT_EQ(z1, z2);
+      EXPECT_EQ(n1, n2);
+      std::vector<double> p1 = L.x, q1(L.x.size(), 0.0), d1(L.fine.ny), p2 = L.x, q2 = q1, d2(L.fine.ny);
+      update_direction_and_apply_texels_reference(L.fine, L.bits.data(), L.b.data(), beta, p1.data(), q1.data(), d1.data());
+      update_direction_and_apply_texels(L.fine, L.bits.data(), L.b.data(), beta, p2.data(), q2.data(), d2.data(), ex);
+      EXPECT_EQ(p1, p2);
+      EXPECT_EQ(q1, q2);
+      EXPECT_EQ(d1, d2);
+    }
   }
 }
 
@@ -293,74 +305,82 @@ TEST_P(MultigridKernels, OperatorAtListedTexelsEqualsTheWholeGridProduct) {
 }
 
 TEST_P(MultigridKernels, RedBlackTransfersMatchReferencesAndFullForms) {
-  const test::ThreadCountGuard set_threads(2);
-  TwoLevels L(make_laplace_domain(GetParam(), 96));
-  for (int color = 0; color < 2; ++color) {
-    std::vector<double> r1(L.x.size(), 0.0), r2 = r1, full = r1;
-    residual_texels_color_reference(L.fine, L.bits.data(), L.b.data(), L.x.data(), r1.data(), color);
-    residual_texels_color(L.fine, L.bits.data(), L.b.data(), L.x.data(), r2.data(), color);
-    EXPECT_EQ(r1, r2);
-    residual_texels_reference(L.fine, L.bits.data(), L.b.data(), L.x.data(), full.data(), nullptr);
+  // Even and uneven splits of the rows among the threads.
+  for (int threads : {2, 3}) {
+    SCOPED_TRACE(std::to_string(threads) + " threads");
+    const test::ThreadCountGuard set_threads(threads);
+    TwoLevels L(make_laplace_domain(GetParam(), 96));
+    for (int color = 0; color < 2; ++color) {
+      std::vector<double> r1(L.x.size(), 0.0), r2 = r1, full = r1;
+      residual_texels_color_reference(L.fine, L.bits.data(), L.b.data(), L.x.data(), r1.data(), color);
+      residual_texels_color(L.fine, L.bits.data(), L.b.data(), L.x.data(), r2.data(), color);
+      EXPECT_EQ(r1, r2);
+      residual_texels_reference(L.fine, L.bits.data(), L.b.data(), L.x.data(), full.data(), nullptr);
+      for (int j = 0; j < L.fine.ny; ++j)
+        for (int i = 0; i < L.fine.nx; ++i)
+          EXPECT_EQ(r1[L.fine.at(i, j)], (i + j) % 2 == color ? full[L.fine.at(i, j)] : 0.0);
+    }
+    // Restriction of a red-only vector: equal to P^T of that vector (round-off: other order).
+    std::vector<double> red = L.x;
     for (int j = 0; j < L.fine.ny; ++j)
       for (int i = 0; i < L.fine.nx; ++i)
-        EXPECT_EQ(r1[L.fine.at(i, j)], (i + j) % 2 == color ? full[L.fine.at(i, j)] : 0.0);
+        if ((i + j) % 2) red[L.fine.at(i, j)] = 0.0;
+    std::vector<double> b1(L.xc.size(), 0.0), b2 = b1, b3 = b1;
+    restrict_red_residual_reference(L.fine, L.coarse, L.P().view(), red.data(), b1.data());
+    restrict_red_residual(L.fine, L.coarse, L.P().view(), red.data(), b2.data());
+    restrict_residual_reference(L.fine, L.coarse, L.P().view(), red.data(), b3.data());
+    EXPECT_EQ(b1, b2);
+    for (std::size_t t = 0; t < b1.size(); ++t) EXPECT_NEAR(b1[t], b3[t], 1e-13);
+    // Red residual and its restriction in one pass: bitwise the two kernels in turn, for odd
+    // grid sizes too (cell centres in the ghost row / column).
+    for (int size : {96, 75}) {
+      TwoLevels M(make_laplace_domain(GetParam(), size));
+      std::vector<double> r(M.x.size(), 0.0), two_steps(M.xc.size(), 0.0), ref = two_steps, fused = two_steps;
+      residual_texels_color(M.fine, M.bits.data(), M.b.data(), M.x.data(), r.data(), 0);
+      restrict_red_residual(M.fine, M.coarse, M.P().view(), r.data(), two_steps.data());
+      restrict_red_residual_texels_reference(M.fine, M.coarse, M.P().view(), M.bits.data(), M.b.data(), M.x.data(),
+                                             ref.data());
+      restrict_red_residual_texels(M.fine, M.coarse, M.P().view(), M.bits.data(), M.b.data(), M.x.data(),
+                                   fused.data());
+      EXPECT_EQ(ref, two_steps);
+      EXPECT_EQ(fused, two_steps);
+    }
+    // Prolongation to red nodes: the full prolongation's values there, black untouched.
+    std::vector<std::uint8_t> active(L.bits.size());
+    for (std::size_t t = 0; t < active.size(); ++t) active[t] = (L.bits[t] & is_unknown) ? 1 : 0;
+    std::vector<double> x1 = L.x, x2 = L.x, x3 = L.x;
+    prolong_correction_red_reference(L.fine, L.coarse, L.P().view(), L.xc.data(), active.data(), x1.data());
+    prolong_correction_red(L.fine, L.coarse, L.P().view(), L.xc.data(), active.data(), x2.data());
+    prolong_correction_reference(L.fine, L.coarse, L.P().view(), L.xc.data(), active.data(), x3.data());
+    EXPECT_EQ(x1, x2);
+    for (int j = 0; j < L.fine.ny; ++j)
+      for (int i = 0; i < L.fine.nx; ++i)
+        EXPECT_EQ(x1[L.fine.at(i, j)], (i + j) % 2 == 0 ? x3[L.fine.at(i, j)] : L.x[L.fine.at(i, j)]);
   }
-  // Restriction of a red-only vector: equal to P^T of that vector (round-off: other order).
-  std::vector<double> red = L.x;
-  for (int j = 0; j < L.fine.ny; ++j)
-    for (int i = 0; i < L.fine.nx; ++i)
-      if ((i + j) % 2) red[L.fine.at(i, j)] = 0.0;
-  std::vector<double> b1(L.xc.size(), 0.0), b2 = b1, b3 = b1;
-  restrict_red_residual_reference(L.fine, L.coarse, L.P().view(), red.data(), b1.data());
-  restrict_red_residual(L.fine, L.coarse, L.P().view(), red.data(), b2.data());
-  restrict_residual_reference(L.fine, L.coarse, L.P().view(), red.data(), b3.data());
-  EXPECT_EQ(b1, b2);
-  for (std::size_t t = 0; t < b1.size(); ++t) EXPECT_NEAR(b1[t], b3[t], 1e-13);
-  // Red residual and its restriction in one pass: bitwise the two kernels in turn, for odd
-  // grid sizes too (cell centres in the ghost row / column).
-  for (int size : {96, 75}) {
-    TwoLevels M(make_laplace_domain(GetParam(), size));
-    std::vector<double> r(M.x.size(), 0.0), two_steps(M.xc.size(), 0.0), ref = two_steps, fused = two_steps;
-    residual_texels_color(M.fine, M.bits.data(), M.b.data(), M.x.data(), r.data(), 0);
-    restrict_red_residual(M.fine, M.coarse, M.P().view(), r.data(), two_steps.data());
-    restrict_red_residual_texels_reference(M.fine, M.coarse, M.P().view(), M.bits.data(), M.b.data(), M.x.data(),
-                                           ref.data());
-    restrict_red_residual_texels(M.fine, M.coarse, M.P().view(), M.bits.data(), M.b.data(), M.x.data(),
-                                 fused.data());
-    EXPECT_EQ(ref, two_steps);
-    EXPECT_EQ(fused, two_steps);
-  }
-  // Prolongation to red nodes: the full prolongation's values there, black untouched.
-  std::vector<std::uint8_t> active(L.bits.size());
-  for (std::size_t t = 0; t < active.size(); ++t) active[t] = (L.bits[t] & is_unknown) ? 1 : 0;
-  std::vector<double> x1 = L.x, x2 = L.x, x3 = L.x;
-  prolong_correction_red_reference(L.fine, L.coarse, L.P().view(), L.xc.data(), active.data(), x1.data());
-  prolong_correction_red(L.fine, L.coarse, L.P().view(), L.xc.data(), active.data(), x2.data());
-  prolong_correction_reference(L.fine, L.coarse, L.P().view(), L.xc.data(), active.data(), x3.data());
-  EXPECT_EQ(x1, x2);
-  for (int j = 0; j < L.fine.ny; ++j)
-    for (int i = 0; i < L.fine.nx; ++i)
-      EXPECT_EQ(x1[L.fine.at(i, j)], (i + j) % 2 == 0 ? x3[L.fine.at(i, j)] : L.x[L.fine.at(i, j)]);
 }
 
 TEST_P(MultigridKernels, FastClassificationEqualsFloodFillReference) {
-  const test::ThreadCountGuard set_threads(2);
-  for (TexelElementShape shape : {TexelElementShape::quad, TexelElementShape::tri}) {
-    const TexelTile tile = make_laplace_domain(GetParam(), 80, shape);
-    std::vector<std::uint8_t> ref, serial, parallel;
-    const int zr = classify_laplace_texels_reference(tile, ref);
-    EXPECT_EQ(classify_laplace_texels(tile, serial, Execution::serial), zr);
-    EXPECT_EQ(classify_laplace_texels(tile, parallel, Execution::parallel), zr);
-    EXPECT_EQ(ref, serial);
-    EXPECT_EQ(ref, parallel);
-    const GridShape g{tile.width, tile.height};
-    std::vector<std::uint8_t> padded(g.padded_size(), 0xff);
-    EXPECT_EQ(classify_laplace_texels_padded(tile, padded.data()), zr);
-    for (int j = -1; j <= g.ny; ++j)
-      for (int i = -1; i <= g.nx; ++i) {
-        const bool inside = i >= 0 && j >= 0 && i < g.nx && j < g.ny;
-        EXPECT_EQ(padded[g.at(i, j)], inside ? ref[tile.index(i, j)] : 0);
-      }
+  // Even and uneven splits of the rows among the threads.
+  for (int threads : {2, 3}) {
+    SCOPED_TRACE(std::to_string(threads) + " threads");
+    const test::ThreadCountGuard set_threads(threads);
+    for (TexelElementShape shape : {TexelElementShape::quad, TexelElementShape::tri}) {
+      const TexelTile tile = make_laplace_domain(GetParam(), 80, shape);
+      std::vector<std::uint8_t> ref, serial, parallel;
+      const int zr = classify_laplace_texels_reference(tile, ref);
+      EXPECT_EQ(classify_laplace_texels(tile, serial, Execution::serial), zr);
+      EXPECT_EQ(classify_laplace_texels(tile, parallel, Execution::parallel), zr);
+      EXPECT_EQ(ref, serial);
+      EXPECT_EQ(ref, parallel);
+      const GridShape g{tile.width, tile.height};
+      std::vector<std::uint8_t> padded(g.padded_size(), 0xff);
+      EXPECT_EQ(classify_laplace_texels_padded(tile, padded.data()), zr);
+      for (int j = -1; j <= g.ny; ++j)
+        for (int i = -1; i <= g.nx; ++i) {
+          const bool inside = i >= 0 && j >= 0 && i < g.nx && j < g.ny;
+          EXPECT_EQ(padded[g.at(i, j)], inside ? ref[tile.index(i, j)] : 0);
+        }
+    }
   }
 }
 
