@@ -24,6 +24,11 @@ inline std::string short_number(double x) {
   return text;
 }
 
+// A point in a message, "[1, 0.5, -0.005]".
+inline std::string short_point(const double x[3]) {
+  return "[" + short_number(x[0]) + ", " + short_number(x[1]) + ", " + short_number(x[2]) + "]";
+}
+
 // "ShellModel::interpolate: u has 3 entries; expected num_dofs() = 84"
 inline void check_size(const char* function, const char* argument, std::size_t size, const char* expected_name,
                        std::size_t expected) {

@@ -7,13 +7,6 @@
 #include "dgtex/surface_point.h"
 
 namespace dgtex {
-namespace {
-
-std::string point_text(const double x[3]) {
-  return "[" + detail::short_number(x[0]) + ", " + detail::short_number(x[1]) + ", " + detail::short_number(x[2]) + "]";
-}
-
-}  // namespace
 
 std::string far_point_caution(const Scene& scene, const Mesh& mesh) {
   if (mesh.num_elements() == 0) return "";
@@ -38,8 +31,9 @@ std::string far_point_caution(const Scene& scene, const Mesh& mesh) {
     const SurfacePoint p = search.closest(given.position->data());
     if (!(p.distance > tolerance)) continue;
     if (far++ == 0)
-      first = given.name + " at " + point_text(given.position->data()) + " is " + detail::short_number(p.distance) +
-              " from the shell, whose nearest point " + point_text(p.position) + " is where it " + given.acts +
+      first = given.name + " at " + detail::short_point(given.position->data()) + " is " +
+              detail::short_number(p.distance) + " from the shell, whose nearest point " +
+              detail::short_point(p.position) + " is where it " + given.acts +
               " (cut points are refused beyond " + detail::short_number(tolerance) +
               ", a quarter of the mean element edge)";
   }

@@ -114,8 +114,7 @@ std::string ShellSimulation::unknown_location(int column) const {
     node = model_.virtual_node_mesh_node(node);
   }
   const double* x = mesh.node(node);
-  what += std::to_string(node) + " at [" + detail::short_number(x[0]) + ", " + detail::short_number(x[1]) + ", " +
-          detail::short_number(x[2]) + "], in element";
+  what += std::to_string(node) + " at " + detail::short_point(x) + ", in element";
   std::vector<int> elements;
   for (int e = 0; e < mesh.num_elements(); ++e) {
     const int* nodes = mesh.element_nodes(e);
