@@ -9,7 +9,7 @@
 
 #include "dgtex/scene_io.h"
 #include "dgtex/scene_run.h"
-#include "dgtex/surface_point.h"
+#include "scene_run_displacement_support.h"
 
 using namespace dgtex;
 
@@ -48,11 +48,7 @@ Scene chad_scene(int steps, double bridge_texels) {
 }
 
 double vertical_displacement(const SceneRun& run, double x, double y) {
-  const double p[3] = {x, y, 0};
-  const SurfacePoint s = closest_surface_point(run.mesh(), p);
-  double u[3];
-  run.model().interpolate(run.displacement(), s.element, s.xi, u);
-  return u[2];
+  return test::displacement_at(run, {x, y, 0})[2];
 }
 
 struct ChadMotion {

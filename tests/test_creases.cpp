@@ -22,7 +22,7 @@
 #include "dgtex/mesh_generators.h"
 #include "dgtex/scene_io.h"
 #include "dgtex/scene_run.h"
-#include "dgtex/surface_point.h"
+#include "scene_run_displacement_support.h"
 
 using namespace dgtex;
 using kernels::TexelTile;
@@ -252,13 +252,7 @@ TEST(Creases, AStraightCreaseIsAHingeOnEveryMesh) {
   for (int n : {1, 3, 5}) {
     SceneRun run(plate_scene(R"(, "creases": [{"points": [[0.5, 0, 0], [0.5, 1, 0]]}])", n));
     run.solve_static();
-    auto z = [&](double x) {
-      const double at[3] = {x, 0.5, 0};
-      const SurfacePoint p = closest_surface_point(run.mesh(), at);
-      double u[3];
-      run.model().interpolate(run.displacement(), p.element, p.xi, u);
-      return u[2];
-    };
+    auto z = [&](double x) { return test::displacement_at(run, {x, 0.5, 0})[2]; };
     const double crease = z(0.5), beyond = z(0.75);
     std::printf("%d x %d quad8: crease %.5g (hinge %.5g), at x = 3/4 %.5g (straight: %.5g)\n", n, n, crease, -hinge,
                 beyond, crease / 2);

@@ -20,8 +20,8 @@
 #include "dgtex/mesh_generators.h"
 #include "dgtex/scene_io.h"
 #include "dgtex/scene_run.h"
-#include "dgtex/surface_point.h"
 #include "dgtex/topology.h"
+#include "scene_run_displacement_support.h"
 
 using namespace dgtex;
 using namespace dgtex::testing_support;
@@ -143,11 +143,7 @@ std::string plate_scene(int divisions, const char* element, const std::string& c
 
 // z displacement at the rest point (x, y, 0).
 double displacement_z(const SceneRun& run, double x, double y) {
-  const double p[3] = {x, y, 0};
-  const SurfacePoint sp = closest_surface_point(run.mesh(), p);
-  double u[3];
-  run.model().interpolate(run.displacement(), sp.element, sp.xi, u);
-  return u[2];
+  return test::displacement_at(run, {x, y, 0})[2];
 }
 
 TEST(CutsSharedEndPoints, JaggedCrackAsTwoCutsRuns) {

@@ -13,8 +13,8 @@
 
 #include "dgtex/scene.h"
 #include "dgtex/scene_run.h"
-#include "dgtex/surface_point.h"
 #include "scene_in_code_support.h"
+#include "scene_run_displacement_support.h"
 
 namespace {
 
@@ -36,10 +36,7 @@ Vec3 displacement_after_a_second(const std::vector<Vec3>& points, const Vec3& pr
   scene.cuts.push_back(cut);
   SceneRun run(scene);
   while (run.steps_taken() < scene.analysis.steps) run.step();
-  const SurfacePoint p = closest_surface_point(run.model().mesh(), probe.data());
-  Vec3 u;
-  run.model().interpolate(run.displacement(), p.element, p.xi, u.data());
-  return u;
+  return test::displacement_at(run, probe);
 }
 
 // Semi-implicit Euler's fall after n steps of dt from rest: g dt^2 n (n + 1) / 2.
