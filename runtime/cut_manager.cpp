@@ -137,6 +137,16 @@ constexpr int kMaxSpurEdges = 2;
 
 using RasterPieces = std::vector<std::pair<int, CutRaster>>;
 
+// Drops the first or last lattice edge of a segment's raster (and its piece, left empty).
+void pop_terminal_edge(RasterPieces& pieces, bool at_end) {
+  auto& edges = (at_end ? pieces.back() : pieces.front()).second.edges;
+  if (at_end) edges.pop_back();
+  else edges.erase(edges.begin());
+  if (!edges.empty()) return;
+  if (at_end) pieces.pop_back();
+  else pieces.erase(pieces.begin());
+}
+
 // Lattice coordinate along a border edge of a lattice point on it, in the numbering of
 // classify_border's s (texel s spans [q, q + 1]); -1 on the tri6 hypotenuse staircase.
 int border_coordinate(ElementType type, int t, int edge, int x, int y) {
@@ -151,29 +161,46 @@ int border_coordinate(ElementType type, int t, int edge, int x, int y) {
 
 }  // namespace
 
-// Physical identity of a segment's terminal: (edge id, terminal point), the same from
-// both sides of a mesh edge; false where it has none (a free-boundary edge, the tri6
-// hypotenuse).
+// Physical identity of a raster edge of element e: the same from both sides of a mesh
+// edge; false where it has none (a free-boundary edge, the tri6 hypotenuse). `from_lower`:
+// whether e is the side the border numbering is counted from.
+bool CutManager::edge_identity(int e, const CutLatticeEdge& edge, long long& id, bool& from_lower) const {
+  const int t = resolution_;
+  from_lower = true;
+  if (edge.left_texel >= 0 && edge.right_texel >= 0) {
+    id = ((static_cast<long long>(e) * (t + 1) + std::min(edge.x, edge.x + edge.dx)) * (t + 1) +
+          std::min(edge.y, edge.y + edge.dy)) * 2 + (edge.dy == 0);
+    return true;
+  }
+  BorderEdge b;
+  if (!classify_border(mesh_.type, t, edge, b)) return false;
+  const auto nb = adjacency_.neighbour(e, b.edge);
+  if (nb[0] < 0) return false;
+  const long long here = (static_cast<long long>(e) * 4 + b.edge) * t + b.s;
+  const long long there = (static_cast<long long>(nb[0]) * 4 + nb[1]) * t + (t - 1 - b.s);
+  from_lower = here <= there;
+  id = -1 - std::min(here, there);
+  return true;
+}
+
+// Physical identity of a segment's terminal: (edge id, terminal point).
 bool CutManager::terminal_key(const std::vector<std::pair<int, CutRaster>>& pieces, bool at_end,
                               std::pair<long long, long long>& key) const {
   const int t = resolution_;
   const int e = at_end ? pieces.back().first : pieces.front().first;
   const CutLatticeEdge& edge = at_end ? pieces.back().second.edges.back() : pieces.front().second.edges.front();
   const int px = at_end ? edge.x + edge.dx : edge.x, py = at_end ? edge.y + edge.dy : edge.y;
-  if (edge.left_texel >= 0 && edge.right_texel >= 0) {
-    key.first = ((static_cast<long long>(e) * (t + 1) + std::min(edge.x, edge.x + edge.dx)) * (t + 1) +
-                 std::min(edge.y, edge.y + edge.dy)) * 2 + (edge.dy == 0);
+  bool from_lower = true;
+  if (!edge_identity(e, edge, key.first, from_lower)) return false;
+  if (key.first >= 0) {
     key.second = static_cast<long long>(px) * (t + 1) + py;
     return true;
   }
   BorderEdge b;
-  if (!classify_border(mesh_.type, t, edge, b)) return false;
-  const auto nb = adjacency_.neighbour(e, b.edge);
+  classify_border(mesh_.type, t, edge, b);
   const int q = border_coordinate(mesh_.type, t, b.edge, px, py);
-  if (nb[0] < 0 || q < 0) return false;
-  const long long here = (static_cast<long long>(e) * 4 + b.edge) * t + b.s;
-  const long long there = (static_cast<long long>(nb[0]) * 4 + nb[1]) * t + (t - 1 - b.s);
-  key = here <= there ? std::pair<long long, long long>{-1 - here, q} : std::pair<long long, long long>{-1 - there, t - q};
+  if (q < 0) return false;
+  key.second = from_lower ? q : t - q;
   return true;
 }
 
@@ -185,14 +212,6 @@ void CutManager::trim_shared_end_spurs(std::vector<std::vector<std::pair<int, Cu
   std::vector<SegmentEnd> ends;
   for (std::size_t v = 0; v < rasters.size(); ++v)
     if (!rasters[v].empty()) ends.push_back({v, false}), ends.push_back({v, true});
-  auto pop = [](RasterPieces& pieces, bool at_end) {
-    auto& edges = (at_end ? pieces.back() : pieces.front()).second.edges;
-    if (at_end) edges.pop_back();
-    else edges.erase(edges.begin());
-    if (!edges.empty()) return;
-    if (at_end) pieces.pop_back();
-    else pieces.erase(pieces.begin());
-  };
   for (std::size_t i = 0; i < ends.size(); ++i)
     for (std::size_t j = i + 1; j < ends.size(); ++j) {
       const SegmentEnd a = ends[i], b = ends[j];
@@ -201,10 +220,51 @@ void CutManager::trim_shared_end_spurs(std::vector<std::vector<std::pair<int, Cu
       for (int trimmed = 0; trimmed < kMaxSpurEdges && !pa.empty() && !pb.empty(); ++trimmed) {
         std::pair<long long, long long> ka, kb;
         if (!terminal_key(pa, a.at_end, ka) || !terminal_key(pb, b.at_end, kb) || ka != kb) break;
-        pop(pa, a.at_end);
-        pop(pb, b.at_end);
+        pop_terminal_edge(pa, a.at_end);
+        pop_terminal_edge(pb, b.at_end);
       }
     }
+}
+
+void CutManager::trim_ends_along_other_segments(std::vector<RasterPieces>& rasters) const {
+  if (rasters.size() < 2) return;
+  struct Holder {
+    long long edge;
+    std::size_t segment;
+    int traversals;
+    bool operator<(const Holder& o) const { return edge != o.edge ? edge < o.edge : segment < o.segment; }
+  };
+  std::vector<Holder> holders;  // sorted by (edge id, segment), one entry per pair
+  long long id = 0;
+  bool from_lower = true;
+  for (std::size_t v = 0; v < rasters.size(); ++v)
+    for (const auto& [e, raster] : rasters[v])
+      for (const CutLatticeEdge& edge : raster.edges)
+        if (edge_identity(e, edge, id, from_lower)) holders.push_back({id, v, 1});
+  std::sort(holders.begin(), holders.end());
+  std::size_t unique = 0;
+  for (std::size_t i = 0; i < holders.size(); ++i) {
+    if (unique > 0 && holders[unique - 1].edge == holders[i].edge && holders[unique - 1].segment == holders[i].segment)
+      ++holders[unique - 1].traversals;
+    else holders[unique++] = holders[i];
+  }
+  holders.resize(unique);
+  for (std::size_t v = 0; v < rasters.size(); ++v)
+    for (const bool at_end : {false, true})
+      while (!rasters[v].empty()) {
+        const auto& [e, raster] = at_end ? rasters[v].back() : rasters[v].front();
+        if (!edge_identity(e, at_end ? raster.edges.back() : raster.edges.front(), id, from_lower)) break;
+        const auto first = std::lower_bound(holders.begin(), holders.end(), Holder{id, 0, 0});
+        Holder* own = nullptr;
+        bool held_by_another = false;
+        for (auto h = first; h != holders.end() && h->edge == id; ++h) {
+          if (h->segment == v) own = &*h;
+          else if (h->traversals > 0) held_by_another = true;
+        }
+        if (!held_by_another || own == nullptr) break;
+        pop_terminal_edge(rasters[v], at_end);
+        --own->traversals;
+      }
 }
 
 
@@ -339,6 +399,7 @@ void CutManager::rasterize_visible(const std::vector<VisibleCutSegment>& visible
     }
   }
   trim_shared_end_spurs(rasters);
+  trim_ends_along_other_segments(rasters);
   for (const auto& pieces : rasters)
     for (const auto& [e, raster] : pieces) kernels::mark_cut_walls(raster, walls_.at(e));
   // Cuts along mesh edges cut the couplings between the two elements' boundary texels.

@@ -33,6 +33,10 @@
 //    end on the same lattice edge (the shared point snaps to one lattice point and each
 //    staircase walks to it from its side), that spur is dropped from both (at most 2
 //    edges), else its texels get contradicting +-1 data and a V's wedge stays attached.
+//  - a segment ending on another cut (the later cut at a crossing, a T-junction) can walk
+//    its last edges along the other cut's staircase: they are dropped from its data (the
+//    other cut's walls stay), else a texel beyond the other cut gets its +-1 and a region
+//    that two cuts close stays attached.
 // CutManager owns its paths, segments, wall tiles and enrichment functions; it keeps a
 // reference to the mesh (which must outlive it; the topology is read by the constructor
 // only). Not thread-safe; the constructor (one cut per thread) and update() use all
@@ -145,8 +149,14 @@ class CutManager {
                          std::vector<std::vector<std::pair<int, kernels::CutRaster>>>& rasters);
   // Drops the lattice edges that two segments sharing an end point both end on (a spur).
   void trim_shared_end_spurs(std::vector<std::vector<std::pair<int, kernels::CutRaster>>>& rasters) const;
+  // Drops a segment's first and last lattice edges while another segment's path has them
+  // (a segment that ends on another cut walking its last edges along that cut's staircase):
+  // they separate as the other cut's; as this segment's data they gave a texel beyond the
+  // other cut this segment's +-1. The walls stay (the other segment marks them).
+  void trim_ends_along_other_segments(std::vector<std::vector<std::pair<int, kernels::CutRaster>>>& rasters) const;
   bool terminal_key(const std::vector<std::pair<int, kernels::CutRaster>>& pieces, bool at_end,
                     std::pair<long long, long long>& key) const;
+  bool edge_identity(int element, const kernels::CutLatticeEdge& edge, long long& id, bool& from_lower) const;
 
   const Mesh& mesh_;
   ElementAdjacency adjacency_;

@@ -52,7 +52,9 @@ struct ShellModelOptions {
   // the node's enrichments by earlier functions that were kept: M_vv - m^T G^-1 m < ratio
   // M_aa, with G their mass Gram matrix and m their couplings to v (M_vv - M_av^2 / M_aa
   // with no other enrichment). Catches fragments a few texels wide and two cut pieces
-  // whose functions nearly coincide at the node.
+  // whose functions nearly coincide at the node. "Earlier": the functions that are +-1 or
+  // 0 at every texel (pieces cut off completely) first, then the others, each group in
+  // function order, so of two nearly coinciding functions a piece's step stays.
   double min_enrichment_mass_ratio = 1e-3;
   // Corotation of enriched elements: 0, per quadrature point; B > 0, one rotation per cluster
   // of points (those of a block of B x B texels on one side of every cut), their rest
@@ -247,6 +249,9 @@ class ShellModel {
  private:
   // v - num_nodes() for a virtual node v, checked.
   int virtual_slot(int virtual_node) const;
+  // The virtual nodes in the order set_enrichments tests their masses: those of functions
+  // that are +-1 or 0 at every texel first, then the others, function by function.
+  std::vector<int> virtual_nodes_heavisides_first() const;
 
   Mesh mesh_;
   std::vector<kernels::ShellSection> sections_;
