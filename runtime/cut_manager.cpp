@@ -450,147 +450,187 @@ bool CutManager::update(double time) {
     std::map<int, std::uint64_t> data_hash;
     std::vector<int> enriched_nodes;  // nodes of E_i (unsorted, repeated)
   };
-  std::vector<SolveJob> jobs;
   bool changed_any = false;
   std::set<std::pair<int, int>> alive;
   std::map<std::pair<int, int>, std::size_t> visible_index;
+  std::vector<TexelData> segment_data(visible.size());
+  std::vector<std::size_t> to_solve;  // visible segments with data
   for (std::size_t v = 0; v < visible.size(); ++v) {
     const std::pair<int, int> key{visible[v].cut, visible[v].segment};
     visible_index[key] = v;
-    const TexelData data = dirichlet_data(rasters[v], mesh_.type, t, adjacency_);
-    if (data.empty()) continue;  // no texel edge: no enrichment
+    segment_data[v] = dirichlet_data(rasters[v], mesh_.type, t, adjacency_);
+    if (segment_data[v].empty()) continue;  // no texel edge: no enrichment
     alive.insert(key);
-
-    // E_i, N_i, Omega_i.
-    std::set<int> nodes, omega;
-    for (const auto& [e, texels] : data)
-      for (int a = 0; a < mesh_.nodes_per_element(); ++a) nodes.insert(mesh_.element_nodes(e)[a]);
-    for (int n : nodes)
-      for (int e : node_elements_[n]) omega.insert(e);
-    std::map<int, std::uint64_t> data_hash;
-    for (int e : omega) {
-      std::uint64_t h = kFnvSeed;
-      const auto it = data.find(e);
-      if (it != data.end())
-        for (const auto& [texel, value] : it->second) {
-          h = fnv(h, &texel, sizeof texel);
-          h = fnv(h, &value, sizeof value);
-        }
-      data_hash[e] = h;
-    }
-
-    auto state_it = states_.find(key);
-    const bool fresh = state_it == states_.end();
-    if (fresh) {
-      state_it = states_.emplace(key, SegmentState{}).first;
-      order_.push_back(key);
-    }
-    SegmentState& state = state_it->second;
-    std::set<int> changed;
-    for (int e : omega) {
-      const bool known = solved_values(state.function, e) != nullptr;
-      if (!known || state.wall_hash[e] != wall_hash(e) || state.data_hash[e] != data_hash[e]) changed.insert(e);
-    }
-    bool omega_same = state.function.elements.size() == omega.size();
-    if (omega_same)
-      for (const ElementTexture& texture : state.function.elements)
-        omega_same = omega_same && omega.count(texture.element) > 0;
-    if (changed.empty() && omega_same) continue;  // settled: keep H_i
-
-    std::set<int> solve;
-    if (fresh || !manager_options_.freeze_settled_elements) {
-      solve = omega;
-    } else {
-      for (int e : changed)
-        for (int a = 0; a < mesh_.nodes_per_element(); ++a)
-          for (int f : node_elements_[mesh_.element_nodes(e)[a]])
-            if (omega.count(f)) solve.insert(f);
-    }
-    SolveJob job;
-    job.key = key;
-    job.data_hash = std::move(data_hash);
-    for (const auto& [e, texels] : data)
-      for (int a = 0; a < mesh_.nodes_per_element(); ++a) job.enriched_nodes.push_back(mesh_.element_nodes(e)[a]);
-    for (int e : omega) {
-      RegionTile r;
-      r.element = e;
-      r.frozen = solve.count(e) == 0;  // then e is known: unknown elements are changed ones
-      // The element's walls, and its previous H where it has one: a frozen tile's data, else
-      // the initial guess (used by the multigrid; CHOLMOD ignores it). Copied once each.
-      const auto w = walls_.find(e);
-      const TexelTile& walled = w != walls_.end() ? w->second : blank;
-      const std::vector<double>* previous = solved_values(state.function, e);
-      r.tile.width = walled.width, r.tile.height = walled.height;
-      r.tile.flags = walled.flags;
-      r.tile.values = previous ? *previous : walled.values;
-      const auto it = data.find(e);
-      if (!r.frozen && it != data.end())
-        for (const auto& [texel, value] : it->second) {
-          r.tile.flags[texel] |= kernels::dirichlet;
-          r.tile.values[texel] = value;
-        }
-      job.region.push_back(std::move(r));
-    }
-    jobs.push_back(std::move(job));
+    to_solve.push_back(v);
   }
+  // Rounds: a step function that takes both +1 and -1 in an element outside E_i (a region
+  // it closes with other cuts reaches into an element where only the others' walls bound
+  // it) adds that element to E_i and is solved again on the grown Omega_i. Without its
+  // enrichment at that element's nodes, the region's part there stayed attached (a bar
+  // across a U on tri6 whose bar lies in one triangle: -0.072 instead of -0.505; session 73).
+  std::map<std::pair<int, int>, SegmentState> before_growth;
+  for (;;) {
+    std::vector<SolveJob> jobs;
+    for (const std::size_t v : to_solve) {
+      const std::pair<int, int> key{visible[v].cut, visible[v].segment};
+      const TexelData& data = segment_data[v];
+      auto state_it = states_.find(key);
+      const bool fresh = state_it == states_.end();
+      if (fresh) {
+        state_it = states_.emplace(key, SegmentState{}).first;
+        order_.push_back(key);
+      }
+      SegmentState& state = state_it->second;
 
-  // The solves of different segments are independent (each reads only the walls and its
-  // own settled values): one per thread when there are several (fewer synchronisations
-  // than a parallel multigrid per tile). Each solve runs the same operations whatever
-  // thread takes it, the regions that need CHOLMOD included (solve_mesh_texel_laplace's
-  // direct solve is lock-free), so the results do not depend on the thread count.
-  const LaplaceSolver solver =
-      options_.solver == EnrichmentOptions::Solver::multigrid ? LaplaceSolver::multigrid : LaplaceSolver::cholmod;
-  std::vector<MeshLaplaceStats> job_stats(jobs.size());
-  std::vector<std::exception_ptr> failures(jobs.size());
-  const auto solve_start = std::chrono::steady_clock::now();
-  // Inside the concurrent loop each multigrid runs its serial kernels (the same results
-  // as the parallel forms): nested parallel regions would cost a team per kernel call.
-  const bool concurrent = jobs.size() > 1 && omp_get_max_threads() > 1 && !omp_in_parallel();
-  LaplaceMultigridOptions multigrid_options;
-  if (concurrent) multigrid_options.execution = kernels::Execution::serial;
-  auto solve_job = [&](std::size_t k) {
-    try {
-      job_stats[k] = solve_mesh_texel_laplace(jobs[k].region, mesh_.type, adjacency_, edge_walls_, solver,
-                                              multigrid_options);
-    } catch (...) {
-      failures[k] = std::current_exception();
+      // E_i, N_i, Omega_i.
+      std::set<int> e_i = state.stepping_elements;
+      for (const auto& [e, texels] : data) e_i.insert(e);
+      std::set<int> nodes, omega;
+      for (int e : e_i)
+        for (int a = 0; a < mesh_.nodes_per_element(); ++a) nodes.insert(mesh_.element_nodes(e)[a]);
+      for (int n : nodes)
+        for (int e : node_elements_[n]) omega.insert(e);
+      std::map<int, std::uint64_t> data_hash;
+      for (int e : omega) {
+        std::uint64_t h = kFnvSeed;
+        const auto it = data.find(e);
+        if (it != data.end())
+          for (const auto& [texel, value] : it->second) {
+            h = fnv(h, &texel, sizeof texel);
+            h = fnv(h, &value, sizeof value);
+          }
+        data_hash[e] = h;
+      }
+
+      std::set<int> changed;
+      for (int e : omega) {
+        const bool known = solved_values(state.function, e) != nullptr;
+        if (!known || state.wall_hash[e] != wall_hash(e) || state.data_hash[e] != data_hash[e]) changed.insert(e);
+      }
+      bool omega_same = state.function.elements.size() == omega.size();
+      if (omega_same)
+        for (const ElementTexture& texture : state.function.elements)
+          omega_same = omega_same && omega.count(texture.element) > 0;
+      if (changed.empty() && omega_same) continue;  // settled: keep H_i
+
+      std::set<int> solve;
+      if (fresh || !manager_options_.freeze_settled_elements) {
+        solve = omega;
+      } else {
+        for (int e : changed)
+          for (int a = 0; a < mesh_.nodes_per_element(); ++a)
+            for (int f : node_elements_[mesh_.element_nodes(e)[a]])
+              if (omega.count(f)) solve.insert(f);
+      }
+      SolveJob job;
+      job.key = key;
+      job.data_hash = std::move(data_hash);
+      job.enriched_nodes.assign(nodes.begin(), nodes.end());
+      for (int e : omega) {
+        RegionTile r;
+        r.element = e;
+        r.frozen = solve.count(e) == 0;  // then e is known: unknown elements are changed ones
+        // The element's walls, and its previous H where it has one: a frozen tile's data, else
+        // the initial guess (used by the multigrid; CHOLMOD ignores it). Copied once each.
+        const auto w = walls_.find(e);
+        const TexelTile& walled = w != walls_.end() ? w->second : blank;
+        const std::vector<double>* previous = solved_values(state.function, e);
+        r.tile.width = walled.width, r.tile.height = walled.height;
+        r.tile.flags = walled.flags;
+        r.tile.values = previous ? *previous : walled.values;
+        const auto it = data.find(e);
+        if (!r.frozen && it != data.end())
+          for (const auto& [texel, value] : it->second) {
+            r.tile.flags[texel] |= kernels::dirichlet;
+            r.tile.values[texel] = value;
+          }
+        job.region.push_back(std::move(r));
+      }
+      jobs.push_back(std::move(job));
     }
-  };
-  kernels::forall_dynamic(
-      static_cast<std::int64_t>(jobs.size()), [&](std::int64_t k) { solve_job(static_cast<std::size_t>(k)); },
-      concurrent ? kernels::Execution::parallel : kernels::Execution::serial);
-  for (const std::exception_ptr& failure : failures)
-    if (failure) std::rethrow_exception(failure);
-  last_.solve_ms = ms_since(solve_start);
 
-  for (std::size_t k = 0; k < jobs.size(); ++k) {
-    SolveJob& job = jobs[k];
-    const MeshLaplaceStats& stats = job_stats[k];
-    last_.solves += 1;
-    last_.unknowns += stats.unknowns;
-    last_.solved_tiles += stats.solved_tiles;
-    last_.frozen_tiles += stats.frozen_tiles;
-    last_.algebraic_multigrid_solves += stats.algebraic_multigrid;
+    // The solves of different segments are independent (each reads only the walls and its
+    // own settled values): one per thread when there are several (fewer synchronisations
+    // than a parallel multigrid per tile). Each solve runs the same operations whatever
+    // thread takes it, the regions that need CHOLMOD included (solve_mesh_texel_laplace's
+    // direct solve is lock-free), so the results do not depend on the thread count.
+    const LaplaceSolver solver =
+        options_.solver == EnrichmentOptions::Solver::multigrid ? LaplaceSolver::multigrid : LaplaceSolver::cholmod;
+    std::vector<MeshLaplaceStats> job_stats(jobs.size());
+    std::vector<std::exception_ptr> failures(jobs.size());
+    const auto solve_start = std::chrono::steady_clock::now();
+    // Inside the concurrent loop each multigrid runs its serial kernels (the same results
+    // as the parallel forms): nested parallel regions would cost a team per kernel call.
+    const bool concurrent = jobs.size() > 1 && omp_get_max_threads() > 1 && !omp_in_parallel();
+    LaplaceMultigridOptions multigrid_options;
+    if (concurrent) multigrid_options.execution = kernels::Execution::serial;
+    auto solve_job = [&](std::size_t k) {
+      try {
+        job_stats[k] = solve_mesh_texel_laplace(jobs[k].region, mesh_.type, adjacency_, edge_walls_, solver,
+                                                multigrid_options);
+      } catch (...) {
+        failures[k] = std::current_exception();
+      }
+    };
+    kernels::forall_dynamic(
+        static_cast<std::int64_t>(jobs.size()), [&](std::int64_t k) { solve_job(static_cast<std::size_t>(k)); },
+        concurrent ? kernels::Execution::parallel : kernels::Execution::serial);
+    for (const std::exception_ptr& failure : failures)
+      if (failure) std::rethrow_exception(failure);
+    last_.solve_ms += ms_since(solve_start);
 
-    SegmentState& state = states_.at(job.key);
-    state.wall_hash.clear();
-    state.data_hash = std::move(job.data_hash);
-    EnrichmentFunction& f = state.function;
-    f.enriched_nodes = std::move(job.enriched_nodes);
-    std::sort(f.enriched_nodes.begin(), f.enriched_nodes.end());
-    f.enriched_nodes.erase(std::unique(f.enriched_nodes.begin(), f.enriched_nodes.end()), f.enriched_nodes.end());
-    f.elements.clear();
-    for (RegionTile& r : job.region) {  // region is sorted by element (omega is a set)
-      state.wall_hash[r.element] = wall_hash(r.element);
-      ElementTexture texture;
-      texture.element = r.element;
-      texture.tile = std::move(r.tile);
-      for (auto& flag : texture.tile.flags) flag &= static_cast<std::uint8_t>(~kernels::dirichlet);
-      f.elements.push_back(std::move(texture));
+    for (std::size_t k = 0; k < jobs.size(); ++k) {
+      SolveJob& job = jobs[k];
+      const MeshLaplaceStats& stats = job_stats[k];
+      last_.solves += 1;
+      last_.unknowns += stats.unknowns;
+      last_.solved_tiles += stats.solved_tiles;
+      last_.frozen_tiles += stats.frozen_tiles;
+      last_.algebraic_multigrid_solves += stats.algebraic_multigrid;
+
+      SegmentState& state = states_.at(job.key);
+      state.wall_hash.clear();
+      state.data_hash = std::move(job.data_hash);
+      EnrichmentFunction& f = state.function;
+      f.enriched_nodes = std::move(job.enriched_nodes);
+      std::sort(f.enriched_nodes.begin(), f.enriched_nodes.end());
+      f.enriched_nodes.erase(std::unique(f.enriched_nodes.begin(), f.enriched_nodes.end()), f.enriched_nodes.end());
+      f.elements.clear();
+      for (RegionTile& r : job.region) {  // region is sorted by element (omega is a set)
+        state.wall_hash[r.element] = wall_hash(r.element);
+        ElementTexture texture;
+        texture.element = r.element;
+        texture.tile = std::move(r.tile);
+        for (auto& flag : texture.tile.flags) flag &= static_cast<std::uint8_t>(~kernels::dirichlet);
+        f.elements.push_back(std::move(texture));
+      }
+      changed_any = true;
     }
-    changed_any = true;
+    to_solve.clear();
+    for (const SolveJob& job : jobs) {
+      SegmentState& state = states_.at(job.key);
+      if (!is_step_function(state.function)) continue;
+      const std::size_t v = visible_index.at(job.key);
+      std::set<int> stepping = state.stepping_elements;
+      for (const ElementTexture& texture : state.function.elements) {
+        if (segment_data[v].count(texture.element)) continue;
+        const auto& values = texture.tile.values;
+        if (std::find(values.begin(), values.end(), 1.0) != values.end() &&
+            std::find(values.begin(), values.end(), -1.0) != values.end())
+          stepping.insert(texture.element);
+      }
+      if (stepping.size() == state.stepping_elements.size()) continue;
+      before_growth.emplace(job.key, state);  // the first time only
+      state.stepping_elements = std::move(stepping);
+      to_solve.push_back(v);
+    }
+    if (to_solve.empty()) break;
   }
+  // A function that was a step only within its first Omega_i (its two sides meet beyond
+  // it, as around a crack tip closed at texel level) is not one on the grown region: it
+  // keeps its first region and values.
+  for (auto& [key, state] : before_growth)
+    if (!is_step_function(states_.at(key).function)) states_.at(key) = std::move(state);
   // Segments no longer visible (time went back) lose their functions.
   for (auto it = order_.begin(); it != order_.end();) {
     if (alive.count(*it)) {

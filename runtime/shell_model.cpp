@@ -1028,21 +1028,6 @@ int ShellModel::virtual_slot(int virtual_node) const {
   return virtual_node - num_nodes();
 }
 
-namespace {
-
-// Whether a function is +-1 (or 0) at every texel: the Heaviside of pieces that its cut
-// separates completely (a closed loop, a region two cuts close), which the Laplace solve
-// sets exactly (one value of data on each component). A harmonic function (one with a
-// crack tip) varies, so the scan usually ends at the first texels.
-bool is_step_function(const EnrichmentFunction& function) {
-  for (const ElementTexture& texture : function.elements)
-    for (const double value : texture.tile.values)
-      if (value != 0 && value != 1 && value != -1) return false;
-  return true;
-}
-
-}  // namespace
-
 std::vector<int> ShellModel::virtual_nodes_heavisides_first() const {
   const int nn = num_nodes();
   std::vector<char> step(enrichments_->size());

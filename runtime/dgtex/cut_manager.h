@@ -36,13 +36,18 @@
 //  - a segment ending on another cut (the later cut at a crossing, a T-junction) can walk
 //    its last edges along the other cut's staircase: they are dropped from its data (the
 //    other cut's walls stay), else a texel beyond the other cut gets its +-1 and a region
-//    that two cuts close stays attached.
+//    that two cuts close stays attached;
+//  - a region that a segment closes with other cuts can reach into elements where only the
+//    others' walls bound it (no data of the segment there): where the segment's function
+//    is a step (+-1 or 0 at every texel) and takes both +1 and -1 in such an element, the
+//    element joins E_i and the function is solved again on the grown Omega_i, in rounds.
 // CutManager owns its paths, segments, wall tiles and enrichment functions; it keeps a
 // reference to the mesh (which must outlive it; the topology is read by the constructor
 // only). Not thread-safe; the constructor (one cut per thread) and update() use all
 // OpenMP threads. Times in the scene's unit (SI: s), lengths in the mesh's (m).
 #include <cstdint>
 #include <map>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -144,6 +149,9 @@ class CutManager {
   struct SegmentState {
     std::map<int, std::uint64_t> wall_hash, data_hash;  // per element of Omega_i at the last solve
     EnrichmentFunction function;  // H_i on every element of Omega_i (sorted by element), all N_i
+    // Elements without data of the segment where its step function takes both +1 and -1
+    // (a piece it closes with other cuts reaches into them): in E_i as well.
+    std::set<int> stepping_elements;
   };
   void rasterize_visible(const std::vector<VisibleCutSegment>& visible,
                          std::vector<std::vector<std::pair<int, kernels::CutRaster>>>& rasters);

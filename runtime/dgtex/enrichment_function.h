@@ -36,4 +36,15 @@ struct EnrichmentFunction {
   std::vector<ElementTexture> elements;  // Omega_i, sorted by element index
 };
 
+// Whether H is +-1 (or 0) at every texel: the Heaviside of pieces its cut, alone or with
+// others, separates completely (a closed loop, a region two cuts close), which the Laplace
+// solve sets exactly (one value of data on each component). A harmonic function (one with
+// a crack tip) varies, so the scan usually ends at the first texels.
+inline bool is_step_function(const EnrichmentFunction& function) {
+  for (const ElementTexture& texture : function.elements)
+    for (const double value : texture.tile.values)
+      if (value != 0 && value != 1 && value != -1) return false;
+  return true;
+}
+
 }  // namespace dgtex
