@@ -539,13 +539,19 @@ bool CutManager::update(double time) {
         r.tile.flags = walled.flags;
         r.tile.values = previous ? *previous : walled.values;
         const auto it = data.find(e);
-        if (!r.frozen && it != data.end())
+        if (it != data.end())  // a frozen tile's data texels hold their values already
           for (const auto& [texel, value] : it->second) {
             r.tile.flags[texel] |= kernels::dirichlet;
             r.tile.values[texel] = value;
           }
         job.region.push_back(std::move(r));
       }
+      // A cut that closes a region (a loop's last texel edge) changes H beyond the one-ring
+      // it touches: the region's component is now constant. Its settled tiles are solved
+      // again, else they kept their harmonic values (a progressive loop on tri6 whose region
+      // spans two triangles: 0.033 off a fresh solve, the piece held; session 73).
+      for (const int l : stale_frozen_tiles(job.region, mesh_.type, adjacency_, edge_walls_))
+        job.region[l].frozen = false;
       jobs.push_back(std::move(job));
     }
 

@@ -520,6 +520,47 @@ Eigen::VectorXd solve_by_cholmod(const detail::SparseRows& a, const Eigen::Vecto
 
 }  // namespace
 
+std::vector<int> stale_frozen_tiles(std::vector<RegionTile>& tiles, ElementType type, const ElementAdjacency& adjacency,
+                                    const MeshEdgeWalls& edge_walls) {
+  std::vector<int> stale;
+  if (std::none_of(tiles.begin(), tiles.end(), [](const RegionTile& r) { return r.frozen; })) return stale;
+  TexelGraph graph(tiles, type, adjacency, edge_walls);
+  const int n = graph.nodes(), tt = tiles.front().tile.width * tiles.front().tile.width;
+  auto is_data = [&](int v) { return (tiles[v / tt].tile.flags[v % tt] & kernels::dirichlet) != 0; };
+  auto is_free = [&](int v) { return graph.active(v) && !is_data(v); };
+  // Components of the free texels, frozen tiles' included (parent[v] <= v: one forward
+  // pass flattens them).
+  std::vector<int> parent(n);
+  for (int v = 0; v < n; ++v) parent[v] = v;
+  for (int v = 0; v < n; ++v)
+    if (is_free(v))
+      graph.for_each_coupling(v, [&](int w) {
+        if (w < v && is_free(w)) kernels::unite_smaller_root(parent, v, w);
+      });
+  for (int v = 0; v < n; ++v) parent[v] = parent[parent[v]];
+  enum : std::uint8_t { no_data = 0, constant = 1, varying = 2 };
+  std::vector<std::uint8_t> state(n, no_data);
+  std::vector<double> constant_value(n, 0.0);
+  for (int d = 0; d < n; ++d)
+    if (graph.active(d) && is_data(d))
+      graph.for_each_coupling(d, [&](int w) {
+        if (!is_free(w)) return;
+        const int root = parent[w];
+        const double x = graph.value(d);
+        if (state[root] == no_data) state[root] = constant, constant_value[root] = x;
+        else if (state[root] == constant && x != constant_value[root]) state[root] = varying;
+      });
+  for (int l = 0; l < static_cast<int>(tiles.size()); ++l) {
+    if (!tiles[l].frozen) continue;
+    for (int v = l * tt; v < (l + 1) * tt; ++v)
+      if (is_free(v) && state[parent[v]] != varying && graph.value(v) != constant_value[parent[v]]) {
+        stale.push_back(l);
+        break;
+      }
+  }
+  return stale;
+}
+
 MeshLaplaceStats solve_mesh_texel_laplace(std::vector<RegionTile>& tiles, ElementType type,
                                           const ElementAdjacency& adjacency, const MeshEdgeWalls& edge_walls,
                                           LaplaceSolver solver, const LaplaceMultigridOptions& options) {

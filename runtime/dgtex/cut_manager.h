@@ -12,7 +12,9 @@
 //     walls of all other cuts and on Omega_i's outer boundary, 0 on components without data,
 //     C0 across element edges. While a cut advances only the one-ring of the elements whose
 //     data or walls changed is re-solved; the other elements of Omega_i keep their values
-//     (settled, thesis §5.5.3) and act as C0 Dirichlet data.
+//     (settled, thesis §5.5.3) and act as C0 Dirichlet data, except where a cut has closed a
+//     region since: a settled element holding texels of a component with one data value (or
+//     none) but other values is solved again (stale_frozen_tiles).
 // Degenerate cases and their remedies:
 //  - a cut along an element edge: the couplings across the edge are cut and the texels on
 //    both sides get +-1 (the path is traced in one of the two elements);

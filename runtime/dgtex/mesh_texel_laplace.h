@@ -104,6 +104,15 @@ struct MeshLaplaceStats {
 // where a multigrid does not converge: simplicial with the AMD ordering. None calls BLAS or
 // METIS, so concurrent calls (one segment per thread in CutManager) need no lock and give
 // the bits of a serial call.
+// The frozen tiles (indices into `tiles`) holding texels of a component whose data are one
+// value, or none, while their stored H is not that constant (0 for none): components of
+// every active texel that is not data, across mesh edges and frozen tiles alike, data being
+// the texels with the dirichlet bit (set it on frozen tiles' data texels too). A cut that
+// closes a region after those tiles settled leaves their harmonic values stale, where the
+// solution is now a constant. Reads the tiles only (non-const for TexelGraph).
+std::vector<int> stale_frozen_tiles(std::vector<RegionTile>& tiles, ElementType type, const ElementAdjacency& adjacency,
+                                    const MeshEdgeWalls& edge_walls);
+
 MeshLaplaceStats solve_mesh_texel_laplace(std::vector<RegionTile>& tiles, ElementType type,
                                           const ElementAdjacency& adjacency, const MeshEdgeWalls& edge_walls,
                                           LaplaceSolver solver = LaplaceSolver::cholmod,
