@@ -226,6 +226,23 @@ void CutManager::trim_shared_end_spurs(std::vector<std::vector<std::pair<int, Cu
     }
 }
 
+bool CutManager::both_values_reach_open_edges(const EnrichmentFunction& function) const {
+  std::set<int> omega;
+  for (const ElementTexture& texture : function.elements) omega.insert(texture.element);
+  bool plus = false, minus = false;
+  for (const ElementTexture& texture : function.elements)
+    for (int k = 0; k < adjacency_.edges_per_element(); ++k) {
+      const int beyond = adjacency_.neighbour(texture.element, k)[0];
+      if (beyond < 0 || omega.count(beyond)) continue;  // the mesh's boundary, or inside Omega_i
+      for (int s = 0; s < resolution_; ++s) {
+        const double value = texture.tile.values[edge_texel_index(mesh_.type, resolution_, k, s)];
+        plus = plus || value == 1;
+        minus = minus || value == -1;
+      }
+    }
+  return plus && minus;
+}
+
 void CutManager::trim_ends_along_other_segments(std::vector<RasterPieces>& rasters) const {
   if (rasters.size() < 2) return;
   struct Holder {
@@ -402,6 +419,31 @@ void CutManager::rasterize_visible(const std::vector<VisibleCutSegment>& visible
   trim_ends_along_other_segments(rasters);
   for (const auto& pieces : rasters)
     for (const auto& [e, raster] : pieces) kernels::mark_cut_walls(raster, walls_.at(e));
+  // Whether a segment's end touches a wall other than its own last edge and the next
+  // segment's first, or lies on its element's border (not looked at closer): only then can
+  // this update have closed a region.
+  tip_touches_a_wall_ = false;
+  const int t = resolution_;
+  for (std::size_t v = 0; v < rasters.size(); ++v) {
+    const auto& pieces = rasters[v];
+    if (pieces.empty()) continue;
+    const bool next_starts_here = v + 1 < rasters.size() && visible[v + 1].cut == visible[v].cut &&
+                                  visible[v + 1].segment == visible[v].segment + 1 && !rasters[v + 1].empty();
+    const auto& [e, raster] = pieces.back();
+    const CutLatticeEdge& last = raster.edges.back();
+    const int x = last.x + last.dx, y = last.y + last.dy;
+    if (x <= 0 || y <= 0 || x >= t || y >= t || (mesh_.type == ElementType::tri6 && x + y >= t - 1)) {
+      tip_touches_a_wall_ = true;
+      break;
+    }
+    const TexelTile& walls = walls_.at(e);
+    const int walls_at_tip = walls.is_wall_north(x - 1, y - 1) + walls.is_wall_north(x, y - 1) +
+                             walls.is_wall_east(x - 1, y - 1) + walls.is_wall_east(x - 1, y);
+    if (walls_at_tip >= (next_starts_here ? 3 : 2)) {
+      tip_touches_a_wall_ = true;
+      break;
+    }
+  }
   // Cuts along mesh edges cut the couplings between the two elements' boundary texels.
   for (const auto& pieces : rasters)
     for (const auto& [e, raster] : pieces)
@@ -550,8 +592,9 @@ bool CutManager::update(double time) {
       // it touches: the region's component is now constant. Its settled tiles are solved
       // again, else they kept their harmonic values (a progressive loop on tri6 whose region
       // spans two triangles: 0.033 off a fresh solve, the piece held; session 73).
-      for (const int l : stale_frozen_tiles(job.region, mesh_.type, adjacency_, edge_walls_))
-        job.region[l].frozen = false;
+      if (tip_touches_a_wall_)
+        for (const int l : stale_frozen_tiles(job.region, mesh_.type, adjacency_, edge_walls_))
+          job.region[l].frozen = false;
       jobs.push_back(std::move(job));
     }
 
@@ -615,7 +658,7 @@ bool CutManager::update(double time) {
     to_solve.clear();
     for (const SolveJob& job : jobs) {
       SegmentState& state = states_.at(job.key);
-      if (!is_step_function(state.function)) continue;
+      if (!is_step_function(state.function) || both_values_reach_open_edges(state.function)) continue;
       const std::size_t v = visible_index.at(job.key);
       std::set<int> stepping = state.stepping_elements;
       for (const ElementTexture& texture : state.function.elements) {

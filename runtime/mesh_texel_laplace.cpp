@@ -530,13 +530,24 @@ std::vector<int> stale_frozen_tiles(std::vector<RegionTile>& tiles, ElementType 
   auto is_free = [&](int v) { return graph.active(v) && !is_data(v); };
   // Components of the free texels, frozen tiles' included (parent[v] <= v: one forward
   // pass flattens them).
+  // Within a tile in texel order (west and south neighbours, as the solve's pass), then
+  // across mesh edges.
+  const int t = tiles.front().tile.width;
   std::vector<int> parent(n);
-  for (int v = 0; v < n; ++v) parent[v] = v;
-  for (int v = 0; v < n; ++v)
-    if (is_free(v))
-      graph.for_each_coupling(v, [&](int w) {
-        if (w < v && is_free(w)) kernels::unite_smaller_root(parent, v, w);
-      });
+  for (int l = 0; l < static_cast<int>(tiles.size()); ++l) {
+    const std::uint8_t* flags = tiles[l].tile.flags.data();
+    for (int k = 0; k < tt; ++k) {
+      const int v = l * tt + k, i = k % t, j = k / t;
+      parent[v] = v;
+      if (!is_free(v)) continue;
+      if (i > 0 && is_free(v - 1) && !(flags[k - 1] & kernels::wall_east)) kernels::unite_smaller_root(parent, v, v - 1);
+      if (j > 0 && is_free(v - t) && !(flags[k - t] & kernels::wall_north)) kernels::unite_smaller_root(parent, v, v - t);
+    }
+  }
+  for (int l = 0; l < static_cast<int>(tiles.size()); ++l)
+    graph.for_each_coupling_across_edges(l, [&](int v, int w) {
+      if (is_free(v) && is_free(w)) kernels::unite_smaller_root(parent, v, w);
+    });
   for (int v = 0; v < n; ++v) parent[v] = parent[parent[v]];
   enum : std::uint8_t { no_data = 0, constant = 1, varying = 2 };
   std::vector<std::uint8_t> state(n, no_data);

@@ -164,6 +164,11 @@ class CutManager {
   // they separate as the other cut's; as this segment's data they gave a texel beyond the
   // other cut this segment's +-1. The walls stay (the other segment marks them).
   void trim_ends_along_other_segments(std::vector<std::vector<std::pair<int, kernels::CutRaster>>>& rasters) const;
+  // Whether H takes both +1 and -1 on Omega_i's edges toward elements outside it: its two
+  // sides may meet beyond Omega_i, so a step there need not be one (fracture's first
+  // segment of cut 1); a region the segment closes lies inside Omega_i, and one of its
+  // values stays off those edges.
+  bool both_values_reach_open_edges(const EnrichmentFunction& function) const;
   bool terminal_key(const std::vector<std::pair<int, kernels::CutRaster>>& pieces, bool at_end,
                     std::pair<long long, long long>& key) const;
   bool edge_identity(int element, const kernels::CutLatticeEdge& edge, long long& id, bool& from_lower) const;
@@ -189,6 +194,7 @@ class CutManager {
   std::vector<EnrichmentSegment> function_segments_;
   std::vector<std::vector<std::pair<int, kernels::CutRaster>>> function_rasters_;
   int dependent_nodes_ = 0;
+  bool tip_touches_a_wall_ = false;  // at the last rasterisation: a region may have closed
   CutUpdateStats last_;
 };
 
