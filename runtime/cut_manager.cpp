@@ -669,7 +669,7 @@ bool CutManager::update(double time) {
           stepping.insert(texture.element);
       }
       if (stepping.size() == state.stepping_elements.size()) continue;
-      before_growth.emplace(job.key, state);  // the first time only
+      before_growth.try_emplace(job.key, state);  // the first time only
       state.stepping_elements = std::move(stepping);
       to_solve.push_back(v);
     }

@@ -528,10 +528,9 @@ std::vector<int> stale_frozen_tiles(std::vector<RegionTile>& tiles, ElementType 
   const int n = graph.nodes(), tt = tiles.front().tile.width * tiles.front().tile.width;
   auto is_data = [&](int v) { return (tiles[v / tt].tile.flags[v % tt] & kernels::dirichlet) != 0; };
   auto is_free = [&](int v) { return graph.active(v) && !is_data(v); };
-  // Components of the free texels, frozen tiles' included (parent[v] <= v: one forward
-  // pass flattens them).
-  // Within a tile in texel order (west and south neighbours, as the solve's pass), then
-  // across mesh edges.
+  // Components of the free texels, frozen tiles' included: within each tile in texel order
+  // (west and south neighbours), then across mesh edges (parent[v] <= v: one forward pass
+  // flattens them).
   const int t = tiles.front().tile.width;
   std::vector<int> parent(n);
   for (int l = 0; l < static_cast<int>(tiles.size()); ++l) {

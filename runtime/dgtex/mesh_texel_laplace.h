@@ -95,15 +95,6 @@ struct MeshLaplaceStats {
   double ms = 0;  // wall time of the whole call
 };
 
-// Solves in place: free texels of non-frozen tiles get H; data texels keep their values.
-// All tiles must be T x T of the same T, elements distinct (std::invalid_argument
-// otherwise); std::runtime_error if CHOLMOD fails. With LaplaceSolver::multigrid, regions
-// that lie flat (as blocks of tiles or texel by texel) are solved by the tile multigrid on
-// one patch tile, the others by algebraic multigrid on the texel graph (graph_laplacian_amg.h),
-// both to options.tolerance. CHOLMOD solves the region with LaplaceSolver::cholmod and
-// where a multigrid does not converge: simplicial with the AMD ordering. None calls BLAS or
-// METIS, so concurrent calls (one segment per thread in CutManager) need no lock and give
-// the bits of a serial call.
 // The frozen tiles (indices into `tiles`) holding texels of a component whose data are one
 // value, or none, while their stored H is not that constant (0 for none): components of
 // every active texel that is not data, across mesh edges and frozen tiles alike, data being
@@ -113,6 +104,15 @@ struct MeshLaplaceStats {
 std::vector<int> stale_frozen_tiles(std::vector<RegionTile>& tiles, ElementType type, const ElementAdjacency& adjacency,
                                     const MeshEdgeWalls& edge_walls);
 
+// Solves in place: free texels of non-frozen tiles get H; data texels keep their values.
+// All tiles must be T x T of the same T, elements distinct (std::invalid_argument
+// otherwise); std::runtime_error if CHOLMOD fails. With LaplaceSolver::multigrid, regions
+// that lie flat (as blocks of tiles or texel by texel) are solved by the tile multigrid on
+// one patch tile, the others by algebraic multigrid on the texel graph (graph_laplacian_amg.h),
+// both to options.tolerance. CHOLMOD solves the region with LaplaceSolver::cholmod and
+// where a multigrid does not converge: simplicial with the AMD ordering. None calls BLAS or
+// METIS, so concurrent calls (one segment per thread in CutManager) need no lock and give
+// the bits of a serial call.
 MeshLaplaceStats solve_mesh_texel_laplace(std::vector<RegionTile>& tiles, ElementType type,
                                           const ElementAdjacency& adjacency, const MeshEdgeWalls& edge_walls,
                                           LaplaceSolver solver = LaplaceSolver::cholmod,
