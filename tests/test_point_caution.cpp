@@ -3,14 +3,15 @@
 // beyond which cut points are refused.
 #include <gtest/gtest.h>
 
-#include <filesystem>
 #include <string>
+#include <vector>
 
 #include "dgtex/cut_path.h"
 #include "dgtex/mesh_generators.h"
 #include "dgtex/point_caution.h"
 #include "dgtex/scene_io.h"
 #include "dgtex/scene_model.h"
+#include "example_scene_files_support.h"
 
 namespace {
 
@@ -46,14 +47,12 @@ TEST(PointCaution, LoadsAndProbesOffTheShellAreCautionedFromAQuarterOfAnEdge) {
 }
 
 TEST(PointCaution, NoExampleSceneIsCautioned) {
-  int scenes = 0;
-  for (const auto& entry : std::filesystem::directory_iterator(std::string(DGTEX_SOURCE_DIR) + "/examples/scenes")) {
-    if (entry.path().extension() != ".json") continue;
-    const Scene scene = load_scene(entry.path().string());
-    EXPECT_EQ(far_point_caution(scene, build_scene_mesh(scene)), "") << entry.path();
-    ++scenes;
+  const std::vector<std::string> files = test::example_scene_files();
+  for (const std::string& file : files) {
+    const Scene scene = load_scene(file);
+    EXPECT_EQ(far_point_caution(scene, build_scene_mesh(scene)), "") << file;
   }
-  EXPECT_GE(scenes, 10);
+  EXPECT_GE(files.size(), 10u);
 }
 
 }  // namespace

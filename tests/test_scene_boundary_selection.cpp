@@ -3,7 +3,6 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
-#include <filesystem>
 #include <string>
 #include <vector>
 
@@ -11,6 +10,7 @@
 #include "dgtex/scene_io.h"
 #include "dgtex/scene_model.h"
 #include "dgtex/selection_caution.h"
+#include "example_scene_files_support.h"
 
 namespace {
 
@@ -146,14 +146,12 @@ TEST(SelectionCaution, AToleranceOfAPercentOfTheMeshOrMoreIsCautioned) {
 }
 
 TEST(SelectionCaution, NoExampleSceneIsCautioned) {
-  int scenes = 0;
-  for (const auto& entry : std::filesystem::directory_iterator(std::string(DGTEX_SOURCE_DIR) + "/examples/scenes")) {
-    if (entry.path().extension() != ".json") continue;
-    const Scene scene = load_scene(entry.path().string());
-    EXPECT_EQ(selection_tolerance_caution(scene, build_scene_mesh(scene)), "") << entry.path();
-    ++scenes;
+  const std::vector<std::string> files = test::example_scene_files();
+  for (const std::string& file : files) {
+    const Scene scene = load_scene(file);
+    EXPECT_EQ(selection_tolerance_caution(scene, build_scene_mesh(scene)), "") << file;
   }
-  EXPECT_GE(scenes, 10);
+  EXPECT_GE(files.size(), 10u);
 }
 
 }  // namespace
