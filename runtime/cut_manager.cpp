@@ -490,7 +490,7 @@ bool CutManager::update(double time) {
     std::pair<int, int> key;
     std::vector<RegionTile> region;
     std::map<int, std::uint64_t> data_hash;
-    std::vector<int> enriched_nodes;  // nodes of E_i (unsorted, repeated)
+    std::vector<int> enriched_nodes;  // N_i: the nodes of E_i, sorted
   };
   bool changed_any = false;
   std::set<std::pair<int, int>> alive;
@@ -642,8 +642,6 @@ bool CutManager::update(double time) {
       state.data_hash = std::move(job.data_hash);
       EnrichmentFunction& f = state.function;
       f.enriched_nodes = std::move(job.enriched_nodes);
-      std::sort(f.enriched_nodes.begin(), f.enriched_nodes.end());
-      f.enriched_nodes.erase(std::unique(f.enriched_nodes.begin(), f.enriched_nodes.end()), f.enriched_nodes.end());
       f.elements.clear();
       for (RegionTile& r : job.region) {  // region is sorted by element (omega is a set)
         state.wall_hash[r.element] = wall_hash(r.element);

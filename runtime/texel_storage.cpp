@@ -9,6 +9,7 @@
 #include <sstream>
 #include <stdexcept>
 #include <unordered_map>
+#include <unordered_set>
 
 #include <openvdb/io/File.h>
 #include <openvdb/openvdb.h>
@@ -45,7 +46,7 @@ std::vector<int> parse_slot_list(const std::string& text, const std::string& pat
                              "\" " + problem + "; expected element indices (>= 0) or -1, comma-separated, each once");
   };
   std::vector<int> elements;
-  std::unordered_map<int, bool> seen;
+  std::unordered_set<int> seen;
   if (text.empty()) return elements;
   std::istringstream in(text);
   for (std::string item; std::getline(in, item, ',');) {
@@ -55,7 +56,7 @@ std::vector<int> parse_slot_list(const std::string& text, const std::string& pat
     const long value = std::strtol(begin, &end, 10);
     if (item.empty() || end != begin + item.size() || errno == ERANGE || value < -1 || value > INT_MAX)
       refuse("holds '" + item + "'");
-    if (value >= 0 && !seen.emplace(static_cast<int>(value), true).second)
+    if (value >= 0 && !seen.insert(static_cast<int>(value)).second)
       refuse("lists element " + item + " twice");
     elements.push_back(static_cast<int>(value));
   }
