@@ -273,9 +273,10 @@ ShellState SceneRun::state() const {
       e.node_values.assign(npe, 0.0f);
       e.dofs.assign(3 * npe, 0.0);
       for (int a = 0; a < npe; ++a) {
-        const int v = model_->virtual_node(i, mesh_.element_nodes(texture.element)[a]);
+        double shift = 0;
+        const int v = model_->enrichment_dofs(i, mesh_.element_nodes(texture.element)[a], &shift);
         if (v < 0) continue;  // node not enriched by this function: its DOFs are zero
-        e.node_values[a] = static_cast<float>(model_->node_shift(v));
+        e.node_values[a] = static_cast<float>(shift);
         for (int c = 0; c < 3; ++c) e.dofs[3 * a + c] = u[3 * v + c];
       }
       state.enrichments.push_back(std::move(e));

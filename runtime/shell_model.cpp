@@ -6,6 +6,8 @@
 #include <cstring>
 #include <stdexcept>
 #include <string>
+#include <tuple>
+#include <utility>
 
 #include <Eigen/Dense>
 #include <omp.h>
@@ -247,7 +249,8 @@ kernels::PointSectionBatch ShellModel::textured_batch() const {
           textured_qp_start_.data(), textured_qp_.data(), textured_qp_sections_.data()};
 }
 
-void ShellModel::install_enrichments(std::vector<EnrichmentFunction> functions, bool build) {
+void ShellModel::install_enrichments(std::vector<EnrichmentFunction> functions, bool build,
+                                     std::vector<EnrichmentTie> ties) {
   const int ne = mesh_.num_elements();
   const int nn = mesh_.num_nodes();
   const int npe = mesh_.nodes_per_element();
@@ -297,15 +300,19 @@ void ShellModel::install_enrichments(std::vector<EnrichmentFunction> functions, 
                                  [](const ElementTexture& et, int e) { return et.element < e; });
       return it != f.elements.end() && it->element == element;
     };
-    for (int a : f.enriched_nodes)
+    std::vector<int> nodes_with_function = f.enriched_nodes;  // its own DOFs or tied ones
+    for (const EnrichmentTie& tie : ties)
+      if (tie.function == i) nodes_with_function.push_back(tie.node);
+    for (int a : nodes_with_function)
       for (const auto& [e, local] : incident[a])
         if (!has_texture(e))
           fail(i, "element " + std::to_string(e) + " is incident to enriched node " + std::to_string(a) +
                       " but has no texture (Omega_i must hold every element incident to N_i)");
+    std::sort(nodes_with_function.begin(), nodes_with_function.end());
     for (const ElementTexture& et : f.elements) {
       const int* nodes = mesh_.element_nodes(et.element);
       if (std::any_of(nodes, nodes + npe, [&](int a) {
-            return std::binary_search(f.enriched_nodes.begin(), f.enriched_nodes.end(), a);
+            return std::binary_search(nodes_with_function.begin(), nodes_with_function.end(), a);
           }))
         ++functions_on[et.element];
     }
@@ -337,23 +344,30 @@ void ShellModel::install_enrichments(std::vector<EnrichmentFunction> functions, 
                                [](const ElementTexture& et, int e) { return et.element < e; });
     return it != list.end() && it->element == element ? &it->tile : nullptr;
   };
+  auto node_shift_of = [&](int i, int a) {
+    double sum = 0;
+    for (const auto& [e, local] : incident[a]) {
+      const kernels::TexelTile* tile = texture_of(i, e);  // there is one (checked above)
+      double xi[2];
+      kernels::node_parametric_position(type, local, xi);
+      kernels::TextureSample sample;
+      kernels::sample_texture(type, resolution, {tile->values.data(), tile->flags.data()}, xi[0], xi[1], sample);
+      sum += sample.value;
+    }
+    return incident[a].empty() ? 0.0 : sum / static_cast<double>(incident[a].size());
+  };
   for (int i = 0; i < static_cast<int>(enrichments_->size()); ++i) {
     for (int a : (*enrichments_)[i].enriched_nodes) {
-      double sum = 0;
-      for (const auto& [e, local] : incident[a]) {
-        const kernels::TexelTile* tile = texture_of(i, e);  // there is one (checked above)
-        double xi[2];
-        kernels::node_parametric_position(type, local, xi);
-        kernels::TextureSample sample;
-        kernels::sample_texture(type, resolution, {tile->values.data(), tile->flags.data()}, xi[0], xi[1], sample);
-        sum += sample.value;
-      }
       virtual_node_function_.push_back(i);
       virtual_node_mesh_node_.push_back(a);
-      virtual_node_shift_.push_back(incident[a].empty() ? 0.0 : sum / static_cast<double>(incident[a].size()));
+      virtual_node_shift_.push_back(node_shift_of(i, a));
     }
     function_slot_start_.push_back(static_cast<int>(virtual_node_function_.size()));
   }
+  ties_ = std::move(ties);
+  std::sort(ties_.begin(), ties_.end(),
+            [](const EnrichmentTie& x, const EnrichmentTie& y) { return std::tie(x.function, x.node) < std::tie(y.function, y.node); });
+  for (EnrichmentTie& tie : ties_) tie.shift = node_shift_of(tie.function, tie.node);
 
   // Element enrichments, grouped per element in the order of the functions.
   struct ElementEnrichment {
@@ -367,9 +381,10 @@ void ShellModel::install_enrichments(std::vector<EnrichmentFunction> functions, 
       ElementEnrichment ee{&et.tile, {}, {}};
       bool any = false;
       for (int a = 0; a < npe; ++a) {
-        const int v = virtual_node(i, mesh_.element_nodes(et.element)[a]);
+        double shift = 0.0;
+        const int v = enrichment_dofs(i, mesh_.element_nodes(et.element)[a], &shift);
         ee.nodes[a] = v;
-        ee.shifts[a] = v >= 0 ? virtual_node_shift_[v - nn] : 0.0;
+        ee.shifts[a] = shift;
         any = any || v >= 0;
       }
       if (any) per_element[et.element].push_back(ee);
@@ -719,6 +734,31 @@ int ShellModel::virtual_node(int function, int node) const {
   const auto it = std::lower_bound(nodes.begin(), nodes.end(), node);
   if (it == nodes.end() || *it != node) return -1;
   return mesh_.num_nodes() + function_slot_start_[function] + static_cast<int>(it - nodes.begin());
+}
+
+namespace {
+
+bool repeats_a_node(const int* global, int count) {
+  for (int a = 1; a < count; ++a)
+    if (std::find(global, global + a, global[a]) != global + a) return true;
+  return false;
+}
+
+}  // namespace
+
+int ShellModel::enrichment_dofs(int function, int node, double* shift) const {
+  int v = virtual_node(function, node);
+  double h = v >= 0 ? virtual_node_shift_[v - mesh_.num_nodes()] : 0.0;
+  if (v < 0) {
+    const auto it = std::lower_bound(ties_.begin(), ties_.end(), std::make_pair(function, node),
+                                     [](const EnrichmentTie& t, const std::pair<int, int>& key) {
+                                       return std::make_pair(t.function, t.node) < key;
+                                     });
+    if (it != ties_.end() && it->function == function && it->node == node)
+      v = virtual_node(function, it->partner), h = it->shift;
+  }
+  if (shift) *shift = h;
+  return v;
 }
 
 kernels::ElementBatch ShellModel::element_batch() const {
@@ -1110,6 +1150,8 @@ void ShellModel::set_enrichments(std::vector<EnrichmentFunction> functions) {
   std::vector<std::vector<int>> kept_nodes(enrichments_->size());
   int pruned = 0;
   std::vector<std::vector<int>> kept_at(num_nodes());  // per mesh node: its kept virtual nodes so far
+  std::vector<char> kept_node(num_enriched_nodes(), 0);  // per virtual node
+  std::vector<int> small_on_support;  // pruned virtual nodes whose own mass is the small one
   for (const int v : virtual_nodes_heavisides_first()) {
     const int node = virtual_node_mesh_node_[v - nn];
     std::vector<int> earlier = {node};  // N^a, then its kept enrichments
@@ -1124,43 +1166,97 @@ void ShellModel::set_enrichments(std::vector<EnrichmentFunction> functions) {
     const double independent = coupling(v, v) - cross.dot(gram.ldlt().solve(cross));
     if (independent < options_.min_enrichment_mass_ratio * gram(0, 0)) {  // gram(0, 0) = M_aa
       ++pruned;
+      if (coupling(v, v) < options_.min_enrichment_mass_ratio * gram(0, 0)) small_on_support.push_back(v);
     } else {
       kept_nodes[virtual_node_function_[v - nn]].push_back(node);
       kept_at[node].push_back(v);
+      kept_node[v - nn] = 1;
     }
   }
   if (pruned == 0) {
     rebuild(&element_mass);
     return;
   }
+  const std::vector<EnrichmentTie> ties = enrichment_ties(small_on_support, kept_node, element_mass);
   // install_enrichments below replaces every member derived from enrichments_. The
   // functions were installed by this call, so no copy of the model shares them yet.
   std::vector<EnrichmentFunction> kept = std::move(*enrichments_);
   for (size_t i = 0; i < kept.size(); ++i) kept[i].enriched_nodes = std::move(kept_nodes[i]);
-  // Functions left without nodes go; the others keep the elements of Omega_i that still
-  // touch one of their nodes.
+  // Functions left without nodes go (so have no ties); the others keep the elements of
+  // Omega_i that still touch one of their nodes, own or tied.
   std::vector<EnrichmentFunction> functions_left;
-  for (auto& f : kept) {
+  std::vector<int> index_left(kept.size(), -1);
+  for (size_t i = 0; i < kept.size(); ++i) {
+    EnrichmentFunction& f = kept[i];
     if (f.enriched_nodes.empty()) continue;
+    std::vector<int> nodes_with_function = f.enriched_nodes;
+    for (const EnrichmentTie& tie : ties)
+      if (tie.function == static_cast<int>(i)) nodes_with_function.push_back(tie.node);
+    std::sort(nodes_with_function.begin(), nodes_with_function.end());
     std::vector<ElementTexture> elements;
     for (auto& texture : f.elements) {
       const int* nodes = mesh_.element_nodes(texture.element);
       bool touches = false;
       for (int a = 0; a < mesh_.nodes_per_element() && !touches; ++a)
-        touches = std::binary_search(f.enriched_nodes.begin(), f.enriched_nodes.end(), nodes[a]);
+        touches = std::binary_search(nodes_with_function.begin(), nodes_with_function.end(), nodes[a]);
       if (touches) elements.push_back(std::move(texture));
     }
     f.elements = std::move(elements);
+    index_left[i] = static_cast<int>(functions_left.size());
     functions_left.push_back(std::move(f));
   }
+  std::vector<EnrichmentTie> ties_left = ties;
+  for (EnrichmentTie& tie : ties_left) tie.function = index_left[tie.function];
   // This rebuild alone keeps the first build's quadrature where whole functions went.
   rebuilding_pruned_basis_ = true;
   struct Reset {
     bool& flag;
     ~Reset() { flag = false; }
   } reset{rebuilding_pruned_basis_};
-  install_enrichments(std::move(functions_left));
+  install_enrichments(std::move(functions_left), true, std::move(ties_left));
   pruned_enriched_nodes_ = pruned;
+}
+
+std::vector<ShellModel::EnrichmentTie> ShellModel::enrichment_ties(const std::vector<int>& small_on_support,
+                                                                   const std::vector<char>& kept_node,
+                                                                   const std::vector<double>& element_mass) const {
+  // A node whose enriched function has almost no mass on its support holds only a corner of
+  // a piece there, (H - H(xi^a)) N^a being 0 off the piece. Dropped, the piece's other
+  // nodes no longer sum to 1 on that corner: the piece cannot translate and is held by the
+  // elastic energy of that corner (a triangle cut out around a node of a 2 x 2 plate fell
+  // 0.02 instead of 0.505 in a second; session 74). Every enriched DOF of a Heaviside has
+  // the same value in a translation of either side, so adding the dropped function to the
+  // DOFs of another node of the same function keeps the translations, and the sum is as
+  // well conditioned as that node's function alone. The partner: the kept node whose
+  // function overlaps it most (largest |M_vw|); none overlapping: dropped as before.
+  const int nn = num_nodes(), W = width_;
+  std::vector<char> small(num_enriched_nodes(), 0);
+  for (const int v : small_on_support) small[v - nn] = 1;
+  std::vector<std::vector<double>> overlap(num_enriched_nodes());
+  for (int x = 0; x < num_enriched_elements(); ++x) {
+    const int* global = enriched_global_nodes_.data() + static_cast<size_t>(x) * W;
+    const double* mass = element_mass.data() + static_cast<size_t>(x) * W * W;
+    for (int p = 0; p < W; ++p) {
+      if (global[p] < nn || !small[global[p] - nn]) continue;
+      const int v = global[p];
+      auto& sums = overlap[v - nn];
+      if (sums.empty()) sums.assign(num_enriched_nodes(), 0.0);
+      for (int q = 0; q < W; ++q)
+        if (global[q] >= nn && kept_node[global[q] - nn] && virtual_node_function_[global[q] - nn] == virtual_node_function_[v - nn])
+          sums[global[q] - nn] += mass[p * W + q];
+    }
+  }
+  std::vector<EnrichmentTie> ties;
+  for (const int v : small_on_support) {
+    const auto& sums = overlap[v - nn];
+    int partner = -1;
+    double largest = 0;
+    for (std::size_t w = 0; w < sums.size(); ++w)
+      if (std::abs(sums[w]) > largest) largest = std::abs(sums[w]), partner = static_cast<int>(w);
+    if (partner >= 0)
+      ties.push_back({virtual_node_function_[v - nn], virtual_node_mesh_node_[v - nn], virtual_node_mesh_node_[partner], 0.0});
+  }
+  return ties;
 }
 
 int ShellModel::basis_at(int element, const double xi[2], int* global, double* values) const {
@@ -1368,7 +1464,7 @@ std::vector<std::vector<double>> ShellModel::moments_of_fields(const ShellModel&
       const bool parallel = count > block;
       const std::int64_t slices = parallel ? kernels::parallel_team_size() : 1;
       // Then w N_A g_c summed per basis function: each of `slices` items takes a run of the
-      // element's basis functions (its global nodes are distinct) and adds, for every field,
+      // element's basis functions (where its global nodes are distinct) and adds, for every field,
       // point after point into a local copy of their sums: the same additions in the same
       // order as the serial loop, so the bits do not depend on the slices (one per thread:
       // each reads the span's values once), and no scattered stores (2x faster).
@@ -1400,7 +1496,19 @@ std::vector<std::vector<double>> ShellModel::moments_of_fields(const ShellModel&
       // the static split of this loop).
       const kernels::Execution execution = parallel ? kernels::Execution::parallel : kernels::Execution::serial;
       kernels::forall_dynamic((count + block - 1) / block, evaluate, execution);
-      kernels::forall(slices, accumulate, execution);
+      if (!repeats_a_node(global.data(), basis_count)) {
+        kernels::forall(slices, accumulate, execution);
+        continue;
+      }
+      // A node tied to another (set_enrichments) adds to that one's sums: point by point,
+      // as mass_weighted_moments adds them.
+      for (std::int64_t p = 0; p < count; ++p) {
+        const double* d = data.data() + p * per_point;
+        const double* values = kept ? kept + (begin + p) * kept_.width : d + 1;
+        for (int f = 0; f < nf; ++f)
+          for (int a = 0; a < basis_count; ++a)
+            for (int c = 0; c < 3; ++c) out[f][3 * global[a] + c] += d[0] * values[a] * d[1 + stride + 3 * f + c];
+      }
     }
   }
   if (points_read_from_source) *points_read_from_source = read_from_source;

@@ -115,7 +115,10 @@ class ShellModel {
   // enriched element that has a material texture; each before anything changes, so the
   // model keeps its basis when it throws.
   // Enriched nodes below options().min_enrichment_mass_ratio are dropped (and functions
-  // left without nodes), so enrichments() may hold less than was given.
+  // left without nodes), so enrichments() may hold less than was given. A node dropped for
+  // its function's small mass on its support (a corner of a piece) is tied instead where
+  // the function keeps a node that overlaps it: its enriched function adds to that node's
+  // DOFs (enrichment_dofs), so the piece keeps its translations.
   // Cost: an enriched element whose textures (and enriched nodes and shifts) are bitwise
   // those of the previous call on this model or the model it was copied from keeps its
   // quadrature (and mass and load weights); the results equal a fresh model's bitwise.
@@ -137,7 +140,8 @@ class ShellModel {
     cut_edge_resolution_ = resolution;
     cut_edge_texels_ = std::move(flags);
   }
-  int num_pruned_enriched_nodes() const { return pruned_enriched_nodes_; }
+  int num_pruned_enriched_nodes() const { return pruned_enriched_nodes_; }  // tied ones included
+  int num_tied_enriched_nodes() const { return static_cast<int>(ties_.size()); }
   void clear_enrichments() { set_enrichments({}); }
   // For a model about to receive a basis change: from the next set_enrichments on, keep the
   // new basis's values at the enriched elements' quadrature points as the mass integration
@@ -166,6 +170,10 @@ class ShellModel {
   int num_enriched_dofs() const { return 3 * num_enriched_nodes(); }
   // Virtual node of (function i, mesh node a), or -1 if a is not in N_i.
   int virtual_node(int function, int node) const;
+  // The virtual node whose DOFs carry (function i, mesh node a)'s enriched function
+  // (H_i - H_i(xi^a)) N^a: a's own (virtual_node), or the one a was tied to
+  // (set_enrichments); -1 if neither. `shift`, if given, receives H_i(xi^a).
+  int enrichment_dofs(int function, int node, double* shift = nullptr) const;
   // Mesh node a and function i of virtual node v, and H_i(xi^a) (num_nodes() <= v <
   // num_nodes() + num_enriched_nodes(), else std::invalid_argument: a loop from 0 read
   // before the arrays).
@@ -434,9 +442,22 @@ class ShellModel {
   void integrate_enriched_elements(const kernels::EnrichedElementBatch& eb, std::vector<double>& mass);
 
   int pruned_enriched_nodes_ = 0;
-  // Takes the functions and sets up the per-element layout; `build`: then rebuild() (else
-  // the caller must, after reading the element integrals).
-  void install_enrichments(std::vector<EnrichmentFunction> functions, bool build = true);
+  // A mesh node whose enriched function of `function` has no DOFs of its own: it adds to
+  // those of `partner`, a node of the same function (set_enrichments). shift: H_i(xi^node).
+  struct EnrichmentTie {
+    int function, node, partner;
+    double shift;
+  };
+  std::vector<EnrichmentTie> ties_;  // sorted by (function, node)
+  // set_enrichments' ties for the pruned virtual nodes `small_on_support`, partners among
+  // the kept ones, from the enriched elements' mass (#enriched elements x width^2).
+  std::vector<EnrichmentTie> enrichment_ties(const std::vector<int>& small_on_support, const std::vector<char>& kept_node,
+                                             const std::vector<double>& element_mass) const;
+  // Takes the functions (and ties, their shifts computed here) and sets up the per-element
+  // layout; `build`: then rebuild() (else the caller must, after reading the element
+  // integrals).
+  void install_enrichments(std::vector<EnrichmentFunction> functions, bool build = true,
+                           std::vector<EnrichmentTie> ties = {});
   // Everything derived from the mesh, sections and enrichments. `integrated_mass`: the
   // mass integrate_enriched_elements just gave for the current enrichments (not run again).
   void rebuild(std::vector<double>* integrated_mass = nullptr);
