@@ -300,15 +300,12 @@ void ShellModel::install_enrichments(std::vector<EnrichmentFunction> functions, 
                                  [](const ElementTexture& et, int e) { return et.element < e; });
       return it != f.elements.end() && it->element == element;
     };
-    std::vector<int> nodes_with_function = f.enriched_nodes;  // its own DOFs or tied ones
-    for (const EnrichmentTie& tie : ties)
-      if (tie.function == i) nodes_with_function.push_back(tie.node);
+    const std::vector<int> nodes_with_function = nodes_with_own_or_tied_dofs(f, i, ties);
     for (int a : nodes_with_function)
       for (const auto& [e, local] : incident[a])
         if (!has_texture(e))
           fail(i, "element " + std::to_string(e) + " is incident to enriched node " + std::to_string(a) +
                       " but has no texture (Omega_i must hold every element incident to N_i)");
-    std::sort(nodes_with_function.begin(), nodes_with_function.end());
     for (const ElementTexture& et : f.elements) {
       const int* nodes = mesh_.element_nodes(et.element);
       if (std::any_of(nodes, nodes + npe, [&](int a) {
@@ -1177,7 +1174,7 @@ void ShellModel::set_enrichments(std::vector<EnrichmentFunction> functions) {
     rebuild(&element_mass);
     return;
   }
-  const std::vector<EnrichmentTie> ties = enrichment_ties(small_on_support, kept_node, element_mass);
+  std::vector<EnrichmentTie> ties = enrichment_ties(small_on_support, kept_node, element_mass);
   // install_enrichments below replaces every member derived from enrichments_. The
   // functions were installed by this call, so no copy of the model shares them yet.
   std::vector<EnrichmentFunction> kept = std::move(*enrichments_);
@@ -1189,10 +1186,7 @@ void ShellModel::set_enrichments(std::vector<EnrichmentFunction> functions) {
   for (size_t i = 0; i < kept.size(); ++i) {
     EnrichmentFunction& f = kept[i];
     if (f.enriched_nodes.empty()) continue;
-    std::vector<int> nodes_with_function = f.enriched_nodes;
-    for (const EnrichmentTie& tie : ties)
-      if (tie.function == static_cast<int>(i)) nodes_with_function.push_back(tie.node);
-    std::sort(nodes_with_function.begin(), nodes_with_function.end());
+    const std::vector<int> nodes_with_function = nodes_with_own_or_tied_dofs(f, static_cast<int>(i), ties);
     std::vector<ElementTexture> elements;
     for (auto& texture : f.elements) {
       const int* nodes = mesh_.element_nodes(texture.element);
@@ -1205,16 +1199,24 @@ void ShellModel::set_enrichments(std::vector<EnrichmentFunction> functions) {
     index_left[i] = static_cast<int>(functions_left.size());
     functions_left.push_back(std::move(f));
   }
-  std::vector<EnrichmentTie> ties_left = ties;
-  for (EnrichmentTie& tie : ties_left) tie.function = index_left[tie.function];
+  for (EnrichmentTie& tie : ties) tie.function = index_left[tie.function];
   // This rebuild alone keeps the first build's quadrature where whole functions went.
   rebuilding_pruned_basis_ = true;
   struct Reset {
     bool& flag;
     ~Reset() { flag = false; }
   } reset{rebuilding_pruned_basis_};
-  install_enrichments(std::move(functions_left), true, std::move(ties_left));
+  install_enrichments(std::move(functions_left), true, std::move(ties));
   pruned_enriched_nodes_ = pruned;
+}
+
+std::vector<int> ShellModel::nodes_with_own_or_tied_dofs(const EnrichmentFunction& f, int function,
+                                                         const std::vector<EnrichmentTie>& ties) {
+  std::vector<int> nodes = f.enriched_nodes;
+  for (const EnrichmentTie& tie : ties)
+    if (tie.function == function) nodes.push_back(tie.node);
+  std::sort(nodes.begin(), nodes.end());
+  return nodes;
 }
 
 std::vector<ShellModel::EnrichmentTie> ShellModel::enrichment_ties(const std::vector<int>& small_on_support,

@@ -254,4 +254,22 @@ TEST(SceneCutLoops, ATriangleCutOutAroundANodeFallsWithItsCornersTied) {
   }
 }
 
+// A square loop with a corner on the plate's centre node and two sides along mesh edges
+// (tri6): where a side along one element's hypotenuse meets a side along another's leg, the
+// path retraces a stretch of the mesh edge from both elements. The hypotenuse's staircase
+// passed it with two lattice edges, the leg with one, so the retrace did not cancel, a
+// texel outside the loop got 0 instead of -1, and the loop's function was harmonic: the
+// square fell 0.016 instead of 0.505 (T = 16-64, until session 74).
+TEST(SceneCutLoops, ALoopWithSidesAlongTri6EdgesFromACornerOnANodeFallsFreely) {
+  const Vec3 a{0.5, 0.5, 0}, b{0.809, 0.5, 0}, c{0.809, 0.83, 0}, d{0.5, 0.83, 0};
+  for (const int T : {16, 32}) {
+    SCOPED_TRACE("T = " + std::to_string(T));
+    const Vec3 u = displacement_after_a_second({{a, b, c, d, a}}, {0.66, 0.66, 0}, ElementType::tri6, T);
+    std::printf("T = %d: the square moved [%.1e, %.1e, %.6f] (free fall %.6f, off by %.1e)\n", T, u[0], u[1], u[2],
+                kFreeFall, std::abs(u[2] - kFreeFall) / std::abs(kFreeFall));
+    EXPECT_NEAR(u[2], kFreeFall, 1e-9 * std::abs(kFreeFall));
+    EXPECT_LT(std::hypot(u[0], u[1]), 1e-9);
+  }
+}
+
 }  // namespace

@@ -449,6 +449,10 @@ class ShellModel {
     double shift;
   };
   std::vector<EnrichmentTie> ties_;  // sorted by (function, node)
+  // The nodes of f's enriched functions, sorted: f.enriched_nodes and those `ties` tie for
+  // `function` (its index).
+  static std::vector<int> nodes_with_own_or_tied_dofs(const EnrichmentFunction& f, int function,
+                                                      const std::vector<EnrichmentTie>& ties);
   // set_enrichments' ties for the pruned virtual nodes `small_on_support`, partners among
   // the kept ones, from the enriched elements' mass (#enriched elements x width^2).
   std::vector<EnrichmentTie> enrichment_ties(const std::vector<int>& small_on_support, const std::vector<char>& kept_node,
