@@ -570,7 +570,18 @@ bool CutManager::update(double time) {
       if (omega_same)
         for (const ElementTexture& texture : state.function.elements)
           omega_same = omega_same && omega.count(texture.element) > 0;
-      if (changed.empty() && omega_same) continue;  // settled: keep H_i
+      if (changed.empty() && omega_same) {  // settled: keep H_i
+        // A round that adds an element whose nodes' elements were all in Omega_i already
+        // gives the same H_i, but N_i gains the element's nodes: without them the region's
+        // part there stayed attached (a tri6 triangle at T = 32: -0.233 instead of -0.505,
+        // swinging sideways; session 74).
+        std::vector<int> grown_nodes(nodes.begin(), nodes.end());
+        if (state.function.enriched_nodes != grown_nodes) {
+          state.function.enriched_nodes = std::move(grown_nodes);
+          changed_any = true;
+        }
+        continue;
+      }
 
       std::set<int> solve;
       if (fresh || !manager_options_.freeze_settled_elements) {
