@@ -222,6 +222,24 @@ bool CutManager::terminal_key(const std::vector<std::pair<int, CutRaster>>& piec
 }
 
 void CutManager::trim_shared_end_spurs(std::vector<std::vector<std::pair<int, CutRaster>>>& rasters) const {
+  // A segment whose path ends by stepping one lattice edge into an element and straight
+  // back (its end point snapped onto the border it had crossed) cancels that retrace in its
+  // own data, but the retrace hid the edge before it, which the next segment shares, from
+  // the matching below: that edge's +-1 then reached a texel outside the loop they close,
+  // and the segment's function was no step (a tri6 triangle at T = 32; session 74).
+  const auto walked_back = [](const CutLatticeEdge& first, const CutLatticeEdge& second) {
+    return second.x == first.x + first.dx && second.y == first.y + first.dy && second.dx == -first.dx &&
+           second.dy == -first.dy;
+  };
+  for (RasterPieces& pieces : rasters)
+    for (const bool at_end : {false, true})
+      while (!pieces.empty()) {
+        const std::vector<CutLatticeEdge>& edges = (at_end ? pieces.back() : pieces.front()).second.edges;
+        if (edges.size() < 2) break;
+        if (at_end ? !walked_back(edges[edges.size() - 2], edges.back()) : !walked_back(edges[0], edges[1])) break;
+        pop_terminal_edge(pieces, at_end);
+        pop_terminal_edge(pieces, at_end);
+      }
   struct SegmentEnd {
     std::size_t segment;
     bool at_end;  // the end of the segment's path (else its start)
