@@ -591,8 +591,8 @@ bool CutManager::update(double time) {
       if (changed.empty() && omega_same) {  // settled: keep H_i
         // A round that adds an element whose nodes' elements were all in Omega_i already
         // gives the same H_i, but N_i gains the element's nodes: without them the region's
-        // part there stayed attached (a tri6 triangle at T = 32: -0.233 instead of -0.505,
-        // swinging sideways; session 74).
+        // part there stayed attached (a square cut as a U and a bar on a 2 x 2 tri6 plate:
+        // -0.176 instead of -0.505, swinging sideways; session 74).
         std::vector<int> grown_nodes(nodes.begin(), nodes.end());
         if (state.function.enriched_nodes != grown_nodes) {
           state.function.enriched_nodes = std::move(grown_nodes);
