@@ -55,6 +55,12 @@ Vec3 displacement_after_a_second(const std::vector<std::vector<Vec3>>& cuts, con
 // Semi-implicit Euler's fall after n steps of dt from rest: g dt^2 n (n + 1) / 2.
 constexpr double kFreeFall = -1.0 * 0.01 * 0.01 * 100 * 101 / 2;
 
+// Prints "<what> moved [x, y, z] (free fall f, off by r)<extra>" for the test's log.
+void print_fall(const std::string& what, const Vec3& u, const std::string& extra = "") {
+  std::printf("%s moved [%.1e, %.1e, %.6f] (free fall %.6f, off by %.1e)%s\n", what.c_str(), u[0], u[1], u[2], kFreeFall,
+              std::abs(u[2] - kFreeFall) / std::abs(kFreeFall), extra.c_str());
+}
+
 TEST(SceneCutLoops, TheInsideOfASelfCrossingCutsLoopFallsFreely) {
   // A -> B -> C -> D crosses itself at X = (0.725, 0.75): the loop X -> B -> C -> X lies in
   // element 3, away from its nodes.
@@ -64,8 +70,7 @@ TEST(SceneCutLoops, TheInsideOfASelfCrossingCutsLoopFallsFreely) {
                                      {"self-crossing cut", {a, b, c, d}}}) {
     SCOPED_TRACE(name);
     const Vec3 u = displacement_after_a_second({points}, inside);
-    std::printf("%s: the loop's inside moved [%.1e, %.1e, %.6f] (free fall %.6f, off by %.1e)\n", name.c_str(),
-                u[0], u[1], u[2], kFreeFall, std::abs(u[2] - kFreeFall) / std::abs(kFreeFall));
+    print_fall(name + ": the loop's inside", u);
     EXPECT_NEAR(u[2], kFreeFall, 1e-9 * std::abs(kFreeFall));  // measured 1.0e-13 off (both)
     EXPECT_LT(std::hypot(u[0], u[1]), 1e-9);
   }
@@ -249,9 +254,8 @@ TEST(SceneCutLoops, ATriangleCutOutAroundANodeFallsWithItsCornersTied) {
     const Vec3 u = displacement_after_a_second({{a, b, c, a}}, inside, type, 16, [&](const SceneRun& run) {
       tied = run.model().num_tied_enriched_nodes();
     });
-    std::printf("%s: the triangle moved [%.1e, %.1e, %.6f] (free fall %.6f, off by %.1e), %d nodes tied\n",
-                type == ElementType::quad8 ? "quad8" : "tri6", u[0], u[1], u[2], kFreeFall,
-                std::abs(u[2] - kFreeFall) / std::abs(kFreeFall), tied);
+    print_fall(std::string(type == ElementType::quad8 ? "quad8" : "tri6") + ": the triangle", u,
+               ", " + std::to_string(tied) + " nodes tied");
     EXPECT_GT(tied, 0);
     EXPECT_NEAR(u[2], kFreeFall, 2e-3 * std::abs(kFreeFall));
     EXPECT_LT(std::hypot(u[0], u[1]), 1e-3);
@@ -269,8 +273,7 @@ TEST(SceneCutLoops, ALoopWithSidesAlongTri6EdgesFromACornerOnANodeFallsFreely) {
   for (const int T : {16, 32}) {
     SCOPED_TRACE("T = " + std::to_string(T));
     const Vec3 u = displacement_after_a_second({{a, b, c, d, a}}, {0.66, 0.66, 0}, ElementType::tri6, T);
-    std::printf("T = %d: the square moved [%.1e, %.1e, %.6f] (free fall %.6f, off by %.1e)\n", T, u[0], u[1], u[2],
-                kFreeFall, std::abs(u[2] - kFreeFall) / std::abs(kFreeFall));
+    print_fall("T = " + std::to_string(T) + ": the square", u);
     EXPECT_NEAR(u[2], kFreeFall, 1e-9 * std::abs(kFreeFall));
     EXPECT_LT(std::hypot(u[0], u[1]), 1e-9);
   }
@@ -288,8 +291,7 @@ TEST(SceneCutLoops, ATriangleWhosePathEndsOnARetraceIsOneStepFunction) {
   const Vec3 u = displacement_after_a_second({{a, b, c, a}}, {0.54, 0.55, 0}, ElementType::tri6, 32, [&](const SceneRun& run) {
     for (const EnrichmentFunction& f : run.model().enrichments()) steps.push_back(is_step_function(f));
   });
-  std::printf("the triangle moved [%.1e, %.1e, %.6f] (free fall %.6f, off by %.1e); %zu function(s)\n", u[0], u[1],
-              u[2], kFreeFall, std::abs(u[2] - kFreeFall) / std::abs(kFreeFall), steps.size());
+  print_fall("the triangle", u, "; " + std::to_string(steps.size()) + " function(s)");
   EXPECT_EQ(steps, std::vector<bool>{true});
   EXPECT_NEAR(u[2], kFreeFall, 1e-4 * std::abs(kFreeFall));  // measured 2e-6 off (a tied node)
   EXPECT_LT(std::hypot(u[0], u[1]), 1e-6);
@@ -308,8 +310,7 @@ TEST(SceneCutLoops, AGrowthRoundThatNeedsNoSolveStillGrowsTheFunctionsNodes) {
   const std::vector<std::vector<Vec3>> cuts = {{u_shape[0], u_shape[1], u_shape[2], u_shape[3]}, {u_shape[3], u_shape[0]}};
   for (const Vec3& probe : {Vec3{0.45, 0.45, 0}, Vec3{0.55, 0.55, 0}}) {
     const Vec3 u = displacement_after_a_second(cuts, probe, ElementType::tri6, 16);
-    std::printf("(%.2f, %.2f) moved [%.1e, %.1e, %.6f] (free fall %.6f, off by %.1e)\n", probe[0], probe[1], u[0], u[1],
-                u[2], kFreeFall, std::abs(u[2] - kFreeFall) / std::abs(kFreeFall));
+    print_fall("(" + std::to_string(probe[0]) + ", " + std::to_string(probe[1]) + ")", u);
     EXPECT_NEAR(u[2], kFreeFall, 1e-2 * std::abs(kFreeFall));
     EXPECT_LT(std::hypot(u[0], u[1]), 1e-3);
   }
