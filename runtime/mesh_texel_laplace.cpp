@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <chrono>
+#include <cmath>
 #include <cstdlib>
 #include <limits>
 #include <memory>
@@ -135,6 +136,7 @@ class TexelGraph {
   std::array<int, 2> across(int l, int edge) const { return across_[4 * l + edge]; }
   bool active(int node) const { return !(flags(node) & kernels::inactive); }
   double& value(int node) { return tiles_[node / tt_].tile.values[node % tt_]; }
+  double value(int node) const { return tiles_[node / tt_].tile.values[node % tt_]; }
 
   // Whether texel (i, j) of a tile can couple across a mesh edge: the element's border
   // texels (tri6: also the hypotenuse's staircase; beyond it all texels are inactive).
@@ -166,6 +168,33 @@ class TexelGraph {
         const int v = l * tt_ + edge_texel_index(type_, t_, k, s);
         const int w = nb[0] * tt_ + edge_texel_index(type_, t_, nb[1], t_ - 1 - s);
         if (active(v) && active(w)) f(v, w);
+      }
+    }
+  }
+
+  // Calls f(v, w) for every pair of active lattice neighbours that a wall separates: in a
+  // tile (its wall bits), and across a mesh edge that a cut along it blocks (each such pair
+  // twice, once from either tile).
+  template <class F>
+  void for_each_walled_pair(F&& f) const {
+    for (int l = 0; l < static_cast<int>(tiles_.size()); ++l) {
+      const std::uint8_t* flags = tiles_[l].tile.flags.data();
+      for (int j = 0; j < t_; ++j)
+        for (int i = 0; i < t_; ++i) {
+          const int k = j * t_ + i, v = l * tt_ + k;
+          if (!active(v)) continue;
+          if (i + 1 < t_ && (flags[k] & kernels::wall_east) && active(v + 1)) f(v, v + 1);
+          if (j + 1 < t_ && (flags[k] & kernels::wall_north) && active(v + t_)) f(v, v + t_);
+        }
+      for (int k = 0; k < (type_ == ElementType::quad8 ? 4 : 3); ++k) {
+        const auto nb = across_[4 * l + k];
+        if (nb[0] < 0) continue;
+        for (int s = 0; s < t_; ++s) {
+          if (!blocked(l, k, s) && !blocked(nb[0], nb[1], t_ - 1 - s)) continue;
+          const int v = l * tt_ + edge_texel_index(type_, t_, k, s);
+          const int w = nb[0] * tt_ + edge_texel_index(type_, t_, nb[1], t_ - 1 - s);
+          if (active(v) && active(w)) f(v, w);
+        }
       }
     }
   }
@@ -224,6 +253,54 @@ detail::SparseRows texel_laplacian(TexelGraph& graph, const std::vector<int>& no
   std::copy(columns.begin(), columns.end(), a.innerIndexPtr());
   std::copy(values.begin(), values.end(), a.valuePtr());
   return a;
+}
+
+// The value of each component that no data reaches (parent: flattened roots; untouched(v)
+// says whether texel v is free in one), per root: such components that walls join into
+// one group take the value that every texel beyond the group's walls holds, where there is
+// one; NaN where those texels disagree or there are none.
+// Such a component is a piece that other cuts separate from this cut's texels, and any
+// constant is harmonic there. With 0 there, the cut's enriched functions
+// (H - H(xi^a)) N^a were nonzero on the piece for every node of either side, copies of the
+// functions of the cuts around the piece; the enrichment-mass test then found the copies
+// dependent and dropped them, and with them their part next to this cut (a corner cut off
+// beside a loop on a 4 x 4 plate: both pieces hung on each other, swinging 0.28 sideways).
+// The one value beyond the walls is the side of this cut the piece lies on: the functions
+// of the nodes on that side vanish on the piece, as with this cut alone. A group beside
+// both sides keeps 0: the quadrants beyond an X's crossing, walled apart by the crack's
+// other segment, would otherwise take +1 and -1 and repeat that segment's function.
+template <class Untouched>
+std::unordered_map<int, double> untouched_component_values(const TexelGraph& graph, const std::vector<int>& parent,
+                                                           Untouched&& untouched) {
+  std::unordered_map<int, int> group;  // root -> a root of its group (union-find over roots)
+  auto find = [&](int root) {
+    auto it = group.emplace(root, root).first;
+    while (it->second != it->first) it = group.find(it->second);
+    return it->first;
+  };
+  graph.for_each_walled_pair([&](int v, int w) {
+    if (!untouched(v)) return;
+    const int a = find(parent[v]);
+    if (untouched(w)) {
+      const int b = find(parent[w]);
+      if (a != b) group[std::max(a, b)] = std::min(a, b);
+    }
+  });
+  std::unordered_map<int, double> group_value;  // NaN once two values met
+  graph.for_each_walled_pair([&](int v, int w) {
+    for (int side = 0; side < 2; ++side, std::swap(v, w)) {
+      if (!untouched(v) || untouched(w)) continue;
+      const double beyond = graph.value(w);
+      const auto [it, first] = group_value.emplace(find(parent[v]), beyond);
+      if (!first && it->second != beyond) it->second = std::numeric_limits<double>::quiet_NaN();
+    }
+  });
+  std::unordered_map<int, double> value;
+  for (const auto& entry : group) {
+    const auto it = group_value.find(find(entry.first));
+    value[entry.first] = it == group_value.end() ? std::numeric_limits<double>::quiet_NaN() : it->second;
+  }
+  return value;
 }
 
 // Walls (or opens) the edge between patch texels g and q, lattice neighbours (q = g +- 1 or
@@ -560,6 +637,10 @@ std::vector<int> stale_frozen_tiles(std::vector<RegionTile>& tiles, ElementType 
         if (state[root] == no_data) state[root] = constant, constant_value[root] = x;
         else if (state[root] == constant && x != constant_value[root]) state[root] = varying;
       });
+  // A component without data holds the value beyond its walls, as the solve gives it.
+  auto untouched = [&](int v) { return is_free(v) && state[parent[v]] == no_data; };
+  for (const auto& [root, value] : untouched_component_values(graph, parent, untouched))
+    if (!std::isnan(value)) constant_value[root] = value;
   for (int l = 0; l < static_cast<int>(tiles.size()); ++l) {
     if (!tiles[l].frozen) continue;
     for (int v = l * tt; v < (l + 1) * tt; ++v)
@@ -680,6 +761,7 @@ MeshLaplaceStats solve_mesh_texel_laplace(std::vector<RegionTile>& tiles, Elemen
   std::vector<int> unknown_of;
   std::vector<int> node_of;
   node_of.reserve(n);
+  bool any_untouched = false;  // a component without data (its value is set after the solve)
   for (int v = 0; v < n; ++v) {
     if (!is_free[v]) continue;
     const int root = parent[v];
@@ -693,6 +775,7 @@ MeshLaplaceStats solve_mesh_texel_laplace(std::vector<RegionTile>& tiles, Elemen
       node_of.push_back(v);
     } else {
       graph.value(v) = state[root] == constant ? constant_value[root] : 0.0;
+      any_untouched |= state[root] == no_data;
     }
   }
   stats.unknowns = static_cast<int>(node_of.size());
@@ -875,6 +958,15 @@ MeshLaplaceStats solve_mesh_texel_laplace(std::vector<RegionTile>& tiles, Elemen
         const Eigen::VectorXd x = solve_by_cholmod(a, b, tiles.size(), stats.relative_residual);
         for (int k = 0; k < m; ++k) graph.value(node_of[k]) = x[k];
       }
+    }
+  }
+  if (any_untouched) {  // after the solve: the texels beyond their walls have their values
+    auto untouched = [&](int v) { return is_free[v] && state[parent[v]] == no_data; };
+    const std::unordered_map<int, double> values = untouched_component_values(graph, parent, untouched);
+    for (int v = 0; v < n; ++v) {
+      if (!untouched(v)) continue;
+      const auto it = values.find(parent[v]);
+      if (it != values.end() && !std::isnan(it->second)) graph.value(v) = it->second;
     }
   }
   stats.ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();

@@ -235,3 +235,56 @@ TEST(LaplaceMeshComponents, CombTeethAndABoxAcrossTheElementEdgeJoin) {
   for (std::size_t a : {1u, 3u})  // each solver: 2 threads bitwise as 1
     for (std::size_t l = 0; l < 2; ++l) EXPECT_EQ(answers[a][l].tile.values, answers[a - 1][l].tile.values);
 }
+
+// A component that no data reaches (a piece other cuts separate from this cut's texels) is
+// harmonic for any constant; it takes the one value beyond its walls, the side of the cut
+// it lies on, so that the enriched functions of the nodes on that side vanish on it. Walls
+// joining several such components (the quadrants beyond an X's crossing) make one group;
+// a group beside two values keeps 0. Two tiles: a wall splits tile 1 at column 64 into a
+// left part, open to tile 0 across the element edge, with data +1 there, and a right part
+// with data -1. A box walled in inside tile 0 gets +1; a box walled in across the split gets
+// 0 in both halves. Tile 0 frozen with those values is not stale; with its box at 0 it is.
+TEST(LaplaceMeshComponents, AWalledBoxWithoutDataTakesTheOneValueBeyondItsWalls) {
+  const Mesh mesh = make_rectangle(2, 1, 2, 1, ElementType::quad8);
+  const ElementAdjacency adjacency(mesh, build_topology(mesh));
+  std::vector<RegionTile> region(2);
+  for (int l = 0; l < 2; ++l) {
+    region[l].element = l;
+    region[l].tile = kernels::make_element_tile(mesh.type, T);
+    for (double& v : region[l].tile.values) v = 0.5;  // a warm start, not an answer
+  }
+  kernels::TexelTile& left = region[0].tile;
+  kernels::TexelTile& right = region[1].tile;
+  constexpr Box inside{20, 40, 20, 40}, across{50, 80, 60, 90};
+  wall_in(left, inside);
+  wall_in(right, across);
+  for (int j = 0; j < T; ++j) right.flags[j * T + 63] |= kernels::wall_east;
+  left.flags[100 * T + 100] |= kernels::dirichlet;
+  left.values[100 * T + 100] = 1;
+  right.flags[10 * T + 100] |= kernels::dirichlet;
+  right.values[10 * T + 100] = -1;
+  for (LaplaceSolver solver : {LaplaceSolver::multigrid, LaplaceSolver::cholmod}) {
+    SCOPED_TRACE(solver == LaplaceSolver::multigrid ? "multigrid" : "cholmod");
+    std::vector<RegionTile> solved = region;
+    const MeshLaplaceStats stats =
+        solve_mesh_texel_laplace(solved, mesh.type, adjacency, MeshEdgeWalls(T), solver, LaplaceMultigridOptions{});
+    EXPECT_EQ(stats.constant_components, 2);
+    EXPECT_EQ(stats.unknowns, 0);
+    int wrong = 0;
+    for (int j = 0; j < T; ++j)
+      for (int i = 0; i < T; ++i) {
+        const int k = j * T + i;
+        wrong += solved[0].tile.values[k] != 1.0;  // the box as all around it
+        const double expected = across.contains(i, j) ? 0.0 : i < 64 ? 1.0 : -1.0;
+        wrong += solved[1].tile.values[k] != expected;
+      }
+    EXPECT_EQ(wrong, 0);
+    // Settled, tile 0 is data for a solve of tile 1 (its data texel marked as such): with
+    // its box at the value beyond the walls it is not stale; with the box at 0 it is.
+    solved[0].frozen = true;
+    EXPECT_TRUE(stale_frozen_tiles(solved, mesh.type, adjacency, MeshEdgeWalls(T)).empty());
+    for (int j = inside.y0; j <= inside.y1; ++j)
+      for (int i = inside.x0; i <= inside.x1; ++i) solved[0].tile.values[j * T + i] = 0;
+    EXPECT_EQ(stale_frozen_tiles(solved, mesh.type, adjacency, MeshEdgeWalls(T)), std::vector<int>{0});
+  }
+}

@@ -9,8 +9,8 @@
 //     texel edges (across a mesh edge: the texel on each side), E_i = elements holding such
 //     texels, N_i = their nodes, Omega_i = all elements incident to N_i;
 //  3. solves H_i on Omega_i as one texel graph (mesh_texel_laplace.h): zero Neumann on the
-//     walls of all other cuts and on Omega_i's outer boundary, 0 on components without data,
-//     C0 across element edges. While a cut advances only the one-ring of the elements whose
+//     walls of all other cuts and on Omega_i's outer boundary, components without data at
+//     the one value beyond their walls (else 0), C0 across element edges. While a cut advances only the one-ring of the elements whose
 //     data or walls changed is re-solved; the other elements of Omega_i keep their values
 //     (settled, thesis §5.5.3) and act as C0 Dirichlet data, except where a cut has closed a
 //     region since: a settled element holding texels of a component with one data value (or

@@ -6,8 +6,10 @@
 //    canonical component order (by smallest texel index);
 //  - the generalized Heaviside of one complete cut: +1 on the components left of the
 //    cut's direction, -1 on those right of it, 0 on components it does not touch (§5.4.1,
-//    and the "Neumann-only components are 0" rule of §5.5.2). This is exactly the
-//    harmonic enrichment of a complete cut, obtained without a solve.
+//    and the "Neumann-only components are 0" rule of §5.5.2). This is the harmonic
+//    enrichment of a complete cut on one tile, obtained without a solve, as the thesis
+//    defines it; the cut manager's region solves give an untouched component the value
+//    beyond its walls instead (mesh_texel_laplace.h).
 // Values are written into tile.values of tiles that copy the input's flags.
 // Pure functions over caller-owned tiles (thread-safe on distinct tiles). Values are
 // dimensionless (+-1, 0).

@@ -13,9 +13,11 @@
 // Tiles marked frozen are data: every active texel is a Dirichlet value for the texels of
 // solved tiles coupled to it (the C0 constraints from settled neighbouring enrichments of
 // §5.5.3). Elements outside the region leave zero Neumann. Free texels in a component
-// (connected through free-free couplings) with no data get 0; a component whose data are
-// all one value v gets exactly v without a solve; the rest are the unknowns of one SPD
-// system. With LaplaceSolver::multigrid (the enrichment's default) a single tile, or a quad8
+// (connected through free-free couplings) with no data get the value that every texel
+// beyond its walls holds (after the solve), where there is one, else 0; components without
+// data that walls join count as one there (mesh_texel_laplace.cpp,
+// untouched_component_values). A component whose data are all one value v gets exactly v
+// without a solve; the rest are the unknowns of one SPD system. With LaplaceSolver::multigrid (the enrichment's default) a single tile, or a quad8
 // region whose solved (non-frozen) tiles lie side by side in the plane without turning or
 // closing up (e.g. blocks of a rectangle mesh: chad's 2x2; a cylinder ring closed only
 // through frozen tiles: slinky after its first cut settles), is solved by the tile multigrid
@@ -96,9 +98,10 @@ struct MeshLaplaceStats {
 };
 
 // The frozen tiles (indices into `tiles`) holding texels of a component whose data are one
-// value, or none, while their stored H is not that constant (0 for none): components of
-// every active texel that is not data, across mesh edges and frozen tiles alike, data being
-// the texels with the dirichlet bit (set it on frozen tiles' data texels too). A cut that
+// value, or none, while their stored H is not that constant (for none: the value beyond
+// its walls, as solve_mesh_texel_laplace gives it): components of every active texel that
+// is not data, across mesh edges and frozen tiles alike, data being the texels with the
+// dirichlet bit (set it on frozen tiles' data texels too). A cut that
 // closes a region after those tiles settled leaves their harmonic values stale, where the
 // solution is now a constant. Reads the tiles only (non-const for TexelGraph).
 std::vector<int> stale_frozen_tiles(std::vector<RegionTile>& tiles, ElementType type, const ElementAdjacency& adjacency,
