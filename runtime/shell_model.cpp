@@ -1230,7 +1230,11 @@ std::vector<ShellModel::EnrichmentTie> ShellModel::enrichment_ties(const std::ve
   // the same value in a translation of either side, so adding the dropped function to the
   // DOFs of another node of the same function keeps the translations, and the sum is as
   // well conditioned as that node's function alone. The partner: the kept node whose
-  // function overlaps it most (largest |M_vw|); none overlapping: dropped as before.
+  // function overlaps it most (largest |M_vw|). None overlaps where the nodes of the
+  // piece's corner beside v all went, or lie on the piece (their functions live on the
+  // other side): the nearest kept node of the function then, since the translations hold
+  // for any partner (a zigzag cut off a 3 x 2 tri6 plate's corner held it by three
+  // dropped nodes of one element: -0.044 instead of -0.505, until session 75).
   const int nn = num_nodes(), W = width_;
   std::vector<char> small(num_enriched_nodes(), 0);
   for (const int v : small_on_support) small[v - nn] = 1;
@@ -1255,10 +1259,27 @@ std::vector<ShellModel::EnrichmentTie> ShellModel::enrichment_ties(const std::ve
     double largest = 0;
     for (std::size_t w = 0; w < sums.size(); ++w)
       if (std::abs(sums[w]) > largest) largest = std::abs(sums[w]), partner = static_cast<int>(w);
+    if (partner < 0) partner = nearest_kept_node_of_the_function(v, kept_node);
     if (partner >= 0)
       ties.push_back({virtual_node_function_[v - nn], virtual_node_mesh_node_[v - nn], virtual_node_mesh_node_[partner], 0.0});
   }
   return ties;
+}
+
+int ShellModel::nearest_kept_node_of_the_function(int v, const std::vector<char>& kept_node) const {
+  const int nn = num_nodes();
+  const double* x = mesh_.node(virtual_node_mesh_node_[v - nn]);
+  int nearest = -1;
+  double nearest_distance = 0;
+  for (int w = 0; w < num_enriched_nodes(); ++w) {
+    if (!kept_node[w] || virtual_node_function_[w] != virtual_node_function_[v - nn]) continue;
+    const double* y = mesh_.node(virtual_node_mesh_node_[w]);
+    const double distance = (x[0] - y[0]) * (x[0] - y[0]) + (x[1] - y[1]) * (x[1] - y[1]) + (x[2] - y[2]) * (x[2] - y[2]);
+    // Distances equal up to round-off (a regular mesh has many) go to the lower index, so
+    // that the choice does not change with the length unit.
+    if (nearest < 0 || distance < nearest_distance * (1 - 1e-9)) nearest = w, nearest_distance = distance;
+  }
+  return nearest;
 }
 
 int ShellModel::basis_at(int element, const double xi[2], int* global, double* values) const {

@@ -64,13 +64,17 @@ TEST(KeptBasisValues, ProjectionMomentsEqualTheEvaluatedOnesBitwise) {
 TEST(KeptBasisValues, APrunedBasisTakesItsColumnsOfTheFirstBuildsValues) {
   // A cut one texel from the left edge leaves nodes with almost no enriched mass: the
   // first build evaluates every element, the pruned rebuild reuses all their integrals.
+  // (The old model's cut crosses both elements, so that neither reuses the old model's
+  // integrals, which have no kept values: the nodes tied on the element edge bring the
+  // right element into the pruned basis.)
   const Mesh mesh = make_rectangle(1, 0.5, 2, 1, ElementType::quad8);
-  const auto old_model =
-      enriched_model(mesh, {straight_cut_enrichment(mesh, 64, [](const double* x) { return x[0] - 0.25; })}, 1e-3);
+  const auto old_model = enriched_model(
+      mesh, {straight_cut_enrichment(mesh, 64, [](const double* x) { return x[0] + 0.4 * x[1] - 0.55; }, false)}, 1e-3);
   const std::vector<EnrichmentFunction> sliver = {
       straight_cut_enrichment(mesh, 64, [](const double* x) { return x[0] - 0.5 / 64; })};
   const auto keeping = expect_kept_moments_bitwise(*old_model, sliver);
   EXPECT_GT(keeping->num_pruned_enriched_nodes(), 0);
+  EXPECT_GT(keeping->num_tied_enriched_nodes(), 0);
 }
 
 TEST(KeptBasisValues, ABasisWithoutEnrichedElementsKeepsNone) {

@@ -457,6 +457,9 @@ class ShellModel {
   // the kept ones, from the enriched elements' mass (#enriched elements x width^2).
   std::vector<EnrichmentTie> enrichment_ties(const std::vector<int>& small_on_support, const std::vector<char>& kept_node,
                                              const std::vector<double>& element_mass) const;
+  // The kept virtual node (kept_node: per virtual node) of virtual node v's function nearest
+  // to v's mesh node (-1: none), as an index among the virtual nodes.
+  int nearest_kept_node_of_the_function(int v, const std::vector<char>& kept_node) const;
   // Takes the functions (and ties, their shifts computed here) and sets up the per-element
   // layout; `build`: then rebuild() (else the caller must, after reading the element
   // integrals).
