@@ -10,11 +10,12 @@
 //     texels, N_i = their nodes, Omega_i = all elements incident to N_i;
 //  3. solves H_i on Omega_i as one texel graph (mesh_texel_laplace.h): zero Neumann on the
 //     walls of all other cuts and on Omega_i's outer boundary, components without data at
-//     the one value beyond their walls (else 0), C0 across element edges. While a cut advances only the one-ring of the elements whose
-//     data or walls changed is re-solved; the other elements of Omega_i keep their values
-//     (settled, thesis §5.5.3) and act as C0 Dirichlet data, except where a cut has closed a
-//     region since: a settled element holding texels of a component with one data value (or
-//     none) but other values is solved again (stale_frozen_tiles).
+//     the one value beyond their walls (else 0), C0 across element edges. While a cut
+//     advances only the one-ring of the elements whose data or walls changed is re-solved;
+//     the other elements of Omega_i keep their values (settled, thesis §5.5.3) and act as
+//     C0 Dirichlet data, except where a cut has closed a region since: a settled element
+//     holding texels of a component with one data value (or none) but other values is
+//     solved again (stale_frozen_tiles).
 // Degenerate cases and their remedies:
 //  - a cut along an element edge: the couplings across the edge are cut and the texels on
 //    both sides get +-1 (the path is traced in one of the two elements);

@@ -17,11 +17,12 @@
 // beyond its walls holds (after the solve), where there is one, else 0; components without
 // data that walls join count as one there (mesh_texel_laplace.cpp,
 // untouched_component_values). A component whose data are all one value v gets exactly v
-// without a solve; the rest are the unknowns of one SPD system. With LaplaceSolver::multigrid (the enrichment's default) a single tile, or a quad8
-// region whose solved (non-frozen) tiles lie side by side in the plane without turning or
-// closing up (e.g. blocks of a rectangle mesh: chad's 2x2; a cylinder ring closed only
-// through frozen tiles: slinky after its first cut settles), is solved by the tile multigrid
-// on one patch tile holding the same couplings (options: tolerance, warm start from the
+// without a solve; the rest are the unknowns of one SPD system. With
+// LaplaceSolver::multigrid (the enrichment's default) a single tile, or a quad8 region
+// whose solved (non-frozen) tiles lie side by side in the plane without turning or closing
+// up (e.g. blocks of a rectangle mesh: chad's 2x2; a cylinder ring closed only through
+// frozen tiles: slinky after its first cut settles), is solved by the tile multigrid on one
+// patch tile holding the same couplings (options: tolerance, warm start from the
 // tiles' values); frozen texels coupled to solved ones enter that patch as Dirichlet ghost
 // texels beside the edge they couple across, walled off from everything else; a ring closed
 // through solved tiles, on a patch cut open at a seam. Other regions whose texels still lie on
