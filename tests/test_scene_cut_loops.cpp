@@ -369,4 +369,22 @@ TEST(SceneCutLoops, ACornerWhoseDroppedNodesOverlapNoKeptOneFallsWithThemTied) {
   EXPECT_LT(std::hypot(u[0], u[1]), 1e-4);
 }
 
+// A bar across both legs of a U on a 4 x 4 tri6 plate (cells split sheared): the region it
+// closes reaches into the row of elements below the bar, and beyond the bar's Omega_i,
+// where both the region's value and the plate's reach Omega_i's open edges. That is how a
+// step looks that is one only within Omega_i (its sides meet beyond a crack tip), and it
+// got no growth rounds: the region hung on the row below (-0.019 instead of -0.505, until
+// session 75). The bar's middle segment ends on the U's walls at both ends, no free tip:
+// now it grows.
+TEST(SceneCutLoops, ARegionABarClosesBeyondItsOwnElementsFallsFreely) {
+  const std::vector<Vec3> u_shape{{0.62, 0.95, 0}, {0.62, 0.62, 0}, {0.88, 0.62, 0}, {0.88, 0.95, 0}};
+  const std::vector<Vec3> bar{{0.6, 0.88, 0}, {0.9, 0.88, 0}};
+  Scene scene = cut_plate({u_shape, bar}, ElementType::tri6, 16);
+  scene.mesh.divisions = {4, 4};
+  const Vec3 u = displacement_after_a_second(scene, {0.75, 0.75, 0});
+  print_fall("the region", u);
+  EXPECT_NEAR(u[2], kFreeFall, 1e-9 * std::abs(kFreeFall));
+  EXPECT_LT(std::hypot(u[0], u[1]), 1e-9);
+}
+
 }  // namespace

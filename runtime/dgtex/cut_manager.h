@@ -43,7 +43,8 @@
 //  - a region that a segment closes with other cuts can reach into elements where only the
 //    others' walls bound it (no data of the segment there): where the segment's function
 //    is a step (+-1 or 0 at every texel) and takes both +1 and -1 in such an element, the
-//    element joins E_i and the function is solved again on the grown Omega_i, in rounds.
+//    element joins E_i and the function is solved again on the grown Omega_i, in rounds
+//    (where both values reach Omega_i's open edges, only for a segment without a free tip).
 // CutManager owns its paths, segments, wall tiles and enrichment functions; it keeps a
 // reference to the mesh (which must outlive it; the topology is read by the constructor
 // only). Not thread-safe; the constructor (one cut per thread) and update() use all
@@ -196,6 +197,9 @@ class CutManager {
   std::vector<std::vector<std::pair<int, kernels::CutRaster>>> function_rasters_;
   int dependent_nodes_ = 0;
   bool tip_touches_a_wall_ = false;  // at the last rasterisation: a region may have closed
+  // At the last rasterisation, per visible segment: both its ends touch a wall or lie on an
+  // element's border (it has no free tip).
+  std::vector<char> ends_touch_walls_;
   CutUpdateStats last_;
 };
 
