@@ -710,7 +710,7 @@ bool CutManager::update(double time) {
       // meet beyond a free tip, around a crack tip closed at texel level): no rounds for it.
       // A segment without a free tip closes a region that reaches beyond Omega_i instead (a
       // bar across a U on a sheared tri6 plate, the U's corners in the row below the bar:
-      // -0.0001 instead of -0.505, until session 75).
+      // -0.019 instead of -0.505, until session 75).
       const std::size_t v = visible_index.at(job.key);
       if (!is_step_function(state.function) ||
           (!ends_touch_walls_[v] && both_values_reach_open_edges(state.function)))
