@@ -81,9 +81,16 @@ bool every_side_meets_the_other(const SideTexels& sides, const std::map<int, Tex
 
   while (!layer.empty()) {
     next.clear();
+    int element = -1;  // the last texel's element, whose look-ups most texels share
+    std::vector<int>* here = nullptr;
+    const TexelTile* tile_here = nullptr;
     for (const Texel& x : layer) {
-      std::vector<int>& here = sets_in(x.element);
-      int root = sets.find(here[x.index]);
+      if (x.element != element) {
+        element = x.element;
+        here = &sets_in(element);
+        tile_here = &tile_of(element);
+      }
+      int root = sets.find((*here)[x.index]);
       --sets.waiting(root);
       auto reach = [&](std::vector<int>& reached, int e, int index) {
         if (reached[index] < 0) {
@@ -94,12 +101,12 @@ bool every_side_meets_the_other(const SideTexels& sides, const std::map<int, Tex
           root = sets.unite(root, sets.find(reached[index]));
         }
       };
-      const TexelTile& tile = tile_of(x.element);
+      const TexelTile& tile = *tile_here;
       const int i = x.index % t, j = x.index / t;
-      if (kernels::texels_coupled_east(tile, i, j)) reach(here, x.element, x.index + 1);
-      if (i > 0 && kernels::texels_coupled_east(tile, i - 1, j)) reach(here, x.element, x.index - 1);
-      if (kernels::texels_coupled_north(tile, i, j)) reach(here, x.element, x.index + t);
-      if (j > 0 && kernels::texels_coupled_north(tile, i, j - 1)) reach(here, x.element, x.index - t);
+      if (kernels::texels_coupled_east(tile, i, j)) reach(*here, x.element, x.index + 1);
+      if (i > 0 && kernels::texels_coupled_east(tile, i - 1, j)) reach(*here, x.element, x.index - 1);
+      if (kernels::texels_coupled_north(tile, i, j)) reach(*here, x.element, x.index + t);
+      if (j > 0 && kernels::texels_coupled_north(tile, i, j - 1)) reach(*here, x.element, x.index - t);
       int edges[2], positions[2];
       const int on_edges = (tile.flags[x.index] & kernels::inactive) ? 0 : texel_edges(type, t, i, j, edges, positions);
       for (int k = 0; k < on_edges; ++k) {
