@@ -733,7 +733,7 @@ bool CutManager::update(double time) {
         auto met = sides_meet.find(job.key);
         if (met == sides_meet.end())
           met = sides_meet
-                    .emplace(job.key, detail::every_side_meets_the_other(segment_data[v], walls_, blank, mesh_.type,
+                    .emplace(job.key, detail::every_side_meets_the_other(segment_data, v, walls_, blank, mesh_.type,
                                                                          adjacency_, edge_walls_))
                     .first;
         if (met->second) continue;

@@ -22,7 +22,7 @@ class SeedSets {
     parent_.push_back(static_cast<int>(parent_.size()));
     sides_.push_back(side);
     waiting_.push_back(1);
-    one_sided_ += side != both;
+    one_sided_ += one_sided_value(side);
     return parent_.back();
   }
   int find(int s) {
@@ -31,20 +31,22 @@ class SeedSets {
   }
   int unite(int a, int b) {  // roots
     if (a == b) return a;
-    one_sided_ -= (sides_[a] != both) + (sides_[b] != both);
+    one_sided_ -= one_sided_value(sides_[a]) + one_sided_value(sides_[b]);
     parent_[b] = a;
     sides_[a] |= sides_[b];
     waiting_[a] += waiting_[b];
-    one_sided_ += sides_[a] != both;
+    one_sided_ += one_sided_value(sides_[a]);
     return a;
   }
   long long& waiting(int root) { return waiting_[root]; }
-  bool one_sided(int root) const { return sides_[root] != both; }
+  bool one_sided(int root) const { return one_sided_value(sides_[root]); }
   int one_sided_roots() const { return one_sided_; }
 
-  static constexpr unsigned plus = 1, minus = 2, both = 3;
+  static constexpr unsigned neither = 0, plus = 1, minus = 2, both = 3;
 
  private:
+  static bool one_sided_value(unsigned sides) { return sides == plus || sides == minus; }
+
   std::vector<int> parent_;
   std::vector<unsigned> sides_;
   std::vector<long long> waiting_;
@@ -53,8 +55,9 @@ class SeedSets {
 
 }  // namespace
 
-bool every_side_meets_the_other(const SideTexels& sides, const std::map<int, TexelTile>& walls, const TexelTile& blank,
-                                ElementType type, const ElementAdjacency& adjacency, const MeshEdgeWalls& edge_walls) {
+bool every_side_meets_the_other(const std::vector<SideTexels>& segments, std::size_t segment,
+                                const std::map<int, TexelTile>& walls, const TexelTile& blank, ElementType type,
+                                const ElementAdjacency& adjacency, const MeshEdgeWalls& edge_walls) {
   const int t = blank.width, tt = t * t;
   std::unordered_map<int, std::vector<int>> set_of;  // element -> per texel: the set that reached it, or -1
   auto sets_in = [&](int e) -> std::vector<int>& {
@@ -69,14 +72,23 @@ bool every_side_meets_the_other(const SideTexels& sides, const std::map<int, Tex
 
   SeedSets sets;
   std::vector<Texel> layer, next;
-  for (const auto& [e, texels] : sides) {
-    std::vector<int>& reached = sets_in(e);
-    for (const auto& [index, value] : texels) {
-      if ((value != 1 && value != -1) || reached[index] >= 0) continue;
-      reached[index] = sets.add(value == 1 ? SeedSets::plus : SeedSets::minus);
-      layer.push_back({e, index});
+  auto seed = [&](const SideTexels& sides, bool signed_sides) {
+    for (const auto& [e, texels] : sides) {
+      std::vector<int>& reached = sets_in(e);
+      for (const auto& [index, value] : texels) {
+        if (reached[index] >= 0) continue;
+        const unsigned side = !signed_sides ? SeedSets::neither
+                              : value == 1  ? SeedSets::plus
+                              : value == -1 ? SeedSets::minus
+                                            : SeedSets::neither;
+        reached[index] = sets.add(side);
+        layer.push_back({e, index});
+      }
     }
-  }
+  };
+  seed(segments[segment], true);
+  for (std::size_t k = 0; k < segments.size(); ++k)
+    if (k != segment) seed(segments[k], false);
   if (sets.one_sided_roots() == 0) return true;
 
   while (!layer.empty()) {

@@ -38,24 +38,23 @@ class TwoElementPlate {
         blank_(kernels::make_element_tile(ElementType::quad8, T)),
         edge_walls_(T) {}
 
-  // Walls for every line; the texels beside the `tested` lines' edges are the sides (+1
-  // left, -1 right).
+  // Walls for every line. The texels beside the `tested` lines' edges are the sides of
+  // segment 0 (+1 left, -1 right), each of the `others` is a segment of its own.
   bool sides_meet(const std::vector<Line>& tested, const std::vector<Line>& others = {}) {
     std::map<int, kernels::TexelTile> walls;
-    detail::SideTexels sides;
-    auto draw = [&](const Line& line, bool side) {
+    std::vector<detail::SideTexels> segments(1 + others.size());
+    auto draw = [&](const Line& line, detail::SideTexels& sides) {
       kernels::TexelTile& tile = walls.try_emplace(line.element, blank_).first->second;
       const kernels::CutRaster raster = kernels::rasterize_cut(line.points, tile);
-      if (!side) return;
       for (const kernels::CutLatticeEdge& edge : raster.edges)
         if (edge.left_texel >= 0 && edge.right_texel >= 0) {
           sides[line.element].push_back({edge.left_texel, 1.0});
           sides[line.element].push_back({edge.right_texel, -1.0});
         }
     };
-    for (const Line& line : tested) draw(line, true);
-    for (const Line& line : others) draw(line, false);
-    return detail::every_side_meets_the_other(sides, walls, blank_, mesh_.type, adjacency_, edge_walls_);
+    for (const Line& line : tested) draw(line, segments[0]);
+    for (std::size_t k = 0; k < others.size(); ++k) draw(others[k], segments[1 + k]);
+    return detail::every_side_meets_the_other(segments, 0, walls, blank_, mesh_.type, adjacency_, edge_walls_);
   }
 
  private:
