@@ -1269,10 +1269,11 @@ std::vector<ShellModel::EnrichmentTie> ShellModel::enrichment_ties(const std::ve
 int ShellModel::nearest_kept_node_of_the_function(int v, const std::vector<char>& kept_node) const {
   const int nn = num_nodes();
   const double* x = mesh_.node(virtual_node_mesh_node_[v - nn]);
+  const int function = virtual_node_function_[v - nn];
   int nearest = -1;
   double nearest_distance = 0;
-  for (int w = 0; w < num_enriched_nodes(); ++w) {
-    if (!kept_node[w] || virtual_node_function_[w] != virtual_node_function_[v - nn]) continue;
+  for (int w = function_slot_start_[function]; w < function_slot_start_[function + 1]; ++w) {
+    if (!kept_node[w]) continue;
     const double* y = mesh_.node(virtual_node_mesh_node_[w]);
     const double distance = (x[0] - y[0]) * (x[0] - y[0]) + (x[1] - y[1]) * (x[1] - y[1]) + (x[2] - y[2]) * (x[2] - y[2]);
     // Distances equal up to round-off (a regular mesh has many) go to the lower index, so
