@@ -1,7 +1,8 @@
 # CTest case InstallConsumer.FindPackageBuildRun (registered in cmake/areas/install_consumer.cmake):
 # proves that dgtex links as a runtime from a clean project. Run in script mode (cmake -P):
 #   1. cmake --install <DGTEX_BUILD_DIR> --prefix <WORK_DIR>/prefix, and start the installed
-#      dgtex tool from there (also a one-step bench of an installed example scene),
+#      dgtex tool from there (also a one-step bench of an installed example scene); the
+#      installed library exports none of MPI's C++ bindings,
 #   2. configure examples/consumer against that prefix only (CMAKE_PREFIX_PATH), check that
 #      find_package(dgtex) found the package there and not some other installed copy,
 #   3. build it, with a translation unit that includes every installed header (-Werror), at
@@ -10,8 +11,8 @@
 #      (built beside it from the README's text).
 # Any failing step fails the test with that step's output.
 # Inputs: DGTEX_BUILD_DIR, SOURCE_DIR, CONSUMER_SOURCE_DIR, WORK_DIR, GENERATOR, MAKE_PROGRAM,
-#         CXX_COMPILER, CXX_COMPILER_LAUNCHER (may be empty).
-foreach(var DGTEX_BUILD_DIR SOURCE_DIR CONSUMER_SOURCE_DIR WORK_DIR GENERATOR CXX_COMPILER)
+#         CXX_COMPILER, CXX_COMPILER_LAUNCHER (may be empty), NM.
+foreach(var DGTEX_BUILD_DIR SOURCE_DIR CONSUMER_SOURCE_DIR WORK_DIR GENERATOR CXX_COMPILER NM)
   if(NOT DEFINED ${var} OR "${${var}}" STREQUAL "")
     message(FATAL_ERROR "install_consumer_test.cmake: -D${var}=... is required")
   endif()
@@ -48,6 +49,21 @@ if(NOT result EQUAL 0 OR at EQUAL -1)
   message(FATAL_ERROR "installed dgtex bench scenes did not use ${prefix}/share/dgtex/scenes (exit ${result}):\n${out}")
 endif()
 message(STATUS "installed dgtex bench scenes: ok (the installed scenes)")
+
+# The installed library defines no symbol of MPI's C++ bindings (HYPRE, inside it, needs
+# MPI's C interface only): as exported weak symbols they would stand in for those of a
+# program built against another MPI.
+file(GLOB_RECURSE installed_library ${prefix}/*/libdgtex.so)
+if(NOT installed_library)
+  message(FATAL_ERROR "no libdgtex.so installed under ${prefix}")
+endif()
+run_step("exported symbols" ${NM} -D -C --defined-only ${installed_library})
+string(REGEX MATCHALL "[^\n]*MPI::[^\n]*" mpi_symbols "${step_output}")
+if(mpi_symbols)
+  list(LENGTH mpi_symbols count)
+  list(GET mpi_symbols 0 first)
+  message(FATAL_ERROR "${installed_library} exports ${count} symbols of MPI's C++ bindings, e.g.\n  ${first}")
+endif()
 
 # README.md's C++ example (the first ```cpp block after "## Using dgtex as a library"),
 # wrapped in a main() with the includes it assumes, built and run from the source tree below.

@@ -7,6 +7,11 @@
 #include <limits>
 #include <stdexcept>
 
+// HYPRE needs MPI's C interface only. MPI's C++ bindings would be compiled into this
+// library as 216 exported weak MPI:: symbols, which a program built against another MPI
+// would get in place of its own.
+#define OMPI_SKIP_MPICXX 1
+#define MPICH_SKIP_MPICXX 1
 #include <mpi.h>
 #include <HYPRE.h>
 #include <HYPRE_IJ_mv.h>

@@ -13,6 +13,7 @@ if(DGTEX_BUILD_TESTS AND NOT DGTEX_SANITIZE)
                    -DMAKE_PROGRAM=${CMAKE_MAKE_PROGRAM}
                    -DCXX_COMPILER=${CMAKE_CXX_COMPILER}
                    -DCXX_COMPILER_LAUNCHER=${CMAKE_CXX_COMPILER_LAUNCHER}
+                   -DNM=${CMAKE_NM}
                    -P ${PROJECT_SOURCE_DIR}/cmake/install_consumer_test.cmake)
   set_tests_properties(InstallConsumer.FindPackageBuildRun PROPERTIES TIMEOUT 600)
 endif()
