@@ -55,6 +55,10 @@ struct ShellModelOptions {
   // whose functions nearly coincide at the node. "Earlier": the functions that are +-1 or
   // 0 at every texel (pieces cut off completely) first, then the others, each group in
   // function order, so of two nearly coinciding functions a piece's step stays.
+  // A small function, M_vv < ratio M_aa (a node's support holds a corner of a piece, or a
+  // fragment beyond the node), is judged by its own mass instead: kept where the functions
+  // kept so far on its elements (of every node) leave at least 1e-6 of M_vv, else dropped
+  // or tied (the nodes beyond a sliver, whose functions depend on each other there).
   double min_enrichment_mass_ratio = 1e-3;
   // Corotation of enriched elements: 0, per quadrature point; B > 0, one rotation per cluster
   // of points (those of a block of B x B texels on one side of every cut), their rest
@@ -115,10 +119,10 @@ class ShellModel {
   // enriched element that has a material texture; each before anything changes, so the
   // model keeps its basis when it throws.
   // Enriched nodes below options().min_enrichment_mass_ratio are dropped (and functions
-  // left without nodes), so enrichments() may hold less than was given. A node dropped for
-  // its function's small mass on its support (a corner of a piece) is tied instead where
-  // the function keeps a node that overlaps it: its enriched function adds to that node's
-  // DOFs (enrichment_dofs), so the piece keeps its translations.
+  // left without nodes), so enrichments() may hold less than was given. A node dropped
+  // whose function has a small mass on its support (it depends on the other functions
+  // there) is tied instead to a kept node of its function: its enriched function adds to
+  // that node's DOFs (enrichment_dofs), so the piece keeps its translations.
   // Cost: an enriched element whose textures (and enriched nodes and shifts) are bitwise
   // those of the previous call on this model or the model it was copied from keeps its
   // quadrature (and mass and load weights); the results equal a fresh model's bitwise.
@@ -457,6 +461,13 @@ class ShellModel {
   // the kept ones, from the enriched elements' mass (#enriched elements x width^2).
   std::vector<EnrichmentTie> enrichment_ties(const std::vector<int>& small_on_support, const std::vector<char>& kept_node,
                                              const std::vector<double>& element_mass) const;
+  // The part of virtual node v's own mass that the basis functions kept so far do not carry
+  // on v's support: the Schur complement of M_vv in the mass Gram matrix of the standard
+  // functions and kept enriched ones (kept_node: per virtual node) of the enriched elements
+  // holding v (`holding`: each one's index and v's slot in it), integrated over those
+  // elements only. Element masses as in enrichment_ties.
+  double independent_mass_on_support(int v, const std::vector<std::pair<int, int>>& holding,
+                                     const std::vector<char>& kept_node, const std::vector<double>& element_mass) const;
   // The kept virtual node (kept_node: per virtual node) of virtual node v's function nearest
   // to v's mesh node (-1: none), as an index among the virtual nodes.
   int nearest_kept_node_of_the_function(int v, const std::vector<char>& kept_node) const;
