@@ -392,8 +392,6 @@ TEST(SceneCutLoops, ARegionABarClosesBeyondItsOwnElementsFallsFreely) {
   EXPECT_LT(std::hypot(u[0], u[1]), 1e-9);
 }
 
-}  // namespace
-
 // Random triangles and quadrilaterals cut out of a soft 2 x 2 plate (E = 1e7, so the plate
 // around them sags and turns), quad8 and tri6, T = 16 and 32. Where no function of the
 // pieces' corners is tied, the piece falls exactly; a tied node keeps it weakly tied to the
@@ -432,3 +430,5 @@ TEST(SceneCutLoops, RandomPiecesCutOutOfASoftPlateFallFreelyUnlessTied) {
   EXPECT_GE(exact, 16);
   EXPECT_LT(worst, 5e-2);
 }
+
+}  // namespace

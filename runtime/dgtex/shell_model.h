@@ -56,9 +56,10 @@ struct ShellModelOptions {
   // 0 at every texel (pieces cut off completely) first, then the others, each group in
   // function order, so of two nearly coinciding functions a piece's step stays.
   // A small function, M_vv < ratio M_aa (a node's support holds a corner of a piece, or a
-  // fragment beyond the node), is judged by its own mass instead: kept where the functions
-  // kept so far on its elements (of every node) leave at least 1e-6 of M_vv, else dropped
-  // or tied (the nodes beyond a sliver, whose functions depend on each other there).
+  // fragment beyond the node), is judged by its own mass instead: kept where it has at
+  // least 1e-12 M_aa and the functions kept so far on its elements (of every node) leave at
+  // least 1e-6 of M_vv, else dropped or tied (the nodes beyond a sliver, whose functions
+  // depend on each other there).
   double min_enrichment_mass_ratio = 1e-3;
   // Corotation of enriched elements: 0, per quadrature point; B > 0, one rotation per cluster
   // of points (those of a block of B x B texels on one side of every cut), their rest
