@@ -458,15 +458,15 @@ class ShellModel {
   // `function` (its index).
   static std::vector<int> nodes_with_own_or_tied_dofs(const EnrichmentFunction& f, int function,
                                                       const std::vector<EnrichmentTie>& ties);
-  // set_enrichments' ties for the pruned virtual nodes `small_on_support`, partners among
-  // the kept ones, from the enriched elements' mass (#enriched elements x width^2).
-  std::vector<EnrichmentTie> enrichment_ties(const std::vector<int>& small_on_support, const std::vector<char>& kept_node,
-                                             const std::vector<double>& element_mass) const;
+  // set_enrichments' ties for the pruned virtual nodes `small_on_support`: each to the
+  // nearest kept node of its function (kept_node: per virtual node), where there is one.
+  std::vector<EnrichmentTie> enrichment_ties(const std::vector<int>& small_on_support,
+                                             const std::vector<char>& kept_node) const;
   // The part of virtual node v's own mass that the basis functions kept so far do not carry
   // on v's support: the Schur complement of M_vv in the mass Gram matrix of the standard
   // functions and kept enriched ones (kept_node: per virtual node) of the enriched elements
   // holding v (`holding`: each one's index and v's slot in it), integrated over those
-  // elements only. Element masses as in enrichment_ties.
+  // elements only. element_mass: per enriched element its width^2 mass entries.
   double independent_mass_on_support(int v, const std::vector<std::pair<int, int>>& holding,
                                      const std::vector<char>& kept_node, const std::vector<double>& element_mass) const;
   // The kept virtual node (kept_node: per virtual node) of virtual node v's function nearest
