@@ -1170,8 +1170,8 @@ void ShellModel::set_enrichments(std::vector<EnrichmentFunction> functions) {
   for (int x = 0; x < num_enriched_elements(); ++x)
     for (int p = 0; p < W; ++p)
       if (const int g = enriched_global_nodes_[static_cast<size_t>(x) * W + p]; g >= nn) slots_of[g - nn].push_back({x, p});
-  for (const int v : virtual_nodes_heavisides_first()) {
-    const int node = virtual_node_mesh_node_[v - nn];
+  // The part of v's mass that N^a and the node's enrichments kept so far do not carry.
+  auto independent_mass_at_node = [&](int v, int node) {
     std::vector<int> earlier = {node};  // N^a, then its kept enrichments
     earlier.insert(earlier.end(), kept_at[node].begin(), kept_at[node].end());
     const int k = static_cast<int>(earlier.size());
@@ -1181,7 +1181,11 @@ void ShellModel::set_enrichments(std::vector<EnrichmentFunction> functions) {
       cross[i] = coupling(v, earlier[i]);
       for (int j = 0; j <= i; ++j) gram(i, j) = gram(j, i) = coupling(earlier[i], earlier[j]);
     }
-    const double own = coupling(v, v), standard = gram(0, 0);  // M_vv, M_aa
+    return coupling(v, v) - cross.dot(gram.ldlt().solve(cross));
+  };
+  for (const int v : virtual_nodes_heavisides_first()) {
+    const int node = virtual_node_mesh_node_[v - nn];
+    const double own = coupling(v, v), standard = coupling(node, node);  // M_vv, M_aa
     const bool small = own < options_.min_enrichment_mass_ratio * standard;
     // A small function (a corner of a piece, or a fragment beyond the node) is judged
     // against its own mass instead, on its support, with every function there: until
@@ -1191,7 +1195,7 @@ void ShellModel::set_enrichments(std::vector<EnrichmentFunction> functions) {
     const bool keep = small ? own > kMinOwnMassRatio * standard &&
                                   independent_mass_on_support(v, slots_of[v - nn], kept_node, element_mass) >=
                                       kMinIndependenceOnSupport * own
-                            : own - cross.dot(gram.ldlt().solve(cross)) >= options_.min_enrichment_mass_ratio * standard;
+                            : independent_mass_at_node(v, node) >= options_.min_enrichment_mass_ratio * standard;
     if (!keep) {
       ++pruned;
       if (small) small_on_support.push_back(v);
