@@ -2,7 +2,7 @@
 # proves that dgtex links as a runtime from a clean project. Run in script mode (cmake -P):
 #   1. cmake --install <DGTEX_BUILD_DIR> --prefix <WORK_DIR>/prefix, and start the installed
 #      dgtex tool from there (also a one-step bench of an installed example scene); the
-#      installed library exports none of MPI's C++ bindings,
+#      installed library exports the names of namespace dgtex only,
 #   2. configure examples/consumer against that prefix only (CMAKE_PREFIX_PATH), check that
 #      find_package(dgtex) found the package there and not some other installed copy,
 #   3. build it, with a translation unit that includes every installed header (-Werror), at
@@ -50,20 +50,39 @@ if(NOT result EQUAL 0 OR at EQUAL -1)
 endif()
 message(STATUS "installed dgtex bench scenes: ok (the installed scenes)")
 
-# The installed library defines no symbol of MPI's C++ bindings (HYPRE, inside it, needs
-# MPI's C interface only): as exported weak symbols they would stand in for those of a
-# program built against another MPI.
+# The installed library exports the names of namespace dgtex only (runtime/exported_symbols.map):
+# an exported weak copy of a dependency's template (OpenVDB, oneTBB, nlohmann::json, the
+# standard library, Eigen; MPI's C++ bindings until session 77) would stand in for a
+# program's own, built against another version.
 file(GLOB_RECURSE installed_library ${prefix}/*/libdgtex.so)
 if(NOT installed_library)
   message(FATAL_ERROR "no libdgtex.so installed under ${prefix}")
 endif()
 run_step("exported symbols" ${NM} -D -C --defined-only ${installed_library})
-string(REGEX MATCHALL "[^\n]*MPI::[^\n]*" mpi_symbols "${step_output}")
-if(mpi_symbols)
-  list(LENGTH mpi_symbols count)
-  list(GET mpi_symbols 0 first)
-  message(FATAL_ERROR "${installed_library} exports ${count} symbols of MPI's C++ bindings, e.g.\n  ${first}")
+string(REPLACE ";" "\\;" exported "${step_output}")
+string(REPLACE "\n" ";" exported "${exported}")
+set(foreign "")
+set(own 0)
+foreach(line IN LISTS exported)
+  # "<address> <type> <demangled name>"
+  if(line MATCHES "^[0-9a-f]+ [A-Za-z] (.*)$")
+    set(name "${CMAKE_MATCH_1}")
+    if(name MATCHES "^((typeinfo|typeinfo name|vtable) for )?dgtex::")
+      math(EXPR own "${own} + 1")
+    else()
+      list(APPEND foreign "${name}")
+    endif()
+  endif()
+endforeach()
+if(foreign)
+  list(LENGTH foreign count)
+  list(GET foreign 0 first)
+  message(FATAL_ERROR "${installed_library} exports ${count} symbols outside namespace dgtex, e.g.\n  ${first}")
 endif()
+if(own LESS 100)
+  message(FATAL_ERROR "${installed_library} exports ${own} symbols of namespace dgtex: expected its API (hundreds)")
+endif()
+message(STATUS "exported symbols: ${own}, all of namespace dgtex")
 
 # README.md's C++ example (the first ```cpp block after "## Using dgtex as a library"),
 # wrapped in a main() with the includes it assumes, built and run from the source tree below.
