@@ -1297,18 +1297,20 @@ double ShellModel::independent_mass_on_support(int v, const std::vector<std::pai
   Eigen::MatrixXd gram = Eigen::MatrixXd::Zero(n, n);
   Eigen::VectorXd cross = Eigen::VectorXd::Zero(n);
   double own = 0;
+  std::vector<int> row_of(W);  // per slot of an element: its Gram row, -1 for v and the functions left out
   for (const auto& [x, slot] : holding) {
     const int* global = enriched_global_nodes_.data() + static_cast<size_t>(x) * W;
     const double* mass = element_mass.data() + static_cast<size_t>(x) * W * W;
-    own += mass[slot * W + slot];
     for (int p = 0; p < W; ++p) {
       const auto row = global[p] >= 0 ? index.find(global[p]) : index.end();
-      if (row == index.end()) continue;
-      cross[row->second] += mass[slot * W + p];
-      for (int q = 0; q < W; ++q) {
-        const auto column = global[q] >= 0 ? index.find(global[q]) : index.end();
-        if (column != index.end()) gram(row->second, column->second) += mass[p * W + q];
-      }
+      row_of[p] = row == index.end() ? -1 : row->second;
+    }
+    own += mass[slot * W + slot];
+    for (int p = 0; p < W; ++p) {
+      if (row_of[p] < 0) continue;
+      cross[row_of[p]] += mass[slot * W + p];
+      for (int q = 0; q < W; ++q)
+        if (row_of[q] >= 0) gram(row_of[p], row_of[q]) += mass[p * W + q];
     }
   }
   // The Gram matrix restricted to a few elements can be singular (enriched functions that
