@@ -15,6 +15,9 @@
 // Keeps no reference to the topology or sections it was built from. The references its
 // accessors return (pattern, mass_blocks, rest_state, enrichments, material_textures) hold
 // until the next set_enrichments or set_material_textures, which rebuild them.
+// Sources: runtime/shell_model.cpp (building, assembly), enrichment_pruning.cpp (which
+// enriched DOFs a basis keeps, drops or ties), shell_model_point_values.cpp (the basis at
+// points: interpolation, point forces, moments for basis changes).
 #include <cstdint>
 #include <functional>
 #include <memory>

@@ -1,0 +1,277 @@
+// ShellModel's choice of enriched DOFs: which enriched functions a basis keeps, drops or
+// ties to another node of their function, judged by their mass (the dropping and tying rules
+// of README "Degenerate cases and their remedies").
+#include "dgtex/shell_model.h"
+
+#include <algorithm>
+#include <map>
+#include <utility>
+
+#include <Eigen/Dense>
+
+namespace dgtex {
+
+namespace {
+
+// A small enriched function (own mass below min_enrichment_mass_ratio M_aa) with less mass
+// than this times M_aa is dropped or tied whatever its independence: H carries the Laplace
+// solves' error (relative tolerance 1e-6), and a function of (1e-6)^2 M_aa may be that
+// error alone. The smallest in the example scenes and in session 77's sweep had 1e-9 M_aa.
+constexpr double kMinOwnMassRatio = 1e-12;
+// A small function is kept where the part of its own mass that the other functions on its
+// support do not carry is at least this fraction. Measured in session 77 (the example
+// scenes, a 1-texel sliver, 200 pieces cut out of plates): functions that depend on others
+// (the sliver's nodes beyond it, whose N^a on a line span a few functions) 1e-11 or less,
+// the others 1e-6 or more (the corners of pieces; 90 % above 1e-3).
+constexpr double kMinIndependenceOnSupport = 1e-6;
+
+}  // namespace
+
+void ShellModel::set_enrichments(std::vector<EnrichmentFunction> functions) {
+  pruned_enriched_nodes_ = 0;
+  kept_ = KeptBasisValues{};  // of the basis being replaced (a basis without enriched elements integrates nothing)
+  const bool test_masses = options_.min_enrichment_mass_ratio > 0;
+  install_enrichments(std::move(functions), !test_masses);
+  if (!test_masses) return;
+  if (num_enriched_nodes() == 0) {
+    rebuild();
+    return;
+  }
+  // A cut that leaves a fragment a few texels wide makes enriched functions that are almost
+  // dependent: (H - H(xi^a)) N^a either has almost no support (a node beyond the fragment)
+  // or equals a multiple of N^a except on the fragment (a node on the fragment's side).
+  // Either way the system loses definiteness to round-off (the thesis has no remedy). As
+  // in XFEM practice such enriched DOFs are dropped: the part of the function's mass that
+  // N^a does not already carry, M_vv - M_av^2 / M_aa, is below min_enrichment_mass_ratio
+  // times M_aa. The fragment stays attached where its DOFs were dropped; the cut still
+  // separates everything else.
+  // The same holds between functions: two cut pieces that run close to each other give a
+  // node two enrichments that nearly coincide on its support (independent_enriched_nodes
+  // only drops exact copies). So "already carry" means N^a and the node's enrichments kept
+  // so far, in function order: the Schur complement of M_vv in their mass Gram matrix.
+  // Fracture had such pairs at three nodes: their difference, a mode with almost no mass,
+  // went unstable under corotation after ~140 steps (90 m/s against the sheet's 2.5, and
+  // 43 PCG iterations a step; tests/test_enrichment_fragments.cpp).
+  // Which of two nearly coinciding functions stays is a choice: the Heavisides of pieces
+  // cut off completely are tested first, so they stay. A region closed by two cuts (a U
+  // and a bar across it) has the bar's +-1 and the U's harmonic function, which varies only
+  // between the U's free ends and the bar; tested in function order, the U's stayed at the
+  // region's far nodes and glued the region to that strip (tri6, T = 16: the region fell
+  // 0.245 instead of 0.505 in a second, swinging 0.2 sideways; session 73).
+  // The masses come from the enriched elements' integrals before the block pattern is
+  // built (a pruned basis builds it once, for the kept nodes): every element incident to an
+  // enriched node is an enriched element, so the mass block of two functions of one node
+  // is the sum of their element entries in element order, as the assembly sums it.
+  std::vector<double> element_mass;
+  integrate_enriched_elements(enriched_element_batch(), element_mass);
+  const int nn = num_nodes(), W = width_;
+  std::vector<std::vector<int>> functions_at(nn);  // per mesh node: N^a, then its virtual nodes
+  std::vector<int> position(nn + num_enriched_nodes(), -1);  // of a basis node in its list
+  for (int v = nn; v < nn + num_enriched_nodes(); ++v) {
+    const int node = virtual_node_mesh_node_[v - nn];  // the arrays, unchecked: v is in range here
+    auto& list = functions_at[node];
+    if (list.empty()) list.push_back(node), position[node] = 0;
+    position[v] = static_cast<int>(list.size());
+    list.push_back(v);
+  }
+  std::vector<std::vector<double>> node_mass(nn);  // per mesh node: Gram of its list, row-major
+  for (int a = 0; a < nn; ++a) node_mass[a].assign(functions_at[a].size() * functions_at[a].size(), 0.0);
+  auto mesh_node_of = [&](int g) { return g < nn ? g : virtual_node_mesh_node_[g - nn]; };
+  for (int x = 0; x < num_enriched_elements(); ++x) {
+    const int* global = enriched_global_nodes_.data() + static_cast<size_t>(x) * W;
+    const double* mass = element_mass.data() + static_cast<size_t>(x) * W * W;
+    for (int p = 0; p < W; ++p) {
+      if (global[p] < 0 || position[global[p]] < 0) continue;
+      const int a = mesh_node_of(global[p]);
+      const size_t size = functions_at[a].size();
+      for (int q = 0; q < W; ++q)
+        if (global[q] >= 0 && position[global[q]] >= 0 && mesh_node_of(global[q]) == a)
+          node_mass[a][position[global[p]] * size + position[global[q]]] += mass[p * W + q];
+    }
+  }
+  auto coupling = [&](int row, int column) {
+    const int a = mesh_node_of(row);
+    return node_mass[a][position[row] * functions_at[a].size() + position[column]];
+  };
+  // The nodes kept per function first; the textures are moved (not copied) only if any go.
+  std::vector<std::vector<int>> kept_nodes(enrichments_->size());
+  int pruned = 0;
+  std::vector<std::vector<int>> kept_at(num_nodes());  // per mesh node: its kept virtual nodes so far
+  std::vector<char> kept_node(num_enriched_nodes(), 0);  // per virtual node
+  std::vector<int> small_on_support;  // pruned virtual nodes whose own mass is the small one
+  std::vector<std::vector<std::pair<int, int>>> slots_of(num_enriched_nodes());  // per virtual node: (element, slot)
+  for (int x = 0; x < num_enriched_elements(); ++x)
+    for (int p = 0; p < W; ++p)
+      if (const int g = enriched_global_nodes_[static_cast<size_t>(x) * W + p]; g >= nn) slots_of[g - nn].push_back({x, p});
+  // The part of v's mass that N^a and the node's enrichments kept so far do not carry.
+  auto independent_mass_at_node = [&](int v, int node) {
+    std::vector<int> earlier = {node};  // N^a, then its kept enrichments
+    earlier.insert(earlier.end(), kept_at[node].begin(), kept_at[node].end());
+    const int k = static_cast<int>(earlier.size());
+    Eigen::MatrixXd gram(k, k);
+    Eigen::VectorXd cross(k);
+    for (int i = 0; i < k; ++i) {
+      cross[i] = coupling(v, earlier[i]);
+      for (int j = 0; j <= i; ++j) gram(i, j) = gram(j, i) = coupling(earlier[i], earlier[j]);
+    }
+    return coupling(v, v) - cross.dot(gram.ldlt().solve(cross));
+  };
+  for (const int v : virtual_nodes_heavisides_first()) {
+    const int node = virtual_node_mesh_node_[v - nn];
+    const double own = coupling(v, v), standard = coupling(node, node);  // M_vv, M_aa
+    const bool small = own < options_.min_enrichment_mass_ratio * standard;
+    // A small function (a corner of a piece, or a fragment beyond the node) is judged
+    // against its own mass instead, on its support, with every function there: until
+    // session 77 each was dropped or tied, and a tied corner kept its piece weakly tied to
+    // the plate's motion (session 77's sweep of 200 pieces cut out of soft plates: up to
+    // 1.8 % off free fall, 50 runs over 0.1 %; now 0.97 % and 7 runs, 173 exact).
+    const bool keep = small ? own > kMinOwnMassRatio * standard &&
+                                  independent_mass_on_support(v, slots_of[v - nn], kept_node, element_mass) >=
+                                      kMinIndependenceOnSupport * own
+                            : independent_mass_at_node(v, node) >= options_.min_enrichment_mass_ratio * standard;
+    if (!keep) {
+      ++pruned;
+      if (small) small_on_support.push_back(v);
+    } else {
+      kept_nodes[virtual_node_function_[v - nn]].push_back(node);
+      kept_at[node].push_back(v);
+      kept_node[v - nn] = 1;
+    }
+  }
+  if (pruned == 0) {
+    rebuild(&element_mass);
+    return;
+  }
+  std::vector<EnrichmentTie> ties = enrichment_ties(small_on_support, kept_node);
+  // install_enrichments below replaces every member derived from enrichments_. The
+  // functions were installed by this call, so no copy of the model shares them yet.
+  std::vector<EnrichmentFunction> kept = std::move(*enrichments_);
+  for (size_t i = 0; i < kept.size(); ++i) kept[i].enriched_nodes = std::move(kept_nodes[i]);
+  // Functions left without nodes go (so have no ties); the others keep the elements of
+  // Omega_i that still touch one of their nodes, own or tied.
+  std::vector<EnrichmentFunction> functions_left;
+  std::vector<int> index_left(kept.size(), -1);
+  for (size_t i = 0; i < kept.size(); ++i) {
+    EnrichmentFunction& f = kept[i];
+    if (f.enriched_nodes.empty()) continue;
+    const std::vector<int> nodes_with_function = nodes_with_own_or_tied_dofs(f, static_cast<int>(i), ties);
+    std::vector<ElementTexture> elements;
+    for (auto& texture : f.elements) {
+      const int* nodes = mesh_.element_nodes(texture.element);
+      bool touches = false;
+      for (int a = 0; a < mesh_.nodes_per_element() && !touches; ++a)
+        touches = std::binary_search(nodes_with_function.begin(), nodes_with_function.end(), nodes[a]);
+      if (touches) elements.push_back(std::move(texture));
+    }
+    f.elements = std::move(elements);
+    index_left[i] = static_cast<int>(functions_left.size());
+    functions_left.push_back(std::move(f));
+  }
+  for (EnrichmentTie& tie : ties) tie.function = index_left[tie.function];
+  // This rebuild alone keeps the first build's quadrature where whole functions went.
+  rebuilding_pruned_basis_ = true;
+  struct Reset {
+    bool& flag;
+    ~Reset() { flag = false; }
+  } reset{rebuilding_pruned_basis_};
+  install_enrichments(std::move(functions_left), true, std::move(ties));
+  pruned_enriched_nodes_ = pruned;
+}
+
+std::vector<int> ShellModel::nodes_with_own_or_tied_dofs(const EnrichmentFunction& f, int function,
+                                                         const std::vector<EnrichmentTie>& ties) {
+  std::vector<int> nodes = f.enriched_nodes;
+  for (const EnrichmentTie& tie : ties)
+    if (tie.function == function) nodes.push_back(tie.node);
+  std::sort(nodes.begin(), nodes.end());
+  return nodes;
+}
+
+std::vector<ShellModel::EnrichmentTie> ShellModel::enrichment_ties(const std::vector<int>& small_on_support,
+                                                                   const std::vector<char>& kept_node) const {
+  // A node whose enriched function has almost no mass on its support holds only a corner of
+  // a piece there, (H - H(xi^a)) N^a being 0 off the piece. Dropped, the piece's other
+  // nodes no longer sum to 1 on that corner: the piece cannot translate and is held by the
+  // elastic energy of that corner (a triangle cut out around a node of a 2 x 2 plate fell
+  // 0.02 instead of 0.505 in a second; session 74). Every enriched DOF of a Heaviside has
+  // the same value in a translation of either side, so adding the dropped function to the
+  // DOFs of another node of the same function keeps the translations, and the sum is as
+  // well conditioned as that node's function alone. The piece still follows the plate's
+  // motion at the tied node against the partner's, so the partner is the nearest kept node
+  // of the function. Until session 77 it was the one whose function overlaps most (largest
+  // |M_vw|; the nearest only where none overlaps): once most small functions were kept,
+  // that read up to 2.7 % off free fall where the nearest reads 0.19 % (a triangle cut out
+  // of a soft plate, SceneCutLoops.RandomPiecesCutOutOfASoftPlateFallFreelyUnlessTied).
+  const int nn = num_nodes();
+  std::vector<EnrichmentTie> ties;
+  for (const int v : small_on_support) {
+    const int partner = nearest_kept_node_of_the_function(v, kept_node);
+    if (partner >= 0)
+      ties.push_back({virtual_node_function_[v - nn], virtual_node_mesh_node_[v - nn], virtual_node_mesh_node_[partner], 0.0});
+  }
+  return ties;
+}
+
+double ShellModel::independent_mass_on_support(int v, const std::vector<std::pair<int, int>>& holding,
+                                               const std::vector<char>& kept_node,
+                                               const std::vector<double>& element_mass) const {
+  // Integrated over v's elements only, the others' Gram is smaller than over their whole
+  // supports, so this errs towards dependence. A sliver's functions at the nodes beyond it
+  // are independent node by node (of N^a and the node's other enrichments) but not of each
+  // other: the Gram of all functions there finds it.
+  const int nn = num_nodes(), W = width_;
+  std::map<int, int> index;  // basis node -> row of the Gram matrix
+  for (const auto& [x, slot] : holding)
+    for (int q = 0; q < W; ++q) {
+      const int g = enriched_global_nodes_[static_cast<size_t>(x) * W + q];
+      if (g >= 0 && g != v && (g < nn || kept_node[g - nn])) index.emplace(g, static_cast<int>(index.size()));
+    }
+  const int n = static_cast<int>(index.size());
+  Eigen::MatrixXd gram = Eigen::MatrixXd::Zero(n, n);
+  Eigen::VectorXd cross = Eigen::VectorXd::Zero(n);
+  double own = 0;
+  std::vector<int> row_of(W);  // per slot of an element: its Gram row, -1 for v and the functions left out
+  for (const auto& [x, slot] : holding) {
+    const int* global = enriched_global_nodes_.data() + static_cast<size_t>(x) * W;
+    const double* mass = element_mass.data() + static_cast<size_t>(x) * W * W;
+    for (int p = 0; p < W; ++p) {
+      const auto row = global[p] >= 0 ? index.find(global[p]) : index.end();
+      row_of[p] = row == index.end() ? -1 : row->second;
+    }
+    own += mass[slot * W + slot];
+    for (int p = 0; p < W; ++p) {
+      if (row_of[p] < 0) continue;
+      cross[row_of[p]] += mass[slot * W + p];
+      for (int q = 0; q < W; ++q)
+        if (row_of[q] >= 0) gram(row_of[p], row_of[q]) += mass[p * W + q];
+    }
+  }
+  // The Gram matrix restricted to a few elements can be singular (enriched functions that
+  // differ only elsewhere): a pseudo-inverse, over the eigenvalues above round-off.
+  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eigen(gram);
+  const Eigen::VectorXd along = eigen.eigenvectors().transpose() * cross;
+  const double largest = n > 0 ? eigen.eigenvalues().maxCoeff() : 0.0;
+  double independent = own;
+  for (int k = 0; k < n; ++k)
+    if (eigen.eigenvalues()[k] > 1e-14 * largest) independent -= along[k] * along[k] / eigen.eigenvalues()[k];
+  return independent;
+}
+
+int ShellModel::nearest_kept_node_of_the_function(int v, const std::vector<char>& kept_node) const {
+  const int nn = num_nodes();
+  const double* x = mesh_.node(virtual_node_mesh_node_[v - nn]);
+  const int function = virtual_node_function_[v - nn];
+  int nearest = -1;
+  double nearest_distance = 0;
+  for (int w = function_slot_start_[function]; w < function_slot_start_[function + 1]; ++w) {
+    if (!kept_node[w]) continue;
+    const double* y = mesh_.node(virtual_node_mesh_node_[w]);
+    const double distance = (x[0] - y[0]) * (x[0] - y[0]) + (x[1] - y[1]) * (x[1] - y[1]) + (x[2] - y[2]) * (x[2] - y[2]);
+    // Distances equal up to round-off (a regular mesh has many) go to the lower index, so
+    // that the choice does not change with the length unit.
+    if (nearest < 0 || distance < nearest_distance * (1 - 1e-9)) nearest = w, nearest_distance = distance;
+  }
+  return nearest;
+}
+
+}  // namespace dgtex
