@@ -496,6 +496,16 @@ void CutManager::rasterize_visible(const std::vector<VisibleCutSegment>& visible
 
 bool CutManager::update(double time) {
   if (!std::isfinite(time)) throw std::invalid_argument("CutManager::update: time " + std::to_string(time) + " is not finite");
+  if (half_updated_)
+    throw std::logic_error("CutManager::update: an earlier update failed and left this manager half updated (its "
+                           "walls, textures and functions partly of that update's time); build a new one");
+  half_updated_ = true;  // until the update completes: an exception leaves it set
+  const bool changed = update_functions(time);
+  half_updated_ = false;
+  return changed;
+}
+
+bool CutManager::update_functions(double time) {
   const auto start = std::chrono::steady_clock::now();
   last_ = CutUpdateStats{};
   time_ = time;

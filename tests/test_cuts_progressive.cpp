@@ -7,6 +7,7 @@
 #include <Eigen/Dense>
 #include <cmath>
 
+#include "address_space_support.h"
 #include "cut_test_support.h"
 #include "dgtex/cut_manager.h"
 #include "dgtex/mesh_generators.h"
@@ -122,6 +123,43 @@ TEST(CutsProgressive, CutGrowsMonotonicallyWithTime) {
   }
   EXPECT_EQ(static_cast<int>(last_functions), static_cast<int>(std::ceil(length)));
   EXPECT_FALSE(m.update(0.5 + length + 1.0));  // complete: a later update changes nothing
+}
+
+// An update that throws leaves the manager half updated (walls drawn, some functions
+// solved). Until session 79 a later update to the same time then reported "no change" and
+// handed out those functions; now every later update says the manager is spent.
+TEST(CutsProgressive, AnUpdateThatFailedMakesEveryLaterUpdateThrow) {
+#if defined(__SANITIZE_ADDRESS__)
+  GTEST_SKIP() << "ASan reserves terabytes of address space: no limit to lower";
+#endif
+  // A cut along a strip of four elements: its first segment is solved on two of them,
+  // unlimited; then the address space is limited to a little above what the process holds,
+  // and the update that draws the cut across all four needs regions ~2x as large.
+  const Mesh mesh = make_rectangle(4, 1, 4, 1, ElementType::quad8);
+  Cut cut = points_cut({{0.1, 0.5, 0}, {3.9, 0.5, 0}});
+  cut.has_schedule = true;
+  cut.speed = 1.0;
+  EnrichmentOptions o = cholmod_enrichment(128);
+  o.new_cut_length = 0.5;
+  CutManager m(mesh, build_topology(mesh), {cut}, o);
+  ASSERT_TRUE(m.update(0.2));
+  {
+    test::ScopedAddressSpaceLimit limit(std::int64_t{4} << 20);
+    if (!limit.why_not().empty()) GTEST_SKIP() << limit.why_not();
+    EXPECT_ANY_THROW(m.update(3.0));
+  }
+  try {
+    m.update(3.0);
+    ADD_FAILURE() << "a half-updated manager updated again";
+  } catch (const std::logic_error& e) {
+    EXPECT_NE(std::string(e.what()).find("half updated"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("build a new one"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW(m.update(3.5), std::logic_error);
+  // A fresh manager does the update the failed one could not.
+  CutManager fresh(mesh, build_topology(mesh), {cut}, o);
+  EXPECT_TRUE(fresh.update(3.0));
+  EXPECT_FALSE(fresh.functions().empty());
 }
 
 TEST(CutsProgressive, UnscheduledCutIsCompleteAfterTheFirstUpdate) {

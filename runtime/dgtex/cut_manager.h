@@ -106,8 +106,9 @@ class CutManager {
 
   // Brings the functions to `time` (finite, else std::invalid_argument); true when they
   // changed (added, removed or re-solved). A Laplace solve that fails throws
-  // std::runtime_error, memory std::bad_alloc; the manager is then half updated (a later
-  // update to the same time reports no change): discard it, as SceneRun does. Times are
+  // std::runtime_error, memory std::bad_alloc; the manager is then half updated, and every
+  // later update throws std::logic_error saying so (it reported "no change" until session
+  // 79): discard it, as SceneRun does. Times are
   // meant not to decrease: an update to an earlier time draws the cuts as far as that time,
   // but with CutManagerOptions::freeze_settled_elements it keeps the textures it settled
   // later (0.23 off a fresh manager's at the earlier time, in a test of session 71).
@@ -185,8 +186,12 @@ class CutManager {
   std::vector<std::vector<double>> boundaries_;
   std::vector<std::vector<int>> node_elements_;  // elements incident to each node
 
+  // The functions brought to `time` (update's work; update guards it).
+  bool update_functions(double time);
+
   double time_ = -1;
   bool updated_once_ = false;
+  bool half_updated_ = false;  // an update threw: the state below is partly the new time's
   std::vector<VisibleCutSegment> visible_;
   std::map<int, kernels::TexelTile> walls_;
   MeshEdgeWalls edge_walls_;
