@@ -60,6 +60,10 @@ class ShellSimulation {
   // not positive definite at rest (penalty too low), std::runtime_error when a corotated
   // step fails away from rest (its matrix not positive definite, a right-hand side that is
   // not finite, or no convergence even with a fresh factor: the run has likely diverged).
+  // A step that throws leaves displacement, velocity and time as they were, so it may be
+  // retried (a smaller time step); the steps after it then agree with a run that never
+  // failed bitwise without reuse_factorization, and to within the solver's tolerance with
+  // it (the failure may have replaced the reused factor).
   void step(const DynamicsOptions& options);
 
   const std::vector<double>& displacement() const { return u_; }
