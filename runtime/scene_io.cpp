@@ -257,8 +257,13 @@ class SceneReader {
     scene.source_name = source_;
     scene.base_dir = base_dir_;
     if (!root.is_object()) fail("(root)", "the scene must be a JSON object", root, "{\"mesh\": {...}, \"material\": {...}, ...}");
+    // Before the keys: a later format's new keys would read as unknown ones.
+    if (const json* v = find(root, "version"))
+      if (!v->is_number_integer() || v->get<long long>() != scene_format_version)
+        fail("version", "not a scene format this dgtex reads (a scene for a later dgtex?)", *v,
+             "expected " + std::to_string(scene_format_version) + ", or no version key");
     check_keys(root, "",
-               {"mesh", "material", "penalty", "boundary", "loads", "analysis", "probes", "cuts", "creases", "enrichment", "render",
+               {"version", "mesh", "material", "penalty", "boundary", "loads", "analysis", "probes", "cuts", "creases", "enrichment", "render",
                 "output", "material_textures"});
     scene.mesh = read_mesh(require(root, "", "mesh", "a generator object or {\"file\": ...}"), "mesh");
     scene.material = read_material(require(root, "", "material", "an object with youngs_modulus, poisson_ratio, thickness"),
@@ -978,6 +983,7 @@ json mesh_to_json(const MeshSpec& m) {
 
 json scene_to_json(const Scene& scene) {
   json out;
+  out["version"] = scene_format_version;
   out["mesh"] = mesh_to_json(scene.mesh);
   const Material& m = scene.material;
   out["material"] = {{"youngs_modulus", m.youngs_modulus},

@@ -83,6 +83,19 @@ TEST(SceneErrors, UnknownTopLevelKey) {
             std::string::npos);
 }
 
+// The optional top-level "version" is the scene format's (dgtex::scene_format_version).
+// A later format's scene is refused by its version, before its new keys read as unknown.
+TEST(SceneErrors, AVersionOtherThanTheFormatsIsRefusedBeforeTheKeys) {
+  EXPECT_EQ(error_of_text(with(valid_scene(), "/version"_json_pointer, dgtex::scene_format_version).dump()), "");
+  expect_error(with(valid_scene(), "/version"_json_pointer, 2), "version", "2",
+               "not a scene format this dgtex reads (a scene for a later dgtex?), got 2; expected 1, or no version key");
+  expect_error(with(valid_scene(), "/version"_json_pointer, "1"), "version", "\"1\"", "expected 1");
+  expect_error(with(valid_scene(), "/version"_json_pointer, 1.0), "version", "1.0", "expected 1");
+  json later = with(valid_scene(), "/version"_json_pointer, 2);
+  later["joints"] = json::array();
+  expect_error(later, "version", "2", "not a scene format this dgtex reads");
+}
+
 TEST(SceneErrors, UnknownNestedKey) {
   json s = valid_scene();
   s["material"]["youngs_modulous"] = 1e6;

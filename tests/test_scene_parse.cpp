@@ -6,6 +6,8 @@
 #include <sstream>
 #include <string>
 
+#include <nlohmann/json.hpp>
+
 #include "dgtex/mesh_generators.h"
 #include "dgtex/scene_io.h"
 #include "dgtex/scene_model.h"
@@ -220,6 +222,7 @@ TEST(SceneParse, CanonicalJsonRoundTrips) {
     const std::string text = scene_to_json_text(first);
     const Scene second = parse_scene(text, "echo.json");
     EXPECT_EQ(scene_to_json_text(second), text);
+    EXPECT_EQ(nlohmann::json::parse(text).at("version"), scene_format_version);  // the format it is written in
     EXPECT_EQ(second.material.youngs_modulus, first.material.youngs_modulus);
     EXPECT_EQ(second.boundary.size(), first.boundary.size());
     EXPECT_EQ(second.cuts.size(), first.cuts.size());

@@ -35,6 +35,11 @@ class SceneError : public std::runtime_error {
   std::string json_path_;
 };
 
+// The scene file format this dgtex reads and writes: a file's optional top-level
+// "version" must equal it (a file of a later format is refused naming both versions,
+// before its keys are checked); scene_to_json_text writes it.
+constexpr int scene_format_version = 1;
+
 // Reads and validates the scene file at path. Relative paths inside it (mesh.file)
 // resolve against the scene file's folder.
 Scene load_scene(const std::string& path);
