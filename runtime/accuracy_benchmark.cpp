@@ -1,6 +1,7 @@
 // Reporting of the speed-against-accuracy sweeps: JSON and Markdown (the machine: benchmark_machine.h).
 #include "dgtex/accuracy_benchmark.h"
 #include "dgtex/stage_timer.h"
+#include "dgtex/version.h"
 
 #include <time.h>
 
@@ -62,7 +63,7 @@ std::string accuracy_charts_json(const std::vector<AccuracyChart>& charts, const
     if (!chart.conclusion.empty()) entry["conclusion"] = chart.conclusion;
     list.push_back(entry);
   }
-  return nlohmann::json{{"machine", machine}, {"command", command}, {"charts", list}}.dump(2) + "\n";
+  return nlohmann::json{{"dgtex_version", version()}, {"machine", machine}, {"command", command}, {"charts", list}}.dump(2) + "\n";
 }
 
 std::string accuracy_charts_markdown(const std::vector<AccuracyChart>& charts, const std::string& machine,

@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "dgtex/accuracy_benchmark.h"
+#include "dgtex/version.h"
 
 namespace {
 
@@ -87,6 +88,7 @@ void check_WritesChartsJsonAndTable(const ReducedRun& run) {
   }
   EXPECT_TRUE(run.chart("plate").at("points").at(0).contains("free_dofs"));
   EXPECT_FALSE(run.json.at("machine").get<std::string>().empty());
+  EXPECT_EQ(run.json.at("dgtex_version"), dgtex::version());
   EXPECT_NE(run.json.at("command").get<std::string>().find("dgtex bench accuracy"), std::string::npos);
   EXPECT_TRUE(fs::exists(run.dir / "accuracy.md"));
 }

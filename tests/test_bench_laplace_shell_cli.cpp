@@ -10,6 +10,7 @@
 #include <string>
 
 #include "cli_test_support.h"
+#include "dgtex/version.h"
 
 namespace fs = std::filesystem;
 using dgtex::test::fresh_dir;
@@ -24,6 +25,7 @@ nlohmann::json read_json(const fs::path& path) {
 
 void expect_machine_with_probe(const nlohmann::json& j) {
   ASSERT_TRUE(j.contains("machine"));
+  EXPECT_EQ(j["dgtex_version"], dgtex::version());  // which build measured
   EXPECT_NE(j["machine"].get<std::string>().find("one-core probe"), std::string::npos) << j["machine"];
 }
 

@@ -18,6 +18,7 @@
 #include "dgtex/scaling_benchmark.h"
 #include "dgtex/scene_io.h"
 #include "dgtex/scene_run.h"
+#include "dgtex/version.h"
 #include "thread_count_support.h"
 
 namespace fs = std::filesystem;
@@ -147,6 +148,7 @@ TEST(BenchScaling, CommandWritesJsonForEveryThreadCountAndAChart) {
   ASSERT_EQ(r.exit_code, 0) << r.stderr_text;
   std::ifstream in(json);
   const nlohmann::json j = nlohmann::json::parse(in);
+  EXPECT_EQ(j["dgtex_version"], dgtex::version());
   ASSERT_EQ(j["kernels"].size(), 1u);
   EXPECT_EQ(j["kernels"][0]["family"], "polar_decomposition");
   ASSERT_EQ(j["kernels"][0]["cases"].size(), 2u);

@@ -21,6 +21,7 @@
 #include "dgtex/scene_benchmark.h"
 #include "dgtex/scene_io.h"
 #include "dgtex/scene_run.h"
+#include "dgtex/version.h"
 
 namespace fs = std::filesystem;
 using namespace dgtex;
@@ -65,6 +66,7 @@ TEST(BenchScenes, JsonHasEveryRequestedSceneWithRequiredKeysAndThesisRatios) {
   // The machine, and its speed probes (one core, every thread at once) before each scene's
   // run and at the end.
   EXPECT_NE(j["machine"].get<std::string>().find(" cores, "), std::string::npos);
+  EXPECT_EQ(j["dgtex_version"], dgtex::version());
   EXPECT_GT(j["machine_probe_ms_at_end"].get<double>(), 0);
   EXPECT_GT(j["machine_probe_all_threads_ms_at_end"].get<double>(), 0);
   for (const nlohmann::json& s : j["scenes"]) {

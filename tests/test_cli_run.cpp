@@ -17,6 +17,7 @@
 
 #include "cli_test_support.h"
 #include "dgtex/texel_memory_estimate.h"
+#include "dgtex/version.h"
 
 namespace fs = std::filesystem;
 
@@ -37,6 +38,7 @@ TEST(CliRun, ClampedPlateSceneWritesReportWithinOnePercent) {
   ASSERT_EQ(r.exit_code, 0) << r.stderr_text;
   std::ifstream in(dir / "out" / "report.json");
   const nlohmann::json report = nlohmann::json::parse(in);
+  EXPECT_EQ(report["dgtex_version"], dgtex::version());  // which build wrote it
   EXPECT_EQ(report["counts"]["elements"], 256);
   EXPECT_EQ(report["counts"]["nodes"], 833);
   EXPECT_EQ(report["counts"]["dofs"], 2499);

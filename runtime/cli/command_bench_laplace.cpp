@@ -18,6 +18,7 @@
 #include "dgtex/laplace_benchmark.h"
 #include "dgtex/laplace_domains.h"
 #include "dgtex/scene.h"
+#include "dgtex/version.h"
 #include "option_errors.h"
 #include "output_paths.h"
 
@@ -169,7 +170,8 @@ int bench_laplace_command(int argc, char** argv) {
     std::printf("smoother (red-black sweep, T=%d): %.2f GB/s; array copy: %.2f GB/s; ratio %.0f%%\n", bandwidth_size,
                 bw.smoother_gb_per_s, bw.copy_gb_per_s, 100.0 * bw.smoother_gb_per_s / bw.copy_gb_per_s);
     if (!json_path.empty()) {
-      const nlohmann::json results{{"machine", machine},
+      const nlohmann::json results{{"dgtex_version", version()},
+                                   {"machine", machine},
                                    {"tolerance", tolerance},
                                    {"cases", cases},
                                    {"speedup_of_multigrid", ratios},

@@ -17,6 +17,7 @@
 #include "gnuplot_chart.h"
 #include "dgtex/benchmark_machine.h"
 #include "dgtex/render_benchmark.h"
+#include "dgtex/version.h"
 #include "option_errors.h"
 #include "output_paths.h"
 
@@ -134,7 +135,8 @@ int bench_render_command(int argc, char** argv) {
       target["met"] = false;
     }
     if (!json_path.empty()) {
-      const nlohmann::json results{{"machine", machine},
+      const nlohmann::json results{{"dgtex_version", version()},
+                                   {"machine", machine},
                                    {"resolution", r.resolution},
                                    {"width", r.width},
                                    {"height", r.height},

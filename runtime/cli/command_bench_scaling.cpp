@@ -24,6 +24,7 @@
 #include "dgtex/model_error.h"
 #include "dgtex/scaling_benchmark.h"
 #include "dgtex/scene_io.h"
+#include "dgtex/version.h"
 #include "option_errors.h"
 #include "output_paths.h"
 
@@ -320,7 +321,8 @@ int bench_scaling_command(int argc, char** argv) {
   try {
     if (!markdown_path.empty()) write_output_file(markdown_path, tables, "--markdown");
     if (!json_path.empty()) {
-      nlohmann::json j = {{"cores", omp_get_num_procs()},
+      nlohmann::json j = {{"dgtex_version", version()},
+                          {"cores", omp_get_num_procs()},
                           {"threads", threads},
                           {"repeats", repeats},
                           {"omp_wait_policy", omp_wait_policy_name()},

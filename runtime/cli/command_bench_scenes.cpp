@@ -25,6 +25,7 @@
 #include "dgtex/model_error.h"
 #include "dgtex/scene_benchmark.h"
 #include "dgtex/scene_io.h"
+#include "dgtex/version.h"
 #include "option_errors.h"
 #include "output_paths.h"
 
@@ -436,7 +437,8 @@ int bench_scenes_command(int argc, char** argv) {
   const std::string machine = describe_machine();
   const int threads_used = omp_get_max_threads();
   ProbeReadings probes;  // of the whole command
-  nlohmann::json all = {{"machine", machine},
+  nlohmann::json all = {{"dgtex_version", version()},
+                        {"machine", machine},
                         {"steps", steps},
                         {"threads", threads_used},
                         {"overlap_cut_updates", !inline_cut_updates},

@@ -22,6 +22,7 @@
 #include "dgtex/mesh_error.h"
 #include "dgtex/scene_io.h"
 #include "dgtex/shell_benchmark.h"
+#include "dgtex/version.h"
 #include "option_errors.h"
 #include "output_paths.h"
 
@@ -224,7 +225,8 @@ int bench_shell_command(int argc, char** argv) {
                          {"factorize_ms_total", r.factorize_ms},
                          {"precondition_ms_total", r.precondition_ms}});
       }
-      const nlohmann::json results{{"machine", machine},
+      const nlohmann::json results{{"dgtex_version", version()},
+                                   {"machine", machine},
                                    {"scene", scene_path},
                                    {"steps", steps},
                                    {"solver", refactor_every_step ? "refactor_every_step" : "pcg_reused_factor"},

@@ -31,6 +31,7 @@
 #include "dgtex/shell_state.h"
 #include "dgtex/surface_point.h"
 #include "dgtex/texel_memory_estimate.h"
+#include "dgtex/version.h"
 #include "api_argument_checks.h"
 #include "interrupt_request.h"
 #include "option_errors.h"
@@ -288,6 +289,7 @@ int run_command(int argc, char** argv) {
   const ShellSimulation& sim = run->simulation();
   const StageTimings timings = run->timings();
   nlohmann::json report;
+  report["dgtex_version"] = version();  // which build wrote it
   report["scene"] = scene_path;
   report["analysis"] = scene.analysis.is_dynamic() ? "dynamic" : "static";
   report["completed"] = interrupted_by == 0;
