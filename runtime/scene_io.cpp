@@ -263,8 +263,8 @@ class SceneReader {
         fail("version", "not a scene format this dgtex reads (a scene for a later dgtex?)", *v,
              "expected " + std::to_string(scene_format_version) + ", or no version key");
     check_keys(root, "",
-               {"version", "mesh", "material", "penalty", "boundary", "loads", "analysis", "probes", "cuts", "creases", "enrichment", "render",
-                "output", "material_textures"});
+               {"version", "mesh", "material", "penalty", "boundary", "loads", "analysis", "probes", "cuts", "creases",
+                "enrichment", "render", "output", "material_textures"});
     scene.mesh = read_mesh(require(root, "", "mesh", "a generator object or {\"file\": ...}"), "mesh");
     scene.material = read_material(require(root, "", "material", "an object with youngs_modulus, poisson_ratio, thickness"),
                                    "material");
