@@ -53,10 +53,7 @@ bool has_extension(const char* list, const std::string& name) {
 }
 
 // EGL displays are per device and process-wide, and eglTerminate is not reference counted:
-// count the live contexts per display so that a failed attempt never kills another
-// context's display. A display that has held a context stays initialised until the process
-// ends (EGL's own exit handler releases it): terminating it unloads the driver, and loading
-// it again cost the next context ~8 ms and leaked Mesa's llvmpipe 240 bytes each time.
+// count the live contexts per display so one context's teardown never kills another's.
 std::mutex display_mutex;
 std::map<EGLDisplay, int> display_users;
 
@@ -253,8 +250,11 @@ EglContext::~EglContext() {
     eglMakeCurrent(display_, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
     if (context_) eglDestroyContext(display_, context_);
     eglGetError();
-    std::lock_guard<std::mutex> lock(display_mutex);
-    --display_users[display_];  // the display stays initialised (above)
+    {
+      std::lock_guard<std::mutex> lock(display_mutex);
+      --display_users[display_];
+    }
+    release_display(display_);
   }
 }
 

@@ -13,10 +13,8 @@
 // The context is made current on the constructing thread; call make_current() before
 // using it from another thread (one thread at a time; it throws std::runtime_error when
 // EGL refuses, e.g. while the context is current on another thread).
-// EglContext owns the EGL context (released by the destructor; not copyable); share it
-// between renderers through std::shared_ptr. The display it was made on stays initialised
-// until the process ends (EGL's exit handler releases it): terminating it unloaded the
-// driver, which cost the next context ~8 ms and leaked Mesa's llvmpipe 240 bytes.
+// EglContext owns the EGL display connection and context (released by the destructor;
+// not copyable); share it between renderers through std::shared_ptr.
 #include <stdexcept>
 #include <string>
 
