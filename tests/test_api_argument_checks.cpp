@@ -25,12 +25,15 @@
 #include "dgtex/topology.h"
 #include "exception_message_support.h"
 #include "scene_in_code_support.h"
+#include "shell_test_support.h"
 
 namespace {
 
 using namespace dgtex;
 using test::message_of;
 using test::strip_built_in_code;
+using testing_support::max_abs;
+using testing_support::max_difference;
 
 TEST(ApiArgumentChecks, ShellModelLoadsAndInterpolationCheckSizesAndElements) {
   const Scene scene = strip_built_in_code(true, false);
@@ -97,11 +100,6 @@ TEST(ApiArgumentChecks, AShellSimulationStepThatThrowsLeavesTheStateAsItWas) {
   scene.penalty = 0.01;
   const Mesh mesh = build_scene_mesh(scene);
   const SceneModel built = build_scene_model(scene, mesh);
-  const auto largest = [](const std::vector<double>& x) {
-    double m = 0;
-    for (const double value : x) m = std::max(m, std::abs(value));
-    return m;
-  };
   for (const bool reuse : {true, false}) {
     SCOPED_TRACE(reuse ? "reusing factors" : "a factor every step");
     ShellSimulation failing(*built.model, built.fixed, built.external_force);
@@ -121,14 +119,11 @@ TEST(ApiArgumentChecks, AShellSimulationStepThatThrowsLeavesTheStateAsItWas) {
     EXPECT_EQ(failing.velocity(), v);
     EXPECT_EQ(failing.time(), time);
     for (int k = 0; k < 3; ++k) failing.step(small), reference.step(small);
-    std::vector<double> du(u.size()), dv(v.size());
-    for (std::size_t d = 0; d < u.size(); ++d)
-      du[d] = failing.displacement()[d] - reference.displacement()[d],
-      dv[d] = failing.velocity()[d] - reference.velocity()[d];
     const double tolerance = reuse ? 1e-8 : 0.0;
-    EXPECT_LE(largest(du), tolerance * largest(reference.displacement()));
-    EXPECT_LE(largest(dv), tolerance * largest(reference.velocity()));
-    EXPECT_GT(largest(reference.displacement()), 0);
+    EXPECT_LE(max_difference(failing.displacement(), reference.displacement()),
+              tolerance * max_abs(reference.displacement()));
+    EXPECT_LE(max_difference(failing.velocity(), reference.velocity()), tolerance * max_abs(reference.velocity()));
+    EXPECT_GT(max_abs(reference.displacement()), 0);
   }
 }
 
