@@ -11,7 +11,7 @@ ProjectedState project_onto_basis(const ShellModel& old_model, const std::vector
                                   const std::vector<char>& fixed) {
   detail::check_size("project_onto_basis", "fixed", fixed.size(), "new_model.num_dofs()", new_model.num_dofs());
   return project_onto_basis(old_model, old_displacement, old_velocity, new_model,
-                            FreeDofSystem(new_model.pattern(), fixed));
+                            FreeDofSystem(new_model.pattern(), fixed, nullptr, &new_model.dependent_nodes()));
 }
 
 ProjectedState project_onto_basis(const ShellModel& old_model, const std::vector<double>& old_displacement,

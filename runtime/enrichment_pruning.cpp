@@ -4,6 +4,8 @@
 #include "dgtex/shell_model.h"
 
 #include <algorithm>
+#include <cmath>
+#include <limits>
 #include <map>
 #include <utility>
 
@@ -142,7 +144,27 @@ void ShellModel::set_enrichments(std::vector<EnrichmentFunction> functions) {
     rebuild(&element_mass);
     return;
   }
-  std::vector<EnrichmentTie> ties = enrichment_ties(small_on_support, kept_node);
+  // Ties of step functions whose function lives on one piece are made exact: the node keeps
+  // its DOFs, as a dependent node (set after the install below).
+  struct ExactTie {
+    int function, node;
+    std::vector<std::pair<int, double>> partners;  // mesh node, weight
+    double piece_value;
+  };
+  std::vector<ExactTie> exact_ties;
+  std::vector<EnrichmentTie> ties;
+  for (const EnrichmentTie& tie : enrichment_ties(small_on_support, kept_node)) {
+    const double piece_value = piece_value_of_step(virtual_node(tie.function, tie.node));
+    if (std::isnan(piece_value)) {
+      ties.push_back(tie);
+      continue;
+    }
+    std::vector<std::pair<int, double>> partners = affine_partners(virtual_node(tie.function, tie.node), kept_node);
+    for (auto& [partner, weight] : partners) partner = virtual_node_mesh_node_[partner];
+    exact_ties.push_back({tie.function, tie.node, std::move(partners), piece_value});
+    std::vector<int>& nodes = kept_nodes[tie.function];
+    nodes.insert(std::lower_bound(nodes.begin(), nodes.end(), tie.node), tie.node);
+  }
   // install_enrichments below replaces every member derived from enrichments_. The
   // functions were installed by this call, so no copy of the model shares them yet.
   std::vector<EnrichmentFunction> kept = std::move(*enrichments_);
@@ -175,7 +197,46 @@ void ShellModel::set_enrichments(std::vector<EnrichmentFunction> functions) {
     ~Reset() { flag = false; }
   } reset{rebuilding_pruned_basis_};
   install_enrichments(std::move(functions_left), true, std::move(ties));
-  pruned_enriched_nodes_ = pruned;
+  pruned_enriched_nodes_ = pruned;  // the exactly tied ones included: they are no unknowns either
+  for (const ExactTie& tie : exact_ties) {
+    // (h_P - h_v) q_v = sum_k lambda_k ((h_P - h_k) q_k + u_k) - u_v: the piece's field
+    // u + (h_P - h) q at v is the affine extrapolation of its field at the partners k. A
+    // node's shift is the same as before the pruning (its elements, which all touch it, stay).
+    const int function = index_left[tie.function];
+    const int v = virtual_node(function, tie.node);
+    const double across_v = tie.piece_value - node_shift(v);
+    DependentNode dependent{v, {{tie.node, -1 / across_v}}};
+    for (const auto& [partner, weight] : tie.partners) {
+      if (weight == 0) continue;  // v on the line of the other two
+      const int w = virtual_node(function, partner);
+      const double across_w = tie.piece_value - node_shift(w);
+      dependent.sources.push_back({partner, weight / across_v});
+      if (across_w != 0) dependent.sources.push_back({w, weight * across_w / across_v});
+    }
+    dependent_nodes_.push_back(std::move(dependent));
+  }
+}
+
+double ShellModel::piece_value_of_step(int v) const {
+  const int nn = num_nodes();
+  const EnrichmentFunction& f = (*enrichments_)[virtual_node_function_[v - nn]];
+  const int node = virtual_node_mesh_node_[v - nn];
+  const double shift = virtual_node_shift_[v - nn];
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  if (!is_step_function(f) || (shift != 0 && shift != 1 && shift != -1)) return nan;
+  double piece = nan;
+  for (const ElementTexture& texture : f.elements) {
+    const int* nodes = mesh_.element_nodes(texture.element);
+    if (std::find(nodes, nodes + mesh_.nodes_per_element(), node) == nodes + mesh_.nodes_per_element()) continue;
+    for (std::size_t t = 0; t < texture.tile.values.size(); ++t) {
+      const double value = texture.tile.values[t];
+      // A tri6 element's tile: its upper half lies outside the element (0 there).
+      if ((texture.tile.flags[t] & kernels::inactive) || value == shift || value == piece) continue;
+      if (!std::isnan(piece)) return nan;  // two pieces besides the node's own
+      piece = value;
+    }
+  }
+  return piece;
 }
 
 std::vector<int> ShellModel::nodes_with_own_or_tied_dofs(const EnrichmentFunction& f, int function,
@@ -201,7 +262,7 @@ std::vector<ShellModel::EnrichmentTie> ShellModel::enrichment_ties(const std::ve
   // of the function. Until session 77 it was the one whose function overlaps most (largest
   // |M_vw|; the nearest only where none overlaps): once most small functions were kept,
   // that read up to 2.7 % off free fall where the nearest reads 0.19 % (a triangle cut out
-  // of a soft plate, SceneCutLoops.RandomPiecesCutOutOfASoftPlateFallFreelyUnlessTied).
+  // of a soft plate, SceneCutLoops.RandomPiecesCutOutOfASoftPlateFallFreely).
   const int nn = num_nodes();
   std::vector<EnrichmentTie> ties;
   for (const int v : small_on_support) {
@@ -255,6 +316,44 @@ double ShellModel::independent_mass_on_support(int v, const std::vector<std::pai
   for (int k = 0; k < n; ++k)
     if (eigen.eigenvalues()[k] > 1e-14 * largest) independent -= along[k] * along[k] / eigen.eigenvalues()[k];
   return independent;
+}
+
+std::vector<std::pair<int, double>> ShellModel::affine_partners(int v, const std::vector<char>& kept_node) const {
+  const int nn = num_nodes();
+  const auto position = [&](int slot) { return Eigen::Vector3d(mesh_.node(virtual_node_mesh_node_[slot])); };
+  const int function = virtual_node_function_[v - nn];
+  const Eigen::Vector3d x = position(v - nn);
+  // The nearest kept node of the function that `admits`, by nearest_kept_node_of_the_function's rule.
+  const auto nearest_where = [&](auto&& admits) {
+    int nearest = -1;
+    double nearest_distance = 0;
+    for (int w = function_slot_start_[function]; w < function_slot_start_[function + 1]; ++w) {
+      if (!kept_node[w] || !admits(w)) continue;
+      const double distance = (position(w) - x).squaredNorm();
+      if (nearest < 0 || distance < nearest_distance * (1 - 1e-9)) nearest = w, nearest_distance = distance;
+    }
+    return nearest;
+  };
+  const int first = nearest_kept_node_of_the_function(v, kept_node);
+  if (first < 0) return {};
+  const int second = nearest_where([&](int w) { return w != first; });
+  if (second < 0) return {{first, 1.0}};
+  const Eigen::Vector3d x1 = position(first), e2 = position(second) - x1;
+  // Beyond the line: the angle at the first partner at least ~11.5 degrees (sin 0.2), so
+  // that the weights stay moderate.
+  const int third = nearest_where([&](int w) {
+    const Eigen::Vector3d e3 = position(w) - x1;
+    return w != first && w != second && e2.cross(e3).norm() > 0.2 * e2.norm() * e3.norm();
+  });
+  if (third < 0) {
+    const double lambda = (x - x1).dot(e2) / e2.squaredNorm();
+    return {{first, 1 - lambda}, {second, lambda}};
+  }
+  const Eigen::Vector3d e3 = position(third) - x1;
+  Eigen::Matrix<double, 3, 2> E;
+  E << e2, e3;
+  const Eigen::Vector2d lambda = (E.transpose() * E).ldlt().solve(E.transpose() * (x - x1));
+  return {{first, 1 - lambda[0] - lambda[1]}, {second, lambda[0]}, {third, lambda[1]}};
 }
 
 int ShellModel::nearest_kept_node_of_the_function(int v, const std::vector<char>& kept_node) const {

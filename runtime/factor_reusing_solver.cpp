@@ -120,12 +120,15 @@ FactorReusingSolver::FactorReusingSolver(const BlockAssembly& pattern, const Fre
     mass_scalar_.resize(blocks);
     for (std::int64_t k = 0; k < blocks; ++k) mass_scalar_[k] = mass[9 * k];
   }
-  std::vector<double> ones(system.size(), 1.0), mask;
-  system.expand_vector(ones, mask);
-  free_.resize(mask.size());
-  for (size_t d = 0; d < mask.size(); ++d) free_[d] = mask[d] != 0;
+  free_.resize(system.num_dofs());
+  summed_.resize(system.num_dofs());
+  for (int d = 0; d < system.num_dofs(); ++d) {
+    free_[d] = system.is_unknown(d);
+    summed_[d] = free_[d] || system.is_dependent(d);
+  }
   if (static_cast<std::int64_t>(mass.size()) == blocks * 9) element_local_blocks_ = element_local_blocks(mass);
   for (char kept : element_local_blocks_) element_local_differs_ |= !kept;
+  if (system.has_dependents()) element_local_differs_ = false;  // its blocks would leave the ties out
   whole_pattern_dense_ =
       SparseCholesky::factors_densely(system.size(), static_cast<std::int64_t>(system.row_index().size()));
   large_dense_ = whole_pattern_dense_ && system.size() >= SparseCholesky::dense_single_precision_min_unknowns;
@@ -283,8 +286,9 @@ void FactorReusingSolver::multiply(const ScaledBlockSum& A, const std::vector<do
                                              spread_.data(), k_product_.data(), m_product_.data());
     }
     for (std::int64_t d = 3 * first; d < 3 * last; ++d)
-      y[d] = scaled_sum_entry(A, free_[d], m_product_[d], k_product_[d]);
+      y[d] = scaled_sum_entry(A, summed_[d], m_product_[d], k_product_[d]);
   });
+  system_.collect(y);
 }
 
 int FactorReusingSolver::pcg(const ScaledBlockSum& A, const std::vector<double>& b, std::vector<double>& x,
@@ -293,16 +297,16 @@ int FactorReusingSolver::pcg(const ScaledBlockSum& A, const std::vector<double>&
   const size_t n = b.size();
   if (kx) {  // A x from the given K x
     multiply_mass(x, q_);
-    for (size_t d = 0; d < n; ++d) q_[d] = scaled_sum_entry(A, free_[d], q_[d], (*kx)[d]);
+    for (size_t d = 0; d < n; ++d) q_[d] = scaled_sum_entry(A, summed_[d], q_[d], (*kx)[d]);
+    system_.collect(q_);
   } else {
     multiply(A, x, q_);
   }
   r_.resize(n);
   b_free_.resize(n);
-  for (size_t d = 0; d < n; ++d) {
-    r_[d] = free_[d] ? b[d] - q_[d] : 0.0;
-    b_free_[d] = free_[d] ? b[d] : 0.0;
-  }
+  for (size_t d = 0; d < n; ++d) b_free_[d] = summed_[d] ? b[d] : 0.0;
+  system_.collect(b_free_);  // T^T b: dependent entries act through their sources
+  for (size_t d = 0; d < n; ++d) r_[d] = b_free_[d] - q_[d];
   const double b_norm = std::sqrt(deterministic_dot(b_free_, b_free_));
   if (!std::isfinite(b_norm))
     throw std::runtime_error("FactorReusingSolver: the right-hand side is not finite (has the state diverged? try a "
@@ -350,6 +354,7 @@ void FactorReusingSolver::solve(const ScaledBlockSum& A, const std::vector<doubl
   ++stats_.solves;
   for (size_t d = 0; d < x.size(); ++d)
     if (!free_[d]) x[d] = 0;
+  system_.distribute(x);  // the iterates stay T x_free: PCG's steps p are expanded so too
   if (system_.size() == 0) {  // every DOF held: nothing to solve
     stats_.last_iterations = 0;
     stats_.last_relative_residual = 0;

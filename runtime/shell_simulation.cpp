@@ -55,7 +55,7 @@ ShellSimulation::ShellSimulation(const ShellModel& model, std::vector<char> fixe
       model_revision_(model.revision()),
       fixed_(checked_size("fixed", std::move(fixed), model.num_dofs())),
       f_ext_(checked_size("external_force", std::move(external_force), model.num_dofs())),
-      system_(model.pattern(), fixed_),
+      system_(model.pattern(), fixed_, nullptr, &model.dependent_nodes()),
       solver_(model.pattern(), system_, model.mass_blocks()) {
   u_.assign(model.num_dofs(), 0.0);
   v_.assign(model.num_dofs(), 0.0);
@@ -87,6 +87,8 @@ void ShellSimulation::set_state(std::vector<double> u, std::vector<double> v) {
   detail::check_finite("ShellSimulation::set_state", "v", v.data(), v.size());
   u_ = std::move(u);
   v_ = std::move(v);
+  system_.distribute(u_);  // the exactly tied DOFs follow their sources (ShellModel::dependent_nodes)
+  system_.distribute(v_);
   previous_v_.clear();
   previous_previous_v_.clear();
 }

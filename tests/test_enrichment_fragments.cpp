@@ -13,8 +13,10 @@
 #include <cstdio>
 #include <utility>
 
+#include "dgtex/free_dof_system.h"
 #include "dgtex/scene_io.h"
 #include "dgtex/scene_run.h"
+#include "dgtex/shell_simulation.h"
 #include "enrichment_test_support.h"
 #include "shell_test_support.h"
 
@@ -25,24 +27,32 @@ namespace {
 
 // Smallest and largest eigenvalue of the Jacobi-scaled mass matrix D^-1/2 M D^-1/2
 // (scale-free; its largest is O(1)).
+// Of the mass matrix the solvers see: over the unknowns of the model's FreeDofSystem (no
+// fixed DOFs; the exactly tied ones eliminated, ShellModel::dependent_nodes).
 std::pair<double, double> scaled_mass_spectrum(const ShellModel& model) {
-  const int n = model.num_dofs();
+  const FreeDofSystem system(model.pattern(), std::vector<char>(model.num_dofs(), 0), nullptr, &model.dependent_nodes());
+  std::vector<double> values;
+  system.gather(model.mass_blocks().data(), 1.0, nullptr, 0.0, values);
+  const int n = system.size();
   Eigen::MatrixXd M = Eigen::MatrixXd::Zero(n, n);
-  const BlockAssembly& p = model.pattern();
-  for (int r = 0; r < p.num_nodes(); ++r)
-    for (std::int64_t k = p.row_start()[r]; k < p.row_start()[r + 1]; ++k)
-      for (int i = 0; i < 3; ++i)
-        for (int j = 0; j < 3; ++j) M(3 * r + i, 3 * p.column()[k] + j) = model.mass_blocks()[9 * k + 3 * i + j];
+  for (int j = 0; j < n; ++j)
+    for (int k = system.column_start()[j]; k < system.column_start()[j + 1]; ++k)
+      M(system.row_index()[k], j) = M(j, system.row_index()[k]) = values[k];
   const Eigen::VectorXd s = M.diagonal().cwiseSqrt().cwiseInverse();
   const Eigen::MatrixXd scaled = s.asDiagonal() * M * s.asDiagonal();
   const Eigen::VectorXd eig = Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(scaled).eigenvalues();
   return {eig(0), eig(n - 1)};
 }
 
-std::unique_ptr<ShellModel> sliver_model(const Mesh& mesh, double min_mass_ratio) {
-  // 1 texel from the left edge of a 2 x 1 plate of 0.5-wide elements at T = 64.
-  return enriched_model(mesh, {straight_cut_enrichment(mesh, 64, [](const double* x) { return x[0] - 0.5 / 64; })},
-                        min_mass_ratio);
+double sliver_cut(const double* x) { return x[0] - 0.5 / 64; }
+
+// 1 texel from the left edge of a 2 x 1 plate of 0.5-wide elements at T = 64. step: the
+// cut's +-1; else one texel of the last element, far from the sliver, reads 0.999, so
+// that the function is no step function (its ties are then column ties, not exact ones).
+std::unique_ptr<ShellModel> sliver_model(const Mesh& mesh, double min_mass_ratio, bool step = true) {
+  EnrichmentFunction f = straight_cut_enrichment(mesh, 64, sliver_cut);
+  if (!step) f.elements.back().tile.values.back() = 0.999;
+  return enriched_model(mesh, {std::move(f)}, min_mass_ratio);
 }
 
 TEST(EnrichmentFragments, DroppingTinySupportsKeepsTheMassMatrixWellConditioned) {
@@ -283,13 +293,122 @@ TEST(EnrichmentFragments, ANodeHoldingASmallCornerOfAPieceIsKeptSoThePieceTransl
 }
 
 // The sliver's functions at the nodes beyond it depend on each other on the sliver, and two
-// are tied (their mass is small): a tied column adds to its partner's moments point by
-// point (moments_of_fields' own path for an element whose global nodes repeat), the same
-// bits as the reference sums.
-TEST(EnrichmentFragments, TiedColumnsAddToTheirPartnersMomentsAsTheReferenceSums) {
+// are tied (their mass is small). Of a step function the ties are exact (the nodes keep
+// their DOFs, dependent on their partners'): an infinitesimal rigid motion r(x) of either
+// piece (standard DOFs r(x^a) on the piece's nodes, enriched DOFs side r(x^a) / 2 at every
+// node) is what the ties give, translations and rotations alike. With one partner per tie
+// (its field copied, the first form of the exact tie) the sliver's rotations were off by
+// 1/8 of their largest entry.
+TEST(EnrichmentFragments, TheTiesOfAStepFunctionKeepEveryRigidMotionOfEitherPiece) {
   const Mesh mesh = make_rectangle(1, 0.5, 2, 1, ElementType::quad8);
   const auto model = sliver_model(mesh, 1e-3);
+  ASSERT_EQ(model->dependent_nodes().size(), 2u);
+  EXPECT_EQ(model->num_tied_enriched_nodes(), 2);
+  EXPECT_EQ(model->num_pruned_enriched_nodes(), 2);  // tied ones included: no unknowns of their own
+  const FreeDofSystem system(model->pattern(), std::vector<char>(model->num_dofs(), 0), nullptr, &model->dependent_nodes());
+  EXPECT_EQ(system.size(), model->num_dofs() - 6);
+  double worst = 0;
+  for (const double side : {1.0, -1.0})
+    for (int axis = 0; axis < 3; ++axis)
+      for (const bool rotation : {false, true}) {
+        const std::vector<double> motion = piece_field(*model, sliver_cut, side, [&](const double* x, double* v) {
+          const double w[3] = {axis == 0 ? 1.0 : 0.0, axis == 1 ? 1.0 : 0.0, axis == 2 ? 1.0 : 0.0};
+          if (!rotation) {
+            v[0] = w[0], v[1] = w[1], v[2] = w[2];
+            return;
+          }
+          v[0] = w[1] * x[2] - w[2] * x[1], v[1] = w[2] * x[0] - w[0] * x[2], v[2] = w[0] * x[1] - w[1] * x[0];
+        });
+        std::vector<double> tied = motion;
+        system.distribute(tied);  // the dependent DOFs from their sources
+        worst = std::max(worst, max_difference(tied, motion) / max_abs(motion));
+      }
+  std::printf("rigid motions of either piece: their tied DOFs off by %.1e\n", worst);
+  EXPECT_LT(worst, 1e-14);  // measured 0
+}
+
+// The step of a model with exact ties, against the system written out densely: the DOFs
+// that are neither held nor tied solve (T^T A T) v = T^T b with A = M + dt^2 K, b = dt f (a
+// force on every DOF, the tied ones' included), and the tied DOFs follow, v = T v_free. T
+// is built here from dependent_nodes() alone. Linear with a factor of its own, and corotated
+// (at rest K is the linear one) by PCG with the reused factor.
+TEST(EnrichmentFragments, AStepOfAModelWithExactTiesSolvesForTheDofsThatAreNotTied) {
+  const Mesh mesh = make_rectangle(1, 0.5, 2, 1, ElementType::quad8);
+  const auto model = sliver_model(mesh, 1e-3);
+  ASSERT_FALSE(model->dependent_nodes().empty());
+  const int n = model->num_dofs();
+  std::vector<char> fixed;
+  fix_nodes(mesh, [](const double* x) { return x[0] > 1 - 1e-9; }, true, true, true, fixed);
+  fixed.resize(n, 0);
+  const std::vector<double> force = random_values(n, 5);
+  const auto dense = [&](const std::vector<double>& blocks) {
+    Eigen::MatrixXd matrix = Eigen::MatrixXd::Zero(n, n);
+    const BlockAssembly& p = model->pattern();
+    for (int r = 0; r < p.num_nodes(); ++r)
+      for (std::int64_t k = p.row_start()[r]; k < p.row_start()[r + 1]; ++k)
+        for (int i = 0; i < 3; ++i)
+          for (int j = 0; j < 3; ++j) matrix(3 * r + i, 3 * p.column()[k] + j) = blocks[9 * k + 3 * i + j];
+    return matrix;
+  };
+  std::vector<double> K;
+  model->assemble_stiffness(nullptr, K, nullptr);
+  const double dt = 1e-3;
+  const Eigen::MatrixXd A = dense(model->mass_blocks()) + dt * dt * dense(K);
+  std::vector<char> tied(n, 0);
+  for (const DependentNode& d : model->dependent_nodes()) tied[3 * d.node] = tied[3 * d.node + 1] = tied[3 * d.node + 2] = 1;
+  std::vector<int> unknown(n, -1);
+  int count = 0;
+  for (int d = 0; d < n; ++d)
+    if (!fixed[d] && !tied[d]) unknown[d] = count++;
+  Eigen::MatrixXd T = Eigen::MatrixXd::Zero(n, count);
+  for (int d = 0; d < n; ++d)
+    if (unknown[d] >= 0) T(d, unknown[d]) = 1;
+  for (const DependentNode& d : model->dependent_nodes())
+    for (const auto& [source, coefficient] : d.sources)
+      for (int c = 0; c < 3; ++c)
+        if (unknown[3 * source + c] >= 0) T(3 * d.node + c, unknown[3 * source + c]) = coefficient;
+  const Eigen::VectorXd b = dt * Eigen::Map<const Eigen::VectorXd>(force.data(), n);
+  const Eigen::VectorXd expected = T * (T.transpose() * A * T).ldlt().solve(T.transpose() * b);
+  for (const bool corotational : {false, true}) {
+    ShellSimulation simulation(*model, fixed, force);
+    DynamicsOptions options;
+    options.time_step = dt;
+    options.corotational = corotational;
+    simulation.step(options);
+    const Eigen::Map<const Eigen::VectorXd> v(simulation.velocity().data(), n);
+    const double off = (v - expected).cwiseAbs().maxCoeff() / expected.cwiseAbs().maxCoeff();
+    std::printf("%s: velocity off the dense solve by %.1e of its largest entry\n",
+                corotational ? "corotated, PCG with the reused factor" : "linear", off);
+    EXPECT_LT(off, corotational ? 1e-7 : 1e-10);
+  }
+  // Later corotated steps iterate with the factor of an earlier matrix (PCG's products over
+  // all DOFs, collected): the same steps as a fresh factor of each step's own T^T A T.
+  std::vector<std::vector<double>> displacements;
+  for (const bool reuse : {true, false}) {
+    ShellSimulation simulation(*model, fixed, force);
+    DynamicsOptions options;
+    options.time_step = 0.02;
+    options.corotational = true;
+    options.reuse_factorization = reuse;
+    for (int step = 0; step < 10; ++step) simulation.step(options);
+    if (reuse) {
+      EXPECT_GT(simulation.solver_statistics().iterations, 10);
+    }
+    displacements.push_back(simulation.displacement());
+  }
+  const double off = max_difference(displacements[0], displacements[1]) / max_abs(displacements[1]);
+  std::printf("10 corotated steps: reusing the factor off a factor a step by %.1e\n", off);
+  EXPECT_LT(off, 1e-6);
+}
+
+// Of a function that is no step the ties are column ties: a tied column adds to its
+// partner's moments point by point (moments_of_fields' own path for an element whose global
+// nodes repeat), the same bits as the reference sums.
+TEST(EnrichmentFragments, TiedColumnsAddToTheirPartnersMomentsAsTheReferenceSums) {
+  const Mesh mesh = make_rectangle(1, 0.5, 2, 1, ElementType::quad8);
+  const auto model = sliver_model(mesh, 1e-3, false);
   ASSERT_GT(model->num_tied_enriched_nodes(), 0);
+  ASSERT_TRUE(model->dependent_nodes().empty());
   std::vector<double> field(model->num_dofs());
   for (std::size_t k = 0; k < field.size(); ++k) field[k] = std::sin(0.7 * static_cast<double>(k) + 0.3);
   const std::vector<double> moments = model->moments_of_fields(*model, {&field})[0];

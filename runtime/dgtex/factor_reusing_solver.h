@@ -44,6 +44,10 @@
 // factorised in turn before the assembly instead (ShellSimulation::step): beside it the
 // assembly would run on one thread fewer for longer than the factorisation takes.
 //
+// Dependent nodes (the system's, FreeDofSystem): the solve runs over the free DOFs of
+// T^T A T; b is collected (T^T b) and x distributed (x = T x_free) before it returns, and
+// the element-local preconditioner is not used (its blocks would not hold the ties).
+//
 // Determinism: the factor (CHOLMOD with serial BLAS), the block matrix-vector product
 // and the dot products (fixed chunking, summed in a fixed order) do not depend on the
 // number of threads, and neither does the refactorisation decision, so x is bitwise
@@ -219,7 +223,8 @@ class FactorReusingSolver {
   std::vector<double> values_, r_, z_, p_, q_, reduced_in_, reduced_out_, b_free_, guess_;
   // Scratch of the block products: the spread vector (kernels/block_product.h), K x and M x.
   mutable std::vector<double> spread_, k_product_, m_product_;
-  std::vector<char> free_;
+  std::vector<char> free_;    // per DOF: an unknown of the system (neither fixed nor dependent)
+  std::vector<char> summed_;  // per DOF: free or dependent, the rows A x sums before collecting
   SparseCholesky* pending_factor_ = nullptr;  // whole pattern: the caller's factor that factorize_pending() refreshes
   // Element-local preconditioner: the blocks it keeps, its system and factor (built on
   // first use), and whether it is in use.

@@ -25,6 +25,7 @@
 #include <vector>
 
 #include "dgtex/block_assembly.h"
+#include "dgtex/dependent_node.h"
 #include "dgtex/enrichment_function.h"
 #include "dgtex/kernels/enriched_edge_kernel.h"
 #include "dgtex/kernels/enriched_element_kernel.h"
@@ -125,8 +126,14 @@ class ShellModel {
   // Enriched nodes below options().min_enrichment_mass_ratio are dropped (and functions
   // left without nodes), so enrichments() may hold less than was given. A node dropped
   // whose function has a small mass on its support (it depends on the other functions
-  // there) is tied instead to a kept node of its function: its enriched function adds to
-  // that node's DOFs (enrichment_dofs), so the piece keeps its translations.
+  // there) is tied instead to a kept node of its function, so the piece keeps its
+  // translations. For a step function whose function lives on one piece of its support
+  // (one value there besides the node's shift), the tie is exact: the node keeps its DOFs,
+  // which follow its partners' as a dependent node (dependent_nodes()): the piece's field
+  // at the node is the affine extrapolation of its field at up to three kept nodes of the
+  // function, so the piece translates and turns freely however the plate around moves.
+  // Other functions tie by adding the enriched function to the nearest kept node's DOFs
+  // (enrichment_dofs).
   // Cost: an enriched element whose textures (and enriched nodes and shifts) are bitwise
   // those of the previous call on this model or the model it was copied from keeps its
   // quadrature (and mass and load weights); the results equal a fresh model's bitwise.
@@ -149,7 +156,16 @@ class ShellModel {
     cut_edge_texels_ = std::move(flags);
   }
   int num_pruned_enriched_nodes() const { return pruned_enriched_nodes_; }  // tied ones included
-  int num_tied_enriched_nodes() const { return static_cast<int>(ties_.size()); }
+  int num_tied_enriched_nodes() const { return static_cast<int>(ties_.size() + dependent_nodes_.size()); }
+  // The exactly tied virtual nodes (set_enrichments): node v of a step function, whose
+  // function lives where the step takes the value h_P (the piece), tied to kept nodes k of
+  // the function with weights lambda_k (affine_partners), has
+  //   (h_P - h_v) q_v = sum_k lambda_k ((h_P - h_k) q_k + u_k) - u_v
+  // (h the nodes' shifts, q their enriched DOFs, u the standard DOFs of their mesh nodes):
+  // the piece's field u + (h_P - h) q at v is the affine extrapolation of its field at the
+  // partners. A ShellSimulation and project_onto_basis solve over the other DOFs
+  // (FreeDofSystem) and keep these at their sources' combination.
+  const std::vector<DependentNode>& dependent_nodes() const { return dependent_nodes_; }
   void clear_enrichments() { set_enrichments({}); }
   // For a model about to receive a basis change: from the next set_enrichments on, keep the
   // new basis's values at the enriched elements' quadrature points as the mass integration
@@ -457,6 +473,12 @@ class ShellModel {
     double shift;
   };
   std::vector<EnrichmentTie> ties_;  // sorted by (function, node)
+  std::vector<DependentNode> dependent_nodes_;  // the exact ties, by virtual node
+  // The one value a step function takes on the elements around virtual node v other than
+  // v's shift: where v's function (H - H(xi^a)) N^a lives. NaN where the function is no
+  // step, where the shift is not one of its values (a node on a wall) or where two other
+  // values are there (two pieces).
+  double piece_value_of_step(int v) const;
   // The nodes of f's enriched functions, sorted: f.enriched_nodes and those `ties` tie for
   // `function` (its index).
   static std::vector<int> nodes_with_own_or_tied_dofs(const EnrichmentFunction& f, int function,
@@ -475,6 +497,12 @@ class ShellModel {
   // The kept virtual node (kept_node: per virtual node) of virtual node v's function nearest
   // to v's mesh node (-1: none), as an index among the virtual nodes.
   int nearest_kept_node_of_the_function(int v, const std::vector<char>& kept_node) const;
+  // An exact tie's partners (virtual node slots, like kept_node's) and weights lambda
+  // (summing to 1): the nearest kept node of v's function, the next nearest, and the
+  // nearest beyond the line of those two, where there are such; sum lambda_k x_k is the
+  // point of their plane (their line) nearest v's node, so that a field affine over the
+  // partners (a translation, a rotation) extrapolates to v exactly.
+  std::vector<std::pair<int, double>> affine_partners(int v, const std::vector<char>& kept_node) const;
   // Takes the functions (and ties, their shifts computed here) and sets up the per-element
   // layout; `build`: then rebuild() (else the caller must, after reading the element
   // integrals).

@@ -68,7 +68,9 @@ class ShellSimulation {
 
   const std::vector<double>& displacement() const { return u_; }
   const std::vector<double>& velocity() const { return v_; }
-  void set_state(std::vector<double> u, std::vector<double> v);  // #dofs each, finite, else std::invalid_argument
+  // #dofs each, finite, else std::invalid_argument. The DOFs of the model's dependent nodes
+  // (ShellModel::dependent_nodes, exact ties) are set from their sources.
+  void set_state(std::vector<double> u, std::vector<double> v);
   double time() const { return time_; }
   const StageTimings& timings() const { return timings_; }
   const FreeDofSystem& system() const { return system_; }
