@@ -8,6 +8,9 @@
 #include <random>
 #include <vector>
 
+#include <Eigen/Dense>
+
+#include "dgtex/block_assembly.h"
 #include "dgtex/mesh_generators.h"
 #include "dgtex/shell_model.h"
 #include "dgtex/topology.h"
@@ -24,6 +27,18 @@ inline double max_difference(const std::vector<double>& a, const std::vector<dou
   double m = 0;
   for (std::size_t i = 0; i < a.size(); ++i) m = std::max(m, std::abs(a[i] - b[i]));
   return m;
+}
+
+// A block matrix of the pattern (9 doubles a block) written out densely, 3 rows and
+// columns a node.
+inline Eigen::MatrixXd dense_from_blocks(const BlockAssembly& pattern, const std::vector<double>& blocks) {
+  const int n = 3 * pattern.num_nodes();
+  Eigen::MatrixXd matrix = Eigen::MatrixXd::Zero(n, n);
+  for (int r = 0; r < pattern.num_nodes(); ++r)
+    for (std::int64_t k = pattern.row_start()[r]; k < pattern.row_start()[r + 1]; ++k)
+      for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j) matrix(3 * r + i, 3 * pattern.column()[k] + j) = blocks[9 * k + 3 * i + j];
+  return matrix;
 }
 
 using NodePredicate = std::function<bool(const double* x)>;

@@ -324,12 +324,7 @@ TEST(EnrichedAssembly, PartialCutStaysPositiveDefiniteAndAdaptiveQuadratureIsAcc
     std::vector<int> free;
     for (int d = 0; d < n; ++d)
       if (!fixed[d]) free.push_back(d);
-    Eigen::MatrixXd Kd = Eigen::MatrixXd::Zero(n, n);
-    const BlockAssembly& p = model.pattern();
-    for (int r = 0; r < p.num_nodes(); ++r)
-      for (std::int64_t k = p.row_start()[r]; k < p.row_start()[r + 1]; ++k)
-        for (int i = 0; i < 3; ++i)
-          for (int j = 0; j < 3; ++j) Kd(3 * r + i, 3 * p.column()[k] + j) = K[k * 9 + i * 3 + j];
+    const Eigen::MatrixXd Kd = dense_from_blocks(model.pattern(), K);
     Eigen::MatrixXd Kf(free.size(), free.size());
     Eigen::VectorXd ff(free.size());
     for (size_t i = 0; i < free.size(); ++i) {

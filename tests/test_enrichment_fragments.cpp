@@ -348,19 +348,11 @@ TEST(EnrichmentFragments, AStepOfAModelWithExactTiesSolvesForTheDofsThatAreNotTi
   fix_nodes(mesh, [](const double* x) { return x[0] > 1 - 1e-9; }, true, true, true, fixed);
   fixed.resize(n, 0);
   const std::vector<double> force = random_values(n, 5);
-  const auto dense = [&](const std::vector<double>& blocks) {
-    Eigen::MatrixXd matrix = Eigen::MatrixXd::Zero(n, n);
-    const BlockAssembly& p = model->pattern();
-    for (int r = 0; r < p.num_nodes(); ++r)
-      for (std::int64_t k = p.row_start()[r]; k < p.row_start()[r + 1]; ++k)
-        for (int i = 0; i < 3; ++i)
-          for (int j = 0; j < 3; ++j) matrix(3 * r + i, 3 * p.column()[k] + j) = blocks[9 * k + 3 * i + j];
-    return matrix;
-  };
   std::vector<double> K;
   model->assemble_stiffness(nullptr, K, nullptr);
   const double dt = 1e-3;
-  const Eigen::MatrixXd A = dense(model->mass_blocks()) + dt * dt * dense(K);
+  const Eigen::MatrixXd A =
+      dense_from_blocks(model->pattern(), model->mass_blocks()) + dt * dt * dense_from_blocks(model->pattern(), K);
   std::vector<char> tied(n, 0);
   for (const DependentNode& d : model->dependent_nodes()) tied[3 * d.node] = tied[3 * d.node + 1] = tied[3 * d.node + 2] = 1;
   std::vector<int> unknown(n, -1);

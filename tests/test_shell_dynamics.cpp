@@ -151,15 +151,7 @@ StripInItsLowestMode strip_in_its_lowest_mode() {
   std::vector<double> K;
   strip.model->assemble_stiffness(nullptr, K, nullptr);
   const int n = model.num_dofs();
-  Eigen::MatrixXd Kd = Eigen::MatrixXd::Zero(n, n), Md = Eigen::MatrixXd::Zero(n, n);
-  const BlockAssembly& p = model.pattern();
-  for (int r = 0; r < p.num_nodes(); ++r)
-    for (std::int64_t k = p.row_start()[r]; k < p.row_start()[r + 1]; ++k)
-      for (int i = 0; i < 3; ++i)
-        for (int j = 0; j < 3; ++j) {
-          Kd(3 * r + i, 3 * p.column()[k] + j) = K[k * 9 + i * 3 + j];
-          Md(3 * r + i, 3 * p.column()[k] + j) = model.mass_blocks()[k * 9 + i * 3 + j];
-        }
+  const Eigen::MatrixXd Kd = dense_from_blocks(model.pattern(), K), Md = dense_from_blocks(model.pattern(), model.mass_blocks());
   std::vector<int> free;
   for (int d = 0; d < n; ++d)
     if (!strip.fixed[d]) free.push_back(d);
