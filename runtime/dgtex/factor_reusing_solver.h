@@ -255,7 +255,7 @@ class FactorReusingSolver {
   void spread(const std::vector<double>& x) const;
   // Rows [first, last) of M x, x in spread_.
   void multiply_mass_rows(std::int64_t first, std::int64_t last, double* y) const;
-  // y = A x over free DOFs (fixed entries of y set to zero).
+  // y = T^T A x over free DOFs, x = T x_free (fixed and dependent entries of y zero).
   void multiply(const ScaledBlockSum& A, const std::vector<double>& x, std::vector<double>& y) const;
   // Runs PCG from x; returns iterations used, or -1 if max_iterations did not suffice.
   // kx: K x for the initial x, or null (then computed).
