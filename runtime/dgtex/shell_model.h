@@ -166,6 +166,11 @@ class ShellModel {
   // partners. A ShellSimulation and project_onto_basis solve over the other DOFs
   // (FreeDofSystem) and keep these at their sources' combination.
   const std::vector<DependentNode>& dependent_nodes() const { return dependent_nodes_; }
+  // Whether they extrapolate from up to three partners each (a piece's rotations kept), or
+  // copy the nearest partner's field (translations only: where the weighted ties would leave
+  // the mass matrix over the unknowns singular, mass_is_definite_over_the_unknowns). False
+  // without dependent nodes.
+  bool exact_ties_keep_rotations() const { return exact_ties_keep_rotations_; }
   void clear_enrichments() { set_enrichments({}); }
   // For a model about to receive a basis change: from the next set_enrichments on, keep the
   // new basis's values at the enriched elements' quadrature points as the mass integration
@@ -474,6 +479,7 @@ class ShellModel {
   };
   std::vector<EnrichmentTie> ties_;  // sorted by (function, node)
   std::vector<DependentNode> dependent_nodes_;  // the exact ties, by virtual node
+  bool exact_ties_keep_rotations_ = false;
   // The one value a step function takes on the elements around virtual node v other than
   // v's shift: where v's function (H - H(xi^a)) N^a lives. NaN where the function is no
   // step, where the shift is not one of its values (a node on a wall) or where two other
@@ -503,6 +509,9 @@ class ShellModel {
   // point of their plane (their line) nearest v's node, so that a field affine over the
   // partners (a translation, a rotation) extrapolates to v exactly.
   std::vector<std::pair<int, double>> affine_partners(int v, const std::vector<char>& kept_node) const;
+  // Whether the mass matrix over the DOFs that are not dependent (no fixed ones) has every
+  // Cholesky pivot above 1e-10 of its diagonal entry.
+  bool mass_is_definite_over_the_unknowns() const;
   // Takes the functions (and ties, their shifts computed here) and sets up the per-element
   // layout; `build`: then rebuild() (else the caller must, after reading the element
   // integrals).
