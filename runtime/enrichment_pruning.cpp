@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <limits>
 #include <map>
 #include <utility>
@@ -377,27 +378,15 @@ double ShellModel::independent_mass_on_support(int v, const std::vector<std::pai
 std::vector<std::pair<int, double>> ShellModel::affine_partners(int v, const std::vector<char>& kept_node) const {
   const int nn = num_nodes();
   const auto position = [&](int slot) { return Eigen::Vector3d(mesh_.node(virtual_node_mesh_node_[slot])); };
-  const int function = virtual_node_function_[v - nn];
   const Eigen::Vector3d x = position(v - nn);
-  // The nearest kept node of the function that `admits`, by nearest_kept_node_of_the_function's rule.
-  const auto nearest_where = [&](auto&& admits) {
-    int nearest = -1;
-    double nearest_distance = 0;
-    for (int w = function_slot_start_[function]; w < function_slot_start_[function + 1]; ++w) {
-      if (!kept_node[w] || !admits(w)) continue;
-      const double distance = (position(w) - x).squaredNorm();
-      if (nearest < 0 || distance < nearest_distance * (1 - 1e-9)) nearest = w, nearest_distance = distance;
-    }
-    return nearest;
-  };
   const int first = nearest_kept_node_of_the_function(v, kept_node);
   if (first < 0) return {};
-  const int second = nearest_where([&](int w) { return w != first; });
+  const int second = nearest_kept_node_of_the_function(v, kept_node, [&](int w) { return w != first; });
   if (second < 0) return {{first, 1.0}};
   const Eigen::Vector3d x1 = position(first), e2 = position(second) - x1;
   // Beyond the line: the angle at the first partner at least ~11.5 degrees (sin 0.2), so
   // that the weights stay moderate.
-  const int third = nearest_where([&](int w) {
+  const int third = nearest_kept_node_of_the_function(v, kept_node, [&](int w) {
     const Eigen::Vector3d e3 = position(w) - x1;
     return w != first && w != second && e2.cross(e3).norm() > 0.2 * e2.norm() * e3.norm();
   });
@@ -412,14 +401,15 @@ std::vector<std::pair<int, double>> ShellModel::affine_partners(int v, const std
   return {{first, 1 - lambda[0] - lambda[1]}, {second, lambda[0]}, {third, lambda[1]}};
 }
 
-int ShellModel::nearest_kept_node_of_the_function(int v, const std::vector<char>& kept_node) const {
+int ShellModel::nearest_kept_node_of_the_function(int v, const std::vector<char>& kept_node,
+                                                   const std::function<bool(int)>& admits) const {
   const int nn = num_nodes();
   const double* x = mesh_.node(virtual_node_mesh_node_[v - nn]);
   const int function = virtual_node_function_[v - nn];
   int nearest = -1;
   double nearest_distance = 0;
   for (int w = function_slot_start_[function]; w < function_slot_start_[function + 1]; ++w) {
-    if (!kept_node[w]) continue;
+    if (!kept_node[w] || (admits && !admits(w))) continue;
     const double* y = mesh_.node(virtual_node_mesh_node_[w]);
     const double distance = (x[0] - y[0]) * (x[0] - y[0]) + (x[1] - y[1]) * (x[1] - y[1]) + (x[2] - y[2]) * (x[2] - y[2]);
     // Distances equal up to round-off (a regular mesh has many) go to the lower index, so

@@ -134,6 +134,8 @@ class ShellModel {
   // function, so the piece translates and turns freely however the plate around moves.
   // Other functions tie by adding the enriched function to the nearest kept node's DOFs
   // (enrichment_dofs).
+  // A basis with exact ties factorises its mass matrix once more (the check of
+  // mass_is_definite_over_the_unknowns) and holds a copy of its pruned functions meanwhile.
   // Cost: an enriched element whose textures (and enriched nodes and shifts) are bitwise
   // those of the previous call on this model or the model it was copied from keeps its
   // quadrature (and mass and load weights); the results equal a fresh model's bitwise.
@@ -501,8 +503,10 @@ class ShellModel {
   double independent_mass_on_support(int v, const std::vector<std::pair<int, int>>& holding,
                                      const std::vector<char>& kept_node, const std::vector<double>& element_mass) const;
   // The kept virtual node (kept_node: per virtual node) of virtual node v's function nearest
-  // to v's mesh node (-1: none), as an index among the virtual nodes.
-  int nearest_kept_node_of_the_function(int v, const std::vector<char>& kept_node) const;
+  // to v's mesh node (-1: none), as an index among the virtual nodes; among those `admits`
+  // accepts, if given.
+  int nearest_kept_node_of_the_function(int v, const std::vector<char>& kept_node,
+                                        const std::function<bool(int)>& admits = {}) const;
   // An exact tie's partners (virtual node slots, like kept_node's) and weights lambda
   // (summing to 1): the nearest kept node of v's function, the next nearest, and the
   // nearest beyond the line of those two, where there are such; sum lambda_k x_k is the
