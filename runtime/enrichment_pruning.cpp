@@ -154,18 +154,21 @@ void ShellModel::set_enrichments(std::vector<EnrichmentFunction> functions) {
     int function, node;
     std::vector<std::pair<int, double>> partners;  // mesh node, weight
     double piece_value;
+    int nearest_partner;  // mesh node
+    bool avoids_the_mode = false;  // its partners chosen away from a singular mode of the mass
   };
   std::vector<ExactTie> exact_ties;
   std::vector<EnrichmentTie> ties;
   for (const EnrichmentTie& tie : enrichment_ties(small_on_support, kept_node)) {
-    const double piece_value = piece_value_of_step(virtual_node(tie.function, tie.node));
+    const int v = virtual_node(tie.function, tie.node);
+    const double piece_value = piece_value_of_step(v);
     if (std::isnan(piece_value)) {
       ties.push_back(tie);
       continue;
     }
-    std::vector<std::pair<int, double>> partners = affine_partners(virtual_node(tie.function, tie.node), kept_node);
+    std::vector<std::pair<int, double>> partners = affine_partners(v, kept_node);
     for (auto& [partner, weight] : partners) partner = virtual_node_mesh_node_[partner];
-    exact_ties.push_back({tie.function, tie.node, std::move(partners), piece_value});
+    exact_ties.push_back({tie.function, tie.node, std::move(partners), piece_value, tie.partner});
     std::vector<int>& nodes = kept_nodes[tie.function];
     nodes.insert(std::lower_bound(nodes.begin(), nodes.end(), tie.node), tie.node);
   }
@@ -206,10 +209,11 @@ void ShellModel::set_enrichments(std::vector<EnrichmentFunction> functions) {
   if (!exact_ties.empty()) functions_for_column_ties = functions_left, column_ties = ties;
   install_enrichments(std::move(functions_left), true, std::move(ties));
   pruned_enriched_nodes_ = pruned;  // the exactly tied ones included: they are no unknowns either
-  // partners: all of each tie's (affine), or its nearest alone (translations only).
-  const auto set_dependent_nodes = [&](bool affine) {
+  const auto set_dependent_nodes = [&] {
     dependent_nodes_.clear();
+    exact_ties_copying_one_partner_ = 0;
     for (const ExactTie& tie : exact_ties) {
+      exact_ties_copying_one_partner_ += tie.partners.size() == 1;
       // (h_P - h_v) q_v = sum_k lambda_k ((h_P - h_k) q_k + u_k) - u_v: the piece's field
       // u + (h_P - h) q at v is the affine extrapolation of its field at the partners k. A
       // node's shift is the same as before the pruning (its elements, which all touch it, stay).
@@ -217,8 +221,7 @@ void ShellModel::set_enrichments(std::vector<EnrichmentFunction> functions) {
       const int v = virtual_node(function, tie.node);
       const double across_v = tie.piece_value - node_shift(v);
       DependentNode dependent{v, {{tie.node, -1 / across_v}}};
-      for (std::size_t k = 0; k < (affine ? tie.partners.size() : 1); ++k) {
-        const auto [partner, weight] = affine ? tie.partners[k] : std::pair{tie.partners[0].first, 1.0};
+      for (const auto& [partner, weight] : tie.partners) {
         if (weight == 0) continue;  // v on the line of the other two
         const int w = virtual_node(function, partner);
         const double across_w = tie.piece_value - node_shift(w);
@@ -228,50 +231,109 @@ void ShellModel::set_enrichments(std::vector<EnrichmentFunction> functions) {
       dependent_nodes_.push_back(std::move(dependent));
     }
   };
-  set_dependent_nodes(true);
+  set_dependent_nodes();
   if (exact_ties.empty()) return;
-  exact_ties_keep_rotations_ = true;
-  if (mass_is_definite_over_the_unknowns()) return;
-  exact_ties_keep_rotations_ = false;
   // A tie adds the tied function to its partners' columns with weights; on a piece a texel
   // or two wide (whose functions restricted to a line span a few), such a column can cancel
   // against the other kept functions, and the mass matrix is singular to round-off (its
   // smallest pivot 1e-14-8e-12 of its diagonal entry in 19 bases of session 80's sweeps
   // (610 runs), the others 2e-6 or more; a progressive loop's mass projection failed so:
   // the weights 1/2, 1/2 of a mid-side node's partners made one partner's column a
-  // combination of three others). Then each tie takes its nearest partner alone
-  // (translations only; all 19 were definite so), and failing that, the ties of this basis
-  // are column ties, as before session 80.
-  set_dependent_nodes(false);
-  if (mass_is_definite_over_the_unknowns()) return;
+  // combination of three others). Then the ties that carry the singular mode (on their node
+  // or a source) take the nearest partners that do not carry it, and failing that, their
+  // nearest partner alone (translations only), until the mass is definite: each tie changes
+  // twice at most. Until session 81 every tie of such a basis took its nearest partner
+  // alone: 54 of 400 pieces cut out of a plate under a point force kept their translations
+  // only, now none (47 of their 406 bases had a singular mode, each definite once the ties
+  // carrying it had changed partners once). Should the mode carry no tie that can still
+  // change, every tie takes its nearest partner alone, and failing that too, the ties of
+  // this basis are column ties, as before session 80.
+  std::vector<char> exact_tie_slot(num_enriched_nodes(), 0);
+  for (const DependentNode& dependent : dependent_nodes_) exact_tie_slot[dependent.node - nn] = 1;
+  for (;;) {
+    const std::vector<double> mode = singular_mass_mode();
+    if (mode.empty()) return;
+    // A node carries the mode where one of its DOFs holds 1 % of the largest entry or more.
+    const auto carries = [&](int node) {
+      return std::max({std::abs(mode[3 * node]), std::abs(mode[3 * node + 1]), std::abs(mode[3 * node + 2])}) >= 0.01;
+    };
+    bool changed = false;
+    for (std::size_t i = 0; i < exact_ties.size(); ++i) {
+      ExactTie& tie = exact_ties[i];
+      const DependentNode& dependent = dependent_nodes_[i];
+      if (tie.partners.size() == 1 || (!carries(dependent.node) &&
+                                       std::none_of(dependent.sources.begin(), dependent.sources.end(),
+                                                    [&](const auto& source) { return carries(source.first); })))
+        continue;
+      changed = true;
+      const bool avoided = tie.avoids_the_mode;
+      tie.avoids_the_mode = true;
+      if (!avoided) {
+        std::vector<char> partner_slot(num_enriched_nodes(), 0);  // kept, not carrying the mode
+        for (int w = 0; w < num_enriched_nodes(); ++w) partner_slot[w] = !exact_tie_slot[w] && !carries(nn + w);
+        std::vector<std::pair<int, double>> partners = affine_partners(dependent.node, partner_slot);
+        for (auto& [partner, weight] : partners) partner = virtual_node_mesh_node_[partner];
+        if (partners.size() > 1) {
+          tie.partners = std::move(partners);
+          continue;
+        }
+      }
+      tie.partners = {{tie.nearest_partner, 1.0}};
+    }
+    if (!changed) break;
+    set_dependent_nodes();
+  }
+  for (ExactTie& tie : exact_ties) tie.partners = {{tie.nearest_partner, 1.0}};
+  set_dependent_nodes();
+  if (singular_mass_mode().empty()) return;
   for (const ExactTie& tie : exact_ties) {
     const int function = index_left[tie.function];
     std::vector<int>& nodes = functions_for_column_ties[function].enriched_nodes;
     nodes.erase(std::lower_bound(nodes.begin(), nodes.end(), tie.node));
-    column_ties.push_back({function, tie.node, tie.partners.front().first, 0.0});
+    column_ties.push_back({function, tie.node, tie.nearest_partner, 0.0});
   }
   install_enrichments(std::move(functions_for_column_ties), true, std::move(column_ties));
 }
 
-bool ShellModel::mass_is_definite_over_the_unknowns() const {
+std::vector<double> ShellModel::singular_mass_mode() const {
   // Pivots above round-off (1e-16 of their diagonal entries) by a wide margin, and far below
   // those of functions the pruning keeps (their independent part 1e-6 of their own mass).
   constexpr double kMinPivotRatio = 1e-10;
   const FreeDofSystem system(pattern(), std::vector<char>(num_dofs(), 0), nullptr, &dependent_nodes_);
   std::vector<double> values;
   system.gather(mass_blocks().data(), 1.0, nullptr, 0.0, values);
-  SparseCholesky cholesky;
-  cholesky.analyze(system.size(), system.column_start(), system.row_index());
-  try {
-    cholesky.factorize(values);
-  } catch (const NotPositiveDefinite&) {
-    return false;
-  }
-  const std::vector<double> pivots = cholesky.pivots();
+  // A singular mode's pivot is round-off, of either sign: the diagonal raised by far less
+  // than the bound makes it positive, so that the factor exists and finds the mode.
   for (int j = 0; j < system.size(); ++j)
     for (int k = system.column_start()[j]; k < system.column_start()[j + 1]; ++k)
-      if (system.row_index()[k] == j && !(pivots[j] >= kMinPivotRatio * values[k])) return false;
-  return true;
+      if (system.row_index()[k] == j) values[k] *= 1 + 1e-13;
+  SparseCholesky cholesky;
+  cholesky.analyze(system.size(), system.column_start(), system.row_index());
+  std::vector<double> mode(system.size(), 0.0);
+  try {
+    cholesky.factorize(values);
+    const std::vector<double> pivots = cholesky.pivots();
+    int weakest = -1;  // the unknown with the smallest pivot ratio below the bound
+    double weakest_ratio = kMinPivotRatio;
+    for (int j = 0; j < system.size(); ++j)
+      for (int k = system.column_start()[j]; k < system.column_start()[j + 1]; ++k)
+        if (system.row_index()[k] == j && !(pivots[j] >= weakest_ratio * values[k]))
+          weakest = j, weakest_ratio = pivots[j] / values[k];
+    if (weakest < 0) return {};
+    // A mode of pivot p carries that pivot's unknown j (eliminated last among its own), and
+    // M^-1 e_j is that mode times ~1 / p, the others' parts bounded by 1 / (the next pivot).
+    std::vector<double> unit(system.size(), 0.0);
+    unit[weakest] = 1;
+    cholesky.solve(unit, mode);
+  } catch (const NotPositiveDefinite& failure) {
+    mode[failure.column()] = 1;  // one unknown of the mode (no factor to solve with)
+  }
+  std::vector<double> full;
+  system.expand_vector(mode, full);
+  double largest = 0;
+  for (const double x : full) largest = std::max(largest, std::abs(x));
+  for (double& x : full) x /= largest;
+  return full;
 }
 
 double ShellModel::piece_value_of_step(int v) const {

@@ -356,7 +356,7 @@ void ShellModel::install_enrichments(std::vector<EnrichmentFunction> functions, 
   }
   ties_ = std::move(ties);
   dependent_nodes_.clear();  // set_enrichments sets those of a pruned basis after this
-  exact_ties_keep_rotations_ = false;
+  exact_ties_copying_one_partner_ = 0;
   std::sort(ties_.begin(), ties_.end(),
             [](const EnrichmentTie& x, const EnrichmentTie& y) { return std::tie(x.function, x.node) < std::tie(y.function, y.node); });
   for (EnrichmentTie& tie : ties_) tie.shift = node_shift_of(tie.function, tie.node);

@@ -135,7 +135,7 @@ class ShellModel {
   // Other functions tie by adding the enriched function to the nearest kept node's DOFs
   // (enrichment_dofs).
   // A basis with exact ties factorises its mass matrix once more (the check of
-  // mass_is_definite_over_the_unknowns) and holds a copy of its pruned functions meanwhile.
+  // singular_mass_mode) and holds a copy of its pruned functions meanwhile.
   // Cost: an enriched element whose textures (and enriched nodes and shifts) are bitwise
   // those of the previous call on this model or the model it was copied from keeps its
   // quadrature (and mass and load weights); the results equal a fresh model's bitwise.
@@ -168,11 +168,11 @@ class ShellModel {
   // partners. A ShellSimulation and project_onto_basis solve over the other DOFs
   // (FreeDofSystem) and keep these at their sources' combination.
   const std::vector<DependentNode>& dependent_nodes() const { return dependent_nodes_; }
-  // Whether they extrapolate from up to three partners each (a piece's rotations kept), or
-  // copy the nearest partner's field (translations only: where the weighted ties would leave
-  // the mass matrix over the unknowns singular, mass_is_definite_over_the_unknowns). False
-  // without dependent nodes.
-  bool exact_ties_keep_rotations() const { return exact_ties_keep_rotations_; }
+  // How many of them copy one partner's field (translations only) instead of extrapolating
+  // from two or three (a piece's rotations kept): those whose weighted ties would leave the
+  // mass matrix over the unknowns singular (singular_mass_mode), with no other partners that
+  // would not, and those whose function has only one kept node.
+  int exact_ties_copying_one_partner() const { return exact_ties_copying_one_partner_; }
   void clear_enrichments() { set_enrichments({}); }
   // For a model about to receive a basis change: from the next set_enrichments on, keep the
   // new basis's values at the enriched elements' quadrature points as the mass integration
@@ -481,7 +481,7 @@ class ShellModel {
   };
   std::vector<EnrichmentTie> ties_;  // sorted by (function, node)
   std::vector<DependentNode> dependent_nodes_;  // the exact ties, by virtual node
-  bool exact_ties_keep_rotations_ = false;
+  int exact_ties_copying_one_partner_ = 0;
   // The one value a step function takes on the elements around virtual node v other than
   // v's shift: where v's function (H - H(xi^a)) N^a lives. NaN where the function is no
   // step, where the shift is not one of its values (a node on a wall) or where two other
@@ -513,9 +513,10 @@ class ShellModel {
   // point of their plane (their line) nearest v's node, so that a field affine over the
   // partners (a translation, a rotation) extrapolates to v exactly.
   std::vector<std::pair<int, double>> affine_partners(int v, const std::vector<char>& kept_node) const;
-  // Whether the mass matrix over the DOFs that are not dependent (no fixed ones) has every
-  // Cholesky pivot above 1e-10 of its diagonal entry.
-  bool mass_is_definite_over_the_unknowns() const;
+  // Empty where the mass matrix over the DOFs that are not dependent (no fixed ones) has
+  // every Cholesky pivot above 1e-10 of its diagonal entry; else a mode with the smallest
+  // pivot, over all DOFs (the dependent ones from their sources), its largest entry +-1.
+  std::vector<double> singular_mass_mode() const;
   // Takes the functions (and ties, their shifts computed here) and sets up the per-element
   // layout; `build`: then rebuild() (else the caller must, after reading the element
   // integrals).
