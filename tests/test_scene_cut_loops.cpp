@@ -64,6 +64,26 @@ Vec3 displacement_after_a_second(const std::vector<std::vector<Vec3>>& cuts, con
   return displacement_after_a_second(cut_plate(cuts, type, T), probe, at_end);
 }
 
+// A closed polygon (its first vertex repeated at the end) around a random centre in
+// [0.3, 0.8] x [0.25, 0.75] of a random size 0.08-0.2: sides() vertices (drawn after the
+// centre and size), each at 0.7-1.3 times that size from the centre and at an angle off the
+// regular polygon's by up to 0.15 of a side's, the first at a random phase.
+std::vector<Vec3> random_loop(std::mt19937& random, const std::function<int()>& sides, Vec3& centre) {
+  std::uniform_real_distribution<double> uniform(0, 1);
+  const double cx = 0.3 + 0.5 * uniform(random), cy = 0.25 + 0.5 * uniform(random), r = 0.08 + 0.12 * uniform(random);
+  centre = {cx, cy, 0};
+  const int n = sides();
+  const double phase = 2 * M_PI * uniform(random);
+  std::vector<Vec3> loop;
+  for (int s = 0; s < n; ++s) {
+    const double angle = phase + 2 * M_PI * (s + 0.3 * (uniform(random) - 0.5)) / n;
+    const double radius = r * (0.7 + 0.6 * uniform(random));
+    loop.push_back({cx + radius * std::cos(angle), cy + radius * std::sin(angle), 0});
+  }
+  loop.push_back(loop.front());
+  return loop;
+}
+
 // Semi-implicit Euler's fall after n steps of dt from rest: g dt^2 n (n + 1) / 2.
 constexpr double kFreeFall = -1.0 * 0.01 * 0.01 * 100 * 101 / 2;
 
@@ -409,20 +429,12 @@ TEST(SceneCutLoops, RandomPiecesCutOutOfASoftPlateFallFreely) {
   for (const ElementType type : {ElementType::quad8, ElementType::tri6})
     for (const int T : {16, 32})
       for (int k = 0; k < 6; ++k) {
-        const double cx = 0.3 + 0.5 * uniform(random), cy = 0.25 + 0.5 * uniform(random), r = 0.08 + 0.12 * uniform(random);
-        const int sides = uniform(random) < 0.5 ? 3 : 4;
-        const double phase = 2 * M_PI * uniform(random);
-        std::vector<Vec3> loop;
-        for (int s = 0; s < sides; ++s) {
-          const double angle = phase + 2 * M_PI * (s + 0.3 * (uniform(random) - 0.5)) / sides;
-          const double radius = r * (0.7 + 0.6 * uniform(random));
-          loop.push_back({cx + radius * std::cos(angle), cy + radius * std::sin(angle), 0});
-        }
-        loop.push_back(loop.front());
+        Vec3 centre;
+        const std::vector<Vec3> loop = random_loop(random, [&] { return uniform(random) < 0.5 ? 3 : 4; }, centre);
         Scene scene = cut_plate({loop}, type, T);
         scene.material.youngs_modulus = 1e7;
         int tied = 0, exactly_tied = 0;
-        const Vec3 u = displacement_after_a_second(scene, {cx, cy, 0}, [&](const SceneRun& run) {
+        const Vec3 u = displacement_after_a_second(scene, centre, [&](const SceneRun& run) {
           tied = run.model().num_tied_enriched_nodes();
           exactly_tied = static_cast<int>(run.model().dependent_nodes().size());
         });  // the centre lies inside
@@ -454,20 +466,12 @@ TEST(SceneCutLoops, RandomPiecesCutOutOfASoftPlateFallFreely) {
 // = 0; a node that is not has u = r(x) inside the loop and 0 outside.
 TEST(SceneCutLoops, APieceWithTiedNodesKeepsTheMomentumOfEveryRigidMotionUnderAPointForce) {
   std::mt19937 random(80);
-  std::uniform_real_distribution<double> uniform(0, 1);
   int pieces_with_ties = 0, translations_only = 0;
   double worst = 0;
   for (int attempt = 0; attempt < 40 && pieces_with_ties < 6; ++attempt) {
     const ElementType type = attempt % 2 ? ElementType::tri6 : ElementType::quad8;
-    const double cx = 0.3 + 0.5 * uniform(random), cy = 0.25 + 0.5 * uniform(random), r = 0.08 + 0.12 * uniform(random);
-    const double phase = 2 * M_PI * uniform(random);
-    std::vector<Vec3> loop;
-    for (int s = 0; s < 3; ++s) {
-      const double angle = phase + 2 * M_PI * (s + 0.3 * (uniform(random) - 0.5)) / 3;
-      const double radius = r * (0.7 + 0.6 * uniform(random));
-      loop.push_back({cx + radius * std::cos(angle), cy + radius * std::sin(angle), 0});
-    }
-    loop.push_back(loop.front());
+    Vec3 loop_centre;  // the random centre; the force acts near the triangle's centroid
+    const std::vector<Vec3> loop = random_loop(random, [] { return 3; }, loop_centre);
     Scene scene = cut_plate({loop}, type, 16);
     scene.analysis.corotational = false;
     scene.analysis.steps = 20;
