@@ -295,6 +295,28 @@ TEST(SceneCutLoops, ATriangleCutOutAroundANodeFallsWithItsCornersFunctionsKept) 
   }
 }
 
+// A triangle whose corner in the element of node (0, 0.25) gives that node a function of
+// 1.000e-3 M_aa, just above the bound of min_enrichment_mass_ratio, of which 0.9999e-3 M_aa
+// is independent of N^a: it missed the bound at its node by its small mass, not by what
+// N^a carries of it, and was dropped, so the triangle hung on that node (until session 81
+// it fell 0.426 instead of 0.505 in a second, swinging 0.21 sideways). Judged on its
+// support like a smaller corner, it is kept (2.4e-5 of its mass independent there), and the
+// triangle falls freely (5.5e-11 off).
+TEST(SceneCutLoops, ACornerJustAboveTheMassBoundIsJudgedOnItsSupportAndTheTriangleFallsFreely) {
+  const Vec3 a{0.53348305319137201, 0.54020733639468965, 0}, b{0.35638330577876826, 0.54533143600195111, 0},
+      c{0.42036071086497157, 0.4200591585216325, 0};
+  int pruned = -1, tied = -1;
+  const Vec3 u = displacement_after_a_second({{a, b, c, a}}, {0.44, 0.5, 0}, ElementType::quad8, 16,
+                                             [&](const SceneRun& run) {
+                                               pruned = run.model().num_pruned_enriched_nodes();
+                                               tied = run.model().num_tied_enriched_nodes();
+                                             });
+  print_fall("the triangle", u, ", " + std::to_string(pruned) + " nodes dropped or tied, " + std::to_string(tied) + " tied");
+  EXPECT_EQ(pruned, tied);  // none dropped
+  EXPECT_NEAR(u[2], kFreeFall, 1e-9 * std::abs(kFreeFall));
+  EXPECT_LT(std::hypot(u[0], u[1]), 1e-9);
+}
+
 // A square loop with a corner on the plate's centre node and two sides along mesh edges
 // (tri6): where a side along one element's hypotenuse meets a side along another's leg, the
 // path retraces a stretch of the mesh edge from both elements. The hypotenuse's staircase
