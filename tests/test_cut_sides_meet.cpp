@@ -102,8 +102,10 @@ TEST(CutSidesMeet, TheFractureScenesFirstUpdateSolvesEachSegmentOnce) {
   const Mesh mesh = build_scene_mesh(scene);
   CutManager cuts(mesh, build_topology(mesh), scene.cuts, scene.enrichment);
   cuts.update(0);
-  ASSERT_EQ(cuts.function_segments().size(), 5u);
-  EXPECT_EQ(cuts.last_update().solves, 5);  // 8 with the T-junction segment's undone rounds
+  // 4 segments with functions (5 until session 81, when a corner of cut 1 just beyond an
+  // element's border split it as if it crossed itself).
+  ASSERT_EQ(cuts.function_segments().size(), 4u);
+  EXPECT_EQ(cuts.last_update().solves, 4);  // each once (the T-junction segment's undone rounds added 3)
 }
 
 }  // namespace
