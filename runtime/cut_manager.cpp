@@ -478,9 +478,17 @@ void CutManager::rasterize_visible(const std::vector<VisibleCutSegment>& visible
     if (pieces.empty()) continue;
     const CutLatticeEdge& first = pieces.front().second.edges.front();
     const CutLatticeEdge& last = pieces.back().second.edges.back();
-    const bool end = touches_a_wall(pieces.back().first, last.x + last.dx, last.y + last.dy,
-                                    v + 1 < rasters.size() && continues(v, v + 1));
-    const bool start = touches_a_wall(pieces.front().first, first.x, first.y, v > 0 && continues(v - 1, v));
+    // A loop ends where it started. Its last lattice edge can retrace its first (the end
+    // point snapped back across the start's first edge, the retrace cancelling in the data):
+    // then only that edge touches the end point, and the loop was not seen to close: its
+    // settled tiles kept their harmonic values and the piece stayed attached (a triangle cut
+    // progressively on tri6 fell 0.21 instead of 0.505; 5 of 30 such loops, until session 81).
+    const bool closed = pieces.back().first == pieces.front().first && last.x + last.dx == first.x &&
+                        last.y + last.dy == first.y;
+    const bool end = closed || touches_a_wall(pieces.back().first, last.x + last.dx, last.y + last.dy,
+                                              v + 1 < rasters.size() && continues(v, v + 1));
+    const bool start =
+        closed || touches_a_wall(pieces.front().first, first.x, first.y, v > 0 && continues(v - 1, v));
     tip_touches_a_wall_ = tip_touches_a_wall_ || end;
     ends_touch_walls_[v] = start && end;
   }

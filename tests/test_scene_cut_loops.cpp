@@ -603,6 +603,46 @@ TEST(SceneCutLoops, APieceWithTiedNodesKeepsTheMomentumOfEveryRigidMotionUnderAP
 }
 
 
+// A triangle cut out progressively on tri6 (T = 16, drawn at 4 lengths a second): its
+// last lattice edge retraces its first (the end point snapped back across the start's first
+// edge), so only that edge touched the end point, and the update did not see the loop
+// close: its settled tile kept its harmonic values (up to 0.39 off a fresh solve), the
+// function was no step, and the piece fell 0.21 instead of 0.505 in a second (until
+// session 81). Now the progressive function is the fresh one, bitwise, and the piece falls
+// freely once the loop has closed (~0.18 s): u(1 s) - 2 u(0.8 s) + u(0.6 s) = g (0.2 s)^2.
+TEST(SceneCutLoops, AProgressiveLoopWhoseLastEdgeRetracesItsFirstClosesItsRegion) {
+  const std::vector<Vec3> loop = {{0.57447518738906322, 0.55017255158991296, 0},
+                                  {0.3835429552870453, 0.48354418203765021, 0},
+                                  {0.66345289260123685, 0.35093347949543613, 0},
+                                  {0.57447518738906322, 0.55017255158991296, 0}};
+  Scene scene = cut_plate({loop}, ElementType::tri6, 16);
+  scene.material.youngs_modulus = 1e7;
+  scene.cuts[0].has_schedule = true;
+  scene.cuts[0].speed = 4.0;
+  SceneRun run(scene);
+  const Vec3 probe{0.54, 0.46, 0};
+  std::vector<Vec3> u;
+  while (run.steps_taken() < scene.analysis.steps) {
+    run.step();
+    if (run.steps_taken() % 20 == 0 && run.steps_taken() >= 60) u.push_back(test::displacement_at(run, probe));
+  }
+  const Mesh mesh = build_scene_mesh(scene);
+  CutManager fresh(mesh, build_topology(mesh), scene.cuts, scene.enrichment);
+  fresh.update(1.0);
+  const std::vector<EnrichmentFunction>& progressive = run.cuts()->functions();
+  ASSERT_EQ(progressive.size(), 1u);
+  ASSERT_EQ(fresh.functions().size(), 1u);
+  EXPECT_TRUE(is_step_function(progressive[0]));
+  ASSERT_EQ(progressive[0].elements.size(), fresh.functions()[0].elements.size());
+  for (std::size_t k = 0; k < progressive[0].elements.size(); ++k)
+    EXPECT_EQ(progressive[0].elements[k].tile.values, fresh.functions()[0].elements[k].tile.values) << "tile " << k;
+  ASSERT_EQ(u.size(), 3u);
+  const double second_difference = u[2][2] - 2 * u[1][2] + u[0][2], expected = -1.0 * 0.2 * 0.2;
+  std::printf("the triangle: u(1) - 2 u(0.8) + u(0.6) = %.6f (free fall %.6f), u(1) = %.4f\n", second_difference,
+              expected, u[2][2]);
+  EXPECT_NEAR(second_difference, expected, 1e-2 * std::abs(expected));
+}
+
 // A triangle cut out progressively (the loop drawn at 4 lengths a second) from a soft
 // plate. Once it closes, a node's function of a piece a texel or two wide is tied to two
 // partners on a mid-side node's line with weights 1/2, 1/2, and the column of one partner
