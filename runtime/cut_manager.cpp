@@ -482,7 +482,8 @@ void CutManager::rasterize_visible(const std::vector<VisibleCutSegment>& visible
     // point snapped back across the start's first edge, the retrace cancelling in the data):
     // then only that edge touches the end point, and the loop was not seen to close: its
     // settled tiles kept their harmonic values and the piece stayed attached (a triangle cut
-    // progressively on tri6 fell 0.21 instead of 0.505; 4 of 30 such loops, until session 81).
+    // progressively on tri6 fell 0.21 instead of 0.505; 16 of 90 such loops, until session
+    // 81).
     const bool closed = pieces.back().first == pieces.front().first && last.x + last.dx == first.x &&
                         last.y + last.dy == first.y;
     const bool end = closed || touches_a_wall(pieces.back().first, last.x + last.dx, last.y + last.dy,
