@@ -64,8 +64,8 @@ TEST(TexelMemoryEstimate, LowerBoundIsBytesPerActiveTexelOfEveryFieldsRegion) {
 // whose every texel edge lies on other segments' paths has no function (fracture's last
 // 0.004 of cut 2, after its small loop, 3 texel edges: 274 against 261 since session 81,
 // 290 against 271 in sessions 73-80, 290 against 284 before): an over-count of at most a
-// few per cent, inside the
-// bounds' margins (64 bytes a texel against >= 84 measured; on tri6, 160 against >= 192).
+// few per cent, inside the bounds' margins (64 bytes a texel against >= 84 measured; on
+// tri6, 160 against >= 192).
 TEST(TexelMemoryEstimate, FootprintMatchesTheRegionsOfTheWholeCuts) {
   for (const std::string name : {"chad", "spiral6", "slinky", "fracture"}) {
     SCOPED_TRACE(name);
