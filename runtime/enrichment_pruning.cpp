@@ -135,8 +135,8 @@ void ShellModel::set_enrichments(std::vector<EnrichmentFunction> functions) {
     // N^a and the node's other enrichments carry of it (at least half its mass independent
     // there): until session 81 a corner of 1.000e-3 M_aa (just above the bound), 0.9999e-3
     // M_aa independent at its node and 2.4e-5 of its mass on its support, was dropped and
-    // held its piece (45 % of the momentum of a point force's impulse lost; 2 of 400
-    // pieces). Of the example scenes only the slinky has such functions (two, 1.5e-3 and
+    // held its piece (15 % and 45 % of the momentum of a point force's impulse lost in 2 of
+    // 400 pieces). Of the example scenes only the slinky has such functions (two, 1.5e-3 and
     // 1.75e-3 M_aa, 50 % and 56 % independent at their nodes): its probe moved by 7.6e-6 of
     // itself.
     bool small = own < bound;
