@@ -11,6 +11,7 @@
 #include <Eigen/Dense>
 
 #include "dgtex/block_assembly.h"
+#include "dgtex/dependent_node.h"
 #include "dgtex/mesh_generators.h"
 #include "dgtex/shell_model.h"
 #include "dgtex/topology.h"
@@ -39,6 +40,29 @@ inline Eigen::MatrixXd dense_from_blocks(const BlockAssembly& pattern, const std
       for (int i = 0; i < 3; ++i)
         for (int j = 0; j < 3; ++j) matrix(3 * r + i, 3 * pattern.column()[k] + j) = blocks[9 * k + 3 * i + j];
   return matrix;
+}
+
+// T of x = T x_free, written out densely (#dofs x #unknowns): a DOF that is neither fixed
+// nor of a dependent node is an unknown (numbered in DOF order); a dependent node's DOF that
+// is not fixed follows its sources' unknown DOFs with their coefficients (dependent_node.h).
+inline Eigen::MatrixXd dense_elimination_matrix(const std::vector<char>& fixed,
+                                                const std::vector<DependentNode>& dependents) {
+  const int n = static_cast<int>(fixed.size());
+  std::vector<char> dependent(n, 0);
+  for (const DependentNode& d : dependents) dependent[3 * d.node] = dependent[3 * d.node + 1] = dependent[3 * d.node + 2] = 1;
+  std::vector<int> unknown(n, -1);
+  int count = 0;
+  for (int d = 0; d < n; ++d)
+    if (!fixed[d] && !dependent[d]) unknown[d] = count++;
+  Eigen::MatrixXd T = Eigen::MatrixXd::Zero(n, count);
+  for (int d = 0; d < n; ++d)
+    if (unknown[d] >= 0) T(d, unknown[d]) = 1;
+  for (const DependentNode& d : dependents)
+    for (int c = 0; c < 3; ++c)
+      if (!fixed[3 * d.node + c])
+        for (const auto& [source, coefficient] : d.sources)
+          if (unknown[3 * source + c] >= 0) T(3 * d.node + c, unknown[3 * source + c]) = coefficient;
+  return T;
 }
 
 using NodePredicate = std::function<bool(const double* x)>;

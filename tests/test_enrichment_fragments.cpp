@@ -353,19 +353,7 @@ TEST(EnrichmentFragments, AStepOfAModelWithExactTiesSolvesForTheDofsThatAreNotTi
   const double dt = 1e-3;
   const Eigen::MatrixXd A =
       dense_from_blocks(model->pattern(), model->mass_blocks()) + dt * dt * dense_from_blocks(model->pattern(), K);
-  std::vector<char> tied(n, 0);
-  for (const DependentNode& d : model->dependent_nodes()) tied[3 * d.node] = tied[3 * d.node + 1] = tied[3 * d.node + 2] = 1;
-  std::vector<int> unknown(n, -1);
-  int count = 0;
-  for (int d = 0; d < n; ++d)
-    if (!fixed[d] && !tied[d]) unknown[d] = count++;
-  Eigen::MatrixXd T = Eigen::MatrixXd::Zero(n, count);
-  for (int d = 0; d < n; ++d)
-    if (unknown[d] >= 0) T(d, unknown[d]) = 1;
-  for (const DependentNode& d : model->dependent_nodes())
-    for (const auto& [source, coefficient] : d.sources)
-      for (int c = 0; c < 3; ++c)
-        if (unknown[3 * source + c] >= 0) T(3 * d.node + c, unknown[3 * source + c]) = coefficient;
+  const Eigen::MatrixXd T = dense_elimination_matrix(fixed, model->dependent_nodes());
   const Eigen::VectorXd b = dt * Eigen::Map<const Eigen::VectorXd>(force.data(), n);
   const Eigen::VectorXd expected = T * (T.transpose() * A * T).ldlt().solve(T.transpose() * b);
   for (const bool corotational : {false, true}) {

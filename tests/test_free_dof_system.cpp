@@ -15,6 +15,7 @@
 
 #include "dgtex/block_assembly.h"
 #include "dgtex/free_dof_system.h"
+#include "shell_test_support.h"
 
 using namespace dgtex;
 
@@ -129,19 +130,13 @@ TEST(FreeDofSystem, DependentNodesGiveTheSystemOfTTransposeATimesT) {
     for (std::int64_t k = pattern.row_start()[r]; k < pattern.row_start()[r + 1]; ++k)
       for (int i = 0; i < 3; ++i)
         for (int j = 0; j < 3; ++j) blocks[9 * k + 3 * i + j] = dense(3 * r + i, 3 * pattern.column()[k] + j);
-  std::vector<int> unknown(n, -1);
+  std::vector<int> unknown(n, -1);  // the unknowns T numbers, in DOF order
   int count = 0;
   for (int d = 0; d < n; ++d)
     if (!fixed[d] && d / 3 != 21 && d / 3 != 5 && d / 3 != 30) unknown[d] = count++;
   ASSERT_EQ(system.size(), count);
-  Eigen::MatrixXd T = Eigen::MatrixXd::Zero(n, count);
-  for (int d = 0; d < n; ++d)
-    if (unknown[d] >= 0) T(d, unknown[d]) = 1;
-  for (const DependentNode& dependent : dependents)
-    for (int c = 0; c < 3; ++c)
-      if (!fixed[3 * dependent.node + c])
-        for (const auto& [source, coefficient] : dependent.sources)
-          if (unknown[3 * source + c] >= 0) T(3 * dependent.node + c, unknown[3 * source + c]) = coefficient;
+  const Eigen::MatrixXd T = testing_support::dense_elimination_matrix(fixed, dependents);
+  ASSERT_EQ(T.cols(), count);
   const Eigen::MatrixXd reduced = T.transpose() * dense * T;
 
   std::vector<double> values;
