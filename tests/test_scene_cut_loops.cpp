@@ -23,6 +23,7 @@
 #include "dgtex/scene_run.h"
 #include "scene_in_code_support.h"
 #include "scene_run_displacement_support.h"
+#include "shell_test_support.h"
 
 namespace {
 
@@ -682,6 +683,62 @@ TEST(SceneCutLoops, AProgressiveLoopWhoseTiesWouldLeaveTheMassSingularFallsFreel
   EXPECT_GT(most_ties, 0);
   EXPECT_EQ(copying_one_partner, 0);
   EXPECT_NEAR(second_difference, expected, 1e-2 * std::abs(expected));
+}
+
+// The smallest eigenvalue of the model's mass matrix scaled to a unit diagonal, over the
+// DOFs that are unknowns (all but the dependent nodes'; none fixed).
+double smallest_scaled_mass_eigenvalue(const ShellModel& model) {
+  std::vector<char> dependent(model.num_dofs(), 0);
+  for (const DependentNode& node : model.dependent_nodes())
+    for (int c = 0; c < 3; ++c) dependent[3 * node.node + c] = 1;
+  const Eigen::MatrixXd mass = testing_support::dense_from_blocks(model.pattern(), model.mass_blocks());
+  std::vector<int> unknowns;
+  for (int d = 0; d < model.num_dofs(); ++d)
+    if (!dependent[d]) unknowns.push_back(d);
+  Eigen::MatrixXd scaled(unknowns.size(), unknowns.size());
+  for (std::size_t i = 0; i < unknowns.size(); ++i)
+    for (std::size_t j = 0; j < unknowns.size(); ++j)
+      scaled(i, j) = mass(unknowns[i], unknowns[j]) / std::sqrt(mass(unknowns[i], unknowns[i]) * mass(unknowns[j], unknowns[j]));
+  return Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(scaled, Eigen::EigenvaluesOnly).eigenvalues()[0];
+}
+
+// A triangle of ~7 texels cut out progressively on quad8 (T = 16): its path closes in the
+// 11th step around a block of 3 x 2 texels of the top right element. Each of the element's 8
+// enriched functions is independent at its node and none is small, but at the block's
+// quadrature points a combination of them vanishes: the mass matrix was singular to
+// round-off (its smallest eigenvalue, scaled, -2e-16), and the
+// projection onto that basis threw "matrix not positive definite" (until session 82). Now
+// the basis drops the node with the largest entry of the singular mode, and the run goes on
+// with a definite mass at every basis. A fragment this small stays partly attached, as
+// README "Degenerate cases" says of fragments whose nodes are dropped: the run ends where
+// the same loop cut whole from the start does (which drops two nodes), within 2 %
+// (measured 0.9 %).
+TEST(SceneCutLoops, AProgressiveLoopAroundAFewTexelsDropsANodeTheMassCannotTellFromTheOthers) {
+  const std::vector<Vec3> loop = {{0.59383186779808406, 0.70584054250880801, 0},
+                                  {0.47272891748398504, 0.65050327851936085, 0},
+                                  {0.64154266527814729, 0.60919761632782943, 0},
+                                  {0.59383186779808406, 0.70584054250880801, 0}};
+  const Vec3 probe{0.571, 0.652, 0};
+  SceneRun run(progressively_cut_soft_plate(loop, ElementType::quad8));
+  double smallest = 1;
+  int most_pruned = 0, last_basis_changes = 0;
+  while (run.steps_taken() < 100) {
+    ASSERT_NO_THROW(run.step()) << "step " << run.steps_taken() + 1;
+    if (run.basis_changes() == last_basis_changes) continue;
+    last_basis_changes = run.basis_changes();
+    smallest = std::min(smallest, smallest_scaled_mass_eigenvalue(run.model()));
+    most_pruned = std::max(most_pruned, run.model().num_pruned_enriched_nodes());
+  }
+  Scene whole = cut_plate({loop}, ElementType::quad8, 16);
+  whole.material.youngs_modulus = 1e7;
+  const double progressive = test::displacement_at(run, probe)[2];
+  const double cut_from_the_start = displacement_after_a_second(whole, probe)[2];
+  std::printf("%d basis changes, smallest scaled mass eigenvalue %.1e, at most %d nodes dropped; the piece "
+              "moved %.4f (the loop cut from the start %.4f, free fall %.4f)\n",
+              last_basis_changes, smallest, most_pruned, progressive, cut_from_the_start, kFreeFall);
+  EXPECT_GT(smallest, 1e-10);
+  EXPECT_GE(most_pruned, 1);
+  EXPECT_NEAR(progressive, cut_from_the_start, 2e-2 * std::abs(cut_from_the_start));
 }
 
 }  // namespace

@@ -134,8 +134,11 @@ class ShellModel {
   // function, so the piece translates and turns freely however the plate around moves.
   // Other functions tie by adding the enriched function to the nearest kept node's DOFs
   // (enrichment_dofs).
-  // A basis with exact ties factorises its mass matrix once more (the check of
-  // singular_mass_mode) and holds a copy of its pruned functions meanwhile.
+  // Each pruned basis factorises its mass matrix once more (singular_mass_mode, one
+  // component's where the mass is isotropic); while it has a singular mode, the enriched
+  // node with the largest entry of the mode is dropped and the basis chosen again (a piece
+  // of a few texels whose functions the quadrature cannot tell apart). A basis with exact
+  // ties holds a copy of its pruned functions meanwhile.
   // Cost: an enriched element whose textures (and enriched nodes and shifts) are bitwise
   // those of the previous call on this model or the model it was copied from keeps its
   // quadrature (and mass and load weights); the results equal a fresh model's bitwise.
@@ -517,6 +520,10 @@ class ShellModel {
   // every Cholesky pivot above 1e-10 of its diagonal entry; else a mode with the smallest
   // pivot, over all DOFs (the dependent ones from their sources), its largest entry +-1.
   std::vector<double> singular_mass_mode() const;
+  // set_enrichments' installation and choice of enriched DOFs (which functions a basis
+  // keeps, drops or ties, judged by their mass). Returns whether it found the mass matrix
+  // definite (singular_mass_mode) or was asked not to prune: false where it did not check.
+  bool install_and_prune_enrichments(std::vector<EnrichmentFunction> functions);
   // Takes the functions (and ties, their shifts computed here) and sets up the per-element
   // layout; `build`: then rebuild() (else the caller must, after reading the element
   // integrals).
