@@ -359,12 +359,12 @@ bool ShellModel::install_and_prune_enrichments(std::vector<EnrichmentFunction> f
 }
 
 std::vector<double> ShellModel::singular_mass_mode() const {
-  // Pivots above round-off (1e-16 of their diagonal entries) by a wide margin, and far below
-  // those of functions the pruning keeps (their independent part 1e-6 of their own mass).
-  constexpr double kMinPivotRatio = 1e-10;
+  // Above round-off (1e-16) by a wide margin, and far below the smallest eigenvalue of a
+  // basis the pruning keeps (its functions' independent part 1e-6 of their own mass or more).
+  constexpr double kMinEigenvalue = 1e-10;
   // An isotropic mass (every block m I, as the shell's is) is singular where its first
-  // components' matrix is: a system a third the size (the slinky's bases: 0.19 ms a check
-  // instead of 0.71 over all DOFs).
+  // components' matrix is: a system a third the size (the slinky's bases: 0.23 ms a check;
+  // 0.71 over all DOFs, by pivots).
   bool isotropic = true;
   for (std::size_t k = 0; isotropic && k < mass_blocks_.size(); k += 9) {
     const double* m = mass_blocks_.data() + k;
@@ -376,29 +376,38 @@ std::vector<double> ShellModel::singular_mass_mode() const {
   const FreeDofSystem system(pattern(), left_out, nullptr, &dependent_nodes_);
   std::vector<double> values;
   system.gather(mass_blocks().data(), 1.0, nullptr, 0.0, values);
-  // A singular mode's pivot is round-off, of either sign: the diagonal raised by far less
-  // than the bound makes it positive, so that the factor exists and finds the mode.
-  for (int j = 0; j < system.size(); ++j)
+  // A singular mode's eigenvalue is round-off, of either sign: the diagonal raised by far
+  // less than the bound makes it positive, so that the factor exists and finds the mode.
+  const int n = system.size();
+  std::vector<double> root_diagonal(n);  // sqrt(M_jj): D^1/2
+  for (int j = 0; j < n; ++j)
     for (int k = system.column_start()[j]; k < system.column_start()[j + 1]; ++k)
-      if (system.row_index()[k] == j) values[k] *= 1 + 1e-13;
+      if (system.row_index()[k] == j) values[k] *= 1 + 1e-13, root_diagonal[j] = std::sqrt(values[k]);
   SparseCholesky cholesky;
-  cholesky.analyze(system.size(), system.column_start(), system.row_index());
-  std::vector<double> mode(system.size(), 0.0);
+  cholesky.analyze(n, system.column_start(), system.row_index());
+  std::vector<double> mode(n, 0.0);
   try {
     cholesky.factorize(values);
-    const std::vector<double> pivots = cholesky.pivots();
-    int weakest = -1;  // the unknown with the smallest pivot ratio below the bound
-    double weakest_ratio = kMinPivotRatio;
-    for (int j = 0; j < system.size(); ++j)
-      for (int k = system.column_start()[j]; k < system.column_start()[j + 1]; ++k)
-        if (system.row_index()[k] == j && !(pivots[j] >= weakest_ratio * values[k]))
-          weakest = j, weakest_ratio = pivots[j] / values[k];
-    if (weakest < 0) return {};
-    // A mode of pivot p carries that pivot's unknown j (eliminated last among its own), and
-    // M^-1 e_j is that mode times ~1 / p, the others' parts bounded by 1 / (the next pivot).
-    std::vector<double> unit(system.size(), 0.0);
-    unit[weakest] = 1;
-    cholesky.solve(unit, mode);
+    // The smallest eigenvalue of the Jacobi-scaled mass D^-1/2 M D^-1/2 and its vector z, by
+    // inverse iteration with the factor: z <- D^1/2 M^-1 D^1/2 z. A singular mode's
+    // eigenvalue is the diagonal's raise, a kept basis's smallest 1e-6 or more (README
+    // "Degenerate cases"), so a few iterations separate them. (Until session 82 the test was
+    // a pivot below the bound, which misses a mode that the last unknown it eliminates holds
+    // little of: the pivot is about the eigenvalue over that unknown's share squared.)
+    std::vector<double> z(n), scaled(n), solved;
+    for (int j = 0; j < n; ++j) z[j] = 1 + 0.5 * std::sin(j + 1.0);  // any start with a part along every mode
+    double eigenvalue = 0;
+    for (int iteration = 0; iteration < 4; ++iteration) {
+      double norm = 0;
+      for (const double x : z) norm += x * x;
+      for (int j = 0; j < n; ++j) scaled[j] = root_diagonal[j] * z[j] / std::sqrt(norm);
+      cholesky.solve(scaled, solved);
+      double along = 0;  // the Rayleigh quotient of M_s^-1 at the unit z: 1 / M_s's at most
+      for (int j = 0; j < n; ++j) z[j] = root_diagonal[j] * solved[j], along += z[j] * scaled[j] / root_diagonal[j];
+      eigenvalue = 1 / along;
+    }
+    if (!(eigenvalue < kMinEigenvalue)) return {};
+    for (int j = 0; j < n; ++j) mode[j] = z[j] / root_diagonal[j];  // M's mode: D^-1/2 z
   } catch (const NotPositiveDefinite& failure) {
     mode[failure.column()] = 1;  // one unknown of the mode (no factor to solve with)
   }

@@ -516,9 +516,9 @@ class ShellModel {
   // point of their plane (their line) nearest v's node, so that a field affine over the
   // partners (a translation, a rotation) extrapolates to v exactly.
   std::vector<std::pair<int, double>> affine_partners(int v, const std::vector<char>& kept_node) const;
-  // Empty where the mass matrix over the DOFs that are not dependent (no fixed ones) has
-  // every Cholesky pivot above 1e-10 of its diagonal entry; else a mode with the smallest
-  // pivot, over all DOFs (the dependent ones from their sources), its largest entry +-1.
+  // Empty where the mass matrix over the DOFs that are not dependent (no fixed ones), scaled
+  // to a unit diagonal, has its smallest eigenvalue above 1e-10; else that eigenvalue's mode,
+  // over all DOFs (the dependent ones from their sources), its largest entry +-1.
   std::vector<double> singular_mass_mode() const;
   // set_enrichments' installation and choice of enriched DOFs (which functions a basis
   // keeps, drops or ties, judged by their mass). Returns whether it found the mass matrix
