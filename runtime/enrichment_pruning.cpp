@@ -57,28 +57,31 @@ void ShellModel::set_enrichments(std::vector<EnrichmentFunction> functions) {
       if (!dependent[v - nn] && entry > largest) culprit = v, largest = entry;
     }
     if (culprit < 0) break;  // a mode of the dependent nodes alone: left to the projection's error
-    std::vector<EnrichmentFunction> fewer = *enrichments_;
-    for (const EnrichmentTie& tie : ties_) {  // back as own nodes, to be tied again
-      std::vector<int>& nodes = fewer[tie.function].enriched_nodes;
-      nodes.insert(std::lower_bound(nodes.begin(), nodes.end(), tie.node), tie.node);
-    }
-    EnrichmentFunction& f = fewer[virtual_node_function_[culprit - nn]];
-    f.enriched_nodes.erase(std::find(f.enriched_nodes.begin(), f.enriched_nodes.end(), virtual_node_mesh_node_[culprit - nn]));
-    f.elements.erase(std::remove_if(f.elements.begin(), f.elements.end(),
-                                    [&](const ElementTexture& texture) {
-                                      const int* nodes = mesh_.element_nodes(texture.element);
-                                      return std::none_of(nodes, nodes + mesh_.nodes_per_element(), [&](int node) {
-                                        return std::binary_search(f.enriched_nodes.begin(), f.enriched_nodes.end(), node);
-                                      });
-                                    }),
-                     f.elements.end());
-    fewer.erase(std::remove_if(fewer.begin(), fewer.end(),
-                               [](const EnrichmentFunction& function) { return function.enriched_nodes.empty(); }),
-                fewer.end());
-    definite = install_and_prune_enrichments(std::move(fewer));
+    definite = install_and_prune_enrichments(functions_without(culprit));
     ++dropped;
   }
   pruned_enriched_nodes_ += dropped;
+}
+
+std::vector<EnrichmentFunction> ShellModel::functions_without(int v) const {
+  std::vector<EnrichmentFunction> functions = *enrichments_;
+  for (const EnrichmentTie& tie : ties_) {
+    std::vector<int>& nodes = functions[tie.function].enriched_nodes;
+    nodes.insert(std::lower_bound(nodes.begin(), nodes.end(), tie.node), tie.node);
+  }
+  const int nn = num_nodes();
+  EnrichmentFunction& f = functions[virtual_node_function_[v - nn]];
+  f.enriched_nodes.erase(std::find(f.enriched_nodes.begin(), f.enriched_nodes.end(), virtual_node_mesh_node_[v - nn]));
+  const auto touches_none = [&](const ElementTexture& texture) {
+    const int* nodes = mesh_.element_nodes(texture.element);
+    return std::none_of(nodes, nodes + mesh_.nodes_per_element(), [&](int node) {
+      return std::binary_search(f.enriched_nodes.begin(), f.enriched_nodes.end(), node);
+    });
+  };
+  f.elements.erase(std::remove_if(f.elements.begin(), f.elements.end(), touches_none), f.elements.end());
+  const auto without_nodes = [](const EnrichmentFunction& function) { return function.enriched_nodes.empty(); };
+  functions.erase(std::remove_if(functions.begin(), functions.end(), without_nodes), functions.end());
+  return functions;
 }
 
 bool ShellModel::install_and_prune_enrichments(std::vector<EnrichmentFunction> functions) {

@@ -524,6 +524,11 @@ class ShellModel {
   // keeps, drops or ties, judged by their mass). Returns whether it found the mass matrix
   // definite (singular_mass_mode) or was asked not to prune: false where it did not check.
   bool install_and_prune_enrichments(std::vector<EnrichmentFunction> functions);
+  // The installed functions without virtual node v: the nodes tied by column ties back as
+  // their functions' own (to be tied again), v's node left out of its function, the
+  // elements that then touch none of that function's nodes and functions left without
+  // nodes dropped.
+  std::vector<EnrichmentFunction> functions_without(int v) const;
   // Takes the functions (and ties, their shifts computed here) and sets up the per-element
   // layout; `build`: then rebuild() (else the caller must, after reading the element
   // integrals).
