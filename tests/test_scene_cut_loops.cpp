@@ -818,10 +818,10 @@ TEST(SceneCutLoops, AProgressiveLoopAroundAFewTexelsDropsANodeTheMassCannotTellF
 }
 
 // A quadrilateral about a texel across (radius 0.017) cut out progressively: a basis of
-// its run has a singular mass whose Cholesky pivots are all above 1e-10 of their diagonal
-// entries (the unknown eliminated last holds little of the mode), which the check by
-// pivots let through until session 82 (the projection then threw "matrix not positive
-// definite"; 6 of 200 such small loops cut progressively). Inverse iteration finds the mode.
+// its run has a singular mass (scaled, its smallest eigenvalue -1.7e-16) whose Cholesky
+// pivots are all above 1e-10 of their diagonal entries, which the check by pivots let
+// through until session 82 (the projection then threw "matrix not positive definite"; 6 of
+// 200 such small loops cut progressively). Inverse iteration finds the mode.
 TEST(SceneCutLoops, AModeThatNoPivotShowsIsFoundAndItsNodeDropped) {
   const std::vector<Vec3> loop = {{0.3961045050807443, 0.7638933825395714, 0},
                                   {0.39287141893465061, 0.74121606757789427, 0},
