@@ -111,12 +111,7 @@ FactorReusingSolver::FactorReusingSolver(const BlockAssembly& pattern, const Fre
                                          const std::vector<double>& mass, FactorReuseOptions options)
     : pattern_(pattern), system_(system), mass_(mass), options_(options) {
   const std::int64_t blocks = pattern.num_blocks();
-  bool isotropic = static_cast<std::int64_t>(mass.size()) == blocks * 9;
-  for (std::int64_t k = 0; isotropic && k < blocks; ++k) {
-    const double* m = mass.data() + 9 * k;
-    isotropic = m[1] == 0 && m[2] == 0 && m[3] == 0 && m[5] == 0 && m[6] == 0 && m[7] == 0 && m[4] == m[0] && m[8] == m[0];
-  }
-  if (isotropic) {
+  if (static_cast<std::int64_t>(mass.size()) == blocks * 9 && blocks_are_isotropic(mass)) {
     mass_scalar_.resize(blocks);
     for (std::int64_t k = 0; k < blocks; ++k) mass_scalar_[k] = mass[9 * k];
   }

@@ -117,6 +117,17 @@ class BlockAssembly {
   std::vector<std::int64_t> vector_local_;
 };
 
+// Whether every 3x3 block of `blocks` (9 values each, row-major) is m I: an isotropic mass,
+// whose products and factorisations can work on one scalar a block.
+inline bool blocks_are_isotropic(const std::vector<double>& blocks) {
+  for (std::size_t k = 0; k + 9 <= blocks.size(); k += 9) {
+    const double* m = blocks.data() + k;
+    if (m[1] != 0 || m[2] != 0 || m[3] != 0 || m[5] != 0 || m[6] != 0 || m[7] != 0 || m[4] != m[0] || m[8] != m[0])
+      return false;
+  }
+  return true;
+}
+
 // How a product of a block matrix in this pattern with vectors should run: serially below
 // 32768 blocks. Waking the OpenMP team costs more than such a product (a cut single element
 // has 64-21609 blocks: spiral1's K u took 40 us on 2 threads against 3 us serially, and the
